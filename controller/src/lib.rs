@@ -1,1 +1,15 @@
-//! placeholder
+//! AMB control laws, written once and run in three places: inside the plant's
+//! derivative (continuous PD), in the plant's sampled loop (`sampled` mode), and
+//! in the separate controller process.
+//!
+//! Signal chain (MODEL.md §3): inductive sensor (gain `A_s`, V/m) → controller
+//! → power amplifier (gain `A_a`, A/V) → coil. A law sees the sensor voltages
+//! `u = A_s·Δ` (per axis, x then y, Δ the rotor position relative to the
+//! housing) and returns coil currents in amperes, before the amplifier limit.
+#![warn(missing_docs)]
+
+pub mod law;
+pub mod pd;
+
+pub use law::{build_law, saturate, ControlLaw, LawError, LawSpec, LoopConstants, Sample, LAW_NAMES};
+pub use pd::{PdDesign, PdGains, SampledPd};
