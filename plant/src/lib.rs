@@ -1,1 +1,21 @@
-//! placeholder
+//! The plant of the AMB/touchdown-bearing testbed: the physics of MODEL.md
+//! (rotor with unbalance, inner race on Hertzian balls, rotor – race contact
+//! with friction, AMB force law, housing moved by a base shock), its
+//! integrators, and scene runs with their outputs.
+//!
+//! Layout: [`force`] holds one kernel per force law; [`model`] the pure
+//! derivative; [`integrate`] the hand-written integrators; [`config`] the
+//! scene files; [`run`] the loop that owns time; [`trace`], [`summary`],
+//! [`output`] and [`plot`] what a run writes.
+#![warn(missing_docs)]
+
+pub mod config;
+pub mod force;
+pub mod initial;
+pub mod integrate;
+pub mod model;
+pub mod output;
+pub mod plot;
+pub mod run;
+pub mod summary;
+pub mod trace;

@@ -1,0 +1,139 @@
+//! Rotor – inner race contact: a circle inside a circle (MODEL.md §4).
+//!
+//! ```text
+//! d = r_rotor − r_race,  δ = |d| − r_0,  n = d/|d|,  t = (−n_y, n_x)
+//! F_n = K_r δ^(10/9) + C_r(δ) δ̇   (δ > 0; clamped ≥ 0),   C_r(δ) = STEP(δ; 0, 0, δ_max, C_r,max)
+//! v_t = (v_rotor − v_race)·t + ω_r r_r − ω_b r_inner,      F_t = μ(v_t) F_n
+//! ```
+//!
+//! On the rotor: `−F_n n − F_t t` and torque `−r_r F_t`; on the race the
+//! opposite force and torque `+r_inner F_t`. `n` points from the race centre to
+//! the rotor centre; positions may be absolute or relative to the housing
+//! (only differences enter).
+
+use super::friction::Friction;
+use super::smooth::step;
+
+/// Contact parameters.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct RotorRace {
+    /// Radial air gap r_0 between shaft and race bore (m).
+    pub gap: f64,
+    /// Rotor radius r_r (m).
+    pub rotor_radius: f64,
+    /// Race bore radius r_inner = r_r + r_0 (m).
+    pub bore_radius: f64,
+    /// Contact stiffness K_r (N/m^(10/9)).
+    pub stiffness: f64,
+    /// Full contact damping C_r,max (N·s/m), reached at depth δ_max.
+    pub damping_max: f64,
+    /// Depth δ_max at which the damping is fully on (m).
+    pub damping_depth: f64,
+    /// Friction at the contact point.
+    pub friction: Friction,
+}
+
+/// What the contact does at one instant.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct RotorRaceForce {
+    /// Force on the rotor (N); the race gets the opposite.
+    pub on_rotor: [f64; 2],
+    /// Torque on the rotor (N·m).
+    pub torque_rotor: f64,
+    /// Torque on the race (N·m).
+    pub torque_race: f64,
+    /// Normal force F_n (N), ≥ 0.
+    pub normal: f64,
+    /// Friction force F_t (N), signed like the slip.
+    pub tangential: f64,
+}
+
+impl RotorRace {
+    /// Contact force for rotor/race relative position `d` (m), relative
+    /// velocity `dv` (m/s), and spin speeds `omega_rotor`, `omega_race` (rad/s).
+    #[inline]
+    pub fn force(&self, d: [f64; 2], dv: [f64; 2], omega_rotor: f64, omega_race: f64) -> RotorRaceForce {
+        let dist2 = d[0] * d[0] + d[1] * d[1];
+        if dist2 <= self.gap * self.gap {
+            return RotorRaceForce::default();
+        }
+        let dist = dist2.sqrt();
+        let delta = dist - self.gap;
+        let n = [d[0] / dist, d[1] / dist];
+        let t = [-n[1], n[0]];
+        let delta_dot = dv[0] * n[0] + dv[1] * n[1];
+        let damping = step(delta, 0.0, 0.0, self.damping_depth, self.damping_max);
+        let normal = (self.stiffness * delta.powf(10.0 / 9.0) + damping * delta_dot).max(0.0);
+        let slip = dv[0] * t[0] + dv[1] * t[1] + omega_rotor * self.rotor_radius - omega_race * self.bore_radius;
+        let tangential = self.friction.coefficient(slip) * normal;
+        RotorRaceForce {
+            on_rotor: [-normal * n[0] - tangential * t[0], -normal * n[1] - tangential * t[1]],
+            torque_rotor: -self.rotor_radius * tangential,
+            torque_race: self.bore_radius * tangential,
+            normal,
+            tangential,
+        }
+    }
+
+    /// Potential energy stored in the contact spring at gap `delta` (J):
+    /// `K_r δ^(19/9) · 9/19`, for energy-balance checks.
+    pub fn potential(&self, delta: f64) -> f64 {
+        if delta <= 0.0 {
+            0.0
+        } else {
+            self.stiffness * delta.powf(19.0 / 9.0) * 9.0 / 19.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contact() -> RotorRace {
+        RotorRace {
+            gap: 0.15e-3,
+            rotor_radius: 19.85e-3,
+            bore_radius: 20e-3,
+            stiffness: 1.988e9,
+            damping_max: 1000.0,
+            damping_depth: 1e-5,
+            friction: Friction { mu_static: 0.1, mu_dynamic: 0.1, v_static: 0.1, v_dynamic: 0.1 },
+        }
+    }
+
+    #[test]
+    fn no_force_inside_the_gap() {
+        let f = contact().force([0.1e-3, 0.1e-3], [1.0, 1.0], 3000.0, 0.0);
+        assert_eq!(f, RotorRaceForce::default());
+    }
+
+    #[test]
+    fn static_penetration_pushes_rotor_back_with_hertz_law() {
+        let c = contact();
+        let delta = 5e-6;
+        // Rotor displaced down by r_0 + δ, at rest, no spin: pure normal force upward.
+        let f = c.force([0.0, -(c.gap + delta)], [0.0; 2], 0.0, 0.0);
+        let expected = 1.988e9 * delta.powf(10.0 / 9.0);
+        assert!((f.on_rotor[1] - expected).abs() < 1e-9 * expected);
+        assert!(f.on_rotor[0].abs() < 1e-12 && f.tangential == 0.0);
+    }
+
+    #[test]
+    fn friction_opposes_rotor_spin_and_drives_race_forward() {
+        let c = contact();
+        let f = c.force([c.gap + 2e-6, 0.0], [0.0; 2], 3000.0, 0.0);
+        // Positive spin: slip > 0, the rotor's torque is braking, the race's driving.
+        assert!(f.torque_rotor < 0.0 && f.torque_race > 0.0);
+        // Contact at +x, t = +y: friction on the rotor points −y with magnitude μ F_n.
+        assert!((f.on_rotor[1] + 0.1 * f.normal).abs() < 1e-9 * f.normal);
+    }
+
+    #[test]
+    fn normal_force_never_pulls() {
+        let c = contact();
+        // Fast separation with shallow overlap: damping would pull, the clamp stops it.
+        let f = c.force([c.gap + 1e-7, 0.0], [-10.0, 0.0], 0.0, 0.0);
+        assert_eq!(f.normal, 0.0);
+    }
+}

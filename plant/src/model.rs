@@ -1,0 +1,236 @@
+//! The plant's equations of motion: a pure derivative on a fixed-size state.
+//!
+//! Frames: positions are taken **relative to the housing** (the stator, the
+//! TDB outer ring and the sensor form one rigid body moved by the shock), so
+//! the state holds directly what the sensor and the contacts see. The housing
+//! frame is accelerated by `a_h(t)`; each body feels the fictitious force
+//! `−m a_h(t)` at its mass centre. This is the same model as MODEL.md's
+//! inertial-frame equations, written where the gaps live.
+//!
+//! State ordering (SI), positions then velocities, as [`crate::integrate`]'s
+//! symplectic Euler expects:
+//!
+//! ```text
+//! y = [x_r, y_r, θ_r, x_b, y_b, θ_b,  ẋ_r, ẏ_r, ω_r, ẋ_b, ẏ_b, ω_b]
+//! ```
+//!
+//! rotor geometric centre (x_r, y_r), spin angle θ_r; inner race centre
+//! (x_b, y_b) and angle θ_b; the cage angle is kinematic:
+//! `θ_c = θ_c0 + θ_b R_in / (R_in + R_out)` (rotating cage) or `θ_c0` (fixed).
+//!
+//! Rotor (MODEL.md §2, `s = sin θ_r`, `c = cos θ_r`, unbalance e at θ_r):
+//!
+//! ```text
+//! m ẍ − m e s θ̈ = m e ω² c + F_x − m a_hx
+//! m ÿ + m e c θ̈ = m e ω² s + F_y − m g − m a_hy
+//! (J + m e²) θ̈ − m e s ẍ + m e c ÿ = T_drive + T_contact − m e ((g + a_hy) c − a_hx s)
+//! ```
+//!
+//! Eliminating ẍ, ÿ gives `J θ̈ = R_3 + e (s R_1 − c R_2)` with `R_i` the
+//! right-hand sides. With the speed held (default) `θ̈ = 0`.
+//! Race: `m_b ẍ_b = −F_contact + F_balls − m_b (g ŷ + a_h)`,
+//! `J_b θ̈_b = r_inner F_t + M_drag`.
+
+use crate::force::rotor_race::RotorRaceForce;
+use crate::force::{amb::AmbLaw, balls::BallForce, balls::BallSet, drag::RaceDrag, rotor_race::RotorRace};
+use crate::integrate::System;
+use controller::{saturate, LoopConstants, PdGains};
+use shock_table::Programme;
+
+/// State dimension.
+pub const N: usize = 12;
+/// The state vector (see the module doc for its ordering).
+pub type State = [f64; N];
+
+/// Indices into [`State`].
+pub mod ix {
+    /// Rotor x relative to housing (m).
+    pub const XR: usize = 0;
+    /// Rotor y relative to housing (m).
+    pub const YR: usize = 1;
+    /// Rotor spin angle (rad).
+    pub const TR: usize = 2;
+    /// Race x relative to housing (m).
+    pub const XB: usize = 3;
+    /// Race y relative to housing (m).
+    pub const YB: usize = 4;
+    /// Race angle (rad).
+    pub const TB: usize = 5;
+    /// Rotor x velocity (m/s).
+    pub const VXR: usize = 6;
+    /// Rotor y velocity (m/s).
+    pub const VYR: usize = 7;
+    /// Rotor spin speed (rad/s).
+    pub const WR: usize = 8;
+    /// Race x velocity (m/s).
+    pub const VXB: usize = 9;
+    /// Race y velocity (m/s).
+    pub const VYB: usize = 10;
+    /// Race spin speed (rad/s).
+    pub const WB: usize = 11;
+}
+
+/// How the rotor's spin is treated.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "spin", rename_all = "snake_case")]
+pub enum Spin {
+    /// The drive holds the speed exactly (the study's setup): θ̈_r = 0.
+    Held,
+    /// The spin is integrated; a proportional speed loop drives it.
+    Free {
+        /// Speed-loop gain (N·m·s/rad).
+        drive_gain: f64,
+        /// Drive torque limit (N·m).
+        torque_limit: f64,
+    },
+}
+
+/// How the balls move.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Cage {
+    /// The cage rolls with the race: θ̇_c = θ̇_b R_in / (R_in + R_out).
+    Rotating,
+    /// The balls stay at their initial angles.
+    Fixed,
+}
+
+/// Physical parameters, validated, SI.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Params {
+    /// Gravity g (m/s²).
+    pub gravity: f64,
+    /// Rotor mass m_r (kg).
+    pub rotor_mass: f64,
+    /// Unbalance eccentricity e (m).
+    pub eccentricity: f64,
+    /// Rotor polar moment of inertia J_r (kg·m²).
+    pub rotor_inertia: f64,
+    /// Rated speed ω (rad/s); held, or the speed loop's target.
+    pub speed: f64,
+    /// Spin treatment.
+    pub spin: Spin,
+    /// Race mass m_b (kg).
+    pub race_mass: f64,
+    /// Race polar moment J_b (kg·m²).
+    pub race_inertia: f64,
+    /// Cage motion.
+    pub cage: Cage,
+    /// Cage angle at θ_b = 0 (rad): where ball 0 sits.
+    pub cage_phase: f64,
+    /// R_in / (R_in + R_out).
+    pub cage_ratio: f64,
+    /// Rotor – race contact.
+    pub contact: RotorRace,
+    /// Race – ball contacts.
+    pub balls: BallSet,
+    /// Race drag.
+    pub drag: RaceDrag,
+    /// Bearing force law.
+    pub amb: AmbLaw,
+    /// Constants of the AMB loop (sensor, amplifier, k_i, k_s).
+    pub loop_constants: LoopConstants,
+    /// Amplifier current limit i_max (A).
+    pub current_limit: f64,
+}
+
+/// Where the coil current comes from during a derivative evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Control {
+    /// PD evaluated inside the derivative on the exact Δ, Δ̇ (the study's setup).
+    Continuous(PdGains),
+    /// A current held over the macro step (zero-order hold of a sampled law).
+    Held([f64; 2]),
+}
+
+/// The model: parameters, base motion, and the control in force.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Physical parameters.
+    pub params: Params,
+    /// Housing motion.
+    pub base: Programme,
+    /// Control during the current macro step.
+    pub control: Control,
+}
+
+/// Everything one evaluation computes; `dy` is the derivative.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Evaluation {
+    /// Time derivative of the state.
+    pub dy: State,
+    /// Rotor – race contact.
+    pub contact: RotorRaceForce,
+    /// Ball contacts.
+    pub balls: BallForce,
+    /// Coil currents after the amplifier limit (A).
+    pub current: [f64; 2],
+    /// AMB force on the rotor (N).
+    pub amb_force: [f64; 2],
+    /// Housing acceleration (m/s²).
+    pub housing_accel: [f64; 2],
+}
+
+impl Model {
+    /// Evaluates all forces and the state derivative at time `t`.
+    #[inline]
+    pub fn evaluate(&self, t: f64, y: &State) -> Evaluation {
+        use ix::*;
+        let p = &self.params;
+        let a_h = self.base.accel(t);
+        let delta = [y[XR], y[YR]];
+        let current = match self.control {
+            Control::Continuous(gains) => {
+                let a_s = p.loop_constants.sensor_gain_v_per_m;
+                let u = [a_s * delta[0], a_s * delta[1]];
+                let u_dot = [a_s * y[VXR], a_s * y[VYR]];
+                saturate(gains.current(u, u_dot), p.current_limit)
+            }
+            Control::Held(i) => i,
+        };
+        let amb_force = p.amb.force(delta, current);
+
+        let contact = p.contact.force([y[XR] - y[XB], y[YR] - y[YB]], [y[VXR] - y[VXB], y[VYR] - y[VYB]], y[WR], y[WB]);
+        let (cage, cage_rate) = match p.cage {
+            Cage::Rotating => (p.cage_phase + p.cage_ratio * y[TB], p.cage_ratio * y[WB]),
+            Cage::Fixed => (p.cage_phase, 0.0),
+        };
+        let balls = p.balls.force([y[XB], y[YB]], [y[VXB], y[VYB]], cage, cage_rate);
+
+        // Rotor.
+        let (m, e, g) = (p.rotor_mass, p.eccentricity, p.gravity);
+        let (s, c) = y[TR].sin_cos();
+        let w = y[WR];
+        let r1 = m * e * w * w * c + amb_force[0] + contact.on_rotor[0] - m * a_h[0];
+        let r2 = m * e * w * w * s + amb_force[1] + contact.on_rotor[1] - m * (g + a_h[1]);
+        let spin_accel = match p.spin {
+            Spin::Held => 0.0,
+            Spin::Free { drive_gain, torque_limit } => {
+                let drive = (drive_gain * (p.speed - w)).clamp(-torque_limit, torque_limit);
+                let r3 = drive + contact.torque_rotor - m * e * ((g + a_h[1]) * c - a_h[0] * s);
+                (r3 + e * (s * r1 - c * r2)) / p.rotor_inertia
+            }
+        };
+        // Race.
+        let mb = p.race_mass;
+        let race_load = (balls.on_race[0] * balls.on_race[0] + balls.on_race[1] * balls.on_race[1]).sqrt();
+        let race_torque = contact.torque_race + p.drag.torque(y[WB], race_load);
+
+        let mut dy = [0.0; N];
+        dy[..6].copy_from_slice(&y[6..]);
+        dy[VXR] = (r1 + m * e * s * spin_accel) / m;
+        dy[VYR] = (r2 - m * e * c * spin_accel) / m;
+        dy[WR] = spin_accel;
+        dy[VXB] = (balls.on_race[0] - contact.on_rotor[0]) / mb - a_h[0];
+        dy[VYB] = (balls.on_race[1] - contact.on_rotor[1]) / mb - g - a_h[1];
+        dy[WB] = race_torque / p.race_inertia;
+        Evaluation { dy, contact, balls, current, amb_force, housing_accel: a_h }
+    }
+}
+
+impl System<N> for Model {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State, dy: &mut State) {
+        *dy = self.evaluate(t, y).dy;
+    }
+}

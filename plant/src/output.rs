@@ -1,0 +1,87 @@
+//! Writing a run's results to its folder: `trace.csv`, `summary.json`,
+//! `scene.toml` (the scene as resolved, overrides included) and PNG plots.
+
+use crate::config::Scene;
+use crate::plot::{self, Scale, Series};
+use crate::run::RunResult;
+use crate::summary::Summary;
+use anyhow::Context;
+use std::path::Path;
+
+/// Writes everything a run produced. Trace and summary come first, so a
+/// failing plot never loses data.
+pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Result<Summary> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display()))?;
+    let resolved = toml::to_string(&scene.raw).context("serialising the resolved scene")?;
+    std::fs::write(dir.join("scene.toml"), resolved)
+        .with_context(|| format!("writing {}", dir.join("scene.toml").display()))?;
+    result
+        .trace
+        .write_csv(&dir.join("trace.csv"))
+        .with_context(|| format!("writing {}", dir.join("trace.csv").display()))?;
+    let summary = Summary::new(scene, result);
+    write_json(&dir.join("summary.json"), &summary)?;
+    if scene.plots {
+        write_plots(dir, scene, result).context("writing plots")?;
+    }
+    Ok(summary)
+}
+
+/// Writes a value as pretty JSON.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(value).context("serialising JSON")?;
+    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+}
+
+/// The standard plots of a run.
+pub fn write_plots(dir: &Path, scene: &Scene, result: &RunResult) -> Result<(), plot::PlotError> {
+    let tr = &result.trace;
+    let ms: Vec<f64> = tr.t_s.iter().map(|t| t * 1e3).collect();
+    let um = |v: &[f64]| v.iter().map(|x| x * 1e6).collect::<Vec<f64>>();
+    let gap = scene.params.contact.gap;
+    let title = |what: &str| format!("{} — {what}", scene.name);
+
+    plot::orbit(&dir.join("orbit.png"), &title("rotor orbit relative to housing"), &tr.dx_m, &tr.dy_m, gap)?;
+
+    let radius = um(&tr.radius());
+    let gap_line = vec![gap * 1e6; ms.len()];
+    plot::lines(
+        &dir.join("radius.png"),
+        &title("rotor radius"),
+        "time (ms)",
+        "radius (µm)",
+        &[Series { label: "rotor radius", x: &ms, y: &radius }, Series { label: "air gap r0", x: &ms, y: &gap_line }],
+        Scale::Linear,
+    )?;
+
+    let rpm: Vec<f64> = tr.race_speed_rad_s.iter().map(|w| w * 60.0 / std::f64::consts::TAU).collect();
+    plot::lines(
+        &dir.join("race_speed.png"),
+        &title("inner race speed"),
+        "time (ms)",
+        "speed (rpm)",
+        &[Series { label: "race speed", x: &ms, y: &rpm }],
+        Scale::Linear,
+    )?;
+
+    plot::lines(
+        &dir.join("currents.png"),
+        &title("coil currents"),
+        "time (ms)",
+        "current (A)",
+        &[Series { label: "i_x", x: &ms, y: &tr.ix_a }, Series { label: "i_y", x: &ms, y: &tr.iy_a }],
+        Scale::Linear,
+    )?;
+
+    plot::lines(
+        &dir.join("contact_force.png"),
+        &title("rotor – race contact force"),
+        "time (ms)",
+        "force (N)",
+        &[
+            Series { label: "normal", x: &ms, y: &tr.contact_force_n },
+            Series { label: "friction", x: &ms, y: &tr.friction_force_n },
+        ],
+        Scale::Linear,
+    )
+}

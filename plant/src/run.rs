@@ -1,0 +1,224 @@
+//! One scene run: the macro-step loop that owns time.
+//!
+//! A macro step is one controller period `T`. In `continuous` mode the PD is
+//! evaluated inside the derivative; in `sampled` mode the law reads the sensor
+//! at each tick `t_k = k T`, and the command computed from sample `k` is
+//! applied from tick `k + d` (`d = delay_samples`) and held until the next
+//! (zero-order hold). The integrator restarts at every tick. The trace is
+//! recorded at the output rate (dense output inside macro steps).
+
+use crate::config::{ControlMode, Scene};
+use crate::initial::initial_state;
+use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
+use crate::model::{ix, Control, Model, State};
+use crate::trace::Trace;
+use controller::{build_law, saturate, ControlLaw, LawSpec, PdDesign, PdGains, Sample};
+use std::collections::VecDeque;
+
+/// Why a run stopped before its end.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    /// The integrator failed (non-finite state, step-size underflow, stall).
+    #[error("numerical divergence: {0}")]
+    Integration(#[from] IntegrationError),
+    /// A body left the clearance by more than the guard: the contact model has failed.
+    #[error("numerical divergence at t = {t} s: {what} = {value_m:.4e} m exceeds the guard {limit_m:.4e} m; state {state:?}")]
+    RadiusGuard {
+        /// Time (s).
+        t: f64,
+        /// Which radius.
+        what: &'static str,
+        /// Its value (m).
+        value_m: f64,
+        /// The limit (m).
+        limit_m: f64,
+        /// The state.
+        state: Vec<f64>,
+    },
+}
+
+impl RunError {
+    /// Time at which the run failed (s).
+    pub fn time(&self) -> f64 {
+        match self {
+            RunError::Integration(
+                IntegrationError::NonFinite { t, .. }
+                | IntegrationError::StepSizeUnderflow { t, .. }
+                | IntegrationError::TooManySteps { t, .. },
+            ) => *t,
+            RunError::RadiusGuard { t, .. } => *t,
+        }
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// Ran to the scene's duration.
+    Completed,
+    /// Stopped by a numerical failure.
+    Diverged(RunError),
+    /// Stopped on request (Ctrl-C).
+    Interrupted,
+}
+
+/// What the loop reports to its caller while it runs.
+pub trait Hooks {
+    /// Called after each macro step with the simulated time (s).
+    fn progress(&mut self, _t: f64) {}
+    /// Polled after each macro step; `true` stops the run cleanly.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// Hooks that do nothing.
+pub struct Quiet;
+impl Hooks for Quiet {}
+
+/// A finished (or stopped) run.
+#[derive(Debug)]
+pub struct RunResult {
+    /// Recorded trace.
+    pub trace: Trace,
+    /// Integrator statistics.
+    pub stats: Stats,
+    /// Simulated time reached (s).
+    pub simulated: f64,
+    /// Wall time of the loop (s).
+    pub wall_time: f64,
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Final state.
+    pub final_state: State,
+}
+
+/// Continuous PD gains for a scene's controller design.
+pub fn design_gains(scene: &Scene) -> Result<PdGains, controller::LawError> {
+    let c = &scene.controller;
+    PdGains::from_design(
+        &PdDesign { stiffness_n_per_m: c.stiffness, damping_ratio: c.damping_ratio, gravity_bias: c.gravity_bias },
+        &scene.params.loop_constants,
+    )
+}
+
+/// Integrator settings for a scene, with the macro step as the largest step.
+pub fn integrator_settings(scene: &Scene) -> Settings<{ crate::model::N }> {
+    let s = &scene.integrator;
+    Settings {
+        method: s.method,
+        substeps: s.substeps,
+        rtol: s.rtol,
+        atol: s.atol,
+        h_max: scene.controller.period,
+        max_steps: 1_000_000,
+        ..Settings::new(s.method)
+    }
+}
+
+/// Runs a scene from its initial state.
+pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller::LawError> {
+    let gains = design_gains(scene)?;
+    let mut law: Option<Box<dyn ControlLaw>> = match scene.controller.mode {
+        ControlMode::Continuous => None,
+        _ => Some(build_law(
+            &LawSpec {
+                law: &scene.controller.law,
+                stiffness_n_per_m: scene.controller.stiffness,
+                damping_ratio: scene.controller.damping_ratio,
+                period_s: scene.controller.period,
+                gravity_bias: scene.controller.gravity_bias,
+            },
+            &scene.params.loop_constants,
+        )?),
+    };
+    let limit = scene.params.current_limit;
+    let mut model = Model {
+        params: scene.params.clone(),
+        base: scene.base.clone(),
+        control: match law {
+            None => Control::Continuous(gains),
+            Some(_) => Control::Held(saturate(gains.bias_a, limit)),
+        },
+    };
+    let mut integrator = Integrator::new(integrator_settings(scene));
+    let mut y = initial_state(scene);
+    let period = scene.controller.period;
+    let ticks = (scene.duration / period).ceil() as u64;
+    let out_dt = scene.output_interval;
+    let mut trace = Trace::with_capacity((scene.duration / out_dt).ceil() as usize + 2);
+    trace.push(&model, 0.0, &y);
+    let mut next_out: u64 = 1;
+    let mut out_times: Vec<f64> = Vec::with_capacity((period / out_dt).ceil() as usize + 2);
+    let delay = scene.controller.delay_samples as usize;
+    let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
+    queue.extend(std::iter::repeat_n(saturate(gains.bias_a, limit), delay));
+    let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
+    let guards = Guards::new(scene);
+
+    let start = std::time::Instant::now();
+    let mut outcome = Outcome::Completed;
+    let mut t = 0.0;
+    for k in 0..ticks {
+        let t0 = k as f64 * period;
+        let t1 = ((k + 1) as f64 * period).min(scene.duration);
+        if let Some(law) = law.as_mut() {
+            let sample = Sample { seq: k, t_s: t0, sensor_v: [a_s * y[ix::XR], a_s * y[ix::YR]] };
+            queue.push_back(saturate(law.update(&sample), limit));
+            if let Some(cmd) = queue.pop_front() {
+                model.control = Control::Held(cmd);
+            }
+        }
+        out_times.clear();
+        while (next_out as f64) * out_dt <= t1 + 1e-9 * out_dt {
+            out_times.push(((next_out as f64) * out_dt).min(t1));
+            next_out += 1;
+        }
+        let step = integrator.advance_dense(&model, t0, t1, &mut y, &out_times, |ts, ys| trace.push(&model, ts, ys));
+        t = t1;
+        if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
+            outcome = Outcome::Diverged(e);
+            break;
+        }
+        hooks.progress(t1);
+        if hooks.cancelled() {
+            outcome = Outcome::Interrupted;
+            break;
+        }
+    }
+    Ok(RunResult {
+        trace,
+        stats: integrator.stats(),
+        simulated: t,
+        wall_time: start.elapsed().as_secs_f64(),
+        outcome,
+        final_state: y,
+    })
+}
+
+/// Radius limits beyond which the contact model has failed.
+struct Guards {
+    rotor: f64,
+    race: f64,
+}
+
+impl Guards {
+    fn new(scene: &Scene) -> Self {
+        let p = &scene.params;
+        let g = scene.integrator.radius_guard;
+        Self { rotor: p.contact.gap + p.balls.clearance + g, race: p.balls.clearance + g }
+    }
+
+    fn check(&self, t: f64, y: &State) -> Result<(), RunError> {
+        let rotor = y[ix::XR].hypot(y[ix::YR]);
+        let race = y[ix::XB].hypot(y[ix::YB]);
+        let fail = |what, value_m, limit_m| RunError::RadiusGuard { t, what, value_m, limit_m, state: y.to_vec() };
+        if rotor > self.rotor {
+            return Err(fail("rotor radius", rotor, self.rotor));
+        }
+        if race > self.race {
+            return Err(fail("race radius", race, self.race));
+        }
+        Ok(())
+    }
+}

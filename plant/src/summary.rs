@@ -1,0 +1,163 @@
+//! The figures of a run, written as `summary.json`.
+
+use crate::config::Scene;
+use crate::run::{Outcome, RunResult};
+use crate::trace::Trace;
+use serde::Serialize;
+
+/// Revolutions at the end of a run over which steady figures are taken.
+pub const STEADY_REVOLUTIONS: f64 = 200.0;
+
+/// Model choices of a run, for the record.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelInfo {
+    /// `held` or `free`.
+    pub spin: &'static str,
+    /// `rotating` or `fixed`.
+    pub cage: crate::model::Cage,
+    /// `constant` or `palmgren`.
+    pub race_drag: String,
+    /// `linear` or `nonlinear`.
+    pub amb_force: String,
+    /// Number of balls.
+    pub balls: usize,
+    /// Controller mode.
+    pub control_mode: crate::config::ControlMode,
+    /// Control law.
+    pub law: String,
+    /// Controller rate (Hz).
+    pub controller_rate_hz: f64,
+    /// Command delay (samples), sampled modes.
+    pub delay_samples: u32,
+}
+
+/// Integrator of a run, for the record.
+#[derive(Clone, Debug, Serialize)]
+pub struct IntegratorInfo {
+    /// Method.
+    pub method: crate::integrate::Method,
+    /// Relative tolerance (adaptive methods).
+    pub rtol: f64,
+    /// Absolute tolerances per state component (adaptive methods).
+    pub atol: Vec<f64>,
+    /// Substeps per controller period (fixed-step methods).
+    pub substeps: u32,
+    /// Macro step (s).
+    pub macro_step_s: f64,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// `completed`, `diverged` or `interrupted`.
+    pub status: &'static str,
+    /// What went wrong, with time and state.
+    pub error: Option<String>,
+    /// When it went wrong (s).
+    pub failure_time_s: Option<f64>,
+    /// Simulated time reached (s).
+    pub simulated_s: f64,
+    /// Largest rotor radius relative to the housing (m).
+    pub max_radius_m: f64,
+    /// Fraction of trace samples with rotor – race contact over the last 200 revolutions.
+    pub contact_fraction: f64,
+    /// Start of the window of `contact_fraction` (s).
+    pub steady_window_start_s: f64,
+    /// Largest rotor – race normal force at the trace samples (N).
+    pub max_contact_force_n: f64,
+    /// Largest race speed (rpm).
+    pub max_race_speed_rpm: f64,
+    /// Accepted integrator steps.
+    pub steps: u64,
+    /// Rejected steps (adaptive methods).
+    pub rejected_steps: u64,
+    /// Right-hand-side evaluations by the integrator.
+    pub rhs_evals: u64,
+    /// Wall time of the simulation loop (s).
+    pub wall_time_s: f64,
+    /// Simulated seconds per wall-clock second.
+    pub realtime_factor: f64,
+    /// Model choices.
+    pub model: ModelInfo,
+    /// Integrator.
+    pub integrator: IntegratorInfo,
+}
+
+impl Summary {
+    /// Figures of a run.
+    pub fn new(scene: &Scene, result: &RunResult) -> Self {
+        let trace = &result.trace;
+        let revolution = if scene.params.speed > 0.0 { std::f64::consts::TAU / scene.params.speed } else { 0.0 };
+        let window_start = (result.simulated - STEADY_REVOLUTIONS * revolution).max(0.0);
+        let (status, error) = match &result.outcome {
+            Outcome::Completed => ("completed", None),
+            Outcome::Diverged(e) => ("diverged", Some(e.to_string())),
+            Outcome::Interrupted => ("interrupted", Some("interrupted by a signal".to_string())),
+        };
+        let p = &scene.params;
+        let c = &scene.controller;
+        Summary {
+            scene: scene.name.clone(),
+            status,
+            error,
+            failure_time_s: match &result.outcome {
+                Outcome::Diverged(e) => Some(e.time()),
+                _ => None,
+            },
+            simulated_s: result.simulated,
+            max_radius_m: max(trace.radius().into_iter()),
+            contact_fraction: contact_fraction(trace, window_start),
+            steady_window_start_s: window_start,
+            max_contact_force_n: max(trace.contact_force_n.iter().copied()),
+            max_race_speed_rpm: max(trace.race_speed_rad_s.iter().map(|w| w.abs() * 60.0 / std::f64::consts::TAU)),
+            steps: result.stats.steps,
+            rejected_steps: result.stats.rejected,
+            rhs_evals: result.stats.rhs_evals,
+            wall_time_s: result.wall_time,
+            realtime_factor: if result.wall_time > 0.0 { result.simulated / result.wall_time } else { f64::INFINITY },
+            model: ModelInfo {
+                spin: match p.spin {
+                    crate::model::Spin::Held => "held",
+                    crate::model::Spin::Free { .. } => "free",
+                },
+                cage: p.cage,
+                race_drag: scene.raw.touchdown.drag.clone(),
+                amb_force: scene.raw.amb.force_law.clone(),
+                balls: p.balls.count(),
+                control_mode: c.mode,
+                law: c.law.clone(),
+                controller_rate_hz: 1.0 / c.period,
+                delay_samples: c.delay_samples,
+            },
+            integrator: IntegratorInfo {
+                method: scene.integrator.method,
+                rtol: scene.integrator.rtol,
+                atol: scene.integrator.atol.to_vec(),
+                substeps: scene.integrator.substeps,
+                macro_step_s: c.period,
+            },
+        }
+    }
+}
+
+fn max(values: impl Iterator<Item = f64>) -> f64 {
+    values.filter(|v| v.is_finite()).fold(0.0, f64::max)
+}
+
+/// Fraction of samples at or after `from` (s) with a positive contact force.
+pub fn contact_fraction(trace: &Trace, from: f64) -> f64 {
+    let (mut n, mut hits) = (0usize, 0usize);
+    for (t, f) in trace.t_s.iter().zip(&trace.contact_force_n) {
+        if *t >= from {
+            n += 1;
+            hits += usize::from(*f > 0.0);
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        hits as f64 / n as f64
+    }
+}

@@ -1,0 +1,201 @@
+//! Physics invariants of the plant model (MODEL.md), each checked against an
+//! independent closed-form expectation written out in the test.
+
+use plant::config::{validate, RawScene, Scene};
+use plant::integrate::Method;
+use plant::run::{run, Outcome, Quiet, RunResult};
+use std::f64::consts::TAU;
+use std::path::Path;
+
+/// A scene with the study's defaults (no shock), changed by `edit`.
+fn scene(edit: impl FnOnce(&mut RawScene)) -> Scene {
+    let mut raw = RawScene::default();
+    raw.scene.name = "test".into();
+    raw.output.plots = false;
+    edit(&mut raw);
+    validate(raw, Path::new(".")).expect("valid test scene")
+}
+
+fn completed(scene: &Scene) -> RunResult {
+    let r = run(scene, &mut Quiet).expect("law builds");
+    assert_eq!(r.outcome, Outcome::Completed, "run did not complete");
+    r
+}
+
+#[test]
+fn race_rests_on_the_lowest_ball_with_the_hertz_sag() {
+    // With ball 0 straight down, the race weight m_b g sits on that one ball:
+    // m_b g = K_b δ^(3/2)  →  y_b = −(r_cl + (m_b g / K_b)^(2/3)).
+    let s = scene(|_| {});
+    let expected = -(1e-5 + (0.048 * 9.80665 / 7.81e9_f64).powf(2.0 / 3.0));
+    let sag = plant::initial::race_sag(&s.params);
+    assert!((sag - expected).abs() < 1e-12, "sag {sag} vs {expected}");
+
+    // And the race stays there while the rotor is levitated.
+    let s = scene(|r| r.scene.duration_s = 0.05);
+    let tr = completed(&s).trace;
+    for (x, y) in tr.xb_m.iter().zip(&tr.yb_m) {
+        assert!(x.abs() < 1e-12 && (y - expected).abs() < 1e-11, "race moved: ({x}, {y})");
+    }
+}
+
+/// Times of the successive maxima of `y`, refined by a parabola through the three samples.
+fn peaks(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    for i in 1..y.len() - 1 {
+        if y[i] > y[i - 1] && y[i] >= y[i + 1] {
+            let (a, b, c) = (y[i - 1], y[i], y[i + 1]);
+            let denom = a - 2.0 * b + c;
+            let shift = if denom != 0.0 { 0.5 * (a - c) / denom } else { 0.0 };
+            let dt = t[i + 1] - t[i];
+            out.push((t[i] + shift * dt, b - 0.25 * (a - c) * shift));
+        }
+    }
+    out
+}
+
+#[test]
+fn levitated_loop_has_the_designed_frequency_and_damping() {
+    // A free decay from a 20 µm offset, no unbalance: x'' + 2 ξ ω_n x' + ω_n² x = 0 with
+    // ω_n = √(k_e / m_r). Damped frequency ω_n √(1 − ξ²); log decrement 2π ξ / √(1 − ξ²).
+    for (k_e, xi) in [(1e6, 0.01), (2e6, 0.05)] {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.4;
+            r.rotor.eccentricity_um = 0.0;
+            r.controller.stiffness_n_per_m = k_e;
+            r.controller.damping_ratio = xi;
+            r.initial.rotor_x_um = 20.0;
+        });
+        let tr = completed(&s).trace;
+        let p = peaks(&tr.t_s, &tr.dx_m);
+        assert!(p.len() > 10, "too few peaks: {}", p.len());
+        let n = p.len() - 1;
+        let period = (p[n].0 - p[0].0) / n as f64;
+        let omega_n = (k_e / 11.5_f64).sqrt();
+        let f_expected = omega_n * (1.0 - xi * xi).sqrt() / TAU;
+        let f = 1.0 / period;
+        assert!((f - f_expected).abs() < 2e-3 * f_expected, "frequency {f} Hz vs {f_expected} Hz");
+        let decrement = (p[0].1 / p[n].1).ln() / n as f64;
+        let xi_measured = decrement / (TAU * TAU + decrement * decrement).sqrt();
+        assert!((xi_measured - xi).abs() < 0.02 * xi, "damping ratio {xi_measured} vs {xi}");
+        // y stays centred: the gravity bias holds the weight exactly.
+        assert!(tr.dy_m.iter().all(|y| y.abs() < 1e-9), "y moved");
+    }
+}
+
+#[test]
+fn steady_unbalance_orbit_matches_the_linear_response() {
+    // Started at rest, the rotor settles on x + j y = Z e^{jθ_r} with
+    // Z = m e ω² / (k_e − m ω² + j c_e ω). A high damping ratio makes the transient short.
+    let (m, e, k_e, xi, omega) = (11.5, 2e-6, 1e6, 0.3, TAU * 500.0);
+    let s = scene(|r| {
+        r.scene.duration_s = 0.15;
+        r.initial.unbalance_orbit = false;
+        r.controller.damping_ratio = xi;
+    });
+    let tr = completed(&s).trace;
+    let c_e = 2.0 * xi * (k_e * m as f64).sqrt();
+    let (re, im) = (k_e - m * omega * omega, c_e * omega);
+    let scale = m * e * omega * omega / (re * re + im * im);
+    let z = (scale * re, -scale * im);
+    let (mut sum_re, mut sum_im, mut n) = (0.0, 0.0, 0.0);
+    for i in 0..tr.len() {
+        if tr.t_s[i] > 0.1 {
+            // (x + j y) e^{−jθ}
+            let (s, c) = tr.rotor_angle_rad[i].sin_cos();
+            sum_re += tr.dx_m[i] * c + tr.dy_m[i] * s;
+            sum_im += tr.dy_m[i] * c - tr.dx_m[i] * s;
+            n += 1.0;
+        }
+    }
+    let measured = (sum_re / n, sum_im / n);
+    let err = (measured.0 - z.0).hypot(measured.1 - z.1) / z.0.hypot(z.1);
+    assert!(err < 1e-3, "orbit amplitude {measured:?} vs {z:?} (rel. error {err})");
+}
+
+#[test]
+fn energy_is_conserved_without_damping_friction_and_drive_work() {
+    // Undamped PD (a spring k_e about the centre, gravity cancelled by the bias), no contact
+    // damping, no friction, no drag, no unbalance: kinetic + spring + Hertz + race gravity energy
+    // is constant through impacts on the race and the balls.
+    let k_e = 1e6;
+    let s = scene(|r| {
+        r.scene.duration_s = 0.03;
+        r.rotor.eccentricity_um = 0.0;
+        r.controller.stiffness_n_per_m = k_e;
+        r.controller.damping_ratio = 0.0;
+        r.contact.rotor_race_damping_n_s_per_m = 0.0;
+        r.contact.ball_damping_n_s_per_m = 0.0;
+        r.contact.friction_static = 0.0;
+        r.contact.friction_dynamic = 0.0;
+        r.touchdown.drag_torque_n_m = 0.0;
+        r.initial.unbalance_orbit = false;
+        r.initial.rotor_y_um = -155.0;
+        r.integrator.method = Method::Dop853;
+        r.integrator.rtol = 1e-11;
+        r.integrator.atol = 1e-14;
+        r.output.rate_hz = 200_000.0;
+    });
+    let tr = completed(&s).trace;
+    let p = &s.params;
+    let energy = |i: usize| {
+        let (x, y, vx, vy) = (tr.dx_m[i], tr.dy_m[i], tr.vx_m_s[i], tr.vy_m_s[i]);
+        let (xb, yb, vxb, vyb) = (tr.xb_m[i], tr.yb_m[i], tr.vxb_m_s[i], tr.vyb_m_s[i]);
+        let d = (x - xb).hypot(y - yb) - 0.15e-3;
+        let contact = if d > 0.0 { 1.988e9 * d.powf(19.0 / 9.0) * 9.0 / 19.0 } else { 0.0 };
+        let balls: f64 = (0..19)
+            .map(|k| {
+                let psi = p.cage_phase + TAU * k as f64 / 19.0; // cage does not turn: no friction
+                let delta = xb * psi.cos() + yb * psi.sin() - 1e-5;
+                if delta > 0.0 {
+                    0.4 * 7.81e9 * delta.powf(2.5)
+                } else {
+                    0.0
+                }
+            })
+            .sum();
+        0.5 * 11.5 * (vx * vx + vy * vy)
+            + 0.5 * 0.048 * (vxb * vxb + vyb * vyb)
+            + 0.5 * k_e * (x * x + y * y)
+            + contact
+            + balls
+            + 0.048 * 9.80665 * yb
+    };
+    let e0 = energy(0);
+    let touched = tr.contact_force_n.iter().any(|f| *f > 0.0);
+    assert!(touched, "the rotor never hit the race: the test exercises nothing");
+    let mut worst: f64 = 0.0;
+    for i in 0..tr.len() {
+        worst = worst.max((energy(i) - e0).abs());
+    }
+    let scale = 0.5 * k_e * (155e-6_f64).powi(2);
+    eprintln!("energy drift {worst:e} J of {scale:e} J");
+    assert!(worst < 1e-8 * scale, "energy drift {worst} J of {scale} J");
+}
+
+#[test]
+fn friction_spins_the_race_up_in_the_rotor_direction() {
+    let shocked = |mu: f64| {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.06;
+            r.contact.friction_static = mu;
+            r.contact.friction_dynamic = mu;
+            r.shock = vec![toml::from_str(
+                "kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.005",
+            )
+            .expect("shock spec")];
+        });
+        completed(&s).trace
+    };
+    let tr = shocked(0.1);
+    assert!(tr.contact_force_n.iter().any(|f| *f > 0.0), "no contact: the shock is too weak for the test");
+    let max_speed = tr.race_speed_rad_s.iter().copied().fold(f64::MIN, f64::max);
+    let min_speed = tr.race_speed_rad_s.iter().copied().fold(f64::MAX, f64::min);
+    assert!(max_speed > 100.0, "race did not spin up: {max_speed} rad/s");
+    assert!(min_speed > -1.0, "race turned against the rotor: {min_speed} rad/s");
+    // Never faster than the rotor surface can drive it (rolling without slip).
+    assert!(max_speed <= TAU * 500.0 * 19.85 / 20.0 * 1.001, "{max_speed}");
+    // Without friction nothing drives the race.
+    let tr = shocked(0.0);
+    assert!(tr.race_speed_rad_s.iter().all(|w| w.abs() < 1e-9));
+}
