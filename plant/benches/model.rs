@@ -1,1 +1,80 @@
-fn main() {}
+//! Benchmarks: one derivative evaluation (all 19 ball contacts evaluated, rotor
+//! in contact with the race) and one macro step (one controller period) of
+//! each integrator, levitated and in contact.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use plant::config::{validate, RawScene};
+use plant::integrate::{Integrator, Method, Settings};
+use plant::model::{ix, Control, Model, State};
+use plant::run::{design_gains, integrator_settings};
+use std::path::Path;
+
+fn model() -> (Model, plant::config::Scene) {
+    let mut raw = RawScene::default();
+    raw.shock =
+        vec![toml::from_str("kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.0")
+            .expect("shock")];
+    let scene = validate(raw, Path::new(".")).expect("scene");
+    let gains = design_gains(&scene).expect("gains");
+    let model = Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Continuous(gains) };
+    (model, scene)
+}
+
+/// Rotor pressed 160 µm down into the race, race pushed onto the lower balls, both moving.
+fn contact_state() -> State {
+    let mut y = [0.0; plant::model::N];
+    y[ix::YR] = -165e-6;
+    y[ix::XR] = 3e-6;
+    y[ix::YB] = -14e-6;
+    y[ix::XB] = 1e-6;
+    y[ix::VXR] = 0.05;
+    y[ix::VYR] = -0.02;
+    y[ix::WR] = std::f64::consts::TAU * 500.0;
+    y[ix::WB] = 1000.0;
+    y[ix::TB] = 0.3;
+    y
+}
+
+fn derivative(c: &mut Criterion) {
+    let (model, _) = model();
+    let y = contact_state();
+    let ev = model.evaluate(0.002, &y);
+    assert!(ev.contact.normal > 0.0 && ev.balls.loaded >= 3, "bench state must load the contacts: {ev:?}");
+    c.bench_function("derivative/contact_19_balls", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&y)).dy));
+    let levitated = plant::initial::initial_state(&model_scene());
+    c.bench_function("derivative/levitated", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&levitated)).dy));
+}
+
+fn model_scene() -> plant::config::Scene {
+    model().1
+}
+
+fn macro_step(c: &mut Criterion) {
+    let (model, scene) = model();
+    let period = scene.controller.period;
+    let levitated = plant::initial::initial_state(&scene);
+    let cases: [(&str, Settings<{ plant::model::N }>); 3] = [
+        ("dp5_rtol1e-6", integrator_settings(&scene)),
+        ("rk4_16", Settings { substeps: 16, ..Settings::fixed(Method::Rk4, 16) }),
+        ("dop853_rtol1e-9", Settings { rtol: 1e-9, atol: [1e-12; plant::model::N], ..integrator_settings(&scene) }),
+    ];
+    for (name, settings) in cases {
+        for (state_name, y0) in [("levitated", levitated), ("contact", contact_state())] {
+            let settings = Settings {
+                method: if name.starts_with("dop853") { Method::Dop853 } else { settings.method },
+                ..settings.clone()
+            };
+            let mut integrator = Integrator::new(settings);
+            c.bench_function(&format!("macro_step/{name}/{state_name}"), |b| {
+                b.iter(|| {
+                    let mut y = y0;
+                    integrator.advance(&model, 0.002, 0.002 + period, &mut y).expect("step");
+                    y
+                })
+            });
+        }
+    }
+}
+
+criterion_group!(benches, derivative, macro_step);
+criterion_main!(benches);

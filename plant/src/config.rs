@@ -458,13 +458,19 @@ pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigErro
         std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
     let mut value: toml::Table = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
-    for arg in overrides {
-        apply_override(&mut value, arg)?;
+    // The file alone first, so that its own mistakes are blamed on it, then with the overrides.
+    let parse = |table: toml::Table, blame: String| {
+        toml::Value::Table(table)
+            .try_into::<RawScene>()
+            .map_err(|e| ConfigError::Parse { path: blame, message: e.to_string() })
+    };
+    let mut raw = parse(value.clone(), path.display().to_string())?;
+    if !overrides.is_empty() {
+        for arg in overrides {
+            apply_override(&mut value, arg)?;
+        }
+        raw = parse(value, format!("--set {}", overrides.join(" --set ")))?;
     }
-    let mut raw: RawScene = toml::Value::Table(value).try_into().map_err(|e: toml::de::Error| ConfigError::Parse {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
     if raw.scene.name.is_empty() {
         raw.scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     }

@@ -25,10 +25,18 @@ pub struct BallSet {
     pub damping_max: f64,
     /// Depth δ_max at which the damping is fully on (m).
     pub damping_depth: f64,
-    /// `(cos, sin)` of `2π i / z` for each ball, precomputed.
+    /// Number of balls z.
+    count: usize,
+    /// `cos(2π i / z)` for each ball, precomputed (the first `count` entries).
     #[serde(skip)]
-    pitch: Vec<[f64; 2]>,
+    pitch_cos: [f64; MAX_BALLS],
+    /// `sin(2π i / z)` likewise.
+    #[serde(skip)]
+    pitch_sin: [f64; MAX_BALLS],
 }
+
+/// Most balls a set may have.
+pub const MAX_BALLS: usize = 64;
 
 /// Resultant of the ball contacts.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -42,20 +50,28 @@ pub struct BallForce {
 }
 
 impl BallSet {
-    /// A set of `z` equally spaced balls.
+    /// A set of `z` equally spaced balls, `1 ≤ z ≤ MAX_BALLS` (clamped).
     pub fn new(z: usize, clearance: f64, stiffness: f64, damping_max: f64, damping_depth: f64) -> Self {
-        let pitch = (0..z)
-            .map(|i| {
-                let a = std::f64::consts::TAU * i as f64 / z as f64;
-                [a.cos(), a.sin()]
-            })
-            .collect();
-        Self { clearance, stiffness, damping_max, damping_depth, pitch }
+        let count = z.clamp(1, MAX_BALLS);
+        let mut pitch_cos = [0.0; MAX_BALLS];
+        let mut pitch_sin = [0.0; MAX_BALLS];
+        for i in 0..count {
+            let (s, c) = (std::f64::consts::TAU * i as f64 / count as f64).sin_cos();
+            pitch_cos[i] = c;
+            pitch_sin[i] = s;
+        }
+        Self { clearance, stiffness, damping_max, damping_depth, count, pitch_cos, pitch_sin }
     }
 
     /// Number of balls z.
     pub fn count(&self) -> usize {
-        self.pitch.len()
+        self.count
+    }
+
+    /// `(cos ψ_i, sin ψ_i)` of ball `i` for cage angle `(sin θ_c, cos θ_c)`.
+    fn direction(&self, i: usize, s0: f64, c0: f64) -> (f64, f64) {
+        let (cp, sp) = (self.pitch_cos[i], self.pitch_sin[i]);
+        (c0 * cp - s0 * sp, s0 * cp + c0 * sp)
     }
 
     /// Ball forces for race position `eps` (m) and velocity `eps_dot` (m/s)
@@ -67,32 +83,41 @@ impl BallSet {
         if eps[0] * eps[0] + eps[1] * eps[1] <= self.clearance * self.clearance {
             return BallForce::default();
         }
+        // In the cage frame (turned by θ_c) ball i sits at the fixed angle φ_i = 2π i / z, and
+        // ε = (A, B) there, so δ_i = A cos φ_i + B sin φ_i − r_cl, and with the frame turning,
+        // δ̇_i = (Ȧ) cos φ_i + (Ḃ) sin φ_i, Ȧ = ε̇·(c, s) + θ̇_c B, Ḃ = ε̇·(−s, c) − θ̇_c A.
         let (s0, c0) = cage.sin_cos();
+        let a = eps[0] * c0 + eps[1] * s0;
+        let b = eps[1] * c0 - eps[0] * s0;
+        let a_dot = eps_dot[0] * c0 + eps_dot[1] * s0 + cage_rate * b;
+        let b_dot = eps_dot[1] * c0 - eps_dot[0] * s0 - cage_rate * a;
+        let (mut sum_c, mut sum_s) = (0.0, 0.0);
         let mut out = BallForce::default();
-        for &[cp, sp] in &self.pitch {
-            let (c, s) = (c0 * cp - s0 * sp, s0 * cp + c0 * sp);
-            let delta = eps[0] * c + eps[1] * s - self.clearance;
+        for (&cp, &sp) in self.pitch_cos[..self.count].iter().zip(&self.pitch_sin[..self.count]) {
+            let delta = a * cp + b * sp - self.clearance;
             if delta <= 0.0 {
                 continue;
             }
-            let delta_dot = eps_dot[0] * c + eps_dot[1] * s + cage_rate * (eps[1] * c - eps[0] * s);
+            let delta_dot = a_dot * cp + b_dot * sp;
             let damping = step(delta, 0.0, 0.0, self.damping_depth, self.damping_max);
             let load = (self.stiffness * delta * delta.sqrt() + damping * delta_dot).max(0.0);
-            out.on_race[0] -= load * c;
-            out.on_race[1] -= load * s;
+            sum_c += load * cp;
+            sum_s += load * sp;
             out.max_load = out.max_load.max(load);
             out.loaded += u32::from(load > 0.0);
         }
+        // Back to the housing frame: −Σ F_i (cos ψ_i, sin ψ_i).
+        out.on_race = [-(c0 * sum_c - s0 * sum_s), -(s0 * sum_c + c0 * sum_s)];
         out
     }
 
     /// Elastic energy stored in the ball contacts (J): `Σ (2/5) K_b δ_i^(5/2)`.
     pub fn potential(&self, eps: [f64; 2], cage: f64) -> f64 {
-        self.pitch
-            .iter()
-            .map(|&[cp, sp]| {
-                let (s0, c0) = cage.sin_cos();
-                let delta = eps[0] * (c0 * cp - s0 * sp) + eps[1] * (s0 * cp + c0 * sp) - self.clearance;
+        let (s0, c0) = cage.sin_cos();
+        (0..self.count)
+            .map(|i| {
+                let (c, s) = self.direction(i, s0, c0);
+                let delta = eps[0] * c + eps[1] * s - self.clearance;
                 if delta > 0.0 {
                     0.4 * self.stiffness * delta.powf(2.5)
                 } else {
@@ -119,8 +144,9 @@ mod tests {
     #[test]
     fn single_ball_below_carries_hertz_load() {
         let b = balls();
-        // Cage turned so ball 0 is straight down; race pressed down by r_cl + δ.
-        let delta = 1e-6;
+        // Cage turned so ball 0 is straight down; race pressed down by r_cl + δ, shallow enough
+        // that the neighbours at ±2π/19 stay clear: (r_cl + δ) cos(2π/19) < r_cl.
+        let delta = 1e-7;
         let f = b.force([0.0, -(1e-5 + delta)], [0.0; 2], -std::f64::consts::FRAC_PI_2, 0.0);
         let expected = 7.81e9 * delta.powf(1.5);
         assert_eq!(f.loaded, 1);
@@ -132,8 +158,9 @@ mod tests {
     fn load_shared_symmetrically_between_two_balls() {
         let b = balls();
         let half = std::f64::consts::PI / 19.0;
-        // Two balls at −90° ± half a pitch: the x components cancel.
-        let f = b.force([0.0, -2e-5], [0.0; 2], -std::f64::consts::FRAC_PI_2 - half, 0.0);
+        // Two balls at −90° ± half a pitch: the x components cancel; the next pair, at ±3/2
+        // pitch, stays clear: 10.2 µm · cos(3π/19) < r_cl.
+        let f = b.force([0.0, -1.02e-5], [0.0; 2], -std::f64::consts::FRAC_PI_2 - half, 0.0);
         assert_eq!(f.loaded, 2);
         assert!(f.on_race[0].abs() < 1e-9 * f.on_race[1]);
     }
@@ -148,5 +175,31 @@ mod tests {
         let dy = (b.potential([eps[0], eps[1] + h], 0.2) - b.potential([eps[0], eps[1] - h], 0.2)) / (2.0 * h);
         assert!((f.on_race[0] + dx).abs() < 1e-5 * f.on_race[1].abs());
         assert!((f.on_race[1] + dy).abs() < 1e-5 * f.on_race[1].abs());
+    }
+
+    #[test]
+    fn overlap_rate_includes_the_cage_rotation() {
+        // The damping force follows δ̇_i = d/dt δ_i(ε(t), θ_c(t)): compare with a finite
+        // difference of the ball overlaps along a motion with a turning cage.
+        let b = BallSet::new(19, 1e-5, 0.0, 750.0, 1e-5);
+        let (eps, eps_dot, cage, rate) = ([2e-6, -1.15e-5], [0.01, -0.02], 0.1, 300.0);
+        let f = b.force(eps, eps_dot, cage, rate);
+        let h = 1e-9;
+        let expected = (0..19).fold([0.0; 2], |acc, i| {
+            let at = |t: f64| {
+                let (s0, c0) = (cage + rate * t).sin_cos();
+                let (c, s) = b.direction(i, s0, c0);
+                ((eps[0] + eps_dot[0] * t) * c + (eps[1] + eps_dot[1] * t) * s - 1e-5, c, s)
+            };
+            let (d, c, s) = at(0.0);
+            if d <= 0.0 {
+                return acc;
+            }
+            let rate_fd = (at(h).0 - at(-h).0) / (2.0 * h);
+            let load = (step(d, 0.0, 0.0, 1e-5, 750.0) * rate_fd).max(0.0);
+            [acc[0] - load * c, acc[1] - load * s]
+        });
+        assert!((f.on_race[0] - expected[0]).abs() < 1e-6 * expected[1].abs().max(1e-3), "{f:?} vs {expected:?}");
+        assert!((f.on_race[1] - expected[1]).abs() < 1e-6 * expected[1].abs().max(1e-3), "{f:?} vs {expected:?}");
     }
 }

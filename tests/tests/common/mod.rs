@@ -1,0 +1,172 @@
+//! Helpers for the end-to-end tests: building and locating the workspace's
+//! binaries, per-test output folders, and small independent readers for the
+//! files a run writes (the tests do not reuse the plant's own readers).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+/// The workspace root (the parent of this package's folder).
+pub fn workspace_root() -> PathBuf {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    manifest.parent().expect("the test package lives inside the workspace").to_path_buf()
+}
+
+/// A scene file from the workspace's `config/` folder.
+pub fn scene(name: &str) -> PathBuf {
+    workspace_root().join("config").join(name)
+}
+
+/// Builds `bin` of `package` in the profile these tests were built in and
+/// returns the executable's path.
+///
+/// The path is taken from Cargo's own `compiler-artifact` message rather
+/// than guessed from the target folder, so `CARGO_TARGET_DIR`,
+/// `build.target-dir` in a Cargo config, and `--release` are all honoured
+/// without special cases.
+fn build_bin(package: &str, bin: &str) -> PathBuf {
+    let mut cmd = Command::new(env!("CARGO"));
+    cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "-p", package, "--bin", bin]);
+    if !cfg!(debug_assertions) {
+        cmd.arg("--release");
+    }
+    let out = cmd.output().unwrap_or_else(|e| panic!("cannot start cargo to build {bin}: {e}"));
+    assert!(
+        out.status.success(),
+        "cargo build -p {package} --bin {bin} failed ({}):\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    stdout
+        .lines()
+        .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
+        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == bin)
+        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
+        .unwrap_or_else(|| panic!("cargo built no executable named {bin}"))
+}
+
+/// The `plant` binary, built once per test binary.
+pub fn plant_bin() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| build_bin("plant", "plant"))
+}
+
+/// The `shock-table` binary, built once per test binary.
+pub fn shock_table_bin() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| build_bin("shock-table", "shock-table"))
+}
+
+/// Overrides that keep a paper scene short: 50 ms with the shock from 10 ms,
+/// no plots.
+pub const SHORT: &[&str] = &["scene.duration_s=0.05", "shock[0].start_s=0.01", "output.plots=false"];
+
+/// A `plant run <scene> --out <out> --set …` command (not started).
+pub fn plant_run(scene: &Path, out: &Path, sets: &[&str]) -> Command {
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("run").arg(scene).arg("--out").arg(out);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    cmd
+}
+
+/// Runs a command to completion.
+pub fn output(cmd: &mut Command) -> Output {
+    cmd.output().unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"))
+}
+
+/// Standard error as text.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts the exit code, showing standard error when it differs.
+pub fn assert_exit(out: &Output, code: i32) {
+    assert_eq!(out.status.code(), Some(code), "exit status {}; stderr:\n{}", out.status, stderr(out));
+}
+
+/// A fresh folder under the system temp folder, unique per test and
+/// process. Removed on drop unless the test is failing (kept to inspect).
+pub struct TempDir(PathBuf);
+
+impl TempDir {
+    /// Creates `<tmp>/testbed-tests-<name>-<pid>`, emptying any leftover.
+    pub fn new(name: &str) -> Self {
+        let path = std::env::temp_dir().join(format!("testbed-tests-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir_all(&path).unwrap_or_else(|e| panic!("creating {}: {e}", path.display()));
+        Self(path)
+    }
+
+    /// A path inside the folder.
+    pub fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("keeping {} for inspection", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+/// A numeric CSV file with a header row.
+pub struct Csv {
+    /// Column names.
+    pub header: Vec<String>,
+    /// Rows, each as long as the header.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    /// Reads a CSV file of numbers; panics naming the line on malformed data.
+    pub fn read(path: &Path) -> Self {
+        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+        let mut lines = text.lines();
+        let header: Vec<String> = lines
+            .next()
+            .unwrap_or_else(|| panic!("{} is empty", path.display()))
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let rows = lines
+            .enumerate()
+            .map(|(n, line)| {
+                let row: Vec<f64> = line
+                    .split(',')
+                    .map(|v| v.parse().unwrap_or_else(|e| panic!("{} line {}: {v:?}: {e}", path.display(), n + 2)))
+                    .collect();
+                assert_eq!(row.len(), header.len(), "{} line {}: wrong number of fields", path.display(), n + 2);
+                row
+            })
+            .collect();
+        Self { header, rows }
+    }
+
+    /// One column by name.
+    pub fn column(&self, name: &str) -> Vec<f64> {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header));
+        self.rows.iter().map(|r| r[i]).collect()
+    }
+}
+
+/// Reads a JSON file.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A number field of a JSON object.
+pub fn num(v: &serde_json::Value, key: &str) -> f64 {
+    v[key].as_f64().unwrap_or_else(|| panic!("`{key}` is not a number in {v:#}"))
+}
