@@ -199,3 +199,103 @@ fn friction_spins_the_race_up_in_the_rotor_direction() {
     let tr = shocked(0.0);
     assert!(tr.race_speed_rad_s.iter().all(|w| w.abs() < 1e-9));
 }
+
+/// The 10 G study shock at `start_s`.
+fn ten_g(start_s: f64) -> Vec<shock_table::ShockSpec> {
+    vec![toml::from_str(&format!(
+        "kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = {start_s}"
+    ))
+    .expect("shock spec")]
+}
+
+#[test]
+fn free_spin_loses_speed_to_rubbing_and_the_drive_restores_it() {
+    // Free spin, no drive: friction torque −r_r F_t is the only torque (no unbalance work on
+    // average), so the rotor can only slow down during contact, by ∫ r_r F_t dt / J_r.
+    let run_with = |gain: f64| {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.06;
+            r.rotor.spin = "free".into();
+            r.rotor.eccentricity_um = 0.0;
+            r.rotor.drive_gain_n_m_s = gain;
+            r.shock = ten_g(0.005);
+        });
+        completed(&s).trace
+    };
+    let tr = run_with(0.0);
+    let omega0 = TAU * 500.0;
+    let last = *tr.rotor_speed_rad_s.last().expect("rows");
+    assert!(last < omega0 - 1e-3, "no speed loss: {last} vs {omega0}");
+    // Speed loss equals the friction impulse: Δω = −(r_r / J_r) ∫ F_t dt (trapezoid on the trace).
+    let impulse: f64 =
+        tr.t_s.windows(2).zip(tr.friction_force_n.windows(2)).map(|(t, f)| 0.5 * (f[0] + f[1]) * (t[1] - t[0])).sum();
+    let expected = omega0 - 19.85e-3 / 5.81e-3 * impulse;
+    assert!(
+        (last - expected).abs() < 0.02 * (omega0 - expected),
+        "Δω {} vs friction impulse {}",
+        omega0 - last,
+        omega0 - expected
+    );
+    // With a speed loop the drive makes up part of the loss.
+    let driven = *run_with(0.05).rotor_speed_rad_s.last().expect("rows");
+    assert!(driven > last, "drive did not help: {driven} vs {last}");
+}
+
+#[test]
+fn nonlinear_bearing_matches_the_linear_loop_at_small_amplitude() {
+    // The nonlinear law linearises to the same k_i, k_s, so a 2 µm free decay has the same
+    // frequency as the linear loop: ω_n = √(k_e / m_r).
+    let s = scene(|r| {
+        r.scene.duration_s = 0.25;
+        r.rotor.eccentricity_um = 0.0;
+        r.amb.force_law = "nonlinear".into();
+        r.controller.damping_ratio = 0.02;
+        r.initial.rotor_x_um = 2.0;
+    });
+    let tr = completed(&s).trace;
+    let p = peaks(&tr.t_s, &tr.dx_m);
+    let n = p.len() - 1;
+    let f = n as f64 / (p[n].0 - p[0].0);
+    let f_expected = (1e6_f64 / 11.5).sqrt() * (1.0 - 0.02_f64 * 0.02).sqrt() / TAU;
+    assert!((f - f_expected).abs() < 5e-3 * f_expected, "{f} Hz vs {f_expected} Hz");
+    // A large amplitude feels the 1/s² law: the response differs from the linear one.
+    let big = |law: &str| {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.05;
+            r.rotor.eccentricity_um = 0.0;
+            r.amb.force_law = law.into();
+            r.initial.rotor_x_um = 140.0;
+        });
+        completed(&s).trace.dx_m
+    };
+    let (lin, nonlin) = (big("linear"), big("nonlinear"));
+    let diff = lin.iter().zip(&nonlin).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(diff > 1e-6, "nonlinear law indistinguishable at 140 µm: {diff}");
+}
+
+#[test]
+fn palmgren_drag_and_fixed_cage_run_the_shock() {
+    // Palmgren drag is load dependent: under the same shock the race ends slower than with the
+    // study's light constant drag only if its torque is larger; both must stay below the
+    // rolling speed of the rotor surface and never turn backward.
+    let base = |edit: &dyn Fn(&mut RawScene)| {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.05;
+            r.shock = ten_g(0.005);
+            edit(r);
+        });
+        completed(&s).trace
+    };
+    let constant = base(&|_| {});
+    let palmgren = base(&|r| r.touchdown.drag = "palmgren".into());
+    let heavy = base(&|r| r.touchdown.drag_torque_n_m = 1.0);
+    let end = |t: &plant::trace::Trace| *t.race_speed_rad_s.last().expect("rows");
+    assert!(end(&heavy) < end(&constant), "more drag, same speed: {} vs {}", end(&heavy), end(&constant));
+    for tr in [&constant, &palmgren, &heavy] {
+        assert!(tr.race_speed_rad_s.iter().all(|w| *w > -1.0 && *w <= TAU * 500.0 * 19.85 / 20.0 * 1.001));
+    }
+    assert_ne!(end(&palmgren), end(&constant));
+    // Fixed balls: same shock, different ball positions in time, so a different response.
+    let fixed = base(&|r| r.touchdown.cage = plant::model::Cage::Fixed);
+    assert_ne!(fixed.yb_m, constant.yb_m);
+}
