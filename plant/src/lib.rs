@@ -9,6 +9,7 @@
 //! [`output`] and [`plot`] what a run writes.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod config;
 pub mod force;
 pub mod initial;
@@ -18,4 +19,5 @@ pub mod output;
 pub mod plot;
 pub mod run;
 pub mod summary;
+pub mod sweep;
 pub mod trace;

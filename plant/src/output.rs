@@ -23,6 +23,8 @@ pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Resul
     write_json(&dir.join("summary.json"), &summary)?;
     if scene.plots {
         write_plots(dir, scene, result).context("writing plots")?;
+        crate::analysis::write_plots(dir, &scene.name, &result.trace, &summary.analysis, scene.params.contact.gap)
+            .context("writing analysis plots")?;
     }
     Ok(summary)
 }
@@ -84,4 +86,35 @@ pub fn write_plots(dir: &Path, scene: &Scene, result: &RunResult) -> Result<(), 
         ],
         Scale::Linear,
     )
+}
+
+/// Analyses an existing run folder: reads `trace.csv` and `scene.toml`, merges the
+/// analysis into `summary.json` (created if missing) and writes the analysis plots.
+pub fn analyze_dir(dir: &Path) -> anyhow::Result<crate::analysis::Analysis> {
+    let scene_path = dir.join("scene.toml");
+    let text = std::fs::read_to_string(&scene_path).with_context(|| format!("reading {}", scene_path.display()))?;
+    let raw: crate::config::RawScene =
+        toml::from_str(&text).with_context(|| format!("parsing {}", scene_path.display()))?;
+    let trace_path = dir.join("trace.csv");
+    let trace = crate::trace::Trace::read_csv(&trace_path).map_err(anyhow::Error::msg)?;
+    anyhow::ensure!(trace.len() > 1, "{}: fewer than two rows", trace_path.display());
+    let gap = raw.touchdown.air_gap_mm * 1e-3;
+    let setting = crate::analysis::Setting {
+        gap,
+        speed: raw.rotor.speed_hz * std::f64::consts::TAU,
+        phase: 0.0,
+        tolerance: 1e-3,
+    };
+    let analysis = crate::analysis::analyze(&trace, &setting);
+    let summary_path = dir.join("summary.json");
+    let mut summary: serde_json::Value = match std::fs::read_to_string(&summary_path) {
+        Ok(text) => serde_json::from_str(&text).with_context(|| format!("parsing {}", summary_path.display()))?,
+        Err(_) => serde_json::json!({ "scene": raw.scene.name }),
+    };
+    if let (Some(map), serde_json::Value::Object(new)) = (summary.as_object_mut(), serde_json::to_value(&analysis)?) {
+        map.extend(new);
+    }
+    write_json(&summary_path, &summary)?;
+    crate::analysis::write_plots(dir, &raw.scene.name, &trace, &analysis, gap).context("writing analysis plots")?;
+    Ok(analysis)
 }

@@ -1,5 +1,6 @@
 //! The figures of a run, written as `summary.json`.
 
+use crate::analysis::{analyze, Analysis, Setting};
 use crate::config::Scene;
 use crate::run::{Outcome, RunResult};
 use crate::trace::Trace;
@@ -51,7 +52,7 @@ pub struct IntegratorInfo {
 pub struct Summary {
     /// Scene name.
     pub scene: String,
-    /// `completed`, `diverged` or `interrupted`.
+    /// `completed`, `diverged`, `interrupted` or `peer_lost` (co-simulation: the controller was lost).
     pub status: &'static str,
     /// What went wrong, with time and state.
     pub error: Option<String>,
@@ -83,6 +84,12 @@ pub struct Summary {
     pub model: ModelInfo,
     /// Integrator.
     pub integrator: IntegratorInfo,
+    /// Spectra, Poincaré section and classification of the response.
+    #[serde(flatten)]
+    pub analysis: Analysis,
+    /// Co-simulation figures (`lockstep`, `realtime` modes only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cosim: Option<crate::cosim::CosimReport>,
 }
 
 impl Summary {
@@ -95,6 +102,7 @@ impl Summary {
             Outcome::Completed => ("completed", None),
             Outcome::Diverged(e) => ("diverged", Some(e.to_string())),
             Outcome::Interrupted => ("interrupted", Some("interrupted by a signal".to_string())),
+            Outcome::PeerLost(why) => ("peer_lost", Some(why.clone())),
         };
         let p = &scene.params;
         let c = &scene.controller;
@@ -138,8 +146,15 @@ impl Summary {
                 substeps: scene.integrator.substeps,
                 macro_step_s: c.period,
             },
+            analysis: analyze(trace, &analysis_setting(scene)),
+            cosim: result.cosim.clone(),
         }
     }
+}
+
+/// The analysis setting of a scene: Poincaré section at spin phase 0, periodicity tolerance 1e-3 r_0.
+pub fn analysis_setting(scene: &Scene) -> Setting {
+    Setting { gap: scene.params.contact.gap, speed: scene.params.speed, phase: 0.0, tolerance: 1e-3 }
 }
 
 fn max(values: impl Iterator<Item = f64>) -> f64 {
