@@ -357,15 +357,27 @@ pub fn run_sweep(
 pub fn merge(sweep: &Sweep, dir: &Path) -> anyhow::Result<usize> {
     use std::fmt::Write as _;
     let points: Vec<PointResult> = (0..sweep.len()).filter_map(|i| read_point(dir, i)).collect();
-    let mut csv = String::from(
-        "value,post_shock_mode,steady_class,period_k,contact_fraction,whirl_hz,max_radius_m,max_contact_force_n,value2,status,index\n",
-    );
-    let mut pc = String::from("value,n,x_m,y_m,value2\n");
-    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
+    // The second value is a column only for 2-D maps.
+    let map = sweep.spec.map.is_some();
+    let second = |v: Option<f64>| {
+        if map {
+            format!(",{}", v.map_or(String::new(), |v| format!("{v:e}")))
+        } else {
+            String::new()
+        }
+    };
+    let mut csv = String::from("value,post_shock_mode,steady_class,period_k,contact_fraction,whirl_hz,max_radius_m,max_contact_force_n,status,index");
+    let mut pc = String::from("value,n,x_m,y_m");
+    if map {
+        csv.push_str(",value2");
+        pc.push_str(",value2");
+    }
+    csv.push('\n');
+    pc.push('\n');
     for p in &points {
         let _ = writeln!(
             csv,
-            "{:e},{},{},{},{:e},{:e},{:e},{:e},{},{},{}",
+            "{:e},{},{},{},{:e},{:e},{:e},{:e},{},{}{}",
             p.value,
             p.post_shock_mode,
             p.steady_class,
@@ -374,12 +386,12 @@ pub fn merge(sweep: &Sweep, dir: &Path) -> anyhow::Result<usize> {
             p.whirl_hz,
             p.max_radius_m,
             p.max_contact_force_n,
-            opt(p.value2),
             p.status,
-            p.index
+            p.index,
+            second(p.value2)
         );
         for (n, x, y) in &p.poincare {
-            let _ = writeln!(pc, "{:e},{n},{x:e},{y:e},{}", p.value, opt(p.value2));
+            let _ = writeln!(pc, "{:e},{n},{x:e},{y:e}{}", p.value, second(p.value2));
         }
     }
     std::fs::write(dir.join("points.csv"), csv).context("writing points.csv")?;

@@ -41,7 +41,12 @@ pub fn section(trace: &Trace, phase_rad: f64) -> Vec<SectionPoint> {
             continue;
         }
         // Revolutions n with a ≤ 2πn < b (the first row counts if it sits on the phase).
-        let mut n = (a / tau).ceil() as i64;
+        // Crossing n belongs to the interval with a ≤ n·2π < b, compared as n·2π throughout
+        // (a/2π and n·2π round differently), so the intervals share no crossing and miss none.
+        let mut n = (a / tau).floor() as i64 - 1;
+        while (n as f64) * tau < a {
+            n += 1;
+        }
         while (n as f64) * tau < b {
             let target = n as f64 * tau;
             let (t0, t1) = (trace.t_s[i], trace.t_s[i + 1]);
@@ -95,5 +100,23 @@ mod tests {
         }
         // Consecutive n.
         assert!(s.windows(2).all(|w| w[1].n == w[0].n + 1));
+    }
+
+    #[test]
+    fn crossing_on_a_row_is_counted_once() {
+        // Regression: rows exactly at θ = 2πn (a held speed with 40 rows per revolution).
+        let mut tr = Trace::default();
+        let w = std::f64::consts::TAU * 500.0;
+        for i in 0..=2000 {
+            let t = i as f64 * 5e-5;
+            tr.t_s.push(t);
+            tr.rotor_angle_rad.push(w * t);
+            for c in [&mut tr.dx_m, &mut tr.dy_m, &mut tr.vx_m_s, &mut tr.vy_m_s] {
+                c.push(0.0);
+            }
+        }
+        let s = section(&tr, 0.0);
+        let ns: Vec<i64> = s.iter().map(|p| p.n).collect();
+        assert_eq!(ns, (0..50).collect::<Vec<i64>>());
     }
 }

@@ -1,0 +1,156 @@
+//! End-to-end tests of `plant sweep`: a tiny sweep, shards merged equal one
+//! unsharded run, and an interrupted sweep resumes.
+
+mod common;
+
+use common::*;
+use std::path::Path;
+use std::process::Command;
+
+/// A sweep file over the 10 G scene's shock peak, kept short.
+fn sweep_file(dir: &TempDir, points: usize) -> std::path::PathBuf {
+    let path = dir.join("sweep.toml");
+    let text = format!(
+        "scene = {:?}\nset = [\"scene.duration_s=0.1\", \"shock[0].start_s=0.01\"]\nkey = \"shock[0].peak_g\"\nfrom = 1.0\nto = 10.0\npoints = {points}\n",
+        scene("paper-10g.toml").display().to_string()
+    );
+    std::fs::write(&path, text).expect("writing the sweep file");
+    path
+}
+
+fn sweep(file: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("sweep").arg(file).arg("--out").arg(out).args(extra);
+    cmd
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+}
+
+#[test]
+fn tiny_sweep_writes_points_poincare_and_diagrams() {
+    let dir = TempDir::new("sweep-tiny");
+    let file = sweep_file(&dir, 2);
+    let out = dir.join("out");
+    let o = output(&mut sweep(&file, &out, &[]));
+    assert_exit(&o, 0);
+    // points.csv mixes numbers and words: read it as text.
+    let text = read(&out.join("points.csv"));
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    for col in [
+        "value",
+        "post_shock_mode",
+        "steady_class",
+        "period_k",
+        "contact_fraction",
+        "whirl_hz",
+        "max_radius_m",
+        "max_contact_force_n",
+    ] {
+        assert!(header.contains(&col), "points.csv lacks {col}: {header:?}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect("column");
+    let num = |row: &Vec<&str>, name: &str| row[col(name)].parse::<f64>().expect("number");
+    assert_eq!(rows.len(), 2);
+    assert_eq!((num(&rows[0], "value"), num(&rows[1], "value")), (1.0, 10.0));
+    // 1 G does not reach the 0.15 mm gap and recovers; 10 G does reach it.
+    assert!(num(&rows[0], "max_radius_m") < 0.15e-3 && num(&rows[1], "max_radius_m") > 0.15e-3);
+    assert_eq!(rows[0][col("post_shock_mode")], "recovered");
+    // One Poincaré point per revolution of the 0.1 s run at 500 Hz, for each value.
+    let pc = Csv::read(&out.join("poincare.csv"));
+    assert_eq!(&pc.header[..4], ["value", "n", "x_m", "y_m"]);
+    let at_1g = pc.column("value").iter().filter(|v| **v == 1.0).count();
+    assert!((49..=51).contains(&at_1g), "{at_1g} points at 1 G");
+    for png in ["bifurcation_x.png", "bifurcation_y.png"] {
+        let bytes = std::fs::read(out.join(png)).unwrap_or_default();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png} missing");
+    }
+}
+
+#[test]
+fn shards_merged_equal_an_unsharded_sweep() {
+    let dir = TempDir::new("sweep-shards");
+    let file = sweep_file(&dir, 3);
+    let (whole, a, b) = (dir.join("whole"), dir.join("a"), dir.join("b"));
+    assert_exit(&output(&mut sweep(&file, &whole, &[])), 0);
+    assert_exit(&output(&mut sweep(&file, &a, &["--shard", "0/2"])), 0);
+    assert_exit(&output(&mut sweep(&file, &b, &["--shard", "1/2"])), 0);
+    assert!(!a.join("points.csv").exists(), "a shard alone must not claim the whole result");
+    // "Another machine's" shard: copy its points in, then merge.
+    for entry in std::fs::read_dir(b.join("points")).expect("shard b points") {
+        let entry = entry.expect("entry");
+        std::fs::copy(entry.path(), a.join("points").join(entry.file_name())).expect("copy");
+    }
+    assert_exit(&output(&mut sweep(&file, &a, &["--merge"])), 0);
+    assert_eq!(read(&a.join("points.csv")), read(&whole.join("points.csv")));
+    assert_eq!(read(&a.join("poincare.csv")), read(&whole.join("poincare.csv")));
+}
+
+#[test]
+fn interrupted_sweep_keeps_its_points_and_resumes() {
+    let dir = TempDir::new("sweep-resume");
+    let file = sweep_file(&dir, 6);
+    let out = dir.join("out");
+    let mut child = sweep(&file, &out, &["--jobs", "1"]).stderr(std::process::Stdio::piped()).spawn().expect("start");
+    // Wait for the first finished point, then interrupt.
+    let first = out.join("points").join("00000.json");
+    let started = std::time::Instant::now();
+    while !first.exists() {
+        assert!(started.elapsed().as_secs() < 120, "no point finished in 2 minutes");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGINT);
+    }
+    let o = child.wait_with_output().expect("wait");
+    let done = std::fs::read_dir(out.join("points"))
+        .expect("points")
+        .filter(|e| e.as_ref().is_ok_and(|e| e.path().extension().is_some_and(|x| x == "json")))
+        .count();
+    if o.status.code() == Some(0) {
+        // The sweep finished before the signal landed: nothing to resume, but nothing lost.
+        assert_eq!(done, 6);
+        return;
+    }
+    assert_exit(&o, 130);
+    assert!((1..6).contains(&done), "{done} points kept");
+    assert!(!out.join("points.csv").exists());
+    // Resume: only the missing points run.
+    let o = output(&mut sweep(&file, &out, &[]));
+    assert_exit(&o, 0);
+    assert!(stderr(&o).contains(&format!("reused {done}")), "{}", stderr(&o));
+    let whole = dir.join("whole");
+    assert_exit(&output(&mut sweep(&file, &whole, &[])), 0);
+    assert_eq!(read(&out.join("points.csv")), read(&whole.join("points.csv")));
+}
+
+#[test]
+fn bad_sweep_file_exits_2_naming_the_key() {
+    let dir = TempDir::new("sweep-bad");
+    let path = dir.join("bad.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "scene = {:?}\nkey = \"rotor.bogus\"\nfrom = 1.0\nto = 2.0\npoints = 2\n",
+            scene("paper-10g.toml").display().to_string()
+        ),
+    )
+    .expect("write");
+    let o = output(&mut sweep(&path, &dir.join("out"), &[]));
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("bogus"), "{}", stderr(&o));
+    std::fs::write(
+        &path,
+        format!(
+            "scene = {:?}\nkey = \"rotor.mass_kg\"\nfrom = 1.0\nto = 2.0\npoints = 0\n",
+            scene("paper-10g.toml").display().to_string()
+        ),
+    )
+    .expect("write");
+    let o = output(&mut sweep(&path, &dir.join("out"), &[]));
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("points = 0"), "{}", stderr(&o));
+}
