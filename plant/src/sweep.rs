@@ -255,10 +255,14 @@ pub fn read_point(dir: &Path, i: usize) -> Option<PointResult> {
 }
 
 fn write_point(dir: &Path, p: &PointResult) -> anyhow::Result<()> {
-    let path = point_path(dir, p.index);
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, serde_json::to_string(p)?).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, &path).with_context(|| format!("renaming {}", tmp.display()))
+    write_atomic(&point_path(dir, p.index), serde_json::to_string(p)?.as_bytes())
+}
+
+/// Writes through a temporary file (unique per process) and a rename.
+fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
 }
 
 /// Which share of the points a process runs: `index / count`, as `--shard I/N`.
@@ -394,8 +398,9 @@ pub fn merge(sweep: &Sweep, dir: &Path) -> anyhow::Result<usize> {
             let _ = writeln!(pc, "{:e},{n},{x:e},{y:e}{}", p.value, second(p.value2));
         }
     }
-    std::fs::write(dir.join("points.csv"), csv).context("writing points.csv")?;
-    std::fs::write(dir.join("poincare.csv"), pc).context("writing poincare.csv")?;
+    // Atomic: two shards finishing together on a shared folder may both merge.
+    write_atomic(&dir.join("points.csv"), csv.as_bytes())?;
+    write_atomic(&dir.join("poincare.csv"), pc.as_bytes())?;
     plots(sweep, dir, &points).context("writing sweep plots")?;
     Ok(points.len())
 }
