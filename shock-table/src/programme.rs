@@ -45,12 +45,7 @@ impl Shock {
     pub fn new(pulse: Pulse, start_s: f64, direction_rad: f64) -> Result<Self, ShockError> {
         require_non_negative("start_s", start_s, "s")?;
         require_finite("direction_rad", direction_rad, "rad")?;
-        Ok(Self {
-            pulse,
-            start: start_s,
-            direction: direction_rad,
-            unit: unit_vector(direction_rad),
-        })
+        Ok(Self { pulse, start: start_s, direction: direction_rad, unit: unit_vector(direction_rad) })
     }
 
     /// Shock of `pulse` starting at `start_s` (s) along +y (the base is
@@ -106,9 +101,7 @@ impl Programme {
 
     /// Programme with one shock.
     pub fn single(shock: Shock) -> Self {
-        Self {
-            shocks: vec![shock],
-        }
+        Self { shocks: vec![shock] }
     }
 
     /// Housing kinematics at absolute time `t` (s). Hot path: no
@@ -147,6 +140,23 @@ impl Programme {
         self.shocks.iter().map(Shock::end_time).fold(0.0, f64::max)
     }
 
+    /// Absolute times (s) where the housing acceleration or its slope jumps,
+    /// ascending and without repeats (see [`crate::Pulse::breakpoints`]).
+    ///
+    /// ```
+    /// use shock_table::{DoubleHalfSine, Programme, Shock};
+    /// let p = DoubleHalfSine::from_peak(10.0 * 9.80665, 10.0, 80.0).unwrap();
+    /// let prog = Programme::single(Shock::lifting(p.clone().into(), 0.02).unwrap());
+    /// assert_eq!(prog.breakpoints(), vec![0.02, 0.02 + p.t1, 0.02 + p.t2]);
+    /// ```
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> =
+            self.shocks.iter().flat_map(|s| s.pulse.breakpoints().into_iter().map(move |t| s.start + t)).collect();
+        b.sort_by(f64::total_cmp);
+        b.dedup();
+        b
+    }
+
     /// `true` if the programme has no shocks.
     pub fn is_empty(&self) -> bool {
         self.shocks.is_empty()
@@ -160,9 +170,7 @@ mod tests {
     use std::f64::consts::PI;
 
     fn dhs(peak_g: f64) -> Pulse {
-        DoubleHalfSine::from_peak(peak_g * G0_M_S2, 10.0, 80.0)
-            .unwrap()
-            .into()
+        DoubleHalfSine::from_peak(peak_g * G0_M_S2, 10.0, 80.0).unwrap().into()
     }
 
     #[test]
@@ -215,9 +223,6 @@ mod tests {
         s.set_direction(0.0).unwrap();
         assert_eq!(s.unit(), [1.0, 0.0]);
         assert!(s.set_direction(f64::NAN).is_err());
-        assert_eq!(
-            Shock::new(dhs(3.0), -1.0, 0.0).unwrap_err().to_string(),
-            "start_s = -1 s: must be >= 0"
-        );
+        assert_eq!(Shock::new(dhs(3.0), -1.0, 0.0).unwrap_err().to_string(), "start_s = -1 s: must be >= 0");
     }
 }

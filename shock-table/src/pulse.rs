@@ -49,6 +49,19 @@ impl Pulse {
         }
     }
 
+    /// Times from the pulse start (s) where the acceleration or its slope
+    /// jumps: an integrator should end a step there rather than step across.
+    /// Ascending. A recorded pulse lists every sample (its acceleration is
+    /// piecewise linear).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        match self {
+            Pulse::DoubleHalfSine(p) => vec![0.0, p.t1, p.t2],
+            Pulse::HalfSine(p) => vec![0.0, p.duration],
+            Pulse::Sine(p) => vec![0.0, p.duration()],
+            Pulse::Recorded(p) => p.times().to_vec(),
+        }
+    }
+
     /// Time after which the acceleration is zero, s.
     pub fn duration(&self) -> f64 {
         match self {
@@ -94,9 +107,7 @@ mod tests {
             DoubleHalfSine::from_peak(98.0, 10.0, 80.0).unwrap().into(),
             HalfSine::new(49.0, 0.011).unwrap().into(),
             SineVibration::new(9.8, 20.0, 3).unwrap().into(),
-            Recorded::from_samples(vec![0.0, 0.01, 0.03], vec![1.0, -4.0, 2.0])
-                .unwrap()
-                .into(),
+            Recorded::from_samples(vec![0.0, 0.01, 0.03], vec![1.0, -4.0, 2.0]).unwrap().into(),
         ];
         for p in &pulses {
             let d = p.duration();
