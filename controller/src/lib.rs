@@ -6,10 +6,18 @@
 //! → power amplifier (gain `A_a`, A/V) → coil. A law sees the sensor voltages
 //! `u = A_s·Δ` (per axis, x then y, Δ the rotor position relative to the
 //! housing) and returns coil currents in amperes, before the amplifier limit.
+//!
+//! The process side lives here too, so that both binaries link one crate:
+//! [`wire`] holds the `#[repr(C)]` message types of the plant ⇄ controller
+//! protocol, [`link`] the iceoryx2 plumbing, [`file`] the controller's
+//! `--config` file; the `controller` binary is the process adapter.
 #![warn(missing_docs)]
 
+pub mod file;
 pub mod law;
+pub mod link;
 pub mod pd;
+pub mod wire;
 
 pub use law::{build_law, saturate, ControlLaw, LawError, LawSpec, LoopConstants, Sample, LAW_NAMES};
 pub use pd::{PdDesign, PdGains, SampledPd};

@@ -10,10 +10,13 @@ use plant::run::{design_gains, integrator_settings};
 use std::path::Path;
 
 fn model() -> (Model, plant::config::Scene) {
-    let mut raw = RawScene::default();
-    raw.shock =
-        vec![toml::from_str("kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.0")
-            .expect("shock")];
+    let raw = RawScene {
+        shock: vec![toml::from_str(
+            "kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.0",
+        )
+        .expect("shock")],
+        ..Default::default()
+    };
     let scene = validate(raw, Path::new(".")).expect("scene");
     let gains = design_gains(&scene).expect("gains");
     let model = Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Continuous(gains) };

@@ -5,9 +5,10 @@
 //! Any key can be overridden from the command line with `--set a.b=value`
 //! (the value is read as a TOML literal, else as a string).
 
+use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
 use crate::integrate::Method;
-use crate::model::{Cage, Params, Spin};
+use crate::model::{Cage, Params, Spin, Support};
 use controller::LoopConstants;
 use serde::{Deserialize, Serialize};
 use shock_table::{Programme, ShockSpec};
@@ -147,6 +148,10 @@ pub struct RawTouchdown {
     pub ball_clearance_mm: f64,
     /// `rotating` (default) or `fixed`.
     pub cage: Cage,
+    /// `balls` (default: each ball a Hertz contact) or `lumped` (an isotropic ring calibrated on the balls).
+    pub support: String,
+    /// Deflection beyond the clearance at which the lumped ring is calibrated (mm). Default 0.01.
+    pub lumped_reference_mm: f64,
     /// Angle of ball 0 at t = 0 (deg). Default −90 (straight down).
     pub cage_phase_deg: f64,
     /// `constant` (default) or `palmgren`.
@@ -173,6 +178,8 @@ defaults!(RawTouchdown {
     width_mm: f64 = 12.0,
     ball_clearance_mm: f64 = 0.01,
     cage: Cage = Cage::Rotating,
+    support: String = "balls".into(),
+    lumped_reference_mm: f64 = 0.01,
     cage_phase_deg: f64 = -90.0,
     drag: String = "constant".into(),
     drag_torque_n_m: f64 = 0.1,
@@ -289,6 +296,27 @@ pub struct RawController {
     pub delay_samples: u32,
     /// Add the gravity bias current m_r g / k_i on y. Default true.
     pub gravity_bias: bool,
+    /// Co-simulation: what the plant applies when the controller process is
+    /// lost: `hold` (the last current, default), `bias` (bias current only)
+    /// or `stop` (end the run, exit code 4).
+    pub fallback: String,
+    /// Co-simulation: how long a reply may be missing before the plant looks
+    /// up the controller's node; a dead or vanished node is a lost peer, a
+    /// live one is waited for (lockstep) or missed (realtime). Repeated while
+    /// the silence lasts (ms). Default 1 (20 periods at 20 kHz).
+    pub reply_timeout_ms: f64,
+    /// Co-simulation: how long to wait for a new controller after one is
+    /// lost (ms); the plant respawns the controller it started itself.
+    /// 0 (default) stops the run with exit code 4.
+    pub reconnect_timeout_ms: f64,
+    /// Co-simulation: how long to wait for the first controller's handshake (ms). Default 10000.
+    pub connect_timeout_ms: f64,
+    /// Co-simulation: how long a waiting side busy-polls before it blocks on
+    /// an event (µs). Longer costs a core while idle; shorter adds a wake-up
+    /// (several µs) to each late reply. Default 200.
+    pub spin_us: f64,
+    /// Co-simulation: CPU cores to pin `[plant, controller]` to; empty (default) = no pinning.
+    pub pin_cores: Vec<usize>,
 }
 defaults!(RawController {
     mode: ControlMode = ControlMode::Continuous,
@@ -299,6 +327,12 @@ defaults!(RawController {
     current_limit_a: f64 = 2.0,
     delay_samples: u32 = 1,
     gravity_bias: bool = true,
+    fallback: String = "hold".into(),
+    reply_timeout_ms: f64 = 1.0,
+    reconnect_timeout_ms: f64 = 0.0,
+    connect_timeout_ms: f64 = 10_000.0,
+    spin_us: f64 = 200.0,
+    pin_cores: Vec<usize> = Vec::new(),
 });
 
 /// `[integrator]`.
@@ -399,6 +433,37 @@ pub struct ControllerSettings {
     pub delay_samples: u32,
     /// Gravity bias on y.
     pub gravity_bias: bool,
+    /// Co-simulation settings (used in `lockstep` and `realtime`).
+    pub cosim: CosimSettings,
+}
+
+/// What the plant applies when the controller process is lost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fallback {
+    /// Hold the last current.
+    Hold,
+    /// Bias current only (the gravity bias on y, if any).
+    Bias,
+    /// End the run.
+    Stop,
+}
+
+/// Co-simulation settings, validated (SI).
+#[derive(Clone, Debug, Serialize)]
+pub struct CosimSettings {
+    /// What to apply when the controller is lost.
+    pub fallback: Fallback,
+    /// Silence before the controller's node is looked up (s).
+    pub reply_timeout: f64,
+    /// Wait for a new controller after a loss (s); 0 = stop.
+    pub reconnect_timeout: f64,
+    /// Wait for the first handshake (s).
+    pub connect_timeout: f64,
+    /// Busy-poll budget before blocking (s).
+    pub spin: f64,
+    /// Cores for `[plant, controller]`.
+    pub pin_cores: Option<[usize; 2]>,
 }
 
 /// Integrator settings, validated (tolerances per state component).
@@ -548,6 +613,76 @@ fn finite(key: &str, value: f64, unit: &str) -> Result<f64, ConfigError> {
     }
 }
 
+/// Validates the co-simulation keys of `[controller]`.
+fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
+    let fallback = match ctl.fallback.as_str() {
+        "hold" => Fallback::Hold,
+        "bias" => Fallback::Bias,
+        "stop" => Fallback::Stop,
+        other => {
+            return Err(range(
+                "controller.fallback",
+                format!("\"{other}\""),
+                "",
+                "must be \"hold\", \"bias\" or \"stop\"",
+            ))
+        }
+    };
+    let ms = |key: &str, v: f64, zero_ok: bool| -> Result<f64, ConfigError> {
+        let ok = v.is_finite() && (if zero_ok { v >= 0.0 } else { v > 0.0 }) && v <= 3.6e6;
+        if ok {
+            Ok(v * 1e-3)
+        } else {
+            Err(range(key, v, "ms", if zero_ok { "must be between 0 and 3.6e6" } else { "must be > 0 and <= 3.6e6" }))
+        }
+    };
+    let reconnect_timeout = ms("controller.reconnect_timeout_ms", ctl.reconnect_timeout_ms, true)?;
+    if fallback == Fallback::Stop && reconnect_timeout > 0.0 {
+        return Err(range(
+            "controller.reconnect_timeout_ms",
+            ctl.reconnect_timeout_ms,
+            "ms",
+            "must be 0 with controller.fallback = \"stop\" (the run stops at the loss)",
+        ));
+    }
+    if !(ctl.spin_us.is_finite() && (0.0..=1e6).contains(&ctl.spin_us)) {
+        return Err(range("controller.spin_us", ctl.spin_us, "µs", "must be between 0 and 1e6"));
+    }
+    let pin_cores = match ctl.pin_cores.as_slice() {
+        [] => None,
+        &[plant, controller] => {
+            let cores = controller::link::cores_online();
+            for core in [plant, controller] {
+                if core >= cores {
+                    return Err(range(
+                        "controller.pin_cores",
+                        format!("{:?}", ctl.pin_cores),
+                        "",
+                        &format!("core {core} does not exist (this machine has cores 0 to {})", cores - 1),
+                    ));
+                }
+            }
+            Some([plant, controller])
+        }
+        _ => {
+            return Err(range(
+                "controller.pin_cores",
+                format!("{:?}", ctl.pin_cores),
+                "",
+                "must be empty or two cores [plant, controller]",
+            ))
+        }
+    };
+    Ok(CosimSettings {
+        fallback,
+        reply_timeout: ms("controller.reply_timeout_ms", ctl.reply_timeout_ms, false)?,
+        reconnect_timeout,
+        connect_timeout: ms("controller.connect_timeout_ms", ctl.connect_timeout_ms, false)?,
+        spin: ctl.spin_us * 1e-6,
+        pin_cores,
+    })
+}
+
 /// Validates a raw scene into SI parameter types. `base_dir` resolves relative file paths.
 pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     let (r, td, ct, amb, ctl, int) =
@@ -640,6 +775,14 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         damping_depth,
     );
 
+    let support = match td.support.as_str() {
+        "balls" => Support::Balls,
+        "lumped" => Support::Lumped(LumpedSupport::calibrated(
+            &balls,
+            positive("touchdown.lumped_reference_mm", td.lumped_reference_mm, "mm")? * 1e-3,
+        )),
+        other => return Err(range("touchdown.support", format!("\"{other}\""), "", "must be \"balls\" or \"lumped\"")),
+    };
     let ki = positive("amb.ki_n_per_a", amb.ki_n_per_a, "N/A")?;
     let ks = non_negative("amb.ks_n_per_m", amb.ks_n_per_m, "N/m")?;
     let amb_law = match amb.force_law.as_str() {
@@ -688,16 +831,17 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         damping_ratio: non_negative("controller.damping_ratio", ctl.damping_ratio, "")?,
         delay_samples: ctl.delay_samples,
         gravity_bias: ctl.gravity_bias,
+        cosim: cosim_settings(ctl)?,
     };
     if ctl.delay_samples > 1000 {
         return Err(range("controller.delay_samples", ctl.delay_samples, "samples", "must be <= 1000"));
     }
-    if matches!(ctl.mode, ControlMode::Lockstep | ControlMode::Realtime) {
+    if ctl.mode == ControlMode::Realtime && ctl.delay_samples == 0 {
         return Err(range(
-            "controller.mode",
-            format!("\"{:?}\"", ctl.mode).to_lowercase(),
-            "",
-            "co-simulation modes are not available yet (issue 3); use \"continuous\" or \"sampled\"",
+            "controller.delay_samples",
+            ctl.delay_samples,
+            "samples",
+            "must be >= 1 in realtime mode (the reply to sample k arrives during period k)",
         ));
     }
 
@@ -745,6 +889,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         cage_ratio: r_in / (r_in + r_out),
         contact,
         balls,
+        support,
         drag,
         amb: amb_law,
         loop_constants,

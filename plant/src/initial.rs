@@ -28,7 +28,7 @@ pub fn race_sag(p: &Params) -> f64 {
         return 0.0;
     }
     let cage = p.cage_phase;
-    let support = |y: f64| p.balls.force([0.0, y], [0.0; 2], cage, 0.0).on_race[1];
+    let support = |y: f64| p.race_support([0.0, y], [0.0; 2], cage, 0.0).on_race[1];
     let (mut lo, mut hi) = (-(p.balls.clearance + 1e-3), -p.balls.clearance);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);

@@ -12,6 +12,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod config;
+pub mod cosim;
 pub mod force;
 pub mod initial;
 pub mod integrate;

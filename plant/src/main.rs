@@ -3,7 +3,8 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use plant::config::{load_scene, ConfigError};
-use plant::run::{run, Hooks, Outcome};
+use plant::cosim::{ControllerProcess, CosimError, Launch};
+use plant::run::{run_with, Hooks, Outcome, SetupError};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -19,6 +20,9 @@ mod exit {
     pub const BAD_INPUT: u8 = 2;
     /// The simulation diverged (non-finite state, step-size underflow, radius guard).
     pub const DIVERGED: u8 = 3;
+    /// Co-simulation: the controller process was lost (or never answered) and none took
+    /// its place; results up to that point were written.
+    pub const PEER_LOST: u8 = 4;
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     pub const INTERRUPTED: u8 = 130;
 }
@@ -45,6 +49,124 @@ enum Command {
         /// No progress line.
         #[arg(long)]
         quiet: bool,
+        /// Co-simulation (`lockstep`, `realtime`): `spawn` starts the `controller` next to
+        /// this executable; `external` waits for one you start with `controller --run-id ID`.
+        #[arg(long, value_enum, default_value_t = ControllerArg::Spawn)]
+        controller: ControllerArg,
+        /// Co-simulation run id (names the shared-memory services); default: a fresh one.
+        #[arg(long)]
+        run_id: Option<String>,
+    },
+    /// Measurements of the testbed itself.
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
+    /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
+    /// classification; updates summary.json and writes the analysis plots.
+    Analyze {
+        /// Run folder written by `plant run`.
+        dir: PathBuf,
+    },
+    /// Sweep one scene key (or two, for a map) over a range, running the points in parallel;
+    /// writes points.csv, poincare.csv and bifurcation diagrams. Resumes an interrupted sweep.
+    Sweep {
+        /// Sweep file (TOML).
+        sweep: PathBuf,
+        /// Output folder (default: runs/sweep-<file stem>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run only the points i with i % N == I (`--shard I/N`); merge by copying the
+        /// `points/` folders of all shards together and running `--merge`.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<plant::sweep::Shard>,
+        /// Only merge the points present into points.csv, poincare.csv and the plots.
+        #[arg(long)]
+        merge: bool,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+}
+
+/// Who starts the controller process.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum ControllerArg {
+    /// The plant starts it and reaps it.
+    Spawn,
+    /// The user starts it.
+    External,
+}
+
+impl ControllerArg {
+    fn launch(self, run_id: Option<String>) -> Launch {
+        let controller = match self {
+            ControllerArg::Spawn => ControllerProcess::Spawn(None),
+            ControllerArg::External => ControllerProcess::External,
+        };
+        Launch { controller, run_id }
+    }
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// IPC round trip plant → controller process → plant (lockstep frames, the real
+    /// controller binary); prints p50/p99/p99.9/max. Build with `--release` for figures.
+    Ipc {
+        /// Recorded round trips.
+        #[arg(long, default_value_t = 200_000)]
+        samples: u64,
+        /// Unrecorded round trips first.
+        #[arg(long, default_value_t = 20_000)]
+        warmup: u64,
+        /// Pin plant and controller to these cores, e.g. `--pin-cores 0,1`.
+        #[arg(long, value_delimiter = ',')]
+        pin_cores: Option<Vec<usize>>,
+        /// Busy-poll budget before blocking (µs).
+        #[arg(long, default_value_t = 200.0)]
+        spin_us: f64,
+        /// `spawn` (default) or `external`.
+        #[arg(long, value_enum, default_value_t = ControllerArg::Spawn)]
+        controller: ControllerArg,
+        /// Run id; default: a fresh one.
+        #[arg(long)]
+        run_id: Option<String>,
+    },
+    /// Work-precision charts of every integrator on three scenes (levitation, impact, rub),
+    /// the reference floor, and the stability limits of the fixed-step methods.
+    Accuracy {
+        /// Output folder (default: runs/bench-accuracy).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Scene folder holding paper-3g.toml and paper-10g.toml.
+        #[arg(long, default_value = "config")]
+        config: PathBuf,
+        /// Timed runs per setting; the minimum counts.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Two settings per method, one timed run: a smoke test of the bench.
+        #[arg(long)]
+        quick: bool,
+        /// Also run the scipy peer (bench/peer, needs its venv: see bench/peer/README.md) on the
+        /// same scenes and draw it on the same charts.
+        #[arg(long)]
+        peer: bool,
+        /// Python interpreter for the peer.
+        #[arg(long, default_value = "bench/peer/.venv/bin/python")]
+        peer_python: PathBuf,
+    },
+    /// Error and speed of each model simplification (lumped race support, fixed balls, speed
+    /// held, linear bearing) against the most detailed model, on the same three scenes.
+    Models {
+        /// Output folder (default: runs/bench-models).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Scene folder holding paper-3g.toml and paper-10g.toml.
+        #[arg(long, default_value = "config")]
+        config: PathBuf,
+        /// Timed runs per variant; the minimum counts.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
     },
 }
 
@@ -81,20 +203,55 @@ impl Hooks for CliHooks {
     fn cancelled(&self) -> bool {
         self.stop.load(Ordering::Relaxed)
     }
+
+    fn note(&mut self, message: &str) {
+        if self.terminal && !self.quiet {
+            eprint!("\r");
+        }
+        eprintln!("plant: {message}");
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run { scene, out, set, quiet } => run_scene(scene, out, set, quiet),
+        Command::Run { scene, out, set, quiet, controller, run_id } => {
+            run_scene(scene, out, set, quiet, controller.launch(run_id))
+        }
+        Command::Bench { what: BenchCommand::Ipc { samples, warmup, pin_cores, spin_us, controller, run_id } } => {
+            bench_ipc(samples, warmup, pin_cores, spin_us, controller.launch(run_id))
+        }
+        Command::Analyze { dir } => analyze_dir(&dir),
+        Command::Bench { what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python } } => {
+            let peer = peer.then(|| plant::bench::Peer {
+                script: config.join("..").join("bench").join("peer").join("run_peer.py"),
+                python: peer_python,
+            });
+            bench_accuracy(out, &config, repeats, quick, peer.as_ref())
+        }
+        Command::Bench { what: BenchCommand::Models { out, config, repeats } } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-models"));
+            match plant::bench::models(&config, &dir, repeats.max(1), &mut |l| eprintln!("plant bench: {l}")) {
+                Ok(_) => {
+                    eprintln!("plant bench: wrote {}", dir.join("models.csv").display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("plant: error: {e:#}");
+                    ExitCode::from(exit::IO)
+                }
+            }
+        }
+        Command::Sweep { sweep, out, shard, merge, jobs } => sweep_cmd(&sweep, out, shard, merge, jobs),
     }
 }
 
-fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool) -> ExitCode {
+fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool, launch: Launch) -> ExitCode {
     let scene = match load_scene(&path, &set) {
         Ok(s) => s,
         Err(e) => return bad_input(&e),
     };
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
@@ -109,9 +266,10 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool)
         quiet,
         terminal: std::io::stderr().is_terminal(),
     };
-    let result = match run(&scene, &mut hooks) {
+    let result = match run_with(&scene, &launch, &mut hooks) {
         Ok(r) => r,
-        Err(e) => return bad_input(&ConfigError::Law(e)),
+        Err(SetupError::Law(e)) => return bad_input(&ConfigError::Law(e)),
+        Err(SetupError::Cosim(e)) => return cosim_failed(&e),
     };
     if hooks.terminal && !quiet && result.wall_time >= 1.0 {
         eprintln!();
@@ -142,6 +300,185 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool)
         Outcome::Interrupted => {
             eprintln!("plant: interrupted; results up to t = {} s were written", summary.simulated_s);
             ExitCode::from(exit::INTERRUPTED)
+        }
+        Outcome::PeerLost(why) => {
+            eprintln!("plant: error: {why}; results up to t = {} s were written", summary.simulated_s);
+            ExitCode::from(exit::PEER_LOST)
+        }
+    }
+}
+
+/// Exit code and message for a co-simulation that could not start.
+fn cosim_failed(e: &CosimError) -> ExitCode {
+    eprintln!("plant: error: {e}");
+    ExitCode::from(match e {
+        CosimError::Refused { .. } | CosimError::RunId(_) | CosimError::Pin(_) => exit::BAD_INPUT,
+        CosimError::ControllerExited { code: Some(2), .. } => exit::BAD_INPUT,
+        CosimError::NoController { .. } | CosimError::ControllerExited { .. } => exit::PEER_LOST,
+        CosimError::Interrupted => exit::INTERRUPTED,
+        CosimError::ControllerMissing { .. } | CosimError::Spawn { .. } | CosimError::Link(_) => exit::IO,
+    })
+}
+
+/// `plant bench ipc`: round trips through a controller process.
+fn bench_ipc(samples: u64, warmup: u64, pin_cores: Option<Vec<usize>>, spin_us: f64, launch: Launch) -> ExitCode {
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("plant: warning: cannot install the Ctrl-C handler: {e}");
+    }
+    let mut hooks =
+        CliHooks { stop, duration: 0.0, started: Instant::now(), last: Instant::now(), quiet: true, terminal: false };
+    let pins = match pin_cores.as_deref() {
+        None => None,
+        Some(&[plant_core, controller_core]) => Some([plant_core, controller_core]),
+        Some(other) => {
+            eprintln!("plant: error: --pin-cores {other:?}: expected two cores, PLANT,CONTROLLER (e.g. 0,1)");
+            return ExitCode::from(exit::BAD_INPUT);
+        }
+    };
+    if !(spin_us.is_finite() && (0.0..=1e6).contains(&spin_us)) {
+        eprintln!("plant: error: --spin-us {spin_us} µs: must be between 0 and 1e6");
+        return ExitCode::from(exit::BAD_INPUT);
+    }
+    let started = Instant::now();
+    match plant::cosim::bench_round_trips(samples.max(1), warmup, &launch, pins, spin_us, &mut hooks) {
+        Ok((rt, latency, blocks)) => {
+            let wall = started.elapsed().as_secs_f64();
+            println!(
+                "ipc round trip (plant -> controller -> plant), {} samples: p50 {:.2} us, p99 {:.2} us, p99.9 {:.2} us, max {:.2} us",
+                rt.count, rt.p50, rt.p99, rt.p999, rt.max
+            );
+            println!(
+                "frame published -> reply published: p50 {:.2} us, p99 {:.2} us, p99.9 {:.2} us, max {:.2} us",
+                latency.p50, latency.p99, latency.p999, latency.max
+            );
+            println!(
+                "blocking waits {blocks}; pinned {}; spin {spin_us} us; {:.0} round trips/s overall",
+                pins.map_or("no".to_string(), |p| format!("plant {} controller {}", p[0], p[1])),
+                (samples + warmup) as f64 / wall
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => cosim_failed(&e),
+    }
+}
+
+fn sweep_cmd(
+    path: &std::path::Path,
+    out: Option<PathBuf>,
+    shard: Option<plant::sweep::Shard>,
+    merge_only: bool,
+    jobs: Option<usize>,
+) -> ExitCode {
+    let sweep = match plant::sweep::Sweep::load(path) {
+        Ok(s) => s,
+        Err(e) => return bad_input(&e),
+    };
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("sweep-{stem}")));
+    if merge_only {
+        return match plant::sweep::merge(&sweep, &dir) {
+            Ok(n) => {
+                eprintln!("plant: merged {n} of {} points into {}", sweep.len(), dir.display());
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("plant: error: {e:#}");
+                ExitCode::from(exit::IO)
+            }
+        };
+    }
+    if let Some(n) = jobs {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global() {
+            eprintln!("plant: warning: --jobs {n}: {e}");
+        }
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("plant: warning: cannot install the Ctrl-C handler: {e}");
+    }
+    let shard = shard.unwrap_or(plant::sweep::Shard { index: 0, count: 1 });
+    let started = Instant::now();
+    let report = match plant::sweep::run_sweep(&sweep, &dir, shard, &stop, std::io::stderr().is_terminal()) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::IO);
+        }
+    };
+    for (i, e) in &report.failed {
+        eprintln!("plant: point {i} failed: {e}");
+    }
+    eprintln!(
+        "plant: sweep {}: ran {} points in {:.1} s, reused {}, failed {}; {} of {} present{}",
+        dir.display(),
+        report.ran,
+        started.elapsed().as_secs_f64(),
+        report.reused,
+        report.failed.len(),
+        report.present,
+        sweep.len(),
+        if report.merged { "; points.csv, poincare.csv and plots written" } else { "" }
+    );
+    if report.interrupted {
+        eprintln!("plant: interrupted; finished points are kept, run the same command again to resume");
+        ExitCode::from(exit::INTERRUPTED)
+    } else if !report.failed.is_empty() {
+        ExitCode::from(exit::DIVERGED)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn bench_accuracy(
+    out: Option<PathBuf>,
+    config: &std::path::Path,
+    repeats: usize,
+    quick: bool,
+    peer: Option<&plant::bench::Peer>,
+) -> ExitCode {
+    let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-accuracy"));
+    let mut log = |line: &str| eprintln!("plant bench: {line}");
+    let report = match plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::IO);
+        }
+    };
+    match plant::bench::charts(&dir, &report.rows, &report.floors) {
+        Ok(files) => {
+            for f in files {
+                eprintln!("plant bench: wrote {}", f.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            ExitCode::from(exit::IO)
+        }
+    }
+}
+
+fn analyze_dir(dir: &std::path::Path) -> ExitCode {
+    match plant::output::analyze_dir(dir) {
+        Ok(a) => {
+            eprintln!(
+                "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",
+                dir.display(),
+                a.post_shock_mode,
+                a.steady_class,
+                a.period_k,
+                a.whirl_hz
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            ExitCode::from(exit::BAD_INPUT)
         }
     }
 }

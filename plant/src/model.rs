@@ -31,6 +31,7 @@
 //! Race: `m_b ẍ_b = −F_contact + F_balls − m_b (g ŷ + a_h)`,
 //! `J_b θ̈_b = r_inner F_t + M_drag`.
 
+use crate::force::lumped::LumpedSupport;
 use crate::force::rotor_race::RotorRaceForce;
 use crate::force::{amb::AmbLaw, balls::BallForce, balls::BallSet, drag::RaceDrag, rotor_race::RotorRace};
 use crate::integrate::System;
@@ -95,6 +96,16 @@ pub enum Cage {
     Fixed,
 }
 
+/// What carries the inner race.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "support", rename_all = "snake_case")]
+pub enum Support {
+    /// The individual balls (MODEL.md §5), the study's model.
+    Balls,
+    /// An isotropic Hertz ring calibrated on the ball set (a simplification).
+    Lumped(LumpedSupport),
+}
+
 /// Physical parameters, validated, SI.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Params {
@@ -124,6 +135,8 @@ pub struct Params {
     pub contact: RotorRace,
     /// Race – ball contacts.
     pub balls: BallSet,
+    /// What carries the race: the balls, or a lumped ring.
+    pub support: Support,
     /// Race drag.
     pub drag: RaceDrag,
     /// Bearing force law.
@@ -132,6 +145,18 @@ pub struct Params {
     pub loop_constants: LoopConstants,
     /// Amplifier current limit i_max (A).
     pub current_limit: f64,
+}
+
+impl Params {
+    /// Force of the race's support for race position `eps` (m) and velocity `eps_dot` (m/s)
+    /// relative to the housing, cage angle `cage` (rad) and rate `cage_rate` (rad/s).
+    #[inline]
+    pub fn race_support(&self, eps: [f64; 2], eps_dot: [f64; 2], cage: f64, cage_rate: f64) -> BallForce {
+        match self.support {
+            Support::Balls => self.balls.force(eps, eps_dot, cage, cage_rate),
+            Support::Lumped(ring) => ring.force(eps, eps_dot),
+        }
+    }
 }
 
 /// Where the coil current comes from during a derivative evaluation.
@@ -195,7 +220,7 @@ impl Model {
             Cage::Rotating => (p.cage_phase + p.cage_ratio * y[TB], p.cage_ratio * y[WB]),
             Cage::Fixed => (p.cage_phase, 0.0),
         };
-        let balls = p.balls.force([y[XB], y[YB]], [y[VXB], y[VYB]], cage, cage_rate);
+        let balls = p.race_support([y[XB], y[YB]], [y[VXB], y[VYB]], cage, cage_rate);
 
         // Rotor.
         let (m, e, g) = (p.rotor_mass, p.eccentricity, p.gravity);

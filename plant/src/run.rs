@@ -4,10 +4,13 @@
 //! evaluated inside the derivative; in `sampled` mode the law reads the sensor
 //! at each tick `t_k = k T`, and the command computed from sample `k` is
 //! applied from tick `k + d` (`d = delay_samples`) and held until the next
-//! (zero-order hold). The integrator restarts at every tick. The trace is
-//! recorded at the output rate (dense output inside macro steps).
+//! (zero-order hold). `lockstep` and `realtime` do the same with the law in
+//! the controller process ([`crate::cosim`] gives their timing). The
+//! integrator restarts at every tick. The trace is recorded at the output
+//! rate (dense output inside macro steps).
 
 use crate::config::{ControlMode, Scene};
+use crate::cosim::{CosimError, CosimReport, Launch, Session, Stop};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
 use crate::model::{ix, Control, Model, State};
@@ -58,8 +61,21 @@ pub enum Outcome {
     Completed,
     /// Stopped by a numerical failure.
     Diverged(RunError),
-    /// Stopped on request (Ctrl-C).
+    /// Stopped on request (Ctrl-C), or the controller process was stopped by a signal.
     Interrupted,
+    /// The controller process was lost and none took its place (co-simulation).
+    PeerLost(String),
+}
+
+/// Why a run could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    /// The controller design is invalid.
+    #[error("{0}")]
+    Law(#[from] controller::LawError),
+    /// The controller process could not be started or connected.
+    #[error("{0}")]
+    Cosim(#[from] CosimError),
 }
 
 /// What the loop reports to its caller while it runs.
@@ -70,6 +86,9 @@ pub trait Hooks {
     fn cancelled(&self) -> bool {
         false
     }
+    /// A message for the user (co-simulation: waiting for a controller, a
+    /// lost controller); the loop itself never prints.
+    fn note(&mut self, _message: &str) {}
 }
 
 /// Hooks that do nothing.
@@ -91,6 +110,8 @@ pub struct RunResult {
     pub outcome: Outcome,
     /// Final state.
     pub final_state: State,
+    /// Co-simulation figures (`lockstep`, `realtime`).
+    pub cosim: Option<CosimReport>,
 }
 
 /// Continuous PD gains for a scene's controller design.
@@ -116,29 +137,49 @@ pub fn integrator_settings(scene: &Scene) -> Settings<{ crate::model::N }> {
     }
 }
 
-/// Runs a scene from its initial state.
-pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller::LawError> {
+/// Where the command of each tick comes from.
+enum Source {
+    /// The PD inside the derivative.
+    Continuous,
+    /// The law in this process.
+    InProcess(Box<dyn ControlLaw>),
+    /// The law in the controller process.
+    Cosim(Box<Session>),
+}
+
+/// Runs a scene from its initial state; a co-simulation starts the
+/// `controller` next to the running executable.
+pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
+    run_with(scene, &Launch::default(), hooks)
+}
+
+/// Runs a scene from its initial state, launching a co-simulation as `launch` says.
+pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
     let gains = design_gains(scene)?;
-    let mut law: Option<Box<dyn ControlLaw>> = match scene.controller.mode {
-        ControlMode::Continuous => None,
-        _ => Some(build_law(
-            &LawSpec {
-                law: &scene.controller.law,
-                stiffness_n_per_m: scene.controller.stiffness,
-                damping_ratio: scene.controller.damping_ratio,
-                period_s: scene.controller.period,
-                gravity_bias: scene.controller.gravity_bias,
-            },
-            &scene.params.loop_constants,
-        )?),
-    };
     let limit = scene.params.current_limit;
+    let bias = saturate(gains.bias_a, limit);
+    let spec = LawSpec {
+        law: &scene.controller.law,
+        stiffness_n_per_m: scene.controller.stiffness,
+        damping_ratio: scene.controller.damping_ratio,
+        period_s: scene.controller.period,
+        gravity_bias: scene.controller.gravity_bias,
+    };
+    let mut source = match scene.controller.mode {
+        ControlMode::Continuous => Source::Continuous,
+        ControlMode::Sampled => Source::InProcess(build_law(&spec, &scene.params.loop_constants)?),
+        ControlMode::Lockstep | ControlMode::Realtime => {
+            // A design the controller would refuse is bad input here, before any process starts.
+            build_law(&spec, &scene.params.loop_constants)?;
+            Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
+        }
+    };
     let mut model = Model {
         params: scene.params.clone(),
         base: scene.base.clone(),
-        control: match law {
-            None => Control::Continuous(gains),
-            Some(_) => Control::Held(saturate(gains.bias_a, limit)),
+        control: match source {
+            Source::Continuous => Control::Continuous(gains),
+            _ => Control::Held(bias),
         },
     };
     let mut integrator = Integrator::new(integrator_settings(scene));
@@ -150,11 +191,20 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller
     trace.push(&model, 0.0, &y);
     let mut next_out: u64 = 1;
     let mut out_times: Vec<f64> = Vec::with_capacity((period / out_dt).ceil() as usize + 2);
-    let delay = scene.controller.delay_samples as usize;
+    let inherent = match &mut source {
+        Source::Cosim(session) => {
+            session.reserve(ticks as usize);
+            session.inherent_delay()
+        }
+        _ => 0,
+    };
+    let delay = scene.controller.delay_samples.saturating_sub(inherent) as usize;
     let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
-    queue.extend(std::iter::repeat_n(saturate(gains.bias_a, limit), delay));
+    queue.extend(std::iter::repeat_n(bias, delay));
     let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
     let guards = Guards::new(scene);
+    let breakpoints = scene.base.breakpoints();
+    let mut next_breakpoint = 0;
 
     let start = std::time::Instant::now();
     let mut outcome = Outcome::Completed;
@@ -162,11 +212,25 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        if let Some(law) = law.as_mut() {
-            let sample = Sample { seq: k, t_s: t0, sensor_v: [a_s * y[ix::XR], a_s * y[ix::YR]] };
-            queue.push_back(saturate(law.update(&sample), limit));
-            if let Some(cmd) = queue.pop_front() {
-                model.control = Control::Held(cmd);
+        let sample = Sample { seq: k, t_s: t0, sensor_v: [a_s * y[ix::XR], a_s * y[ix::YR]] };
+        let command = match &mut source {
+            Source::Continuous => None,
+            Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),
+            Source::Cosim(session) => match session.command(&sample, hooks) {
+                Ok(cmd) => Some(cmd),
+                Err(stop) => {
+                    outcome = match stop {
+                        Stop::Lost(why) => Outcome::PeerLost(why),
+                        Stop::Interrupted(_) => Outcome::Interrupted,
+                    };
+                    break;
+                }
+            },
+        };
+        if let Some(cmd) = command {
+            queue.push_back(cmd);
+            if let Some(applied) = queue.pop_front() {
+                model.control = Control::Held(applied);
             }
         }
         out_times.clear();
@@ -174,7 +238,15 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller
             out_times.push(((next_out as f64) * out_dt).min(t1));
             next_out += 1;
         }
-        let step = integrator.advance_dense(&model, t0, t1, &mut y, &out_times, |ts, ys| trace.push(&model, ts, ys));
+        let step = advance_across_breakpoints(
+            &mut integrator,
+            &model,
+            (t0, t1),
+            &mut y,
+            &out_times,
+            (&breakpoints, &mut next_breakpoint),
+            |ts, ys| trace.push(&model, ts, ys),
+        );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
             outcome = Outcome::Diverged(e);
@@ -186,14 +258,42 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, controller
             break;
         }
     }
-    Ok(RunResult {
-        trace,
-        stats: integrator.stats(),
-        simulated: t,
-        wall_time: start.elapsed().as_secs_f64(),
-        outcome,
-        final_state: y,
-    })
+    let wall_time = start.elapsed().as_secs_f64();
+    let cosim = match source {
+        Source::Cosim(session) => Some(session.finish(t, (t / period).round() as u64)),
+        _ => None,
+    };
+    Ok(RunResult { trace, stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim })
+}
+
+/// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it
+/// (where the housing acceleration or its slope jumps): a step across such a kink has an
+/// O(h²) local error whatever the method's order. `breakpoints` is sorted; `next` is the index
+/// of the first one not yet passed. Samples at `times` go to `sample`.
+fn advance_across_breakpoints<F: FnMut(f64, &State)>(
+    integrator: &mut Integrator<{ crate::model::N }>,
+    model: &Model,
+    (t0, t1): (f64, f64),
+    y: &mut State,
+    times: &[f64],
+    (breakpoints, next): (&[f64], &mut usize),
+    mut sample: F,
+) -> Result<(), IntegrationError> {
+    let tiny = 1e-9 * (t1 - t0);
+    let mut from = t0;
+    let mut done = 0;
+    while *next < breakpoints.len() && breakpoints[*next] < t1 - tiny {
+        let b = breakpoints[*next];
+        *next += 1;
+        if b <= from + tiny {
+            continue;
+        }
+        let upto = done + times[done..].partition_point(|t| *t <= b);
+        integrator.advance_dense(model, from, b, y, &times[done..upto], &mut sample)?;
+        done = upto;
+        from = b;
+    }
+    integrator.advance_dense(model, from, t1, y, &times[done..], sample)
 }
 
 /// Radius limits beyond which the contact model has failed.

@@ -18,6 +18,8 @@ pub struct ModelInfo {
     pub cage: crate::model::Cage,
     /// `constant` or `palmgren`.
     pub race_drag: String,
+    /// `balls` or `lumped`.
+    pub race_support: String,
     /// `linear` or `nonlinear`.
     pub amb_force: String,
     /// Number of balls.
@@ -132,6 +134,7 @@ impl Summary {
                 },
                 cage: p.cage,
                 race_drag: scene.raw.touchdown.drag.clone(),
+                race_support: scene.raw.touchdown.support.clone(),
                 amb_force: scene.raw.amb.force_law.clone(),
                 balls: p.balls.count(),
                 control_mode: c.mode,

@@ -87,14 +87,14 @@ fn levitated_loop_has_the_designed_frequency_and_damping() {
 fn steady_unbalance_orbit_matches_the_linear_response() {
     // Started at rest, the rotor settles on x + j y = Z e^{jθ_r} with
     // Z = m e ω² / (k_e − m ω² + j c_e ω). A high damping ratio makes the transient short.
-    let (m, e, k_e, xi, omega) = (11.5, 2e-6, 1e6, 0.3, TAU * 500.0);
+    let (m, e, k_e, xi, omega): (f64, f64, f64, f64, f64) = (11.5, 2e-6, 1e6, 0.3, TAU * 500.0);
     let s = scene(|r| {
         r.scene.duration_s = 0.15;
         r.initial.unbalance_orbit = false;
         r.controller.damping_ratio = xi;
     });
     let tr = completed(&s).trace;
-    let c_e = 2.0 * xi * (k_e * m as f64).sqrt();
+    let c_e = 2.0 * xi * (k_e * m).sqrt();
     let (re, im) = (k_e - m * omega * omega, c_e * omega);
     let scale = m * e * omega * omega / (re * re + im * im);
     let z = (scale * re, -scale * im);

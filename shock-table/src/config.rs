@@ -153,14 +153,7 @@ impl ShockSpec {
     /// [`programme_from_specs`] adds `shock[i].`.
     pub fn to_shock(&self, base_dir: &Path) -> Result<Shock, ShockError> {
         let (pulse, start_s, direction_deg) = match self {
-            ShockSpec::DoubleHalfSine {
-                peak_g,
-                design_accel_g,
-                f1_hz,
-                f2_hz,
-                start_s,
-                direction_deg,
-            } => {
+            ShockSpec::DoubleHalfSine { peak_g, design_accel_g, f1_hz, f2_hz, start_s, direction_deg } => {
                 let pulse = match (peak_g, design_accel_g) {
                     (Some(p), None) => {
                         require_positive("peak_g", *p, "G")?;
@@ -191,41 +184,23 @@ impl ShockSpec {
                 };
                 (Pulse::from(pulse), *start_s, *direction_deg)
             }
-            ShockSpec::HalfSine {
-                peak_g,
-                duration_s,
-                start_s,
-                direction_deg,
-            } => {
+            ShockSpec::HalfSine { peak_g, duration_s, start_s, direction_deg } => {
                 require_positive("peak_g", *peak_g, "G")?;
                 require_positive("duration_s", *duration_s, "s")?;
                 let p = HalfSine::new(peak_g * G0_M_S2, *duration_s)?;
                 (Pulse::from(p), *start_s, *direction_deg)
             }
-            ShockSpec::Sine {
-                amplitude_g,
-                freq_hz,
-                cycles,
-                start_s,
-                direction_deg,
-            } => {
+            ShockSpec::Sine { amplitude_g, freq_hz, cycles, start_s, direction_deg } => {
                 require_positive("amplitude_g", *amplitude_g, "G")?;
                 require_positive("freq_hz", *freq_hz, "Hz")?;
                 let n = u32::try_from(*cycles)
                     .ok()
                     .filter(|&n| n >= 1)
-                    .ok_or_else(|| {
-                        invalid("cycles", *cycles as f64, "", "must be an integer >= 1")
-                    })?;
+                    .ok_or_else(|| invalid("cycles", *cycles as f64, "", "must be an integer >= 1"))?;
                 let p = SineVibration::new(amplitude_g * G0_M_S2, *freq_hz, n)?;
                 (Pulse::from(p), *start_s, *direction_deg)
             }
-            ShockSpec::Recorded {
-                file,
-                scale,
-                start_s,
-                direction_deg,
-            } => {
+            ShockSpec::Recorded { file, scale, start_s, direction_deg } => {
                 require_finite("scale", *scale, "")?;
                 if *scale == 0.0 {
                     return Err(invalid("scale", *scale, "", "must be nonzero"));
@@ -257,10 +232,8 @@ pub fn programme_from_specs(specs: &[ShockSpec], base_dir: &Path) -> Result<Prog
 /// Parse a programme from TOML text (`[[shock]]` tables at top level);
 /// `path` is named in errors and its directory resolves recorded files.
 pub fn parse_programme(text: &str, path: &Path) -> Result<Programme, ShockError> {
-    let spec: ProgrammeSpec = toml::from_str(text).map_err(|error| ShockError::Toml {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let spec: ProgrammeSpec =
+        toml::from_str(text).map_err(|error| ShockError::Toml { path: path.to_path_buf(), error })?;
     let base = path.parent().unwrap_or(Path::new("."));
     programme_from_specs(&spec.shock, base)
 }
@@ -268,10 +241,7 @@ pub fn parse_programme(text: &str, path: &Path) -> Result<Programme, ShockError>
 /// Load a standalone programme file (`[[shock]]` tables at top level).
 /// Recorded files are resolved against the file's directory.
 pub fn load_programme(path: &Path) -> Result<Programme, ShockError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ShockError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|error| ShockError::Io { path: path.to_path_buf(), error })?;
     parse_programme(&text, path)
 }
 
@@ -312,16 +282,13 @@ direction_deg = 0.0
 
     /// A scratch directory unique to this test.
     fn scratch(name: &str) -> PathBuf {
-        let d =
-            std::env::temp_dir().join(format!("shock-table-config-{}-{name}", std::process::id()));
+        let d = std::env::temp_dir().join(format!("shock-table-config-{}-{name}", std::process::id()));
         std::fs::create_dir_all(d.join("records")).unwrap();
         d
     }
 
     fn parse_err(toml_text: &str) -> String {
-        parse_programme(toml_text, Path::new("scene.toml"))
-            .unwrap_err()
-            .to_string()
+        parse_programme(toml_text, Path::new("scene.toml")).unwrap_err().to_string()
     }
 
     #[test]
@@ -344,10 +311,7 @@ direction_deg = 0.0
         // recorded: scale 2, along +x, starts at 2 s
         let k = p.eval(2.01);
         assert!((k.vel[0] - 2.0 * 0.01).abs() < 1e-15);
-        let want_y: f64 = p.shocks[..3]
-            .iter()
-            .map(|s| s.pulse.eval(2.01 - s.start).vel)
-            .sum();
+        let want_y: f64 = p.shocks[..3].iter().map(|s| s.pulse.eval(2.01 - s.start).vel).sum();
         assert!((k.vel[1] - want_y).abs() < 1e-15);
         std::fs::remove_dir_all(dir).ok();
     }
@@ -368,64 +332,33 @@ design_accel_g = 20.0
 f1_hz = 10.0
 f2_hz = 80.0"#;
         let p = parse_programme(a, Path::new("x.toml")).unwrap();
-        let b = parse_programme(
-            &a.replace("design_accel_g = 20.0", "peak_g = 10.0"),
-            Path::new("x.toml"),
-        )
-        .unwrap();
+        let b = parse_programme(&a.replace("design_accel_g = 20.0", "peak_g = 10.0"), Path::new("x.toml")).unwrap();
         assert_eq!(p, b);
         assert_eq!(p.shocks[0].start, 0.0);
     }
 
     #[test]
     fn errors_name_key_value_and_unit() {
-        let base =
-            "[[shock]]\nkind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\n";
+        let base = "[[shock]]\nkind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\n";
         let cases = [
-            (
-                base.replace("f2_hz = 80.0", "f2_hz = -3.0"),
-                "shock[0].f2_hz = -3 Hz: must be > 0",
-            ),
-            (
-                base.replace("f2_hz = 80.0", "f2_hz = 5.0"),
-                "shock[0].f2_hz = 5 Hz: must be > f1_hz = 10 Hz",
-            ),
-            (
-                base.replace("peak_g = 10.0", "peak_g = 0.0"),
-                "shock[0].peak_g = 0 G: must be > 0",
-            ),
-            (
-                base.replace("peak_g = 10.0", "peak_g = nan"),
-                "shock[0].peak_g = NaN G: must be finite",
-            ),
-            (
-                format!("{base}start_s = -1.0\n"),
-                "shock[0].start_s = -1 s: must be >= 0",
-            ),
-            (
-                format!("{base}direction_deg = inf\n"),
-                "shock[0].direction_deg = inf deg: must be finite",
-            ),
-            (
-                format!("{base}design_accel_g = 20.0\n"),
-                "shock[0].peak_g: give exactly one of",
-            ),
-            (
-                base.replace("peak_g = 10.0\n", ""),
-                "shock[0].peak_g: missing",
-            ),
+            (base.replace("f2_hz = 80.0", "f2_hz = -3.0"), "shock[0].f2_hz = -3 Hz: must be > 0"),
+            (base.replace("f2_hz = 80.0", "f2_hz = 5.0"), "shock[0].f2_hz = 5 Hz: must be > f1_hz = 10 Hz"),
+            (base.replace("peak_g = 10.0", "peak_g = 0.0"), "shock[0].peak_g = 0 G: must be > 0"),
+            (base.replace("peak_g = 10.0", "peak_g = nan"), "shock[0].peak_g = NaN G: must be finite"),
+            (format!("{base}start_s = -1.0\n"), "shock[0].start_s = -1 s: must be >= 0"),
+            (format!("{base}direction_deg = inf\n"), "shock[0].direction_deg = inf deg: must be finite"),
+            (format!("{base}design_accel_g = 20.0\n"), "shock[0].peak_g: give exactly one of"),
+            (base.replace("peak_g = 10.0\n", ""), "shock[0].peak_g: missing"),
             (
                 format!("{base}[[shock]]\nkind = \"half_sine\"\npeak_g = 5.0\nduration_s = 0.0\n"),
                 "shock[1].duration_s = 0 s: must be > 0",
             ),
             (
-                "[[shock]]\nkind = \"sine\"\namplitude_g = 1.0\nfreq_hz = 20.0\ncycles = -3\n"
-                    .into(),
+                "[[shock]]\nkind = \"sine\"\namplitude_g = 1.0\nfreq_hz = 20.0\ncycles = -3\n".into(),
                 "shock[0].cycles = -3: must be an integer >= 1",
             ),
             (
-                "[[shock]]\nkind = \"sine\"\namplitude_g = -1.0\nfreq_hz = 20.0\ncycles = 3\n"
-                    .into(),
+                "[[shock]]\nkind = \"sine\"\namplitude_g = -1.0\nfreq_hz = 20.0\ncycles = 3\n".into(),
                 "shock[0].amplitude_g = -1 G: must be > 0",
             ),
             (
@@ -441,9 +374,7 @@ f2_hz = 80.0"#;
 
     #[test]
     fn unknown_keys_and_kinds_rejected() {
-        let got = parse_err(
-            "[[shock]]\nkind = \"half_sine\"\npeak_g = 5.0\nduration_s = 0.01\npeak_G = 3.0\n",
-        );
+        let got = parse_err("[[shock]]\nkind = \"half_sine\"\npeak_g = 5.0\nduration_s = 0.01\npeak_G = 3.0\n");
         assert!(got.contains("unknown field `peak_G`"), "{got}");
         assert!(got.starts_with("scene.toml"), "{got}");
         let got = parse_err("[[shock]]\nkind = \"square\"\n");

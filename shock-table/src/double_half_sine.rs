@@ -178,11 +178,7 @@ impl DoubleHalfSine {
             half_sine_segment(self.a2, self.t2 - self.t1, t - self.t1, m.vel, m.disp)
         } else {
             let e = self.end();
-            Kinematics {
-                accel: 0.0,
-                vel: e.vel,
-                disp: e.disp + e.vel * (t - self.t2),
-            }
+            Kinematics { accel: 0.0, vel: e.vel, disp: e.disp + e.vel * (t - self.t2) }
         }
     }
 
@@ -200,11 +196,7 @@ impl DoubleHalfSine {
 }
 
 /// Validate an amplitude `(key, value, unit)` and the corner frequencies.
-fn check_design(
-    amplitude: (&str, f64, &'static str),
-    f1_hz: f64,
-    f2_hz: f64,
-) -> Result<(), ShockError> {
+fn check_design(amplitude: (&str, f64, &'static str), f1_hz: f64, f2_hz: f64) -> Result<(), ShockError> {
     let (key, value, unit) = amplitude;
     require_positive(key, value, unit)?;
     check_corners(f1_hz, f2_hz)
@@ -242,10 +234,7 @@ mod tests {
     /// `|x − printed| ≤ half a unit of the printed last digit` (+ rounding slack).
     fn assert_printed(x: f64, printed: f64, decimals: i32, what: &str) {
         let half = 0.5 * 10f64.powi(-decimals) * (1.0 + 1e-9);
-        assert!(
-            (x - printed).abs() <= half,
-            "{what}: computed {x}, study prints {printed}"
-        );
+        assert!((x - printed).abs() <= half, "{what}: computed {x}, study prints {printed}");
     }
 
     // Physics: the velocity integral of a_1 over [0,t_1] is 2 a_1 t_1/π and
@@ -275,11 +264,7 @@ mod tests {
         for g in [3.0, 20.0] {
             let p = table1(g);
             let d_num = displacement_by_nested_simpson(|t| p.accel(t), &[p.t1, p.t2], p.t2, 400);
-            assert!(
-                (p.lift() - d_num).abs() < 1e-10 * p.lift(),
-                "lift {} vs Simpson-twice {d_num}",
-                p.lift()
-            );
+            assert!((p.lift() - d_num).abs() < 1e-10 * p.lift(), "lift {} vs Simpson-twice {d_num}", p.lift());
             let closed = p.a1 * p.t1 * p.t2 / PI;
             assert!((p.lift() - closed).abs() < 1e-14 * closed);
         }
@@ -295,11 +280,7 @@ mod tests {
                 let v = simpson_piecewise(&a, &[p.t1, p.t2], t, 2000);
                 assert!((k.vel - v).abs() < 1e-10 * p.peak_velocity(), "v at {t}");
                 let d = displacement_by_nested_simpson(a, &[p.t1, p.t2], t, 600);
-                assert!(
-                    (k.disp - d).abs() < 1e-10 * p.lift(),
-                    "d at {t}: {} vs {d}",
-                    k.disp
-                );
+                assert!((k.disp - d).abs() < 1e-10 * p.lift(), "d at {t}: {} vs {d}", k.disp);
             }
         }
     }
@@ -312,10 +293,7 @@ mod tests {
             let l = p.eval(tk - eps);
             let r = p.eval(tk);
             assert!((l.accel - r.accel).abs() < 1e-9 * p.a1, "a at {tk}");
-            assert!(
-                (l.vel - r.vel).abs() < 1e-9 * p.peak_velocity(),
-                "v at {tk}"
-            );
+            assert!((l.vel - r.vel).abs() < 1e-9 * p.peak_velocity(), "v at {tk}");
             assert!((l.disp - r.disp).abs() < 1e-9 * p.lift(), "d at {tk}");
         }
     }
@@ -375,15 +353,9 @@ mod tests {
         let p = table1(3.0);
         let a2_g = p.a2 / G0_M_S2;
         assert_printed(a2_g, -0.26, 2, "a_2 (3 G) from the velocity condition");
-        assert!(
-            (a2_g - -0.44).abs() > 0.1,
-            "the printed −0.44 G is not reproduced"
-        );
+        assert!((a2_g - -0.44).abs() > 0.1, "the printed −0.44 G is not reproduced");
         // With the printed −0.44 G the base would not come to rest.
-        let printed = DoubleHalfSine {
-            a2: -0.44 * G0_M_S2,
-            ..p
-        };
+        let printed = DoubleHalfSine { a2: -0.44 * G0_M_S2, ..p };
         assert!(printed.final_velocity() < -0.2 * p.peak_velocity());
         // The printed formula a_2 = π V_0/(t_2 − t_1) has the wrong sign and size.
         let misprint_formula = PI * p.design_velocity() / (p.t2 - p.t1) / G0_M_S2;
@@ -404,23 +376,11 @@ mod tests {
     #[test]
     fn rejects_bad_design() {
         let msg = |r: Result<DoubleHalfSine, ShockError>| r.unwrap_err().to_string();
-        assert_eq!(
-            msg(DoubleHalfSine::from_peak(1.0, 10.0, -3.0)),
-            "f2_hz = -3 Hz: must be > 0"
-        );
-        assert_eq!(
-            msg(DoubleHalfSine::from_design(0.0, 10.0, 80.0)),
-            "design_accel_m_s2 = 0 m/s²: must be > 0"
-        );
-        assert_eq!(
-            msg(DoubleHalfSine::from_peak(f64::NAN, 10.0, 80.0)),
-            "peak_m_s2 = NaN m/s²: must be finite"
-        );
+        assert_eq!(msg(DoubleHalfSine::from_peak(1.0, 10.0, -3.0)), "f2_hz = -3 Hz: must be > 0");
+        assert_eq!(msg(DoubleHalfSine::from_design(0.0, 10.0, 80.0)), "design_accel_m_s2 = 0 m/s²: must be > 0");
+        assert_eq!(msg(DoubleHalfSine::from_peak(f64::NAN, 10.0, 80.0)), "peak_m_s2 = NaN m/s²: must be finite");
         let m = msg(DoubleHalfSine::from_peak(1.0, 80.0, 10.0));
-        assert!(
-            m.starts_with("f2_hz = 10 Hz: must be > f1_hz = 80 Hz"),
-            "{m}"
-        );
+        assert!(m.starts_with("f2_hz = 10 Hz: must be > f1_hz = 80 Hz"), "{m}");
         assert!(m.contains("displacement-limited"), "{m}");
     }
 

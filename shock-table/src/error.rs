@@ -112,51 +112,24 @@ impl ShockError {
     /// the key `key` they concern.
     pub(crate) fn in_shock(self, index: usize, key: &'static str) -> ShockError {
         match self {
-            ShockError::InvalidParameter {
-                key: k,
-                value,
-                unit,
-                reason,
-            } => ShockError::InvalidParameter {
-                key: format!("shock[{index}].{k}"),
-                value,
-                unit,
-                reason,
-            },
-            ShockError::InvalidConfig { key: k, reason } => ShockError::InvalidConfig {
-                key: format!("shock[{index}].{k}"),
-                reason,
-            },
-            other => ShockError::InShock {
-                index,
-                key,
-                inner: Box::new(other),
-            },
+            ShockError::InvalidParameter { key: k, value, unit, reason } => {
+                ShockError::InvalidParameter { key: format!("shock[{index}].{k}"), value, unit, reason }
+            }
+            ShockError::InvalidConfig { key: k, reason } => {
+                ShockError::InvalidConfig { key: format!("shock[{index}].{k}"), reason }
+            }
+            other => ShockError::InShock { index, key, inner: Box::new(other) },
         }
     }
 }
 
 /// Build an [`ShockError::InvalidParameter`].
-pub(crate) fn invalid(
-    key: impl Into<String>,
-    value: f64,
-    unit: &'static str,
-    reason: impl Into<String>,
-) -> ShockError {
-    ShockError::InvalidParameter {
-        key: key.into(),
-        value,
-        unit,
-        reason: reason.into(),
-    }
+pub(crate) fn invalid(key: impl Into<String>, value: f64, unit: &'static str, reason: impl Into<String>) -> ShockError {
+    ShockError::InvalidParameter { key: key.into(), value, unit, reason: reason.into() }
 }
 
 /// Require `value` finite and `> 0`.
-pub(crate) fn require_positive(
-    key: &str,
-    value: f64,
-    unit: &'static str,
-) -> Result<(), ShockError> {
+pub(crate) fn require_positive(key: &str, value: f64, unit: &'static str) -> Result<(), ShockError> {
     if !value.is_finite() {
         Err(invalid(key, value, unit, "must be finite"))
     } else if value <= 0.0 {
@@ -167,11 +140,7 @@ pub(crate) fn require_positive(
 }
 
 /// Require `value` finite and `>= 0`.
-pub(crate) fn require_non_negative(
-    key: &str,
-    value: f64,
-    unit: &'static str,
-) -> Result<(), ShockError> {
+pub(crate) fn require_non_negative(key: &str, value: f64, unit: &'static str) -> Result<(), ShockError> {
     if !value.is_finite() {
         Err(invalid(key, value, unit, "must be finite"))
     } else if value < 0.0 {
@@ -208,21 +177,14 @@ mod tests {
 
     #[test]
     fn record_message_names_line() {
-        let e = ShockError::Record {
-            path: Some(PathBuf::from("a.csv")),
-            line: Some(4),
-            message: "bad".into(),
-        };
+        let e = ShockError::Record { path: Some(PathBuf::from("a.csv")), line: Some(4), message: "bad".into() };
         assert_eq!(e.to_string(), "a.csv: line 4: bad");
     }
 
     #[test]
     fn io_is_io_through_wrapping() {
-        let e = ShockError::Io {
-            path: PathBuf::from("x"),
-            error: std::io::Error::from(std::io::ErrorKind::NotFound),
-        }
-        .in_shock(2, "file");
+        let e = ShockError::Io { path: PathBuf::from("x"), error: std::io::Error::from(std::io::ErrorKind::NotFound) }
+            .in_shock(2, "file");
         assert!(e.is_io());
         assert!(e.to_string().starts_with("shock[2].file: cannot read x"));
     }

@@ -39,10 +39,7 @@ impl HalfSine {
     pub fn new(peak_m_s2: f64, duration_s: f64) -> Result<Self, ShockError> {
         require_positive("peak_m_s2", peak_m_s2, "m/s²")?;
         require_positive("duration_s", duration_s, "s")?;
-        Ok(Self {
-            peak: peak_m_s2,
-            duration: duration_s,
-        })
+        Ok(Self { peak: peak_m_s2, duration: duration_s })
     }
 
     /// Velocity at the end of the pulse, `2PT/π`, m/s (kept afterwards).
@@ -61,11 +58,7 @@ impl HalfSine {
             return half_sine_segment(self.peak, t_end, t, 0.0, 0.0);
         }
         let end = half_sine_end(self.peak, t_end, 0.0, 0.0);
-        Kinematics {
-            accel: 0.0,
-            vel: end.vel,
-            disp: end.disp + end.vel * (t - t_end),
-        }
+        Kinematics { accel: 0.0, vel: end.vel, disp: end.disp + end.vel * (t - t_end) }
     }
 
     /// Acceleration at `t` (s), m/s².
@@ -97,11 +90,7 @@ pub(crate) fn half_sine_segment(p: f64, t_seg: f64, tau: f64, v0: f64, d0: f64) 
     let w = PI / t_seg;
     let (s, c) = (w * tau).sin_cos();
     let pw = p / w;
-    Kinematics {
-        accel: p * s,
-        vel: v0 + pw * (1.0 - c),
-        disp: d0 + v0 * tau + pw * (tau - s / w),
-    }
+    Kinematics { accel: p * s, vel: v0 + pw * (1.0 - c), disp: d0 + v0 * tau + pw * (tau - s / w) }
 }
 
 /// Kinematics at the end `tau = T` of a half-sine segment, in closed form
@@ -109,11 +98,7 @@ pub(crate) fn half_sine_segment(p: f64, t_seg: f64, tau: f64, v0: f64, d0: f64) 
 /// acceleration 0.
 #[inline]
 pub(crate) fn half_sine_end(p: f64, t_seg: f64, v0: f64, d0: f64) -> Kinematics {
-    Kinematics {
-        accel: 0.0,
-        vel: v0 + 2.0 * p * t_seg / PI,
-        disp: d0 + v0 * t_seg + p * t_seg * t_seg / PI,
-    }
+    Kinematics { accel: 0.0, vel: v0 + 2.0 * p * t_seg / PI, disp: d0 + v0 * t_seg + p * t_seg * t_seg / PI }
 }
 
 #[cfg(test)]
@@ -137,10 +122,7 @@ mod tests {
         for t in [0.002f64, 0.0055, 0.0109, 0.011, 0.02] {
             let v_num = simpson(|s| p.accel(s), 0.0, t.min(p.duration), 2000);
             let v = p.eval(t).vel;
-            assert!(
-                (v - v_num).abs() < 1e-10 * p.final_velocity(),
-                "{t}: {v} vs {v_num}"
-            );
+            assert!((v - v_num).abs() < 1e-10 * p.final_velocity(), "{t}: {v} vs {v_num}");
         }
     }
 

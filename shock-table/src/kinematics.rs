@@ -48,11 +48,7 @@ mod tests {
     #[test]
     fn add_along_projects_onto_unit_vector() {
         let mut k2 = Kinematics2::default();
-        let k = Kinematics {
-            accel: 2.0,
-            vel: 3.0,
-            disp: 4.0,
-        };
+        let k = Kinematics { accel: 2.0, vel: 3.0, disp: 4.0 };
         k2.add_along(k, [0.6, 0.8]);
         k2.add_along(k, [1.0, 0.0]);
         assert_eq!(k2.accel, [2.0 * 0.6 + 2.0, 2.0 * 0.8]);

@@ -49,8 +49,7 @@ pub mod recorded;
 pub mod sine;
 
 pub use config::{
-    load_programme, parse_programme, programme_from_specs, ProgrammeSpec, ShockSpec,
-    DEFAULT_DIRECTION_DEG,
+    load_programme, parse_programme, programme_from_specs, ProgrammeSpec, ShockSpec, DEFAULT_DIRECTION_DEG,
 };
 pub use double_half_sine::DoubleHalfSine;
 pub use error::ShockError;

@@ -66,28 +66,16 @@ struct ExportArgs {
     )]
     peak_g: Option<f64>,
     /// Lower SRS corner frequency f_1, Hz [default: 10] (with --peak-g).
-    #[arg(
-        long = "f1-hz",
-        conflicts_with = "programme",
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "f1-hz", conflicts_with = "programme", allow_negative_numbers = true)]
     f1_hz: Option<f64>,
     /// Upper SRS corner frequency f_2, Hz [default: 80] (with --peak-g).
-    #[arg(
-        long = "f2-hz",
-        conflicts_with = "programme",
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "f2-hz", conflicts_with = "programme", allow_negative_numbers = true)]
     f2_hz: Option<f64>,
     /// Programme file (TOML, `[[shock]]` tables).
     #[arg(long)]
     programme: Option<PathBuf>,
     /// Sample rate, Hz.
-    #[arg(
-        long = "rate-hz",
-        default_value_t = 20000.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "rate-hz", default_value_t = 20000.0, allow_negative_numbers = true)]
     rate_hz: f64,
     /// Length of the history, s [default: end of the programme + 10 %].
     #[arg(long = "duration-s", allow_negative_numbers = true)]
@@ -142,17 +130,12 @@ fn main() -> ExitCode {
 
 /// Output cut short by the reader (`shock-table table | head`): not an error.
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<io::Error>()
-        .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
+    e.downcast_ref::<io::Error>().is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
 }
 
 /// `flag = value unit: reason` for a bad flag value.
 fn bad_flag(flag: &str, value: f64, unit: &str, reason: &str) -> Failure {
-    let unit = if unit.is_empty() {
-        String::new()
-    } else {
-        format!(" {unit}")
-    };
+    let unit = if unit.is_empty() { String::new() } else { format!(" {unit}") };
     Failure::Input(anyhow!("{flag} = {value}{unit}: {reason}"))
 }
 
@@ -168,25 +151,12 @@ fn require_positive(flag: &str, value: f64, unit: &str) -> Result<(), Failure> {
 
 /// Double half-sine from flags; library keys (`f2_hz`) are reported as the
 /// flags (`--f2-hz`).
-fn pulse_from_flags(
-    peak_flag: &str,
-    peak_g: f64,
-    f1_hz: f64,
-    f2_hz: f64,
-) -> Result<DoubleHalfSine, Failure> {
+fn pulse_from_flags(peak_flag: &str, peak_g: f64, f1_hz: f64, f2_hz: f64) -> Result<DoubleHalfSine, Failure> {
     require_positive(peak_flag, peak_g, "G")?;
     DoubleHalfSine::from_peak(peak_g * G0_M_S2, f1_hz, f2_hz).map_err(|e| match e {
-        ShockError::InvalidParameter {
-            key,
-            value,
-            unit,
-            reason,
-        } => bad_flag(
-            &format!("--{}", key.replace('_', "-")),
-            value,
-            unit,
-            &reason.replace("f1_hz", "--f1-hz"),
-        ),
+        ShockError::InvalidParameter { key, value, unit, reason } => {
+            bad_flag(&format!("--{}", key.replace('_', "-")), value, unit, &reason.replace("f1_hz", "--f1-hz"))
+        }
         other => Failure::Input(other.into()),
     })
 }
@@ -213,9 +183,7 @@ struct TableJson<'a> {
 
 fn table(args: &TableArgs) -> Result<(), Failure> {
     if args.peaks_g.is_empty() {
-        return Err(Failure::Input(anyhow!(
-            "--peaks-g: give at least one peak, G"
-        )));
+        return Err(Failure::Input(anyhow!("--peaks-g: give at least one peak, G")));
     }
     let rows = args
         .peaks_g
@@ -236,15 +204,8 @@ fn table(args: &TableArgs) -> Result<(), Failure> {
     let stdout = io::stdout();
     let mut out = stdout.lock();
     let written = if args.json {
-        let doc = TableJson {
-            f1_hz: args.f1_hz,
-            f2_hz: args.f2_hz,
-            g_m_s2: G0_M_S2,
-            rows: &rows,
-        };
-        serde_json::to_writer_pretty(&mut out, &doc)
-            .map_err(io::Error::from)
-            .and_then(|()| writeln!(out))
+        let doc = TableJson { f1_hz: args.f1_hz, f2_hz: args.f2_hz, g_m_s2: G0_M_S2, rows: &rows };
+        serde_json::to_writer_pretty(&mut out, &doc).map_err(io::Error::from).and_then(|()| writeln!(out))
     } else {
         write_table(&mut out, args, &rows)
     };
@@ -276,25 +237,16 @@ fn write_table(out: &mut impl Write, args: &TableArgs, rows: &[Row]) -> io::Resu
 fn export(args: &ExportArgs) -> Result<(), Failure> {
     let programme = match (&args.programme, args.peak_g) {
         (Some(path), _) => {
-            let p = load_programme(path)
-                .map_err(|e| Failure::from_shock(e, format!("programme {}", path.display())))?;
+            let p =
+                load_programme(path).map_err(|e| Failure::from_shock(e, format!("programme {}", path.display())))?;
             if p.is_empty() {
-                return Err(Failure::Input(anyhow!(
-                    "programme {}: no [[shock]] tables",
-                    path.display()
-                )));
+                return Err(Failure::Input(anyhow!("programme {}: no [[shock]] tables", path.display())));
             }
             p
         }
         (None, Some(peak_g)) => {
-            let pulse = pulse_from_flags(
-                "--peak-g",
-                peak_g,
-                args.f1_hz.unwrap_or(10.0),
-                args.f2_hz.unwrap_or(80.0),
-            )?;
-            let shock =
-                Shock::new(pulse.into(), 0.0, FRAC_PI_2).map_err(|e| Failure::Input(e.into()))?;
+            let pulse = pulse_from_flags("--peak-g", peak_g, args.f1_hz.unwrap_or(10.0), args.f2_hz.unwrap_or(80.0))?;
+            let shock = Shock::new(pulse.into(), 0.0, FRAC_PI_2).map_err(|e| Failure::Input(e.into()))?;
             Programme::single(shock)
         }
         // clap enforces one of the two
@@ -320,9 +272,7 @@ fn export(args: &ExportArgs) -> Result<(), Failure> {
     let ctx = || format!("writing {}", args.out.display());
     let file = File::create(&args.out).map_err(|e| io_failure(e, ctx()))?;
     let mut w = BufWriter::new(file);
-    write_history(&mut w, &programme, args.rate_hz, n)
-        .and_then(|()| w.flush())
-        .map_err(|e| io_failure(e, ctx()))
+    write_history(&mut w, &programme, args.rate_hz, n).and_then(|()| w.flush()).map_err(|e| io_failure(e, ctx()))
 }
 
 /// Header of the exported CSV.

@@ -37,12 +37,7 @@ pub(crate) fn simpson_piecewise(f: &impl Fn(f64) -> f64, breaks: &[f64], t: f64,
 
 /// `d(t) = ∫₀ᵗ v`, `v(s) = ∫₀ˢ a`, both by piecewise composite Simpson
 /// ("Simpson twice"), `n` intervals per smooth piece.
-pub(crate) fn displacement_by_nested_simpson(
-    a: impl Fn(f64) -> f64,
-    breaks: &[f64],
-    t: f64,
-    n: usize,
-) -> f64 {
+pub(crate) fn displacement_by_nested_simpson(a: impl Fn(f64) -> f64, breaks: &[f64], t: f64, n: usize) -> f64 {
     let v = |s: f64| simpson_piecewise(&a, breaks, s, n);
     simpson_piecewise(&v, breaks, t, n)
 }

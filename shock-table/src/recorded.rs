@@ -64,12 +64,8 @@ fn check_sample(prev: Option<f64>, t: f64, a: f64) -> Result<(), String> {
         return Err(format!("accel_m_s2 = {a} m/s²: must be finite"));
     }
     match prev {
-        None if t < 0.0 => Err(format!(
-            "t_s = {t} s: the first sample must be at t >= 0 (time from the pulse start)"
-        )),
-        Some(p) if t <= p => Err(format!(
-            "t_s = {t} s: times must be strictly increasing (previous sample at {p} s)"
-        )),
+        None if t < 0.0 => Err(format!("t_s = {t} s: the first sample must be at t >= 0 (time from the pulse start)")),
+        Some(p) if t <= p => Err(format!("t_s = {t} s: times must be strictly increasing (previous sample at {p} s)")),
         _ => Ok(()),
     }
 }
@@ -86,17 +82,9 @@ impl Recorded {
     /// assert!((k.vel - 1.5).abs() < 1e-15 && (k.disp - 0.5625).abs() < 1e-15);
     /// ```
     pub fn from_samples(t: Vec<f64>, a: Vec<f64>) -> Result<Self, ShockError> {
-        let err = |message: String| ShockError::Record {
-            path: None,
-            line: None,
-            message,
-        };
+        let err = |message: String| ShockError::Record { path: None, line: None, message };
         if t.len() != a.len() {
-            return Err(err(format!(
-                "{} times but {} accelerations: lengths must match",
-                t.len(),
-                a.len()
-            )));
+            return Err(err(format!("{} times but {} accelerations: lengths must match", t.len(), a.len())));
         }
         let mut prev = None;
         for (i, (&ti, &ai)) in t.iter().zip(&a).enumerate() {
@@ -104,10 +92,7 @@ impl Recorded {
             prev = Some(ti);
         }
         if t.len() < 2 {
-            return Err(err(format!(
-                "{} sample(s): a record needs at least 2",
-                t.len()
-            )));
+            return Err(err(format!("{} sample(s): a record needs at least 2", t.len())));
         }
         Ok(Self::build(t, a))
     }
@@ -126,10 +111,7 @@ impl Recorded {
             d.push(d[i] + v[i] * h + a[i] * h * h / 2.0 + k * h * h * h / 6.0);
         }
         let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-        let uniform = t
-            .iter()
-            .enumerate()
-            .all(|(i, &ti)| (ti - (t[0] + dt * i as f64)).abs() <= UNIFORM_TOL * dt);
+        let uniform = t.iter().enumerate().all(|(i, &ti)| (ti - (t[0] + dt * i as f64)).abs() <= UNIFORM_TOL * dt);
         let inv_dt = if uniform { 1.0 / dt } else { 0.0 };
         Self { t, a, v, d, inv_dt }
     }
@@ -137,21 +119,15 @@ impl Recorded {
     /// Read a record from a CSV file with header `t_s,accel_m_s2` (see the
     /// module doc). Errors name the file and the line.
     pub fn from_csv(path: &Path) -> Result<Self, ShockError> {
-        let text = std::fs::read_to_string(path).map_err(|error| ShockError::Io {
-            path: path.to_path_buf(),
-            error,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|error| ShockError::Io { path: path.to_path_buf(), error })?;
         Self::parse_csv(&text, Some(path))
     }
 
     /// Parse CSV text (see [`from_csv`](Self::from_csv)); `path` is used in
     /// error messages only.
     pub fn parse_csv(text: &str, path: Option<&Path>) -> Result<Self, ShockError> {
-        let err = |line: Option<usize>, message: String| ShockError::Record {
-            path: path.map(PathBuf::from),
-            line,
-            message,
-        };
+        let err =
+            |line: Option<usize>, message: String| ShockError::Record { path: path.map(PathBuf::from), line, message };
         let mut t = Vec::new();
         let mut a = Vec::new();
         let mut header_seen = false;
@@ -164,10 +140,7 @@ impl Recorded {
             let fields: Vec<&str> = line.split(',').map(str::trim).collect();
             if !header_seen {
                 if fields != ["t_s", "accel_m_s2"] {
-                    return Err(err(
-                        Some(line_no),
-                        format!("header is `{line}`, expected `{RECORD_CSV_HEADER}`"),
-                    ));
+                    return Err(err(Some(line_no), format!("header is `{line}`, expected `{RECORD_CSV_HEADER}`")));
                 }
                 header_seen = true;
                 continue;
@@ -175,15 +148,11 @@ impl Recorded {
             if fields.len() != 2 {
                 return Err(err(
                     Some(line_no),
-                    format!(
-                        "{} field(s) in `{line}`, expected 2 (t_s,accel_m_s2)",
-                        fields.len()
-                    ),
+                    format!("{} field(s) in `{line}`, expected 2 (t_s,accel_m_s2)", fields.len()),
                 ));
             }
             let parse = |s: &str, col: &str| {
-                s.parse::<f64>()
-                    .map_err(|_| err(Some(line_no), format!("{col} = `{s}`: not a number")))
+                s.parse::<f64>().map_err(|_| err(Some(line_no), format!("{col} = `{s}`: not a number")))
             };
             let ti = parse(fields[0], "t_s")?;
             let ai = parse(fields[1], "accel_m_s2")?;
@@ -192,16 +161,10 @@ impl Recorded {
             a.push(ai);
         }
         if !header_seen {
-            return Err(err(
-                None,
-                format!("empty file: expected the header `{RECORD_CSV_HEADER}`"),
-            ));
+            return Err(err(None, format!("empty file: expected the header `{RECORD_CSV_HEADER}`")));
         }
         if t.len() < 2 {
-            return Err(err(
-                None,
-                format!("{} sample(s): a record needs at least 2", t.len()),
-            ));
+            return Err(err(None, format!("{} sample(s): a record needs at least 2", t.len())));
         }
         Ok(Self::build(t, a))
     }
@@ -210,13 +173,7 @@ impl Recorded {
     /// displacement) multiplied by `factor` (dimensionless).
     pub fn scaled(&self, factor: f64) -> Self {
         let mul = |x: &[f64]| x.iter().map(|&y| y * factor).collect();
-        Self {
-            t: self.t.clone(),
-            a: mul(&self.a),
-            v: mul(&self.v),
-            d: mul(&self.d),
-            inv_dt: self.inv_dt,
-        }
+        Self { t: self.t.clone(), a: mul(&self.a), v: mul(&self.v), d: mul(&self.d), inv_dt: self.inv_dt }
     }
 
     /// Sample times, s.
@@ -272,21 +229,13 @@ impl Recorded {
         }
         if t >= self.t[n - 1] {
             let (v, d) = (self.v[n - 1], self.d[n - 1]);
-            return Kinematics {
-                accel: 0.0,
-                vel: v,
-                disp: d + v * (t - self.t[n - 1]),
-            };
+            return Kinematics { accel: 0.0, vel: v, disp: d + v * (t - self.t[n - 1]) };
         }
         let i = self.segment(t);
         let s = t - self.t[i];
         let k = (self.a[i + 1] - self.a[i]) / (self.t[i + 1] - self.t[i]);
         let (a, v, d) = (self.a[i], self.v[i], self.d[i]);
-        Kinematics {
-            accel: a + k * s,
-            vel: v + s * (a + s * k / 2.0),
-            disp: d + s * (v + s * (a / 2.0 + s * k / 6.0)),
-        }
+        Kinematics { accel: a + k * s, vel: v + s * (a + s * k / 2.0), disp: d + s * (v + s * (a / 2.0 + s * k / 6.0)) }
     }
 
     /// Acceleration at `t` (s), m/s².
@@ -418,19 +367,13 @@ mod tests {
         let cases = [
             ("time,a\n0,1\n", "hit.csv: line 1: header is `time,a`"),
             ("t_s,accel_m_s2\n0,1\n0.1\n", "hit.csv: line 3: 1 field(s)"),
-            (
-                "t_s,accel_m_s2\n0,1\n0.1,x\n",
-                "hit.csv: line 3: accel_m_s2 = `x`",
-            ),
+            ("t_s,accel_m_s2\n0,1\n0.1,x\n", "hit.csv: line 3: accel_m_s2 = `x`"),
             (
                 "t_s,accel_m_s2\n0,1\n0.2,1\n# c\n0.2,1\n",
                 "hit.csv: line 5: t_s = 0.2 s: times must be strictly increasing",
             ),
             ("t_s,accel_m_s2\n-1,1\n0,1\n", "hit.csv: line 2: t_s = -1 s"),
-            (
-                "t_s,accel_m_s2\n0,NaN\n1,1\n",
-                "hit.csv: line 2: accel_m_s2 = NaN m/s²",
-            ),
+            ("t_s,accel_m_s2\n0,NaN\n1,1\n", "hit.csv: line 2: accel_m_s2 = NaN m/s²"),
             ("t_s,accel_m_s2\n0,1\n", "hit.csv: 1 sample(s)"),
             ("", "hit.csv: empty file"),
         ];

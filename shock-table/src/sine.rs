@@ -49,11 +49,7 @@ impl SineVibration {
         if cycles == 0 {
             return Err(invalid("cycles", 0.0, "", "must be >= 1"));
         }
-        Ok(Self {
-            amplitude: amplitude_m_s2,
-            freq_hz,
-            cycles,
-        })
+        Ok(Self { amplitude: amplitude_m_s2, freq_hz, cycles })
     }
 
     /// Duration `n/f`, s.
@@ -70,11 +66,7 @@ impl SineVibration {
         let w = 2.0 * PI * self.freq_hz;
         let (s, c) = (w * t).sin_cos();
         let a = self.amplitude;
-        Kinematics {
-            accel: a * c,
-            vel: a / w * s,
-            disp: a / (w * w) * (1.0 - c),
-        }
+        Kinematics { accel: a * c, vel: a / w * s, disp: a / (w * w) * (1.0 - c) }
     }
 
     /// Acceleration at `t` (s), m/s².
@@ -103,17 +95,9 @@ mod tests {
         for t in [0.01, 0.0625, 0.1, 0.149] {
             let k = s.eval(t);
             let v = simpson_piecewise(&a, &[], t, 4000);
-            assert!(
-                (k.vel - v).abs() < 1e-10 * vmax,
-                "v at {t}: {} vs {v}",
-                k.vel
-            );
+            assert!((k.vel - v).abs() < 1e-10 * vmax, "v at {t}: {} vs {v}", k.vel);
             let d = displacement_by_nested_simpson(a, &[], t, 1500);
-            assert!(
-                (k.disp - d).abs() < 1e-9 * dmax,
-                "d at {t}: {} vs {d}",
-                k.disp
-            );
+            assert!((k.disp - d).abs() < 1e-9 * dmax, "d at {t}: {} vs {d}", k.disp);
         }
     }
 
@@ -142,14 +126,8 @@ mod tests {
 
     #[test]
     fn rejects_zero_cycles_and_bad_numbers() {
-        assert_eq!(
-            SineVibration::new(1.0, 1.0, 0).unwrap_err().to_string(),
-            "cycles = 0: must be >= 1"
-        );
-        assert_eq!(
-            SineVibration::new(1.0, 0.0, 3).unwrap_err().to_string(),
-            "freq_hz = 0 Hz: must be > 0"
-        );
+        assert_eq!(SineVibration::new(1.0, 1.0, 0).unwrap_err().to_string(), "cycles = 0: must be >= 1");
+        assert_eq!(SineVibration::new(1.0, 0.0, 3).unwrap_err().to_string(), "freq_hz = 0 Hz: must be > 0");
         assert!(SineVibration::new(-1.0, 1.0, 3).is_err());
     }
 }

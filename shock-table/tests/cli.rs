@@ -5,10 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shock-table"))
-        .args(args)
-        .output()
-        .expect("the shock-table binary runs")
+    Command::new(env!("CARGO_BIN_EXE_shock-table")).args(args).output().expect("the shock-table binary runs")
 }
 
 fn stdout(o: &Output) -> String {
@@ -38,14 +35,8 @@ fn table_prints_three_rows() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let text = stdout(&o);
     let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
-    assert!(
-        lines[0].contains("a_1 (G)") && lines[0].contains("h (mm)"),
-        "{text}"
-    );
-    let rows: Vec<Vec<&str>> = lines[1..]
-        .iter()
-        .map(|l| l.split_whitespace().collect())
-        .collect();
+    assert!(lines[0].contains("a_1 (G)") && lines[0].contains("h (mm)"), "{text}");
+    let rows: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split_whitespace().collect()).collect();
     assert_eq!(rows.len(), 3, "{text}");
     // The study's Table 1, with a_2 of the 3 G row from the velocity
     // condition (−0.26, not the printed −0.44) and h of the 20 G row with
@@ -77,22 +68,12 @@ fn table_json_is_machine_readable() {
 fn export_writes_csv_with_header() {
     let dir = scratch("export");
     let out = dir.join("pulse.csv");
-    let o = run(&[
-        "export",
-        "--peak-g",
-        "10",
-        "--rate-hz",
-        "10000",
-        "--out",
-        s(&out),
-    ]);
+    let o = run(&["export", "--peak-g", "10", "--rate-hz", "10000", "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let text = std::fs::read_to_string(&out).expect("CSV written");
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some(EXPORT_HEADER));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
-        .collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().expect("number")).collect()).collect();
     // default duration: t_2 ≈ 0.0519 s + 10 % ≈ 0.0571 s at 10 kHz
     assert_eq!(rows.len(), 572);
     for r in &rows {
@@ -130,19 +111,10 @@ fn export_programme_file() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let text = std::fs::read_to_string(&out).expect("CSV written");
     assert_eq!(text.lines().count(), 1 + 101);
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .expect("rows")
-        .split(',')
-        .map(|x| x.parse().expect("number"))
-        .collect();
+    let last: Vec<f64> = text.lines().last().expect("rows").split(',').map(|x| x.parse().expect("number")).collect();
     // x: 1 m/s² for 10 ms, then coasting at 0.01 m/s
     assert!((last[3] - 0.01).abs() < 1e-15, "{last:?}");
-    assert!(
-        (last[5] - (0.00005 + 0.01 * 0.09)).abs() < 1e-15,
-        "{last:?}"
-    );
+    assert!((last[5] - (0.00005 + 0.01 * 0.09)).abs() < 1e-15, "{last:?}");
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -153,32 +125,16 @@ fn bad_flag_value_exits_2() {
         &["table", "--f2-hz", "5"],
         &["table", "--peaks-g", "abc"],
         &["export", "--peak-g", "0", "--out", "unused.csv"],
-        &[
-            "export",
-            "--peak-g",
-            "10",
-            "--rate-hz",
-            "0",
-            "--out",
-            "unused.csv",
-        ],
+        &["export", "--peak-g", "10", "--rate-hz", "0", "--out", "unused.csv"],
         &["export", "--out", "unused.csv"],
     ] {
         let o = run(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
     let o = run(&["table", "--f2-hz", "-3"]);
-    assert!(
-        stderr(&o).contains("--f2-hz = -3 Hz: must be > 0"),
-        "{}",
-        stderr(&o)
-    );
+    assert!(stderr(&o).contains("--f2-hz = -3 Hz: must be > 0"), "{}", stderr(&o));
     let o = run(&["table", "--f2-hz", "5"]);
-    assert!(
-        stderr(&o).contains("--f2-hz = 5 Hz: must be > --f1-hz = 10 Hz"),
-        "{}",
-        stderr(&o)
-    );
+    assert!(stderr(&o).contains("--f2-hz = 5 Hz: must be > --f1-hz = 10 Hz"), "{}", stderr(&o));
     assert!(!Path::new("unused.csv").exists());
 }
 
@@ -186,53 +142,27 @@ fn bad_flag_value_exits_2() {
 fn bad_programme_key_exits_2_and_names_it() {
     let dir = scratch("badkey");
     let prog = dir.join("prog.toml");
-    std::fs::write(
-        &prog,
-        "[[shock]]\nkind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = -3.0\n",
-    )
-    .expect("write");
+    std::fs::write(&prog, "[[shock]]\nkind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = -3.0\n")
+        .expect("write");
     let out = dir.join("p.csv");
     let o = run(&["export", "--programme", s(&prog), "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("shock[0].f2_hz = -3 Hz: must be > 0"),
-        "{}",
-        stderr(&o)
-    );
-    std::fs::write(
-        &prog,
-        "[[shock]]\nkind = \"half_sine\"\npeak_g = 5.0\nduration_s = 0.01\nstart = 1\n",
-    )
-    .expect("write");
+    assert!(stderr(&o).contains("shock[0].f2_hz = -3 Hz: must be > 0"), "{}", stderr(&o));
+    std::fs::write(&prog, "[[shock]]\nkind = \"half_sine\"\npeak_g = 5.0\nduration_s = 0.01\nstart = 1\n")
+        .expect("write");
     let o = run(&["export", "--programme", s(&prog), "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("unknown field `start`"),
-        "{}",
-        stderr(&o)
-    );
+    assert!(stderr(&o).contains("unknown field `start`"), "{}", stderr(&o));
     assert!(!out.exists());
     std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
 fn io_errors_exit_1() {
-    let o = run(&[
-        "export",
-        "--programme",
-        "/nonexistent/prog.toml",
-        "--out",
-        "unused.csv",
-    ]);
+    let o = run(&["export", "--programme", "/nonexistent/prog.toml", "--out", "unused.csv"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("/nonexistent/prog.toml"));
-    let o = run(&[
-        "export",
-        "--peak-g",
-        "10",
-        "--out",
-        "/nonexistent/dir/p.csv",
-    ]);
+    let o = run(&["export", "--peak-g", "10", "--out", "/nonexistent/dir/p.csv"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("writing /nonexistent/dir/p.csv"));
 }

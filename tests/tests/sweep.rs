@@ -94,7 +94,7 @@ fn interrupted_sweep_keeps_its_points_and_resumes() {
     let dir = TempDir::new("sweep-resume");
     let file = sweep_file(&dir, 6);
     let out = dir.join("out");
-    let mut child = sweep(&file, &out, &["--jobs", "1"]).stderr(std::process::Stdio::piped()).spawn().expect("start");
+    let child = sweep(&file, &out, &["--jobs", "1"]).stderr(std::process::Stdio::piped()).spawn().expect("start");
     // Wait for the first finished point, then interrupt.
     let first = out.join("points").join("00000.json");
     let started = std::time::Instant::now();

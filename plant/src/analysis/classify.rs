@@ -126,7 +126,7 @@ pub fn correlation_dimension(p: &[[f64; 2]]) -> f64 {
     }
     let count = |r: f64| d2.iter().filter(|&&x| x < r * r * diam2).count().max(1) as f64;
     let (r1, r2) = (0.05, 0.2);
-    (count(r2).ln() - count(r1).ln()) / (r2 / r1 as f64).ln()
+    (count(r2).ln() - count(r1).ln()) / (r2 / r1).ln()
 }
 
 /// Post-shock motion mode from the contact share of the window.

@@ -77,7 +77,7 @@ mod tests {
         let tau = std::f64::consts::TAU;
         for i in 0..4000 {
             let t = i as f64 * dt;
-            let (a1, a2) = (tau * f * t - 0.5236, tau * w2 * t);
+            let (a1, a2) = (tau * f * t - std::f64::consts::FRAC_PI_6, tau * w2 * t);
             tr.t_s.push(t);
             tr.rotor_angle_rad.push(tau * f * t + 0.1);
             tr.dx_m.push(2e-6 * a1.cos() + 10e-6 * a2.cos());
@@ -93,7 +93,7 @@ mod tests {
             // θ_r(t) = φ + 2π n exactly at the crossing time.
             let t_exact = (phase + tau * p.n as f64 - 0.1) / (tau * f);
             assert!((p.t_s - t_exact).abs() < 1e-12, "{} vs {t_exact}", p.t_s);
-            let (a1, a2) = (tau * f * t_exact - 0.5236, tau * w2 * t_exact);
+            let (a1, a2) = (tau * f * t_exact - std::f64::consts::FRAC_PI_6, tau * w2 * t_exact);
             let x = 2e-6 * a1.cos() + 10e-6 * a2.cos();
             let y = 2e-6 * a1.sin() + 10e-6 * a2.sin();
             assert!((p.x_m - x).abs() < 1e-8 && (p.y_m - y).abs() < 1e-8, "{p:?} vs ({x}, {y})");

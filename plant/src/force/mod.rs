@@ -8,5 +8,6 @@ pub mod amb;
 pub mod balls;
 pub mod drag;
 pub mod friction;
+pub mod lumped;
 pub mod rotor_race;
 pub mod smooth;

@@ -1,6 +1,8 @@
 //! Helpers for the end-to-end tests: building and locating the workspace's
 //! binaries, per-test output folders, and small independent readers for the
 //! files a run writes (the tests do not reuse the plant's own readers).
+// Each test binary uses a subset of these helpers.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -50,6 +52,14 @@ fn build_bin(package: &str, bin: &str) -> PathBuf {
 pub fn plant_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
     BIN.get_or_init(|| build_bin("plant", "plant"))
+}
+
+/// The `controller` binary (the co-simulation's controller process), built
+/// once per test binary; `plant` finds it next to itself.
+#[allow(dead_code)] // used by cosim.rs only
+pub fn controller_bin() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| build_bin("controller", "controller"))
 }
 
 /// The `shock-table` binary, built once per test binary.

@@ -17,6 +17,8 @@
 //!   r_0, angles by 2π, velocities by r_0 Ω and angular speeds by Ω
 //!   (Ω the rotor speed): `atol_i = rtol × scale_i`.
 
+pub mod peer;
+
 use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::model::N;
@@ -340,6 +342,10 @@ pub fn stability_limit(b: &BenchScene, method: Method, reference: &Trace) -> any
     Ok(Some((b.scene.controller.period / hi as f64, hi)))
 }
 
+/// Stability of one fixed-step method on one scene: scene, method, the largest stable step
+/// found (s) with its substeps, and the estimated step (s).
+pub type StabilityRow = (String, String, Option<(f64, u32)>, f64);
+
 /// What `plant bench accuracy` measured.
 pub struct AccuracyReport {
     /// All rows (Rust, then any peer rows read back).
@@ -347,15 +353,46 @@ pub struct AccuracyReport {
     /// Per scene: name, reference floor (RMS, max).
     pub floors: Vec<(String, (f64, f64))>,
     /// Per scene and fixed-step method: found step (s), substeps, estimated step (s).
-    pub stability: Vec<(String, String, Option<(f64, u32)>, f64)>,
+    pub stability: Vec<StabilityRow>,
 }
 
-/// Runs the work-precision and stability bench, writing into `out`.
+/// Where the scipy peer lives and how to run it.
+#[derive(Clone, Debug)]
+pub struct Peer {
+    /// Python interpreter (with scipy and numba).
+    pub python: PathBuf,
+    /// `bench/peer/run_peer.py`.
+    pub script: PathBuf,
+}
+
+/// Runs the peer on one scene: writes its spec, runs `run_peer.py`, reads its rows.
+fn run_peer(peer: &Peer, b: &BenchScene, out: &Path, quick: bool, repeats: usize) -> anyhow::Result<Vec<Row>> {
+    let spec_path = out.join(format!("spec_{}.json", b.name));
+    let spec = peer::spec(&b.scene, 0, 1, Some(atol_scale(&b.scene)))?;
+    std::fs::write(&spec_path, serde_json::to_string(&spec)?)
+        .with_context(|| format!("writing {}", spec_path.display()))?;
+    let csv = out.join(format!("peer_{}.csv", b.name));
+    let rtols = if quick { "1e-4,1e-7" } else { "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10" };
+    let status = std::process::Command::new(&peer.python)
+        .arg(&peer.script)
+        .arg(&spec_path)
+        .arg(out.join(format!("reference_{}.csv", b.name)))
+        .args(["--scene", b.name, "--rtols", rtols, "--repeats", &repeats.to_string(), "--out"])
+        .arg(&csv)
+        .status()
+        .with_context(|| format!("starting the peer: {} {}", peer.python.display(), peer.script.display()))?;
+    anyhow::ensure!(status.success(), "the peer failed on {} ({status})", b.name);
+    read_rows(&csv)
+}
+
+/// Runs the work-precision and stability bench, writing into `out`; with `peer`, the scipy
+/// peer runs on the same scenes, references and error measure, and its rows join the charts.
 pub fn accuracy(
     config_dir: &Path,
     out: &Path,
     quick: bool,
     repeats: usize,
+    peer: Option<&Peer>,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<AccuracyReport> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -404,6 +441,17 @@ pub fn accuracy(
                 ));
                 report.rows.push(row);
             }
+        }
+        if let Some(peer) = peer {
+            log(&format!("{}: scipy peer (RK45, DOP853, LSODA)", b.name));
+            let rows = run_peer(peer, &b, out, quick, repeats)?;
+            for r in &rows {
+                log(&format!(
+                    "{}: scipy {} {}: error rms {:.2e} max {:.2e}, {:.3e} s per simulated s, {} evaluations ({})",
+                    b.name, r.method, r.setting, r.err_rms, r.err_max, r.wall_s_per_sim_s, r.rhs_evals, r.status
+                ));
+            }
+            report.rows.extend(rows);
         }
         for method in [Method::ExplicitEuler, Method::SymplecticEuler, Method::Rk4] {
             let found = stability_limit(&b, method, &reference.trace)?;
@@ -537,4 +585,139 @@ pub fn charts(out: &Path, rows: &[Row], floors: &[(String, (f64, f64))]) -> anyh
         written.push(path);
     }
     Ok(written)
+}
+
+/// A model variant of the simplification study: a name and the overrides that make it.
+pub struct Variant {
+    /// Name.
+    pub name: &'static str,
+    /// Scene overrides.
+    pub sets: &'static [&'static str],
+}
+
+/// The most detailed model: every ball, a rolling cage, free spin with a speed loop, the
+/// nonlinear bearing with flux saturation.
+pub const FULL: &[&str] = &[
+    "touchdown.support=\"balls\"",
+    "touchdown.cage=\"rotating\"",
+    "rotor.spin=\"free\"",
+    "amb.force_law=\"nonlinear\"",
+];
+
+/// Each simplification on its own, the study's model (all of the study's choices) and everything simplified.
+pub const VARIANTS: &[Variant] = &[
+    Variant { name: "lumped race support", sets: &["touchdown.support=\"lumped\""] },
+    Variant { name: "fixed balls", sets: &["touchdown.cage=\"fixed\""] },
+    Variant { name: "speed held", sets: &["rotor.spin=\"held\""] },
+    Variant { name: "linear bearing", sets: &["amb.force_law=\"linear\""] },
+    Variant { name: "study model", sets: &["rotor.spin=\"held\"", "amb.force_law=\"linear\""] },
+    Variant {
+        name: "all simplified",
+        sets: &[
+            "touchdown.support=\"lumped\"",
+            "touchdown.cage=\"fixed\"",
+            "rotor.spin=\"held\"",
+            "amb.force_law=\"linear\"",
+        ],
+    },
+];
+
+/// One row of `models.csv`.
+#[derive(Clone, Debug)]
+pub struct ModelRow {
+    /// Scene.
+    pub scene: String,
+    /// Variant name (`full` for the detailed model).
+    pub variant: String,
+    /// Scaled error against the full model over the window: RMS.
+    pub err_rms: f64,
+    /// Max.
+    pub err_max: f64,
+    /// Wall seconds per simulated second with the scene's integrator.
+    pub wall_s_per_sim_s: f64,
+    /// Speed-up over the full model.
+    pub speedup: f64,
+}
+
+fn overridden(b: &BenchScene, sets: &[&str]) -> anyhow::Result<Scene> {
+    let mut table: toml::Table = toml::Value::try_from(&b.scene.raw)?.try_into()?;
+    for s in sets {
+        crate::config::apply_override(&mut table, s)?;
+    }
+    let raw: crate::config::RawScene = toml::Value::Table(table).try_into()?;
+    Ok(crate::config::validate(raw, Path::new("."))?)
+}
+
+/// Measures the error and speed of each simplification against the full model.
+pub fn models(
+    config_dir: &Path,
+    out: &Path,
+    repeats: usize,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<ModelRow>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut rows = Vec::new();
+    for b in scenes(config_dir)? {
+        let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.params.contact.gap);
+        // Accurate runs for the error (model differences, not integration error).
+        let accurate = |s: &Scene| run(&with_integrator(s, Method::Dp5, Setting::Rtol(1e-10)), &mut Quiet);
+        let full = overridden(&b, FULL)?;
+        let full_trace = accurate(&full)?.trace;
+        // The scene's own integrator for the cost.
+        let full_cost = measure(&full, repeats)?.best_wall / full.duration;
+        rows.push(ModelRow {
+            scene: b.name.into(),
+            variant: "full".into(),
+            err_rms: 0.0,
+            err_max: 0.0,
+            wall_s_per_sim_s: full_cost,
+            speedup: 1.0,
+        });
+        for v in VARIANTS {
+            let mut sets: Vec<&str> = FULL.to_vec();
+            sets.extend_from_slice(v.sets);
+            let scene = overridden(&b, &sets)?;
+            let (rms, max) = window_error(&accurate(&scene)?.trace, &full_trace, t0, t1, gap);
+            let cost = measure(&scene, repeats)?.best_wall / scene.duration;
+            log(&format!(
+                "{}: {}: error rms {rms:.2e} max {max:.2e}, speed-up {:.2}",
+                b.name,
+                v.name,
+                full_cost / cost
+            ));
+            rows.push(ModelRow {
+                scene: b.name.into(),
+                variant: v.name.into(),
+                err_rms: rms,
+                err_max: max,
+                wall_s_per_sim_s: cost,
+                speedup: full_cost / cost,
+            });
+        }
+    }
+    let mut s = String::from("scene,variant,err_rms,err_max,wall_s_per_sim_s,speedup\n");
+    for r in &rows {
+        let _ = writeln!(
+            s,
+            "{},{},{:e},{:e},{:e},{:.4}",
+            r.scene, r.variant, r.err_rms, r.err_max, r.wall_s_per_sim_s, r.speedup
+        );
+    }
+    std::fs::write(out.join("models.csv"), s).context("writing models.csv")?;
+    for scene in ["levitation", "impact", "rub"] {
+        let here: Vec<&ModelRow> = rows.iter().filter(|r| r.scene == scene && r.variant != "full").collect();
+        let xs: Vec<Vec<f64>> = here.iter().map(|r| vec![r.speedup]).collect();
+        let ys: Vec<Vec<f64>> = here.iter().map(|r| vec![r.err_rms.max(1e-12)]).collect();
+        let groups: Vec<PointGroup> =
+            here.iter().enumerate().map(|(i, r)| PointGroup { label: &r.variant, x: &xs[i], y: &ys[i] }).collect();
+        plot::loglog(
+            &out.join(format!("models_{scene}.png")),
+            &format!("{scene}: error each simplification adds against the speed it gains"),
+            "speed-up over the full model",
+            "RMS error / air gap against the full model, 50 ms after the shock",
+            &[],
+            &groups,
+        )?;
+    }
+    Ok(rows)
 }

@@ -1,0 +1,200 @@
+//! Co-simulation with the controller as a separate process over iceoryx2
+//! (`controller.mode = "lockstep"` or `"realtime"`); the protocol is in
+//! [`controller::wire`], the plumbing in [`controller::link`].
+//!
+//! # Timing (tick `k` at `t_k = k T`, delay `d = controller.delay_samples`)
+//!
+//! - `lockstep`: at tick `k` the plant publishes sensor frame `k` and waits
+//!   for the reply to `k` (busy-polling `controller.spin_us`, then blocking
+//!   on an event), then treats it exactly as `sampled` mode treats the
+//!   in-process law's output: saturated, pushed into the delay line
+//!   prefilled with `d` bias commands, applied from tick `k + d`. With the
+//!   same law code on the other side and `f64` on the wire, a lockstep run
+//!   is bit-identical to the `sampled` run of the same scene.
+//! - `realtime`: tick `k` starts at wall time `start + k T`. The plant takes
+//!   the reply to sample `k − 1` (it had one period), publishes frame `k`
+//!   and integrates the period. A reply missing at its tick is a deadline
+//!   miss and the last current is held; a reply that comes later is stale
+//!   and dropped. The reply is one sample old by construction, so the
+//!   delay line is prefilled with `d − 1` commands and `d ≥ 1`. A plant
+//!   step that ends after the next tick's start is a plant overrun. Both
+//!   processes busy-wait (the controller for at least 100 periods before it
+//!   blocks): realtime at 20 kHz needs two free cores.
+//!
+//! # Faults
+//!
+//! While a reply is missing for `controller.reply_timeout_ms`, the plant
+//! looks up the controller's node (and its own child process): dead or gone
+//! is a lost peer; alive is waited for (lockstep: a controller under a
+//! debugger is not lost) or counted as misses (realtime). On a loss the
+//! plant records a peer event and applies `controller.fallback` (`hold`
+//! the last current, `bias` current only, or `stop`). With
+//! `controller.reconnect_timeout_ms > 0` it then waits for a new controller
+//! (it respawns the one it started itself; an external one is restarted
+//! by the user): lockstep pauses the simulation meanwhile (the fallback
+//! answers the lost sample), realtime keeps pacing with the fallback.
+//! Without a reconnection the run stops as `peer_lost` (exit code 4).
+//! A controller that stops on SIGINT/SIGTERM says so; the plant then stops
+//! as `interrupted`.
+
+pub mod process;
+pub mod session;
+pub mod stats;
+
+pub use session::{bench_round_trips, Session, Stop};
+pub use stats::{Latencies, Misses, Percentiles};
+
+use controller::link::LinkError;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Where the controller process comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ControllerProcess {
+    /// The plant starts it: the given executable, or `controller` next to the running one.
+    Spawn(Option<PathBuf>),
+    /// The user starts `controller --run-id ID`; the plant waits for it.
+    External,
+}
+
+/// How a co-simulation run is launched (command-line choices, not physics).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Launch {
+    /// Who starts the controller.
+    pub controller: ControllerProcess,
+    /// Run id; `None` = a fresh one (process id, counter, time).
+    pub run_id: Option<String>,
+}
+
+impl Default for Launch {
+    /// The plant starts the `controller` next to its own executable, with a fresh run id.
+    fn default() -> Self {
+        Self { controller: ControllerProcess::Spawn(None), run_id: None }
+    }
+}
+
+/// A fresh run id: `<pid>-<counter>-<ms since 1970, hex>`, unique per
+/// process and call.
+pub fn new_run_id() -> String {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let ms = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_millis()).unwrap_or(0);
+    format!("{}-{n}-{ms:x}", std::process::id())
+}
+
+/// Why a co-simulation could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum CosimError {
+    /// No controller executable where it was looked for.
+    #[error("controller executable not found at {} ({why}): build it with `cargo build --release` (it is built next to `plant`), or start one yourself and pass `--controller external`", path.display())]
+    ControllerMissing {
+        /// Where it was looked for.
+        path: PathBuf,
+        /// Why it is not usable.
+        why: String,
+    },
+    /// The executable could not be started.
+    #[error("cannot start the controller {}: {why}", path.display())]
+    Spawn {
+        /// Executable.
+        path: PathBuf,
+        /// OS error.
+        why: String,
+    },
+    /// The child exited before the handshake (its own message is above).
+    #[error("the controller process exited before the handshake ({status})")]
+    ControllerExited {
+        /// Exit status as text.
+        status: String,
+        /// Exit code, if any.
+        code: Option<i32>,
+    },
+    /// The controller refused the hello.
+    #[error("the controller refused the run ({reason}): {message}")]
+    Refused {
+        /// Refusal kind.
+        reason: &'static str,
+        /// Its message.
+        message: String,
+    },
+    /// Nobody answered the hello in time.
+    #[error("no controller answered within {waited_s} s for run id {run_id}{hint}")]
+    NoController {
+        /// How long the plant waited (s).
+        waited_s: f64,
+        /// Run id.
+        run_id: String,
+        /// What to do.
+        hint: String,
+    },
+    /// SIGINT/SIGTERM while waiting for the controller.
+    #[error("interrupted while waiting for the controller")]
+    Interrupted,
+    /// iceoryx2 failure.
+    #[error(transparent)]
+    Link(#[from] LinkError),
+    /// A bad run id (from `--run-id`).
+    #[error("{0}")]
+    RunId(String),
+    /// Core pinning failed.
+    #[error("controller.pin_cores: {0}")]
+    Pin(String),
+}
+
+/// Something that happened to the peer, for `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PeerEvent {
+    /// `connected`, `lost`, `reconnected`, `stopped`.
+    pub kind: &'static str,
+    /// Simulated time (s).
+    pub t_s: f64,
+    /// Tick index.
+    pub seq: u64,
+    /// Wall time since the loop started (s).
+    pub wall_s: f64,
+    /// Details (the controller's description, the cause of a loss, the fallback applied).
+    pub detail: String,
+}
+
+/// The `cosim` object of `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CosimReport {
+    /// `lockstep` or `realtime`.
+    pub mode: &'static str,
+    /// Run id (service names `amb-testbed/<run_id>/…`).
+    pub run_id: String,
+    /// What the (last) controller said it runs.
+    pub controller: String,
+    /// Handshakes made (1 + reconnections).
+    pub sessions: u32,
+    /// Sensor frames published.
+    pub messages_sent: u64,
+    /// Command frames received (current session's).
+    pub messages_received: u64,
+    /// Samples skipped in the sequence of replies (never answered).
+    pub sequence_gaps: u64,
+    /// Replies that came after their tick (realtime) or answered an older sample.
+    pub stale_replies: u64,
+    /// Replies with non-finite currents (the last current was held).
+    pub invalid_replies: u64,
+    /// Ticks whose reply was missing (realtime).
+    pub deadline_misses: u64,
+    /// `deadline_misses` over the ticks that had a reply due.
+    pub deadline_miss_fraction: f64,
+    /// Longest run of consecutive misses.
+    pub longest_miss_burst: u64,
+    /// Realtime ticks that started more than one period late (the plant could not keep up).
+    pub plant_overruns: u64,
+    /// Ticks run on the fallback current while no controller was connected.
+    pub fallback_ticks: u64,
+    /// Waits of the plant that outlasted the spin budget and blocked.
+    pub blocking_waits: u64,
+    /// Sensor frame published → command frame published by the controller
+    /// (both stamped with `CLOCK_MONOTONIC`), µs.
+    pub latency_us: Percentiles,
+    /// Lockstep: sensor frame published → reply in the plant's hands, µs.
+    pub round_trip_us: Option<Percentiles>,
+    /// Connections, losses, reconnections, stops.
+    pub peer_events: Vec<PeerEvent>,
+}

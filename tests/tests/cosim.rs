@@ -1,0 +1,489 @@
+//! End-to-end tests of the co-simulation: the plant and the `controller`
+//! process over iceoryx2 (issue 3). Both processes are started for real.
+//!
+//! What is pinned: a `lockstep` run writes the same trace, byte for byte, as
+//! the in-process `sampled` run of the scene (same law code, `f64` on the
+//! wire); a `realtime` run completes and reports its misses; faults (the
+//! controller killed — with and without a reconnection —, the plant killed,
+//! SIGINT/SIGTERM to either, leftovers of a crashed run, a rate mismatch)
+//! end the way the issue specifies; two plant/controller pairs run side by
+//! side. Timing figures are never asserted (machines are noisy); counts
+//! are, where the run determines them.
+//!
+//! Scenes are 50 ms slices of `paper-10g.toml` (1000 ticks at 20 kHz) with
+//! the shock at 10 ms, so the file stays well under a minute in debug.
+
+mod common;
+
+use common::{
+    assert_exit, controller_bin, num, output, plant_bin, plant_run, read_json, scene, stderr, Csv, TempDir, SHORT,
+};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{channel, Receiver};
+use std::time::{Duration, Instant};
+
+/// Ticks of a `SHORT` scene at 20 kHz.
+const TICKS: u64 = 1000;
+/// Controller period of the scenes (s).
+const PERIOD: f64 = 1.0 / 20_000.0;
+
+/// `SHORT` plus extra overrides.
+fn sets<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    SHORT.iter().copied().chain(extra.iter().copied()).collect()
+}
+
+/// A unique run id for a test (process id + name), so parallel tests and
+/// parallel test runs never share services.
+fn run_id(name: &str) -> String {
+    format!("t{}-{name}", std::process::id())
+}
+
+/// A child process whose stderr lines arrive on a channel; killed on drop.
+struct Proc {
+    child: Child,
+    lines: Receiver<String>,
+    log: Vec<String>,
+}
+
+impl Proc {
+    fn spawn(cmd: &mut Command) -> Self {
+        let mut child =
+            cmd.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
+        let pipe = child.stderr.take().expect("piped stderr");
+        let (tx, lines) = channel();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Self { child, lines, log: Vec::new() }
+    }
+
+    /// Waits (up to 60 s) for a stderr line containing `needle`.
+    fn wait_line(&mut self, needle: &str) -> String {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        loop {
+            match self.lines.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                Ok(line) => {
+                    self.log.push(line.clone());
+                    if line.contains(needle) {
+                        return line;
+                    }
+                }
+                Err(_) => panic!("no line with {needle:?} within 60 s; stderr so far:\n{}", self.log.join("\n")),
+            }
+        }
+    }
+
+    /// Waits (up to 30 s) for the exit; returns the exit code and all of stderr.
+    fn finish(mut self) -> (Option<i32>, String) {
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let status = loop {
+            if let Some(s) = self.child.try_wait().unwrap() {
+                break s;
+            }
+            assert!(Instant::now() < deadline, "process did not exit within 30 s:\n{}", self.log.join("\n"));
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        // The reader thread ends at EOF.
+        let end = Instant::now() + Duration::from_secs(5);
+        while let Ok(line) = self.lines.recv_timeout(end.saturating_duration_since(Instant::now())) {
+            self.log.push(line);
+        }
+        (status.code(), self.log.join("\n"))
+    }
+
+    fn signal(&self, signal: libc::c_int) {
+        let pid = libc::pid_t::try_from(self.child.id()).unwrap();
+        // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
+        assert_eq!(unsafe { libc::kill(pid, signal) }, 0, "kill({pid}, {signal})");
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// `controller --run-id ID` plus arguments (not started).
+fn controller(id: &str, args: &[&str]) -> Command {
+    let mut cmd = Command::new(controller_bin());
+    cmd.arg("--run-id").arg(id).args(args);
+    cmd
+}
+
+/// A plant run waiting for an external controller (not started).
+fn external_plant(out: &Path, id: &str, extra: &[&str]) -> Command {
+    let mut cmd = plant_run(&scene("paper-10g.toml"), out, &sets(extra));
+    cmd.args(["--controller", "external", "--run-id", id]);
+    cmd
+}
+
+/// True while a process with this pid exists.
+fn exists(pid: i32) -> bool {
+    // SAFETY: kill(pid, 0) only checks for existence.
+    unsafe { libc::kill(pid, 0) == 0 }
+}
+
+/// The controller pid recorded in `summary.json` (`… (pid N)`).
+fn controller_pid(summary: &serde_json::Value) -> i32 {
+    let text = summary["cosim"]["controller"].as_str().expect("cosim.controller");
+    text.rsplit("(pid ").next().and_then(|s| s.trim_end_matches(')').parse().ok()).expect("a pid in cosim.controller")
+}
+
+fn event_kinds(summary: &serde_json::Value) -> Vec<String> {
+    summary["cosim"]["peer_events"]
+        .as_array()
+        .expect("cosim.peer_events")
+        .iter()
+        .map(|e| e["kind"].as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn lockstep_trace_is_bit_identical_to_sampled() {
+    controller_bin();
+    let dir = TempDir::new("cosim-identical");
+    let mut traces = Vec::new();
+    for mode in ["sampled", "lockstep"] {
+        let out = dir.join(mode);
+        let m = format!("controller.mode={mode}");
+        assert_exit(&output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&[&m]))), 0);
+        traces.push(std::fs::read(out.join("trace.csv")).unwrap());
+    }
+    assert!(traces[0] == traces[1], "lockstep and sampled runs of the same scene wrote different traces");
+
+    let s = read_json(&dir.join("lockstep").join("summary.json"));
+    let c = &s["cosim"];
+    assert_eq!(s["status"], "completed");
+    assert_eq!(c["mode"], "lockstep");
+    assert_eq!(num(c, "messages_sent") as u64, TICKS);
+    assert_eq!(num(c, "messages_received") as u64, TICKS);
+    for key in ["sequence_gaps", "stale_replies", "invalid_replies", "deadline_misses", "fallback_ticks"] {
+        assert_eq!(num(c, key), 0.0, "{key} in {c:#}");
+    }
+    assert_eq!(num(&c["round_trip_us"], "count") as u64, TICKS);
+    assert_eq!(event_kinds(&s), ["connected"]);
+    // The sampled run has no cosim object.
+    assert!(read_json(&dir.join("sampled").join("summary.json")).get("cosim").is_none());
+}
+
+#[test]
+fn realtime_run_completes_and_reports_misses() {
+    controller_bin();
+    let dir = TempDir::new("cosim-realtime");
+    let out = dir.join("run");
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=realtime"])));
+    assert_exit(&run, 0);
+    let s = read_json(&out.join("summary.json"));
+    let c = &s["cosim"];
+    assert_eq!(c["mode"], "realtime");
+    assert_eq!(num(c, "messages_sent") as u64, TICKS);
+    // Tick 0 has no reply due; every later tick either had its reply or missed it.
+    let (misses, burst) = (num(c, "deadline_misses"), num(c, "longest_miss_burst"));
+    assert!(misses <= (TICKS - 1) as f64 && burst <= misses, "{c:#}");
+    assert!((num(c, "deadline_miss_fraction") - misses / (TICKS - 1) as f64).abs() < 1e-12, "{c:#}");
+    assert!(num(c, "messages_received") + num(c, "sequence_gaps") <= TICKS as f64, "{c:#}");
+    for key in ["p50", "p99", "p999", "max"] {
+        assert!(num(&c["latency_us"], key).is_finite(), "latency_us.{key} in {c:#}");
+    }
+    assert!(c["round_trip_us"].is_null(), "round trips are a lockstep figure: {c:#}");
+    assert_sampled_rows(&out, 0.05);
+}
+
+/// Asserts trace.csv holds rows 0, T_out, … up to `end` (s) at 20 kHz.
+fn assert_sampled_rows(out: &Path, end: f64) {
+    let t = Csv::read(&out.join("trace.csv")).column("t_s");
+    assert_eq!(t.len(), (end / PERIOD).round() as usize + 1, "rows up to {end} s");
+    assert!((t.last().unwrap() - end).abs() < 1e-9, "last row at {} s, expected {end}", t.last().unwrap());
+}
+
+/// Crash point of the controller (sample index), by fault injection.
+const CRASH_AT: u64 = 300;
+
+#[test]
+fn controller_killed_stops_the_run_with_peer_lost() {
+    controller_bin();
+    let dir = TempDir::new("cosim-killed");
+    let out = dir.join("run");
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=lockstep"]));
+    cmd.env("AMB_CONTROLLER_CRASH_AT_SEQ", CRASH_AT.to_string());
+    let run = output(&mut cmd);
+    let err = stderr(&run);
+    assert_exit(&run, 4);
+    assert!(err.contains("lost") && err.contains(&format!("sample {CRASH_AT}")), "{err}");
+
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "peer_lost", "{s:#}");
+    assert_eq!(event_kinds(&s), ["connected", "lost"]);
+    assert_eq!(num(&s["cosim"]["peer_events"][1], "seq") as u64, CRASH_AT);
+    assert_eq!(num(&s["cosim"], "messages_received") as u64, CRASH_AT);
+    // The run stopped before integrating the lost tick; the trace is flushed up to there.
+    let reached = CRASH_AT as f64 * PERIOD;
+    assert!((num(&s, "simulated_s") - reached).abs() < 1e-12, "{s:#}");
+    assert_sampled_rows(&out, reached);
+}
+
+#[test]
+fn controller_killed_is_respawned_and_the_run_carries_on() {
+    controller_bin();
+    let dir = TempDir::new("cosim-reconnect");
+    let out = dir.join("run");
+    let mut cmd = plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=lockstep", "controller.reconnect_timeout_ms=20000", "controller.fallback=bias"]),
+    );
+    // Inherited by the respawned controller too, which the hook spares (session 2).
+    cmd.env("AMB_CONTROLLER_CRASH_AT_SEQ", CRASH_AT.to_string());
+    let run = output(&mut cmd);
+    let err = stderr(&run);
+    assert_exit(&run, 0);
+    assert!(err.contains("reconnected"), "{err}");
+
+    let s = read_json(&out.join("summary.json"));
+    let c = &s["cosim"];
+    assert_eq!(s["status"], "completed");
+    assert_eq!(event_kinds(&s), ["connected", "lost", "reconnected"]);
+    assert!(c["peer_events"][1]["detail"].as_str().unwrap().contains("bias"), "{c:#}");
+    assert_eq!(num(c, "sessions") as u64, 2);
+    assert_eq!(num(c, "messages_sent") as u64, TICKS);
+    // Every sample was answered but the one the first controller died on.
+    assert_eq!(num(c, "messages_received") as u64, TICKS - 1);
+    assert_eq!(num(c, "fallback_ticks") as u64, 1);
+    // The bias fallback is applied from the tick after the lost sample (delay 1): i_x = 0.
+    let trace = Csv::read(&out.join("trace.csv"));
+    let (t, ix) = (trace.column("t_s"), trace.column("ix_a"));
+    let row = t.iter().position(|t| (t - (CRASH_AT + 1) as f64 * PERIOD).abs() < 1e-9).unwrap() + 1;
+    assert_eq!(ix[row], 0.0, "i_x just after t = {} s", t[row]);
+    assert_sampled_rows(&out, 0.05);
+}
+
+#[cfg(unix)]
+#[test]
+fn plant_killed_makes_the_controller_exit() {
+    let id = run_id("plant-killed");
+    let dir = TempDir::new("cosim-plant-killed");
+    let mut plant =
+        Proc::spawn(&mut external_plant(&dir.join("run"), &id, &["controller.mode=lockstep", "scene.duration_s=30"]));
+    plant.wait_line("waiting up to");
+    let mut ctl = Proc::spawn(&mut controller(&id, &[]));
+    ctl.wait_line("serving run");
+    plant.signal(libc::SIGKILL);
+    let (code, log) = ctl.finish();
+    assert_eq!(code, Some(4), "controller exit code after the plant died; stderr:\n{log}");
+    assert!(log.contains("plant") && (log.contains("died") || log.contains("gone")), "{log}");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_to_the_plant_stops_both_and_flushes() {
+    controller_bin();
+    let dir = TempDir::new("cosim-sigint");
+    let out = dir.join("run");
+    let mut plant = Proc::spawn(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=lockstep", "scene.duration_s=30"]),
+    ));
+    plant.wait_line("plant: t = ");
+    plant.signal(libc::SIGINT);
+    let (code, log) = plant.finish();
+    assert_eq!(code, Some(130), "{log}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "interrupted", "{s:#}");
+    let reached = num(&s, "simulated_s");
+    assert!(reached > 0.0 && reached < 30.0, "{s:#}");
+    // The signal may land while the plant waits for a reply: at most that one is unanswered.
+    let unanswered = num(&s["cosim"], "messages_sent") - num(&s["cosim"], "messages_received");
+    assert!((0.0..=1.0).contains(&unanswered), "{s:#}");
+    assert!(!exists(controller_pid(&s)), "the controller outlived the plant");
+    assert_sampled_rows(&out, reached);
+}
+
+/// Also pins a regression: a signal that landed while the controller was
+/// blocked on its listener ended it with exit code 1 (`InterruptSignal`
+/// taken for an IPC failure) instead of telling the plant and exiting 130.
+#[cfg(unix)]
+#[test]
+fn sigterm_to_the_controller_stops_both_and_flushes() {
+    let id = run_id("sigterm-ctl");
+    let dir = TempDir::new("cosim-sigterm-ctl");
+    let out = dir.join("run");
+    let mut plant = Proc::spawn(&mut external_plant(&out, &id, &["controller.mode=lockstep", "scene.duration_s=30"]));
+    let mut ctl = Proc::spawn(&mut controller(&id, &[]));
+    ctl.wait_line("serving run");
+    plant.wait_line("plant: t = ");
+    ctl.signal(libc::SIGTERM);
+    let (ctl_code, ctl_log) = ctl.finish();
+    assert_eq!(ctl_code, Some(130), "{ctl_log}");
+    let (code, log) = plant.finish();
+    assert_eq!(code, Some(130), "{log}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "interrupted", "{s:#}");
+    assert_eq!(event_kinds(&s), ["connected", "stopped"]);
+    assert_sampled_rows(&out, num(&s, "simulated_s"));
+}
+
+#[cfg(unix)]
+#[test]
+fn leftovers_of_a_crashed_run_do_not_block_the_next() {
+    controller_bin();
+    let id = run_id("leftovers");
+    let dir = TempDir::new("cosim-leftovers");
+    {
+        let plant = Proc::spawn(&mut external_plant(
+            &dir.join("crashed"),
+            &id,
+            &["controller.mode=lockstep", "scene.duration_s=30"],
+        ));
+        let mut ctl = Proc::spawn(&mut controller(&id, &[]));
+        ctl.wait_line("serving run");
+        plant.signal(libc::SIGKILL);
+        ctl.signal(libc::SIGKILL);
+        let _ = plant.finish();
+        let _ = ctl.finish();
+    }
+    // Same run id, so the same service names as the dead pair's.
+    let out = dir.join("next");
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=lockstep"]));
+    cmd.args(["--run-id", &id]);
+    assert_exit(&output(&mut cmd), 0);
+    assert_eq!(read_json(&out.join("summary.json"))["cosim"]["run_id"], id.as_str());
+}
+
+#[test]
+fn rate_mismatch_is_refused_on_both_sides() {
+    let id = run_id("rate");
+    let dir = TempDir::new("cosim-rate");
+    let file = dir.join("ctl.toml");
+    std::fs::write(&file, "[controller]\nrate_hz = 10000.0\n").unwrap();
+    let out = dir.join("run");
+    let plant = Proc::spawn(&mut external_plant(&out, &id, &["controller.mode=lockstep"]));
+    let ctl = output(controller(&id, &["--config", file.to_str().unwrap()]).stdout(Stdio::null()));
+    let ctl_err = stderr(&ctl);
+    assert_exit(&ctl, 2);
+    assert!(ctl_err.contains("rate") && ctl_err.contains("10000") && ctl_err.contains("20000"), "{ctl_err}");
+    let (code, log) = plant.finish();
+    assert_eq!(code, Some(2), "{log}");
+    assert!(log.contains("refused") && log.contains("rate mismatch") && log.contains("10000"), "{log}");
+    assert!(!out.exists(), "a refused run wrote results");
+}
+
+#[test]
+fn controller_rejects_an_unknown_law_with_exit_2() {
+    let run = output(controller("x", &["--law", "nope"]).stdout(Stdio::null()));
+    assert_exit(&run, 2);
+    let err = stderr(&run);
+    assert!(err.contains("nope") && err.contains("pd"), "{err}");
+}
+
+#[test]
+fn controller_without_a_plant_gives_up_with_exit_4() {
+    let run = output(controller(&run_id("lonely"), &["--connect-timeout-s", "0.2"]).stdout(Stdio::null()));
+    assert_exit(&run, 4);
+    assert!(stderr(&run).contains("no hello"), "{}", stderr(&run));
+}
+
+#[test]
+fn missing_controller_executable_is_a_clear_error() {
+    let dir = TempDir::new("cosim-no-controller");
+    let lone = dir.join("plant");
+    if std::fs::hard_link(plant_bin(), &lone).is_err() {
+        std::fs::copy(plant_bin(), &lone).unwrap();
+    }
+    let out = dir.join("run");
+    let mut cmd = Command::new(&lone);
+    cmd.arg("run").arg(scene("paper-10g.toml")).arg("--out").arg(&out);
+    for s in sets(&["controller.mode=lockstep"]) {
+        cmd.args(["--set", s]);
+    }
+    let run = output(&mut cmd);
+    assert_exit(&run, 1);
+    assert!(stderr(&run).contains("cargo build --release"), "{}", stderr(&run));
+}
+
+#[test]
+fn bad_cosim_keys_name_key_value_and_unit() {
+    let dir = TempDir::new("cosim-bad-keys");
+    for (set, needles) in [
+        ("controller.fallback=maybe", &["controller.fallback", "maybe", "hold"][..]),
+        ("controller.reply_timeout_ms=-1", &["controller.reply_timeout_ms", "-1", "ms"][..]),
+        ("controller.pin_cores=[0, 99]", &["controller.pin_cores", "99"][..]),
+    ] {
+        let out = dir.join("run");
+        let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=lockstep", set])));
+        assert_exit(&run, 2);
+        for n in needles {
+            assert!(stderr(&run).contains(n), "{set}: no {n:?} in {}", stderr(&run));
+        }
+    }
+}
+
+#[test]
+fn two_pairs_run_side_by_side() {
+    controller_bin();
+    let dir = TempDir::new("cosim-pairs");
+    let outs: Vec<PathBuf> = ["a", "b"].iter().map(|n| dir.join(n)).collect();
+    let mut procs: Vec<Proc> = outs
+        .iter()
+        .map(|out| Proc::spawn(&mut plant_run(&scene("paper-10g.toml"), out, &sets(&["controller.mode=lockstep"]))))
+        .collect();
+    let results: Vec<(Option<i32>, String)> = procs.drain(..).map(Proc::finish).collect();
+    for (code, log) in &results {
+        assert_eq!(*code, Some(0), "{log}");
+    }
+    let (a, b) = (read_json(&outs[0].join("summary.json")), read_json(&outs[1].join("summary.json")));
+    assert_ne!(a["cosim"]["run_id"], b["cosim"]["run_id"]);
+    assert!(
+        std::fs::read(outs[0].join("trace.csv")).unwrap() == std::fs::read(outs[1].join("trace.csv")).unwrap(),
+        "two lockstep runs of the same scene wrote different traces"
+    );
+}
+
+#[test]
+fn realtime_controller_killed_is_respawned() {
+    controller_bin();
+    let dir = TempDir::new("cosim-rt-reconnect");
+    let out = dir.join("run");
+    let mut cmd = plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=realtime", "controller.reconnect_timeout_ms=20000", "scene.duration_s=0.5"]),
+    );
+    cmd.env("AMB_CONTROLLER_CRASH_AT_SEQ", CRASH_AT.to_string());
+    let run = output(&mut cmd);
+    assert_exit(&run, 0);
+    let s = read_json(&out.join("summary.json"));
+    let c = &s["cosim"];
+    assert_eq!(event_kinds(&s), ["connected", "lost", "reconnected"], "{c:#}");
+    // The loss is seen after the crash, at a tick the wall clock decides.
+    assert!(num(&c["peer_events"][1], "seq") as u64 > CRASH_AT, "{c:#}");
+    assert!(num(c, "fallback_ticks") >= 1.0, "{c:#}");
+    assert_eq!(num(c, "sessions") as u64, 2);
+    assert_sampled_rows(&out, 0.5);
+}
+
+/// The controller's `--config` reader knows every `[controller]` key of a
+/// scene (as law key or as plant-side key), so a scene file is a valid
+/// controller file; a key added to the plant must be added there too.
+#[test]
+fn controller_config_reader_knows_every_scene_controller_key() {
+    let raw = toml::Value::try_from(plant::config::RawController::default()).unwrap();
+    for key in raw.as_table().unwrap().keys() {
+        assert!(
+            controller::file::LAW_KEYS.contains(&key.as_str())
+                || controller::file::PLANT_SIDE_KEYS.contains(&key.as_str()),
+            "controller::file does not know [controller] key `{key}`"
+        );
+    }
+    let text = std::fs::read_to_string(scene("cosim-10g.toml")).unwrap();
+    let o = controller::file::parse(&text).unwrap();
+    assert_eq!((o.rate_hz, o.damping_ratio), (Some(20_000.0), Some(0.026)));
+}
