@@ -8,7 +8,7 @@
 //!   controller-tick grid.
 //! * Error: `|Δ − Δ_ref| / r_0` of the rotor position relative to the
 //!   housing, on the tick grid over the 50 ms after the shock (RMS and max).
-//! * Reference: DOP853 at rtol 1e-12; it is checked against DP5 at rtol
+//! * Reference: DOP853 at rtol 1e-13; it is checked against DP5 at rtol
 //!   1e-11, and the error between the two is the floor below which the
 //!   chart cannot resolve differences.
 //! * Cost: wall time of the simulation loop per simulated second (minimum
@@ -259,7 +259,7 @@ pub fn grid(quick: bool) -> Vec<(Method, Vec<Setting>)> {
 
 /// The reference of a bench scene and its floor.
 pub struct Reference {
-    /// DOP853 at rtol 1e-12.
+    /// DOP853 at rtol 1e-13.
     pub trace: Trace,
     /// Scaled error between the reference and DP5 at rtol 1e-11: (RMS, max).
     pub floor: (f64, f64),
@@ -269,7 +269,7 @@ pub struct Reference {
 
 /// Computes the reference of a scene.
 pub fn reference(b: &BenchScene) -> anyhow::Result<Reference> {
-    let r = run(&with_integrator(&b.scene, Method::Dop853, Setting::Rtol(1e-12)), &mut Quiet)?;
+    let r = run(&with_integrator(&b.scene, Method::Dop853, Setting::Rtol(1e-13)), &mut Quiet)?;
     anyhow::ensure!(
         r.outcome == Outcome::Completed,
         "{}: the DOP853 reference did not complete: {:?}",
@@ -400,11 +400,11 @@ pub fn accuracy(
     for b in scenes(config_dir)? {
         let gap = b.scene.params.contact.gap;
         let (t0, t1) = (b.window_start, b.window_start + WINDOW);
-        log(&format!("{}: reference (DOP853 rtol 1e-12, checked with DP5 rtol 1e-11)", b.name));
+        log(&format!("{}: reference (DOP853 rtol 1e-13, checked with DP5 rtol 1e-11)", b.name));
         let reference = reference(&b)?;
         report.floors.push((b.name.to_string(), reference.floor));
         log(&format!(
-            "{}: reference floor (DP5 1e-11 against DOP853 1e-12): rms {:.2e}, max {:.2e}; peak contact force {:.0} N",
+            "{}: reference floor (DP5 1e-11 against DOP853 1e-13): rms {:.2e}, max {:.2e}; peak contact force {:.0} N",
             b.name, reference.floor.0, reference.floor.1, reference.peak_contact_force
         ));
         write_reference(&out.join(format!("reference_{}.csv", b.name)), &reference.trace, t0, t1)?;
