@@ -377,6 +377,22 @@ pub struct RawInitial {
 }
 defaults!(RawInitial { unbalance_orbit: bool = true, rotor_x_um: f64 = 0.0, rotor_y_um: f64 = 0.0 });
 
+/// `[sensor]`: what the digital controller reads (sampled and co-simulation modes; the
+/// continuous PD sees the exact state). The gain is `amb.sensor_gain_v_per_m`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawSensor {
+    /// White noise added to each sample, standard deviation (V). Default 0.
+    pub noise_v_rms: f64,
+    /// Seed of the noise. Default 1.
+    pub noise_seed: u64,
+    /// ADC resolution (bits); 0 = ideal. Default 0.
+    pub adc_bits: u32,
+    /// ADC input range ±V (V). Default 10.
+    pub adc_range_v: f64,
+}
+defaults!(RawSensor { noise_v_rms: f64 = 0.0, noise_seed: u64 = 1, adc_bits: u32 = 0, adc_range_v: f64 = 10.0 });
+
 /// `[output]`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -410,6 +426,8 @@ pub struct RawScene {
     pub integrator: RawIntegrator,
     /// `[initial]`.
     pub initial: RawInitial,
+    /// `[sensor]`.
+    pub sensor: RawSensor,
     /// `[output]`.
     pub output: RawOutput,
     /// `[[shock]]`: the shock programme.
@@ -509,6 +527,8 @@ pub struct Scene {
     pub integrator: IntegratorSettings,
     /// Initial state.
     pub initial: InitialSettings,
+    /// The sensor as the digital controller reads it.
+    pub sensor: crate::sensor::SensorSettings,
     /// Trace interval (s).
     pub output_interval: f64,
     /// Write plots.
@@ -874,6 +894,16 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
             finite("initial.rotor_y_um", raw.initial.rotor_y_um, "µm")? * 1e-6,
         ],
     };
+    if raw.sensor.adc_bits > 24 {
+        return Err(range("sensor.adc_bits", raw.sensor.adc_bits, "bits", "must be between 0 (ideal) and 24"));
+    }
+    let sensor = crate::sensor::SensorSettings {
+        gain: loop_constants.sensor_gain_v_per_m,
+        noise_v: non_negative("sensor.noise_v_rms", raw.sensor.noise_v_rms, "V")?,
+        seed: raw.sensor.noise_seed,
+        adc_bits: raw.sensor.adc_bits,
+        adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
+    };
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
     let params = Params {
         gravity,
@@ -904,6 +934,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         controller,
         integrator,
         initial,
+        sensor,
         output_interval: 1.0 / output_rate,
         plots: raw.output.plots,
         raw,

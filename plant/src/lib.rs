@@ -20,6 +20,7 @@ pub mod model;
 pub mod output;
 pub mod plot;
 pub mod run;
+pub mod sensor;
 pub mod summary;
 pub mod sweep;
 pub mod trace;

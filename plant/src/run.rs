@@ -14,6 +14,7 @@ use crate::cosim::{CosimError, CosimReport, Launch, Session, Stop};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
 use crate::model::{ix, Control, Model, State};
+use crate::sensor::Sensor;
 use crate::trace::Trace;
 use controller::{build_law, saturate, ControlLaw, LawSpec, PdDesign, PdGains, Sample};
 use std::collections::VecDeque;
@@ -201,7 +202,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
     let delay = scene.controller.delay_samples.saturating_sub(inherent) as usize;
     let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
-    let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
+    let mut sensor = Sensor::new(scene.sensor);
     let guards = Guards::new(scene);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
@@ -212,7 +213,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let sample = Sample { seq: k, t_s: t0, sensor_v: [a_s * y[ix::XR], a_s * y[ix::YR]] };
+        let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
         let command = match &mut source {
             Source::Continuous => None,
             Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),

@@ -299,3 +299,37 @@ fn palmgren_drag_and_fixed_cage_run_the_shock() {
     let fixed = base(&|r| r.touchdown.cage = plant::model::Cage::Fixed);
     assert_ne!(fixed.yb_m, constant.yb_m);
 }
+
+#[test]
+fn sensor_noise_and_adc_reach_the_sampled_loop_reproducibly() {
+    // Sampled PD at 50 kHz (stable); the levitated rotor's currents follow the sensor.
+    let with = |noise: f64, bits: u32, seed: u64| {
+        let s = scene(|r| {
+            r.scene.duration_s = 0.02;
+            r.controller.mode = plant::config::ControlMode::Sampled;
+            r.controller.rate_hz = 50_000.0;
+            r.sensor.noise_v_rms = noise;
+            r.sensor.noise_seed = seed;
+            r.sensor.adc_bits = bits;
+        });
+        completed(&s).trace
+    };
+    let ideal = with(0.0, 0, 1);
+    let noisy = with(0.01, 0, 1);
+    assert_eq!(noisy.ix_a, with(0.01, 0, 1).ix_a, "same seed, same run");
+    assert_ne!(noisy.ix_a, with(0.01, 0, 2).ix_a, "another seed, another run");
+    // i = −A_a (k_p u_k + k_d (u_k − u_{k−1}) / T): white noise σ on u gives a current noise of
+    // σ √((k_p + k_d/T)² + (k_d/T)²), k_p = (k_e + k_s)/(k_i A_s), k_d = c_e/(k_i A_s).
+    let (kp, kd, period) =
+        (1.432e6 / (216.0 * 25_000.0), 2.0 * 0.01 * (1e6_f64 * 11.5).sqrt() / (216.0 * 25_000.0), 2e-5);
+    let expected = 0.01 * ((kp + kd / period).powi(2) + (kd / period).powi(2)).sqrt();
+    let dev =
+        (noisy.ix_a.iter().zip(&ideal.ix_a).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / ideal.len() as f64).sqrt();
+    assert!((dev - expected).abs() < 0.15 * expected, "current noise {dev} A, expected {expected} A");
+    // A coarse 6-bit ADC (0.31 V steps = 12.5 µm) makes the commanded current take few values.
+    let coarse = with(0.0, 6, 1);
+    let mut levels: Vec<i64> = coarse.ix_a.iter().map(|i| (i * 1e9).round() as i64).collect();
+    levels.sort_unstable();
+    levels.dedup();
+    assert!(levels.len() < 10, "{} current levels", levels.len());
+}
