@@ -1,7 +1,9 @@
 //! The control-law trait, the plant constants a law designs itself from, and
 //! the registry that builds a law by name.
 
+use crate::discrete_pd::{DelayPd, DelayPdGains};
 use crate::pd::{PdDesign, PdGains, SampledPd};
+use crate::pid::{PidDesign, PidGains, SampledPid};
 
 /// Plant constants a law needs for its design (SI units).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -57,10 +59,14 @@ pub struct LawSpec<'a> {
     pub period_s: f64,
     /// Add the gravity bias current on the y axis.
     pub gravity_bias: bool,
+    /// Amplifier current limit i_max (A), for anti-windup.
+    pub current_limit_a: f64,
+    /// Command delay d (samples): the command computed from sample k is applied from tick k + d.
+    pub delay_samples: u32,
 }
 
 /// Laws the registry knows.
-pub const LAW_NAMES: &[&str] = &["pd"];
+pub const LAW_NAMES: &[&str] = &["pd", "pid", "pd_delay"];
 
 /// Why a law could not be built.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -84,15 +90,23 @@ pub enum LawError {
 
 /// Builds the sampled law a spec names.
 pub fn build_law(spec: &LawSpec, c: &LoopConstants) -> Result<Box<dyn ControlLaw>, LawError> {
+    let design = PdDesign {
+        stiffness_n_per_m: spec.stiffness_n_per_m,
+        damping_ratio: spec.damping_ratio,
+        gravity_bias: spec.gravity_bias,
+    };
     match spec.law {
         "pd" => {
-            let design = PdDesign {
-                stiffness_n_per_m: spec.stiffness_n_per_m,
-                damping_ratio: spec.damping_ratio,
-                gravity_bias: spec.gravity_bias,
-            };
             let gains = PdGains::from_design(&design, c)?;
             Ok(Box::new(SampledPd::new(gains, spec.period_s)))
+        }
+        "pid" => {
+            let gains = PidGains::from_design(&PidDesign { pd: design, integral_time_s: None }, c)?;
+            Ok(Box::new(SampledPid::new(gains, spec.period_s, spec.current_limit_a)))
+        }
+        "pd_delay" => {
+            let gains = DelayPdGains::from_design(&design, c, spec.period_s, spec.delay_samples)?;
+            Ok(Box::new(DelayPd::new(gains, spec.period_s)))
         }
         other => Err(LawError::Unknown(other.to_string())),
     }

@@ -13,11 +13,17 @@
 //! `--config` file; the `controller` binary is the process adapter.
 #![warn(missing_docs)]
 
+pub mod discrete_pd;
 pub mod file;
 pub mod law;
 pub mod link;
 pub mod pd;
+pub mod pid;
+#[cfg(test)]
+mod test_plant;
 pub mod wire;
 
+pub use discrete_pd::{DelayPd, DelayPdGains};
 pub use law::{build_law, saturate, ControlLaw, LawError, LawSpec, LoopConstants, Sample, LAW_NAMES};
 pub use pd::{PdDesign, PdGains, SampledPd};
+pub use pid::{PidDesign, PidGains, SampledPid};

@@ -191,6 +191,8 @@ fn serve(cli: &Cli, run_id: &str, overrides: &LawOverrides) -> Result<End, Failu
         damping_ratio: overrides.damping_ratio.unwrap_or(hello.damping_ratio),
         period_s: hello.period_s,
         gravity_bias: overrides.gravity_bias.unwrap_or(hello.gravity_bias != 0),
+        current_limit_a: limit,
+        delay_samples: hello.delay_samples,
     };
     let mut law = match build_law(&spec, &hello.loop_constants()) {
         Ok(l) => l,

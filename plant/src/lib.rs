@@ -21,6 +21,7 @@ pub mod output;
 pub mod plot;
 pub mod run;
 pub mod sensor;
+pub mod stability;
 pub mod summary;
 pub mod sweep;
 pub mod trace;

@@ -252,6 +252,14 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool,
         Err(e) => return bad_input(&e),
     };
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
+    match plant::stability::check(&scene) {
+        plant::stability::Verdict::Fine => {}
+        plant::stability::Verdict::Warn(w) => eprintln!("plant: warning: {w}"),
+        plant::stability::Verdict::Refuse(why) => {
+            eprintln!("plant: error: {why}");
+            return ExitCode::from(exit::BAD_INPUT);
+        }
+    }
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();

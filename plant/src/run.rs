@@ -165,6 +165,8 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
         damping_ratio: scene.controller.damping_ratio,
         period_s: scene.controller.period,
         gravity_bias: scene.controller.gravity_bias,
+        current_limit_a: limit,
+        delay_samples: scene.controller.delay_samples,
     };
     let mut source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,

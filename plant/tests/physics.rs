@@ -333,3 +333,28 @@ fn sensor_noise_and_adc_reach_the_sampled_loop_reproducibly() {
     levels.dedup();
     assert!(levels.len() < 10, "{} current levels", levels.len());
 }
+
+#[test]
+fn rk4_blows_up_just_above_the_estimated_limit_on_the_balls_and_not_below() {
+    // The race resting on one ball under its weight is a Hertz oscillator of frequency
+    // ω = √(1.5 K_b √δ / m_b); RK4 is stable for h ω < 2√2. The plant refuses steps beyond
+    // that estimate (plant::stability); check that it is a real boundary, ±20 %.
+    let at = |factor: f64| {
+        let probe = scene(|_| {});
+        let limit = plant::stability::estimate(&probe, Method::Rk4, 0.0);
+        let s = scene(|r| {
+            r.scene.duration_s = 0.05;
+            r.rotor.eccentricity_um = 0.0;
+            r.integrator.method = Method::Rk4;
+            r.integrator.substeps = 1;
+            r.controller.rate_hz = 1.0 / (factor * limit);
+            r.output.rate_hz = r.controller.rate_hz;
+            // Nudge the race off its rest so the mode is excited.
+            r.touchdown.cage_phase_deg = -80.0;
+        });
+        assert_ne!(plant::stability::check(&s), plant::stability::Verdict::Fine, "a contact warning is expected");
+        run(&s, &mut Quiet).expect("runs").outcome
+    };
+    assert_eq!(at(0.8), Outcome::Completed);
+    assert!(matches!(at(1.2), Outcome::Diverged(_)), "stable above the estimate");
+}

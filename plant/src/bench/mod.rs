@@ -283,33 +283,7 @@ pub fn reference(b: &BenchScene) -> anyhow::Result<Reference> {
     Ok(Reference { trace: r.trace, floor, peak_contact_force: peak })
 }
 
-/// Stability estimate of a fixed-step method: the largest step `c / ω_max`, with `ω_max` the
-/// race's frequency on its contacts linearised at the reference's peak contact force (or on
-/// one ball under the race's weight without contact) and `c` the method's stability bound on
-/// the imaginary axis (symplectic Euler 2, RK4 2√2; explicit Euler has none: 0).
-pub fn stability_estimate(scene: &Scene, method: Method, peak_contact_force: f64) -> f64 {
-    let p = &scene.params;
-    let weight = p.race_mass * p.gravity;
-    let load = peak_contact_force.max(weight);
-    // Rotor – race: k = (10/9) K_r δ^(1/9) at δ = (F/K_r)^(9/10).
-    let k_r = if peak_contact_force > 0.0 {
-        let d = (load / p.contact.stiffness).powf(0.9);
-        10.0 / 9.0 * p.contact.stiffness * d.powf(1.0 / 9.0)
-    } else {
-        0.0
-    };
-    // Balls: the load on about two balls, k = 2 · 1.5 K_b δ^(1/2), δ = (F / 2K_b)^(2/3).
-    let share = if peak_contact_force > 0.0 { 2.0 } else { 1.0 };
-    let d = (load / (share * p.balls.stiffness)).powf(2.0 / 3.0);
-    let k_b = share * 1.5 * p.balls.stiffness * d.sqrt();
-    let omega = ((k_r + k_b) / p.race_mass).sqrt();
-    let c = match method {
-        Method::SymplecticEuler => 2.0,
-        Method::Rk4 => 2.0 * std::f64::consts::SQRT_2,
-        _ => 0.0,
-    };
-    c / omega
-}
+pub use crate::stability::estimate as stability_estimate;
 
 /// Largest stable substep found: the smallest substeps count (1 … 4096) for which the window
 /// runs without divergence and with a max scaled error below 1; returns (step, substeps).
