@@ -63,7 +63,7 @@
 //! The design needs a complex pole pair: `0 ≤ ξ_e < 1`.
 
 use crate::law::{ControlLaw, LawError, LoopConstants, Sample};
-use crate::pd::{PdDesign, PdGains};
+use crate::pd::{BackwardDifference, PdDesign, PdGains};
 
 /// A complex number as (re, im); just what the design needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -165,14 +165,13 @@ impl DelayPdGains {
 #[derive(Clone, Debug)]
 pub struct DelayPd {
     gains: DelayPdGains,
-    period_s: f64,
-    prev: Option<[f64; 2]>,
+    rate: BackwardDifference,
 }
 
 impl DelayPd {
     /// A delay-aware PD with the given gains and sampling period (s).
     pub fn new(gains: DelayPdGains, period_s: f64) -> Self {
-        Self { gains, period_s, prev: None }
+        Self { gains, rate: BackwardDifference::new(period_s) }
     }
 
     /// The static closed-loop stiffness (N/m) of this design.
@@ -187,17 +186,12 @@ impl ControlLaw for DelayPd {
     }
 
     fn update(&mut self, s: &Sample) -> [f64; 2] {
-        let u = s.sensor_v;
-        let u_dot = match self.prev {
-            Some(p) => [(u[0] - p[0]) / self.period_s, (u[1] - p[1]) / self.period_s],
-            None => [0.0; 2],
-        };
-        self.prev = Some(u);
-        self.gains.pd.current(u, u_dot)
+        let u_dot = self.rate.rate(s.sensor_v);
+        self.gains.pd.current(s.sensor_v, u_dot)
     }
 
     fn reset(&mut self) {
-        self.prev = None;
+        self.rate.reset();
     }
 }
 
@@ -207,16 +201,7 @@ mod tests {
     use crate::pd::SampledPd;
     use crate::test_plant::{decay_measure, simulate, AxisZoh, Rig};
 
-    fn constants() -> LoopConstants {
-        LoopConstants {
-            ki_n_per_a: 216.0,
-            ks_n_per_m: 4.32e5,
-            amp_gain_a_per_v: 1.0,
-            sensor_gain_v_per_m: 25_000.0,
-            rotor_mass_kg: 11.5,
-            gravity_m_s2: 9.80665,
-        }
-    }
+    use crate::test_plant::constants;
 
     const KE: f64 = 1e6;
     const XI: f64 = 0.01;

@@ -78,20 +78,49 @@ impl PdGains {
     }
 }
 
+/// The derivative of a sampled signal as the backward difference
+/// `u̇_k ≈ (u_k − u_{k−1}) / T` (zero at the first sample), per axis.
+#[derive(Clone, Debug)]
+pub struct BackwardDifference {
+    period_s: f64,
+    prev: Option<[f64; 2]>,
+}
+
+impl BackwardDifference {
+    /// A differencer for sampling period `period_s` (s).
+    pub fn new(period_s: f64) -> Self {
+        Self { period_s, prev: None }
+    }
+
+    /// The rate of `u` at this sample; remembers `u` for the next.
+    #[inline]
+    pub fn rate(&mut self, u: [f64; 2]) -> [f64; 2] {
+        let r = match self.prev {
+            Some(p) => [(u[0] - p[0]) / self.period_s, (u[1] - p[1]) / self.period_s],
+            None => [0.0; 2],
+        };
+        self.prev = Some(u);
+        r
+    }
+
+    /// Forgets the previous sample.
+    pub fn reset(&mut self) {
+        self.prev = None;
+    }
+}
+
 /// The PD law naively sampled: the derivative is the backward difference of
-/// the sampled sensor voltage, `u̇_k ≈ (u_k − u_{k−1}) / T` (zero at the first
-/// sample).
+/// the sampled sensor voltage (see [`BackwardDifference`]).
 #[derive(Clone, Debug)]
 pub struct SampledPd {
     gains: PdGains,
-    period_s: f64,
-    prev: Option<[f64; 2]>,
+    rate: BackwardDifference,
 }
 
 impl SampledPd {
     /// A sampled PD with the given gains and sampling period (s).
     pub fn new(gains: PdGains, period_s: f64) -> Self {
-        Self { gains, period_s, prev: None }
+        Self { gains, rate: BackwardDifference::new(period_s) }
     }
 }
 
@@ -101,17 +130,12 @@ impl ControlLaw for SampledPd {
     }
 
     fn update(&mut self, s: &Sample) -> [f64; 2] {
-        let u = s.sensor_v;
-        let u_dot = match self.prev {
-            Some(p) => [(u[0] - p[0]) / self.period_s, (u[1] - p[1]) / self.period_s],
-            None => [0.0; 2],
-        };
-        self.prev = Some(u);
-        self.gains.current(u, u_dot)
+        let u_dot = self.rate.rate(s.sensor_v);
+        self.gains.current(s.sensor_v, u_dot)
     }
 
     fn reset(&mut self) {
-        self.prev = None;
+        self.rate.reset();
     }
 }
 
@@ -119,16 +143,7 @@ impl ControlLaw for SampledPd {
 mod tests {
     use super::*;
 
-    fn constants() -> LoopConstants {
-        LoopConstants {
-            ki_n_per_a: 216.0,
-            ks_n_per_m: 4.32e5,
-            amp_gain_a_per_v: 1.0,
-            sensor_gain_v_per_m: 25_000.0,
-            rotor_mass_kg: 11.5,
-            gravity_m_s2: 9.80665,
-        }
-    }
+    use crate::test_plant::constants;
 
     #[test]
     fn gains_reproduce_stiffness_damping_and_bias() {

@@ -41,7 +41,7 @@
 //! limit as soon as the error reverses.
 
 use crate::law::{ControlLaw, LawError, LoopConstants, Sample};
-use crate::pd::{PdDesign, PdGains};
+use crate::pd::{BackwardDifference, PdDesign, PdGains};
 
 /// A PID design: the PD design and an integral time constant.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,14 +98,21 @@ pub struct SampledPid {
     period_s: f64,
     limit_a: f64,
     anti_windup: bool,
-    prev: Option<[f64; 2]>,
+    rate: BackwardDifference,
     integral: [f64; 2],
 }
 
 impl SampledPid {
     /// A sampled PID with the given gains, period (s) and current limit (A).
     pub fn new(gains: PidGains, period_s: f64, limit_a: f64) -> Self {
-        Self { gains, period_s, limit_a, anti_windup: true, prev: None, integral: [0.0; 2] }
+        Self {
+            gains,
+            period_s,
+            limit_a,
+            anti_windup: true,
+            rate: BackwardDifference::new(period_s),
+            integral: [0.0; 2],
+        }
     }
 
     /// The same law with the integral never held (for comparison only: it
@@ -129,11 +136,7 @@ impl ControlLaw for SampledPid {
     fn update(&mut self, s: &Sample) -> [f64; 2] {
         let u = s.sensor_v;
         let t = self.period_s;
-        let u_dot = match self.prev {
-            Some(p) => [(u[0] - p[0]) / t, (u[1] - p[1]) / t],
-            None => [0.0; 2],
-        };
-        self.prev = Some(u);
+        let u_dot = self.rate.rate(u);
         let pd = self.gains.pd.current(u, u_dot);
         let a = self.gains.pd.amp_gain_a_per_v * self.gains.ki;
         let mut out = [0.0; 2];
@@ -152,7 +155,7 @@ impl ControlLaw for SampledPid {
     }
 
     fn reset(&mut self) {
-        self.prev = None;
+        self.rate.reset();
         self.integral = [0.0; 2];
     }
 }
@@ -163,16 +166,7 @@ mod tests {
     use crate::law::saturate;
     use crate::test_plant::{simulate, Rig};
 
-    fn constants() -> LoopConstants {
-        LoopConstants {
-            ki_n_per_a: 216.0,
-            ks_n_per_m: 4.32e5,
-            amp_gain_a_per_v: 1.0,
-            sensor_gain_v_per_m: 25_000.0,
-            rotor_mass_kg: 11.5,
-            gravity_m_s2: 9.80665,
-        }
-    }
+    use crate::test_plant::constants;
 
     fn design(xi: f64, gravity_bias: bool) -> PidDesign {
         PidDesign { pd: PdDesign { stiffness_n_per_m: 1e6, damping_ratio: xi, gravity_bias }, integral_time_s: None }
