@@ -62,6 +62,24 @@ enum Command {
         #[command(subcommand)]
         what: BenchCommand,
     },
+    /// Sampled against continuous PD: the scene with the continuous law and sampled at each
+    /// rate (in-process and over iceoryx2); writes compare.csv and overlaid plots.
+    Compare {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Controller rates, e.g. `5k,10k,20k,50k`.
+        #[arg(long, default_value = "5k,10k,20k,50k", value_parser = plant::compare::parse_rates)]
+        rates: std::vec::Vec<f64>,
+        /// Output folder (default: runs/compare-<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene key (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Skip the lockstep (controller process) runs.
+        #[arg(long)]
+        no_cosim: bool,
+    },
     /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
     /// classification; updates summary.json and writes the analysis plots.
     Analyze {
@@ -214,6 +232,7 @@ impl Hooks for CliHooks {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     match cli.command {
         Command::Run { scene, out, set, quiet, controller, run_id } => {
             run_scene(scene, out, set, quiet, controller.launch(run_id))
@@ -222,6 +241,22 @@ fn main() -> ExitCode {
             bench_ipc(samples, warmup, pin_cores, spin_us, controller.launch(run_id))
         }
         Command::Analyze { dir } => analyze_dir(&dir),
+        Command::Compare { scene, rates, out, set, no_cosim } => {
+            let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")));
+            match plant::compare::compare(&scene, &set, &rates, !no_cosim, &dir, &mut |l| {
+                eprintln!("plant compare: {l}")
+            }) {
+                Ok(_) => {
+                    eprintln!("plant compare: wrote {}", dir.join("compare.csv").display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("plant: error: {e:#}");
+                    ExitCode::from(if e.downcast_ref::<ConfigError>().is_some() { exit::BAD_INPUT } else { exit::IO })
+                }
+            }
+        }
         Command::Bench { what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python } } => {
             let peer = peer.then(|| plant::bench::Peer {
                 script: config.join("..").join("bench").join("peer").join("run_peer.py"),
@@ -251,7 +286,6 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool,
         Ok(s) => s,
         Err(e) => return bad_input(&e),
     };
-    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     match plant::stability::check(&scene) {
         plant::stability::Verdict::Fine => {}
         plant::stability::Verdict::Warn(w) => eprintln!("plant: warning: {w}"),

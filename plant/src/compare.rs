@@ -1,0 +1,282 @@
+//! Sampled against continuous control (`plant compare`): the same scene with
+//! the continuous PD (the study's setup) and with the law sampled at each
+//! rate, in-process and over iceoryx2 (lockstep).
+//!
+//! Per run: the deviation from the continuous run (rotor displacement,
+//! RMS and max over the first 100 ms after the shock), the effective damping
+//! ratio of the levitated loop from a free decay (a separate run: no shock,
+//! no unbalance, 20 µm initial offset; log decrement of the peaks), the time
+//! to recover (from the shock start to the last rotor – race contact) and the
+//! post-shock mode.
+
+use crate::config::{load_scene, Scene};
+use crate::plot::{self, PointGroup, Scale, Series};
+use crate::run::{run, Outcome, Quiet, RunResult};
+use crate::summary::Summary;
+use anyhow::Context;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Window after the shock for the deviation (s).
+pub const WINDOW: f64 = 0.1;
+
+/// One compared configuration.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Controller rate (Hz); 0 for the continuous run.
+    pub rate_hz: f64,
+    /// `continuous`, `sampled` or `lockstep`.
+    pub mode: &'static str,
+    /// How the run ended.
+    pub status: String,
+    /// RMS deviation of the rotor displacement from the continuous run (m).
+    pub rms_dev_m: f64,
+    /// Max deviation (m).
+    pub max_dev_m: f64,
+    /// Damping ratio of the levitated loop measured from a free decay.
+    pub damping_ratio: f64,
+    /// Time from the shock start to the last contact (s); NaN if still in contact at the end.
+    pub recover_s: f64,
+    /// Post-shock mode.
+    pub post_shock_mode: String,
+}
+
+fn with(path: &Path, base: &[String], extra: &[String]) -> anyhow::Result<Scene> {
+    let mut sets = base.to_vec();
+    sets.extend_from_slice(extra);
+    Ok(load_scene(path, &sets)?)
+}
+
+fn shock_start(scene: &Scene) -> f64 {
+    scene.base.breakpoints().first().copied().unwrap_or(0.0)
+}
+
+/// Damping ratio from the peaks of a decaying oscillation `x(t)`.
+pub fn damping_from_decay(t: &[f64], x: &[f64]) -> f64 {
+    let peaks: Vec<(f64, f64)> = (1..x.len().saturating_sub(1))
+        .filter(|&i| x[i] > x[i - 1] && x[i] >= x[i + 1] && x[i] > 0.0)
+        .map(|i| (t[i], x[i]))
+        .collect();
+    if peaks.len() < 3 {
+        return f64::NAN;
+    }
+    let n = peaks.len() - 1;
+    let delta = (peaks[0].1 / peaks[n].1).ln() / n as f64;
+    delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt()
+}
+
+fn recover_time(r: &RunResult, start: f64) -> f64 {
+    let tr = &r.trace;
+    let last = tr.contact_force_n.iter().rposition(|f| *f > 0.0);
+    match last {
+        None => 0.0,
+        Some(i) if i + 1 >= tr.len() => f64::NAN,
+        Some(i) => tr.t_s[i] - start,
+    }
+}
+
+fn deviation(r: &RunResult, reference: &RunResult, start: f64) -> (f64, f64) {
+    let (a, b) = (&r.trace, &reference.trace);
+    let (mut sum, mut max, mut n) = (0.0, 0.0_f64, 0usize);
+    for i in 0..a.len().min(b.len()) {
+        let t = b.t_s[i];
+        if t < start || t > start + WINDOW || (a.t_s[i] - t).abs() > 1e-9 {
+            continue;
+        }
+        let d = (a.dx_m[i] - b.dx_m[i]).hypot(a.dy_m[i] - b.dy_m[i]);
+        sum += d * d;
+        max = max.max(d);
+        n += 1;
+    }
+    if n == 0 || r.outcome != Outcome::Completed {
+        (f64::INFINITY, f64::INFINITY)
+    } else {
+        ((sum / n as f64).sqrt(), max)
+    }
+}
+
+/// Runs the comparison and writes `compare.csv` and the plots into `out`.
+pub fn compare(
+    scene_path: &Path,
+    sets: &[String],
+    rates: &[f64],
+    cosim: bool,
+    out: &Path,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<Row>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let continuous = with(scene_path, &base, &["controller.mode=\"continuous\"".into()])?;
+    let start = shock_start(&continuous);
+    // All traces on the same grid: the output rate of the scene.
+    let reference = run(&continuous, &mut Quiet)?;
+    let decay_sets = |extra: &[String]| -> Vec<String> {
+        let mut v = extra.to_vec();
+        v.extend([
+            "rotor.eccentricity_um=0.0".to_string(),
+            "initial.rotor_x_um=20.0".to_string(),
+            format!("scene.duration_s={:?}", 0.6),
+        ]);
+        v.extend(continuous.raw.shock.iter().enumerate().map(|(i, _)| format!("shock[{i}].start_s=1000.0")));
+        v
+    };
+    let decay = |scene_sets: &[String]| -> anyhow::Result<f64> {
+        let s = with(scene_path, &base, &decay_sets(scene_sets))?;
+        let r = run(&s, &mut Quiet)?;
+        // Only the part before any contact: a growing oscillation that reaches the race is capped
+        // by it, which would fake the estimate.
+        let tr = &r.trace;
+        let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
+        Ok(damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]))
+    };
+    let row = |rate: f64, mode: &'static str, r: &RunResult, scene: &Scene, xi: f64| {
+        let (rms, max) = if mode == "continuous" { (0.0, 0.0) } else { deviation(r, &reference, start) };
+        let s = Summary::new(scene, r);
+        Row {
+            rate_hz: rate,
+            mode,
+            status: s.status.to_string(),
+            rms_dev_m: rms,
+            max_dev_m: max,
+            damping_ratio: xi,
+            recover_s: recover_time(r, start),
+            post_shock_mode: serde_json::to_value(s.analysis.post_shock_mode)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_owned))
+                .unwrap_or_default(),
+        }
+    };
+    let mut rows =
+        vec![row(0.0, "continuous", &reference, &continuous, decay(&["controller.mode=\"continuous\"".into()])?)];
+    log(&format!("continuous: damping ratio {:.4}", rows[0].damping_ratio));
+    let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone_trace())];
+    let modes: Vec<&'static str> = if cosim { vec!["sampled", "lockstep"] } else { vec!["sampled"] };
+    for &rate in rates {
+        for &mode in &modes {
+            let extra = vec![format!("controller.mode=\"{mode}\""), format!("controller.rate_hz={rate:?}")];
+            let scene = with(scene_path, &base, &extra)?;
+            let r = run(&scene, &mut Quiet)?;
+            let xi = if mode == "sampled" { decay(&extra)? } else { rows.last().map_or(f64::NAN, |r| r.damping_ratio) };
+            let rw = row(rate, mode, &r, &scene, xi);
+            log(&format!(
+                "{mode} at {rate} Hz: {}, deviation rms {:.2e} m max {:.2e} m, damping ratio {:.4}, recovered after {:.4} s, {}",
+                rw.status, rw.rms_dev_m, rw.max_dev_m, rw.damping_ratio, rw.recover_s, rw.post_shock_mode
+            ));
+            rows.push(rw);
+            if mode == "sampled" {
+                traces.push((format!("sampled {} kHz", rate / 1e3), r));
+            }
+        }
+    }
+    write_csv(&out.join("compare.csv"), &rows)?;
+    plots(out, &traces, start, continuous.params.contact.gap, &continuous.name)?;
+    Ok(rows)
+}
+
+impl RunResult {
+    fn clone_trace(&self) -> RunResult {
+        RunResult {
+            trace: self.trace.clone(),
+            stats: self.stats,
+            simulated: self.simulated,
+            wall_time: self.wall_time,
+            outcome: self.outcome.clone(),
+            final_state: self.final_state,
+            cosim: None,
+        }
+    }
+}
+
+fn write_csv(path: &PathBuf, rows: &[Row]) -> anyhow::Result<()> {
+    let mut s = String::from("rate_hz,mode,status,rms_dev_m,max_dev_m,damping_ratio,recover_s,post_shock_mode\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{},{:e},{:e},{:e},{:e},{}",
+            r.rate_hz, r.mode, r.status, r.rms_dev_m, r.max_dev_m, r.damping_ratio, r.recover_s, r.post_shock_mode
+        );
+    }
+    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
+}
+
+/// The first [`WINDOW`] after the shock of one run, in ms and µm.
+struct Window {
+    t_ms: Vec<f64>,
+    radius_um: Vec<f64>,
+    x_um: Vec<f64>,
+    y_um: Vec<f64>,
+}
+
+impl Window {
+    fn of(r: &RunResult, start: f64) -> Self {
+        let tr = &r.trace;
+        let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start && tr.t_s[i] <= start + WINDOW).collect();
+        Window {
+            t_ms: idx.iter().map(|&i| (tr.t_s[i] - start) * 1e3).collect(),
+            radius_um: idx.iter().map(|&i| tr.dx_m[i].hypot(tr.dy_m[i]) * 1e6).collect(),
+            x_um: idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
+            y_um: idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+        }
+    }
+}
+
+fn plots(out: &Path, traces: &[(String, RunResult)], start: f64, gap: f64, name: &str) -> anyhow::Result<()> {
+    let data: Vec<(String, Window)> = traces.iter().map(|(l, r)| (l.clone(), Window::of(r, start))).collect();
+    let radius: Vec<Series> = data.iter().map(|(l, d)| Series { label: l, x: &d.t_ms, y: &d.radius_um }).collect();
+    plot::lines(
+        &out.join("compare_radius.png"),
+        &format!("{name}: rotor radius, first {:.0} ms after the shock (air gap {:.0} µm)", WINDOW * 1e3, gap * 1e6),
+        "time after the shock (ms)",
+        "radius (µm)",
+        &radius,
+        Scale::Linear,
+    )?;
+    let orbits: Vec<PointGroup> = data.iter().map(|(l, d)| PointGroup { label: l, x: &d.x_um, y: &d.y_um }).collect();
+    plot::scatter(
+        &out.join("compare_orbit.png"),
+        &format!("{name}: orbits, first {:.0} ms after the shock", WINDOW * 1e3),
+        "x (µm)",
+        "y (µm)",
+        &orbits,
+        true,
+    )?;
+    Ok(())
+}
+
+/// Parses `5k,10k,20000` into rates in Hz.
+pub fn parse_rates(text: &str) -> Result<Vec<f64>, String> {
+    text.split(',')
+        .map(|r| {
+            let r = r.trim();
+            let (num, scale) = match r.strip_suffix(['k', 'K']) {
+                Some(n) => (n, 1e3),
+                None => (r, 1.0),
+            };
+            match num.parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
+                _ => Err(format!("--rates: `{r}` is not a rate in Hz (e.g. 20k or 20000)")),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rates_with_k_suffix() {
+        assert_eq!(parse_rates("5k,10K, 20000").unwrap(), vec![5e3, 1e4, 2e4]);
+        assert!(parse_rates("5k,x").unwrap_err().contains("`x`"));
+        assert!(parse_rates("-1").is_err());
+    }
+
+    #[test]
+    fn damping_from_a_known_decay() {
+        let (xi, wn) = (0.02_f64, 300.0_f64);
+        let wd = wn * (1.0 - xi * xi).sqrt();
+        let t: Vec<f64> = (0..20_000).map(|i| i as f64 * 2e-5).collect();
+        let x: Vec<f64> = t.iter().map(|t| (-xi * wn * t).exp() * (wd * t).cos()).collect();
+        assert!((damping_from_decay(&t, &x) - xi).abs() < 1e-4);
+    }
+}
