@@ -280,3 +280,114 @@ mod tests {
         assert!((damping_from_decay(&t, &x) - xi).abs() < 1e-4);
     }
 }
+
+/// One point of a stability map.
+#[derive(Clone, Debug)]
+pub struct MapPoint {
+    /// `rate_damping` or `rate_delay`.
+    pub map: &'static str,
+    /// Controller rate (Hz).
+    pub rate_hz: f64,
+    /// Design damping ratio or delay in samples.
+    pub value: f64,
+    /// Damping ratio measured on the free decay (NaN if it diverged).
+    pub damping_measured: f64,
+    /// `unstable`, or `stable (<post-shock mode>)`.
+    pub class: String,
+}
+
+/// Stability maps of the sampled law: rate × design damping ratio and rate × delay (samples).
+/// A point is unstable when its free decay grows (or diverges); a stable point is labelled
+/// with the post-shock mode of the scene run at that setting.
+pub fn stability_maps(
+    scene_path: &Path,
+    sets: &[String],
+    rates: &[f64],
+    out: &Path,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<MapPoint>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let probe = with(scene_path, &base, &[])?;
+    let shocks = probe.raw.shock.len();
+    let mut points = Vec::new();
+    let grids: [(&'static str, &'static str, Vec<f64>); 2] = [
+        ("rate_damping", "controller.damping_ratio", vec![0.005, 0.01, 0.02, 0.03, 0.05, 0.1]),
+        ("rate_delay", "controller.delay_samples", vec![0.0, 1.0, 2.0, 3.0]),
+    ];
+    for (map, key, values) in grids {
+        for &rate in rates {
+            for &v in &values {
+                let value = if key.ends_with("delay_samples") { format!("{}", v as u32) } else { format!("{v:?}") };
+                let extra = vec![
+                    "controller.mode=\"sampled\"".to_string(),
+                    format!("controller.rate_hz={rate:?}"),
+                    format!("{key}={value}"),
+                ];
+                let mut decay_sets = extra.clone();
+                decay_sets.extend([
+                    "rotor.eccentricity_um=0.0".to_string(),
+                    "initial.rotor_x_um=20.0".to_string(),
+                    "scene.duration_s=0.6".to_string(),
+                ]);
+                decay_sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
+                let decay = run(&with(scene_path, &base, &decay_sets)?, &mut Quiet)?;
+                let tr = &decay.trace;
+                let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
+                let xi = if decay.outcome == Outcome::Completed || free < tr.len() {
+                    damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free])
+                } else {
+                    f64::NAN
+                };
+                let class = if xi.is_nan() || xi <= 0.0 || free < tr.len() {
+                    "unstable".to_string()
+                } else {
+                    let scene = with(scene_path, &base, &extra)?;
+                    let r = run(&scene, &mut Quiet)?;
+                    let s = Summary::new(&scene, &r);
+                    if r.outcome == Outcome::Completed {
+                        format!(
+                            "stable ({})",
+                            serde_json::to_value(s.analysis.post_shock_mode)
+                                .ok()
+                                .and_then(|v| v.as_str().map(str::to_owned))
+                                .unwrap_or_default()
+                        )
+                    } else {
+                        "stable (diverged after the shock)".to_string()
+                    }
+                };
+                log(&format!("{map}: {rate} Hz, {key} = {value}: measured damping {xi:.4}, {class}"));
+                points.push(MapPoint { map, rate_hz: rate, value: v, damping_measured: xi, class });
+            }
+        }
+    }
+    let mut csv = String::from("map,rate_hz,value,damping_measured,class\n");
+    for p in &points {
+        let _ = writeln!(csv, "{},{},{},{:e},{}", p.map, p.rate_hz, p.value, p.damping_measured, p.class);
+    }
+    std::fs::write(out.join("stability_map.csv"), csv).context("writing stability_map.csv")?;
+    for (map, ylabel) in [("rate_damping", "design damping ratio ξ_e"), ("rate_delay", "delay (samples)")] {
+        let mut classes: Vec<String> = points.iter().filter(|p| p.map == map).map(|p| p.class.clone()).collect();
+        classes.sort();
+        classes.dedup();
+        let groups_data: Vec<(String, Vec<f64>, Vec<f64>)> = classes
+            .iter()
+            .map(|c| {
+                let sel: Vec<&MapPoint> = points.iter().filter(|p| p.map == map && &p.class == c).collect();
+                (c.clone(), sel.iter().map(|p| p.rate_hz / 1e3).collect(), sel.iter().map(|p| p.value).collect())
+            })
+            .collect();
+        let groups: Vec<PointGroup> =
+            groups_data.iter().map(|g| PointGroup { label: &g.0, x: &g.1, y: &g.2 }).collect();
+        plot::scatter(
+            &out.join(format!("stability_{map}.png")),
+            &format!("{}: sampled {} — stability by rate and {}", probe.name, probe.controller.law, ylabel),
+            "controller rate (kHz)",
+            ylabel,
+            &groups,
+            false,
+        )?;
+    }
+    Ok(points)
+}

@@ -79,6 +79,9 @@ enum Command {
         /// Skip the lockstep (controller process) runs.
         #[arg(long)]
         no_cosim: bool,
+        /// Also draw the stability maps (rate × damping ratio, rate × delay).
+        #[arg(long)]
+        maps: bool,
     },
     /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
     /// classification; updates summary.json and writes the analysis plots.
@@ -241,12 +244,17 @@ fn main() -> ExitCode {
             bench_ipc(samples, warmup, pin_cores, spin_us, controller.launch(run_id))
         }
         Command::Analyze { dir } => analyze_dir(&dir),
-        Command::Compare { scene, rates, out, set, no_cosim } => {
+        Command::Compare { scene, rates, out, set, no_cosim, maps } => {
             let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")));
-            match plant::compare::compare(&scene, &set, &rates, !no_cosim, &dir, &mut |l| {
-                eprintln!("plant compare: {l}")
-            }) {
+            let mut log = |l: &str| eprintln!("plant compare: {l}");
+            let result = plant::compare::compare(&scene, &set, &rates, !no_cosim, &dir, &mut log).and_then(|rows| {
+                if maps {
+                    plant::compare::stability_maps(&scene, &set, &rates, &dir, &mut log)?;
+                }
+                Ok(rows)
+            });
+            match result {
                 Ok(_) => {
                     eprintln!("plant compare: wrote {}", dir.join("compare.csv").display());
                     ExitCode::SUCCESS

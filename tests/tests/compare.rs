@@ -15,7 +15,7 @@ fn compare_reports_deviation_damping_and_mode_per_rate() {
         Command::new(plant_bin())
             .arg("compare")
             .arg(scene("paper-10g.toml"))
-            .args(["--rates", "20k,50k", "--out"])
+            .args(["--rates", "20k,50k", "--maps", "--out"])
             .arg(&out)
             .args(["--set", "scene.duration_s=0.04", "--set", "shock[0].start_s=0.01"]),
     );
@@ -46,6 +46,23 @@ fn compare_reports_deviation_damping_and_mode_per_rate() {
     // The sampled runs deviate from the continuous one.
     assert!(num(&rows[1], "max_dev_m") > 0.0);
     for png in ["compare_radius.png", "compare_orbit.png"] {
+        assert!(std::fs::read(out.join(png)).unwrap_or_default().starts_with(b"\x89PNG"), "{png}");
+    }
+    // Stability maps: at 20 kHz with one sample of delay the naive PD needs more design damping
+    // than the study's 0.01; without the delay it holds 0.01; each extra sample costs more.
+    let map = std::fs::read_to_string(out.join("stability_map.csv")).expect("stability_map.csv");
+    let class = |m: &str, rate: &str, value: &str| {
+        map.lines()
+            .find(|l| l.starts_with(&format!("{m},{rate},{value},")))
+            .and_then(|l| l.rsplit(',').next())
+            .unwrap_or_else(|| panic!("no map point {m} {rate} {value}"))
+            .to_string()
+    };
+    assert_eq!(class("rate_damping", "20000", "0.01"), "unstable");
+    assert!(class("rate_damping", "20000", "0.05").starts_with("stable"));
+    assert!(class("rate_delay", "20000", "0").starts_with("stable"));
+    assert_eq!(class("rate_delay", "20000", "2"), "unstable");
+    for png in ["stability_rate_damping.png", "stability_rate_delay.png"] {
         assert!(std::fs::read(out.join(png)).unwrap_or_default().starts_with(b"\x89PNG"), "{png}");
     }
 }
