@@ -12,7 +12,7 @@
 use crate::config::{load_scene, Scene};
 use crate::plot::{self, PointGroup, Scale, Series};
 use crate::run::{run, Outcome, Quiet, RunResult};
-use crate::summary::Summary;
+use crate::summary::{snake_name, Summary};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -47,10 +47,6 @@ fn with(path: &Path, base: &[String], extra: &[String]) -> anyhow::Result<Scene>
     Ok(load_scene(path, &sets)?)
 }
 
-fn shock_start(scene: &Scene) -> f64 {
-    scene.base.breakpoints().first().copied().unwrap_or(0.0)
-}
-
 /// Damping ratio from the peaks of a decaying oscillation `x(t)`.
 pub fn damping_from_decay(t: &[f64], x: &[f64]) -> f64 {
     let peaks: Vec<(f64, f64)> = (1..x.len().saturating_sub(1))
@@ -75,24 +71,36 @@ fn recover_time(r: &RunResult, start: f64) -> f64 {
     }
 }
 
+/// Distance of the rotor displacement from the reference's over the window (m): (RMS, max);
+/// infinite for a run that did not complete.
 fn deviation(r: &RunResult, reference: &RunResult, start: f64) -> (f64, f64) {
-    let (a, b) = (&r.trace, &reference.trace);
-    let (mut sum, mut max, mut n) = (0.0, 0.0_f64, 0usize);
-    for i in 0..a.len().min(b.len()) {
-        let t = b.t_s[i];
-        if t < start || t > start + WINDOW || (a.t_s[i] - t).abs() > 1e-9 {
-            continue;
-        }
-        let d = (a.dx_m[i] - b.dx_m[i]).hypot(a.dy_m[i] - b.dy_m[i]);
-        sum += d * d;
-        max = max.max(d);
-        n += 1;
+    if r.outcome != Outcome::Completed {
+        return (f64::INFINITY, f64::INFINITY);
     }
-    if n == 0 || r.outcome != Outcome::Completed {
-        (f64::INFINITY, f64::INFINITY)
-    } else {
-        ((sum / n as f64).sqrt(), max)
-    }
+    crate::bench::window_error(&r.trace, &reference.trace, start, start + WINDOW, 1.0)
+}
+
+/// A free decay of the levitated loop: 20 µm initial offset, no unbalance, the shocks moved
+/// past its end, 0.6 s. Returns the damping ratio of the part before any rotor – race contact
+/// (a growing oscillation that reaches the race is capped by it, which would fake the
+/// estimate), whether a contact happened, and whether the run completed.
+fn free_decay(
+    scene_path: &Path,
+    base: &[String],
+    extra: &[String],
+    shocks: usize,
+) -> anyhow::Result<(f64, bool, bool)> {
+    let mut sets = extra.to_vec();
+    sets.extend([
+        "rotor.eccentricity_um=0.0".to_string(),
+        "initial.rotor_x_um=20.0".to_string(),
+        "scene.duration_s=0.6".to_string(),
+    ]);
+    sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
+    let r = run(&with(scene_path, base, &sets)?, &mut Quiet)?;
+    let tr = &r.trace;
+    let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
+    Ok((damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]), free < tr.len(), r.outcome == Outcome::Completed))
 }
 
 /// Runs the comparison and writes `compare.csv` and the plots into `out`.
@@ -107,28 +115,11 @@ pub fn compare(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
     let continuous = with(scene_path, &base, &["controller.mode=\"continuous\"".into()])?;
-    let start = shock_start(&continuous);
+    let start = continuous.first_shock_start();
     // All traces on the same grid: the output rate of the scene.
     let reference = run(&continuous, &mut Quiet)?;
-    let decay_sets = |extra: &[String]| -> Vec<String> {
-        let mut v = extra.to_vec();
-        v.extend([
-            "rotor.eccentricity_um=0.0".to_string(),
-            "initial.rotor_x_um=20.0".to_string(),
-            format!("scene.duration_s={:?}", 0.6),
-        ]);
-        v.extend(continuous.raw.shock.iter().enumerate().map(|(i, _)| format!("shock[{i}].start_s=1000.0")));
-        v
-    };
-    let decay = |scene_sets: &[String]| -> anyhow::Result<f64> {
-        let s = with(scene_path, &base, &decay_sets(scene_sets))?;
-        let r = run(&s, &mut Quiet)?;
-        // Only the part before any contact: a growing oscillation that reaches the race is capped
-        // by it, which would fake the estimate.
-        let tr = &r.trace;
-        let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
-        Ok(damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]))
-    };
+    let shocks = continuous.raw.shock.len();
+    let decay = |extra: &[String]| free_decay(scene_path, &base, extra, shocks).map(|(xi, _, _)| xi);
     let row = |rate: f64, mode: &'static str, r: &RunResult, scene: &Scene, xi: f64| {
         let (rms, max) = if mode == "continuous" { (0.0, 0.0) } else { deviation(r, &reference, start) };
         let s = Summary::new(scene, r);
@@ -140,16 +131,13 @@ pub fn compare(
             max_dev_m: max,
             damping_ratio: xi,
             recover_s: recover_time(r, start),
-            post_shock_mode: serde_json::to_value(s.analysis.post_shock_mode)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_owned))
-                .unwrap_or_default(),
+            post_shock_mode: snake_name(&s.analysis.post_shock_mode),
         }
     };
     let mut rows =
         vec![row(0.0, "continuous", &reference, &continuous, decay(&["controller.mode=\"continuous\"".into()])?)];
     log(&format!("continuous: damping ratio {:.4}", rows[0].damping_ratio));
-    let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone_trace())];
+    let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone())];
     let modes: Vec<&'static str> = if cosim { vec!["sampled", "lockstep"] } else { vec!["sampled"] };
     for &rate in rates {
         for &mode in &modes {
@@ -171,20 +159,6 @@ pub fn compare(
     write_csv(&out.join("compare.csv"), &rows)?;
     plots(out, &traces, start, continuous.params.contact.gap, &continuous.name)?;
     Ok(rows)
-}
-
-impl RunResult {
-    fn clone_trace(&self) -> RunResult {
-        RunResult {
-            trace: self.trace.clone(),
-            stats: self.stats,
-            simulated: self.simulated,
-            wall_time: self.wall_time,
-            outcome: self.outcome.clone(),
-            final_state: self.final_state,
-            cosim: None,
-        }
-    }
 }
 
 fn write_csv(path: &PathBuf, rows: &[Row]) -> anyhow::Result<()> {
@@ -324,35 +298,16 @@ pub fn stability_maps(
                     format!("controller.rate_hz={rate:?}"),
                     format!("{key}={value}"),
                 ];
-                let mut decay_sets = extra.clone();
-                decay_sets.extend([
-                    "rotor.eccentricity_um=0.0".to_string(),
-                    "initial.rotor_x_um=20.0".to_string(),
-                    "scene.duration_s=0.6".to_string(),
-                ]);
-                decay_sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
-                let decay = run(&with(scene_path, &base, &decay_sets)?, &mut Quiet)?;
-                let tr = &decay.trace;
-                let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
-                let xi = if decay.outcome == Outcome::Completed || free < tr.len() {
-                    damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free])
-                } else {
-                    f64::NAN
-                };
-                let class = if xi.is_nan() || xi <= 0.0 || free < tr.len() {
+                let (decay_xi, touched, completed) = free_decay(scene_path, &base, &extra, shocks)?;
+                let xi = if completed || touched { decay_xi } else { f64::NAN };
+                let class = if xi.is_nan() || xi <= 0.0 || touched {
                     "unstable".to_string()
                 } else {
                     let scene = with(scene_path, &base, &extra)?;
                     let r = run(&scene, &mut Quiet)?;
                     let s = Summary::new(&scene, &r);
                     if r.outcome == Outcome::Completed {
-                        format!(
-                            "stable ({})",
-                            serde_json::to_value(s.analysis.post_shock_mode)
-                                .ok()
-                                .and_then(|v| v.as_str().map(str::to_owned))
-                                .unwrap_or_default()
-                        )
+                        format!("stable ({})", snake_name(&s.analysis.post_shock_mode))
                     } else {
                         "stable (diverged after the shock)".to_string()
                     }

@@ -537,6 +537,13 @@ pub struct Scene {
     pub raw: RawScene,
 }
 
+impl Scene {
+    /// When the base motion first starts (s): the first breakpoint of the programme, or 0.
+    pub fn first_shock_start(&self) -> f64 {
+        self.base.breakpoints().first().copied().unwrap_or(0.0)
+    }
+}
+
 /// Reads a scene file, applies `--set` overrides, validates.
 pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigError> {
     let text =

@@ -97,7 +97,7 @@ pub struct Quiet;
 impl Hooks for Quiet {}
 
 /// A finished (or stopped) run.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct RunResult {
     /// Recorded trace.
     pub trace: Trace,

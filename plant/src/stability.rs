@@ -56,7 +56,7 @@ pub fn check(scene: &Scene) -> Verdict {
         return Verdict::Fine;
     }
     let h = scene.controller.period / f64::from(scene.integrator.substeps);
-    let name = serde_json::to_value(m).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default();
+    let name = crate::summary::snake_name(&m);
     let free = estimate(scene, m, 0.0);
     let contact = estimate(scene, m, REFERENCE_CONTACT_FORCE);
     let substeps = |limit: f64| (scene.controller.period / limit).ceil();

@@ -6,6 +6,11 @@ use crate::run::{Outcome, RunResult};
 use crate::trace::Trace;
 use serde::Serialize;
 
+/// The name a unit enum variant serialises to (`dry_whirl`, `rk4`, …), as written in the outputs.
+pub fn snake_name<T: Serialize>(v: &T) -> String {
+    serde_json::to_value(v).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
+}
+
 /// Revolutions at the end of a run over which steady figures are taken.
 pub const STEADY_REVOLUTIONS: f64 = 200.0;
 

@@ -29,7 +29,7 @@ use crate::analysis::classify::MotionMode;
 use crate::config::{load_scene, ConfigError};
 use crate::plot::{self, PointGroup};
 use crate::run::{run, Hooks, Outcome};
-use crate::summary::Summary;
+use crate::summary::{snake_name as name_of, Summary};
 use anyhow::Context;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -205,10 +205,6 @@ pub struct PointResult {
     pub max_contact_force_n: f64,
     /// Poincaré points of the steady window: (n, x_m, y_m).
     pub poincare: Vec<(i64, f64, f64)>,
-}
-
-fn name_of<T: Serialize>(v: &T) -> String {
-    serde_json::to_value(v).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
 }
 
 struct Stop<'a>(&'a AtomicBool);

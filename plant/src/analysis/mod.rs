@@ -178,7 +178,7 @@ pub fn write_plots(dir: &Path, name: &str, trace: &Trace, a: &Analysis, gap: f64
         &dir.join("poincare.png"),
         &title(&format!(
             "Poincaré map: {}{}",
-            serde_json::to_value(a.steady_class).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default(),
+            crate::summary::snake_name(&a.steady_class),
             a.period_k.map(|k| format!(", k = {k}")).unwrap_or_default()
         )),
         "x (µm)",

@@ -49,7 +49,7 @@ pub fn scenes(config_dir: &Path) -> anyhow::Result<Vec<BenchScene>> {
     let make = |name, what, file: &str, peak: f64| -> anyhow::Result<BenchScene> {
         let path = config_dir.join(file);
         let probe = load_scene(&path, &[]).with_context(|| format!("loading {}", path.display()))?;
-        let start = probe.raw.shock.first().map_or(0.0, shock_start);
+        let start = probe.first_shock_start();
         let rate = 1.0 / probe.controller.period;
         let sets = vec![
             format!("shock[0].peak_g={peak:?}"),
@@ -65,10 +65,6 @@ pub fn scenes(config_dir: &Path) -> anyhow::Result<Vec<BenchScene>> {
         make("impact", "3 G: impact on the race and bounces", "paper-3g.toml", 3.0)?,
         make("rub", "10 G: sustained rubbing", "paper-10g.toml", 10.0)?,
     ])
-}
-
-fn shock_start(spec: &shock_table::ShockSpec) -> f64 {
-    serde_json::to_value(spec).ok().and_then(|v| v.get("start_s").and_then(|s| s.as_f64())).unwrap_or(0.0)
 }
 
 /// Integrator setting of one point of a chart.
@@ -233,7 +229,7 @@ impl Row {
 }
 
 fn method_name(m: Method) -> String {
-    serde_json::to_value(m).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
+    crate::summary::snake_name(&m)
 }
 
 /// The settings swept for each method.
