@@ -19,8 +19,19 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
 ];
 
 /// `[controller]` keys the controller process uses.
-pub const LAW_KEYS: &[&str] =
-    &["law", "rate_hz", "stiffness_n_per_m", "damping_ratio", "current_limit_a", "gravity_bias"];
+pub const LAW_KEYS: &[&str] = &[
+    "law",
+    "rate_hz",
+    "stiffness_n_per_m",
+    "damping_ratio",
+    "current_limit_a",
+    "gravity_bias",
+    "relev_enter_um",
+    "relev_exit_um",
+    "relev_damping_ratio",
+    "relev_hold_ms",
+    "relev_arm_ms",
+];
 
 /// What a `--config` file sets; `None` = take the plant's value from the hello.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -37,6 +48,30 @@ pub struct LawOverrides {
     pub current_limit_a: Option<f64>,
     /// Gravity bias on y.
     pub gravity_bias: Option<bool>,
+    /// `relev`: touch radius (µm).
+    pub relev_enter_um: Option<f64>,
+    /// `relev`: levitating-again radius (µm).
+    pub relev_exit_um: Option<f64>,
+    /// `relev`: damping ratio of the recovery design.
+    pub relev_damping_ratio: Option<f64>,
+    /// `relev`: hold before the nominal design returns (ms).
+    pub relev_hold_ms: Option<f64>,
+    /// `relev`: time from which the rule acts (ms).
+    pub relev_arm_ms: Option<f64>,
+}
+
+impl LawOverrides {
+    /// The `relev` rule: these overrides on top of the plant's.
+    pub fn relev(&self, plant: crate::RelevSpec) -> crate::RelevSpec {
+        let or = |v: Option<f64>, scale: f64, fallback: f64| v.map_or(fallback, |v| v * scale);
+        crate::RelevSpec {
+            enter_m: or(self.relev_enter_um, 1e-6, plant.enter_m),
+            exit_m: or(self.relev_exit_um, 1e-6, plant.exit_m),
+            damping_ratio: or(self.relev_damping_ratio, 1.0, plant.damping_ratio),
+            hold_s: or(self.relev_hold_ms, 1e-3, plant.hold_s),
+            arm_s: or(self.relev_arm_ms, 1e-3, plant.arm_s),
+        }
+    }
 }
 
 /// Why a controller file was rejected.
@@ -94,7 +129,23 @@ pub fn parse(text: &str) -> Result<LawOverrides, String> {
                 Err(format!("{name} = {v} {unit}: must be a finite number > 0"))
             }
         };
+        let non_negative = |unit: &str| -> Result<f64, String> {
+            let v = value
+                .as_float()
+                .or_else(|| value.as_integer().map(|i| i as f64))
+                .ok_or_else(|| format!("{name} = {value}: expected a number ({unit})"))?;
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{name} = {v} {unit}: must be a finite number >= 0"))
+            }
+        };
         match key.as_str() {
+            "relev_enter_um" => out.relev_enter_um = Some(number("µm")?),
+            "relev_exit_um" => out.relev_exit_um = Some(number("µm")?),
+            "relev_damping_ratio" => out.relev_damping_ratio = Some(number("")?),
+            "relev_hold_ms" => out.relev_hold_ms = Some(non_negative("ms")?),
+            "relev_arm_ms" => out.relev_arm_ms = Some(non_negative("ms")?),
             "law" => {
                 let law = value.as_str().ok_or_else(|| format!("{name} = {value}: expected a string"))?;
                 if !crate::LAW_NAMES.contains(&law) {
@@ -104,16 +155,7 @@ pub fn parse(text: &str) -> Result<LawOverrides, String> {
             }
             "rate_hz" => out.rate_hz = Some(number("Hz")?),
             "stiffness_n_per_m" => out.stiffness_n_per_m = Some(number("N/m")?),
-            "damping_ratio" => {
-                let v = value
-                    .as_float()
-                    .or_else(|| value.as_integer().map(|i| i as f64))
-                    .ok_or_else(|| format!("{name} = {value}: expected a number"))?;
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(format!("{name} = {v}: must be a finite number >= 0"));
-                }
-                out.damping_ratio = Some(v);
-            }
+            "damping_ratio" => out.damping_ratio = Some(non_negative("")?),
             "current_limit_a" => out.current_limit_a = Some(number("A")?),
             "gravity_bias" => {
                 out.gravity_bias =
@@ -146,6 +188,15 @@ mod tests {
     fn unknown_law_lists_known_laws() {
         let e = parse("[controller]\nlaw = \"nope\"\n").unwrap_err();
         assert!(e.contains("nope") && e.contains("pd"), "{e}");
+    }
+
+    #[test]
+    fn relev_keys_override_the_plants_rule() {
+        let o = parse("[controller]\nrelev_enter_um = 100\nrelev_arm_ms = 0\n").unwrap();
+        let plant = crate::RelevSpec { enter_m: 1.2e-4, exit_m: 4.5e-5, damping_ratio: 0.2, hold_s: 0.05, arm_s: 0.5 };
+        assert_eq!(o.relev(plant), crate::RelevSpec { enter_m: 100.0 * 1e-6, arm_s: 0.0, ..plant });
+        let e = parse("[controller]\nrelev_hold_ms = -1\n").unwrap_err();
+        assert!(e.contains("controller.relev_hold_ms") && e.contains("ms"), "{e}");
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use crate::discrete_pd::{DelayPd, DelayPdGains};
 use crate::pd::{PdDesign, PdGains, SampledPd};
 use crate::pid::{PidDesign, PidGains, SampledPid};
+use crate::relev::{Relev, RelevSpec};
 
 /// Plant constants a law needs for its design (SI units).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -63,10 +64,12 @@ pub struct LawSpec<'a> {
     pub current_limit_a: f64,
     /// Command delay d (samples): the command computed from sample k is applied from tick k + d.
     pub delay_samples: u32,
+    /// The switching rule of `relev` (ignored by the other laws).
+    pub relev: RelevSpec,
 }
 
 /// Laws the registry knows.
-pub const LAW_NAMES: &[&str] = &["pd", "pid", "pd_delay"];
+pub const LAW_NAMES: &[&str] = &["pd", "pid", "pd_delay", "relev"];
 
 /// Why a law could not be built.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -108,6 +111,7 @@ pub fn build_law(spec: &LawSpec, c: &LoopConstants) -> Result<Box<dyn ControlLaw
             let gains = DelayPdGains::from_design(&design, c, spec.period_s, spec.delay_samples)?;
             Ok(Box::new(DelayPd::new(gains, spec.period_s)))
         }
+        "relev" => Ok(Box::new(Relev::new(&design, &spec.relev, c, spec.period_s, spec.delay_samples)?)),
         other => Err(LawError::Unknown(other.to_string())),
     }
 }

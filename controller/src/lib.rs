@@ -19,6 +19,7 @@ pub mod law;
 pub mod link;
 pub mod pd;
 pub mod pid;
+pub mod relev;
 #[cfg(test)]
 mod test_plant;
 pub mod wire;
@@ -27,3 +28,4 @@ pub use discrete_pd::{DelayPd, DelayPdGains};
 pub use law::{build_law, saturate, ControlLaw, LawError, LawSpec, LoopConstants, Sample, LAW_NAMES};
 pub use pd::{PdDesign, PdGains, SampledPd};
 pub use pid::{PidDesign, PidGains, SampledPid};
+pub use relev::{Relev, RelevSpec};

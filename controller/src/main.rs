@@ -193,6 +193,7 @@ fn serve(cli: &Cli, run_id: &str, overrides: &LawOverrides) -> Result<End, Failu
         gravity_bias: overrides.gravity_bias.unwrap_or(hello.gravity_bias != 0),
         current_limit_a: limit,
         delay_samples: hello.delay_samples,
+        relev: overrides.relev(hello.relev()),
     };
     let mut law = match build_law(&spec, &hello.loop_constants()) {
         Ok(l) => l,

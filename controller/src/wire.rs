@@ -58,7 +58,7 @@ use iceoryx2::prelude::ZeroCopySend;
 /// Protocol version. Incremented on any change of a layout or of the meaning
 /// of a field; it is also part of every iceoryx2 type name below, so peers of
 /// different versions cannot even open each other's services.
-pub const PROTOCOL_VERSION: u32 = 1;
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Number of controlled axes (x, y).
 pub const AXES: u32 = 2;
@@ -100,7 +100,7 @@ pub mod mode {
 /// | 40     | 4    | `status`   | u32       |
 /// | 44     | 4    | `session`  | u32       |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v1.SensorFrame")]
+#[type_name("amb_testbed.v2.SensorFrame")]
 #[repr(C)]
 pub struct SensorFrame {
     /// Tick index k (0, 1, 2, …).
@@ -134,7 +134,7 @@ impl SensorFrame {
 /// | 40     | 4    | `status`      | u32      |
 /// | 44     | 4    | `session`     | u32      |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v1.CommandFrame")]
+#[type_name("amb_testbed.v2.CommandFrame")]
 #[repr(C)]
 pub struct CommandFrame {
     /// The `seq` of the [`SensorFrame`] this answers.
@@ -164,7 +164,7 @@ impl CommandFrame {
 /// |-------:|-----:|--------|------|
 /// | 0      | 8    | `seq`  | u64  |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v1.WakeRequest")]
+#[type_name("amb_testbed.v2.WakeRequest")]
 #[repr(C)]
 pub struct WakeRequest {
     /// The `seq` the sender waits for (informative).
@@ -172,7 +172,7 @@ pub struct WakeRequest {
 }
 
 /// The plant's side of the handshake: what it runs and the law design it
-/// wants. 192 bytes.
+/// wants. 232 bytes.
 ///
 /// | offset | size | field                  | type     |
 /// |-------:|-----:|------------------------|----------|
@@ -198,8 +198,13 @@ pub struct WakeRequest {
 /// | 176    | 8    | `spin_ns`              | u64      |
 /// | 184    | 4    | `mode`                 | u32      |
 /// | 188    | 4    | `plant_pid`            | u32      |
+/// | 192    | 8    | `relev_enter_m`        | f64      |
+/// | 200    | 8    | `relev_exit_m`         | f64      |
+/// | 208    | 8    | `relev_damping_ratio`  | f64      |
+/// | 216    | 8    | `relev_hold_s`         | f64      |
+/// | 224    | 8    | `relev_arm_s`          | f64      |
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("amb_testbed.v1.Hello")]
+#[type_name("amb_testbed.v2.Hello")]
 #[repr(C)]
 pub struct Hello {
     /// [`PROTOCOL_VERSION`] of the plant.
@@ -246,6 +251,16 @@ pub struct Hello {
     pub mode: u32,
     /// Process id of the plant (informative).
     pub plant_pid: u32,
+    /// `relev`: radius at which the rotor counts as touching (m).
+    pub relev_enter_m: f64,
+    /// `relev`: radius below which it counts as levitating again (m).
+    pub relev_exit_m: f64,
+    /// `relev`: damping ratio of the recovery design.
+    pub relev_damping_ratio: f64,
+    /// `relev`: time below the exit radius before the nominal design returns (s).
+    pub relev_hold_s: f64,
+    /// `relev`: time from which the switching rule acts (s).
+    pub relev_arm_s: f64,
 }
 
 /// The controller's side of the handshake. 176 bytes.
@@ -259,7 +274,7 @@ pub struct Hello {
 /// | 16     | 32   | `law`              | [u8; 32]  |
 /// | 48     | 128  | `message`          | [u8; 128] |
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("amb_testbed.v1.Ack")]
+#[type_name("amb_testbed.v2.Ack")]
 #[repr(C)]
 pub struct Ack {
     /// [`PROTOCOL_VERSION`] of the controller.
@@ -326,7 +341,7 @@ const _: () = {
     assert!(offset_of!(CommandFrame, sent_ns) == 32 && offset_of!(CommandFrame, status) == 40);
     assert!(offset_of!(CommandFrame, session) == 44);
     assert!(size_of::<WakeRequest>() == 8);
-    assert!(size_of::<Hello>() == 192 && align_of::<Hello>() == 8);
+    assert!(size_of::<Hello>() == 232 && align_of::<Hello>() == 8);
     assert!(offset_of!(Hello, rate_hz) == 16 && offset_of!(Hello, run_id) == 32 && offset_of!(Hello, law) == 64);
     assert!(offset_of!(Hello, stiffness_n_per_m) == 96 && offset_of!(Hello, ki_n_per_a) == 112);
     assert!(offset_of!(Hello, current_limit_a) == 160 && offset_of!(Hello, delay_samples) == 168);
@@ -469,6 +484,22 @@ impl Hello {
             spin_ns: 200_000,
             mode: mode::LOCKSTEP,
             plant_pid: 0,
+            relev_enter_m: 120e-6,
+            relev_exit_m: 45e-6,
+            relev_damping_ratio: 0.2,
+            relev_hold_s: 0.05,
+            relev_arm_s: 0.0,
+        }
+    }
+
+    /// The `relev` switching rule the hello carries.
+    pub fn relev(&self) -> crate::RelevSpec {
+        crate::RelevSpec {
+            enter_m: self.relev_enter_m,
+            exit_m: self.relev_exit_m,
+            damping_ratio: self.relev_damping_ratio,
+            hold_s: self.relev_hold_s,
+            arm_s: self.relev_arm_s,
         }
     }
 

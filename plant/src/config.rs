@@ -296,6 +296,19 @@ pub struct RawController {
     pub delay_samples: u32,
     /// Add the gravity bias current m_r g / k_i on y. Default true.
     pub gravity_bias: bool,
+    /// `relev`: sensor radius at which the rotor counts as touching (µm).
+    /// Default 0.8 × the air gap.
+    pub relev_enter_um: Option<f64>,
+    /// `relev`: sensor radius below which the rotor counts as levitating
+    /// again (µm). Default 0.3 × the air gap.
+    pub relev_exit_um: Option<f64>,
+    /// `relev`: damping ratio of the recovery design. Default 0.2.
+    pub relev_damping_ratio: f64,
+    /// `relev`: time below the exit radius before the nominal design returns (ms). Default 50.
+    pub relev_hold_ms: f64,
+    /// `relev`: time from which the switching rule acts (ms); before it the law is the
+    /// nominal design alone. Default 0.
+    pub relev_arm_ms: f64,
     /// Co-simulation: what the plant applies when the controller process is
     /// lost: `hold` (the last current, default), `bias` (bias current only)
     /// or `stop` (end the run, exit code 4).
@@ -327,6 +340,11 @@ defaults!(RawController {
     current_limit_a: f64 = 2.0,
     delay_samples: u32 = 1,
     gravity_bias: bool = true,
+    relev_enter_um: Option<f64> = None,
+    relev_exit_um: Option<f64> = None,
+    relev_damping_ratio: f64 = 0.2,
+    relev_hold_ms: f64 = 50.0,
+    relev_arm_ms: f64 = 0.0,
     fallback: String = "hold".into(),
     reply_timeout_ms: f64 = 1.0,
     reconnect_timeout_ms: f64 = 0.0,
@@ -451,6 +469,8 @@ pub struct ControllerSettings {
     pub delay_samples: u32,
     /// Gravity bias on y.
     pub gravity_bias: bool,
+    /// The switching rule of the `relev` law (SI units).
+    pub relev: controller::RelevSpec,
     /// Co-simulation settings (used in `lockstep` and `realtime`).
     pub cosim: CosimSettings,
 }
@@ -638,6 +658,32 @@ fn finite(key: &str, value: f64, unit: &str) -> Result<f64, ConfigError> {
     } else {
         Err(range(key, value, unit, "must be finite"))
     }
+}
+
+/// Validates the `relev_*` keys of `[controller]`; the radii default to 0.8 and 0.3 of the
+/// air gap `gap` (m).
+fn relev_rule(ctl: &RawController, gap: f64) -> Result<controller::RelevSpec, ConfigError> {
+    let enter = positive("controller.relev_enter_um", ctl.relev_enter_um.unwrap_or(0.8e6 * gap), "µm")?;
+    let exit = positive("controller.relev_exit_um", ctl.relev_exit_um.unwrap_or(0.3e6 * gap), "µm")?;
+    if exit >= enter {
+        return Err(range(
+            "controller.relev_exit_um",
+            exit,
+            "µm",
+            &format!("must be below controller.relev_enter_um = {enter} µm"),
+        ));
+    }
+    let xi = positive("controller.relev_damping_ratio", ctl.relev_damping_ratio, "")?;
+    if xi >= 1.0 {
+        return Err(range("controller.relev_damping_ratio", xi, "", "must be < 1 (a complex pole pair)"));
+    }
+    Ok(controller::RelevSpec {
+        enter_m: enter * 1e-6,
+        exit_m: exit * 1e-6,
+        damping_ratio: xi,
+        hold_s: non_negative("controller.relev_hold_ms", ctl.relev_hold_ms, "ms")? * 1e-3,
+        arm_s: non_negative("controller.relev_arm_ms", ctl.relev_arm_ms, "ms")? * 1e-3,
+    })
 }
 
 /// Validates the co-simulation keys of `[controller]`.
@@ -858,6 +904,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         damping_ratio: non_negative("controller.damping_ratio", ctl.damping_ratio, "")?,
         delay_samples: ctl.delay_samples,
         gravity_bias: ctl.gravity_bias,
+        relev: relev_rule(ctl, gap)?,
         cosim: cosim_settings(ctl)?,
     };
     if ctl.delay_samples > 1000 {

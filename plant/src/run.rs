@@ -167,6 +167,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
         gravity_bias: scene.controller.gravity_bias,
         current_limit_a: limit,
         delay_samples: scene.controller.delay_samples,
+        relev: scene.controller.relev,
     };
     let mut source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,

@@ -215,6 +215,16 @@ fn out_of_range_value_exits_2_naming_key_value_and_unit() {
 }
 
 #[test]
+fn relev_rule_out_of_order_exits_2_naming_both_radii() {
+    assert_bad_input(
+        "relev-radii",
+        &scene("relev-10g.toml"),
+        &["controller.relev_exit_um=200"],
+        &["controller.relev_exit_um", "200", "µm", "controller.relev_enter_um = 120"],
+    );
+}
+
+#[test]
 fn unknown_law_exits_2_listing_known_laws() {
     let mut needles = vec!["nope", "pd"];
     needles.extend_from_slice(controller::LAW_NAMES);

@@ -110,6 +110,11 @@ pub fn hello_for(scene: &Scene, run_id: &str) -> Hello {
         spin_ns: (controller_spin(c.mode, c.cosim.spin, c.period) * 1e9) as u64,
         mode: if c.mode == ControlMode::Realtime { mode::REALTIME } else { mode::LOCKSTEP },
         plant_pid: std::process::id(),
+        relev_enter_m: c.relev.enter_m,
+        relev_exit_m: c.relev.exit_m,
+        relev_damping_ratio: c.relev.damping_ratio,
+        relev_hold_s: c.relev.hold_s,
+        relev_arm_s: c.relev.arm_s,
     }
 }
 
