@@ -12,7 +12,7 @@
 use crate::config::{load_scene, Scene};
 use crate::plot::{self, PointGroup, Scale, Series};
 use crate::run::{run, Outcome, Quiet, RunResult};
-use crate::summary::{snake_name, Summary};
+use crate::summary::{recovery_time, snake_name, Summary};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -59,16 +59,6 @@ pub fn damping_from_decay(t: &[f64], x: &[f64]) -> f64 {
     let n = peaks.len() - 1;
     let delta = (peaks[0].1 / peaks[n].1).ln() / n as f64;
     delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt()
-}
-
-fn recover_time(r: &RunResult, start: f64) -> f64 {
-    let tr = &r.trace;
-    let last = tr.contact_force_n.iter().rposition(|f| *f > 0.0);
-    match last {
-        None => 0.0,
-        Some(i) if i + 1 >= tr.len() => f64::NAN,
-        Some(i) => tr.t_s[i] - start,
-    }
 }
 
 /// Distance of the rotor displacement from the reference's over the window (m): (RMS, max);
@@ -130,7 +120,7 @@ pub fn compare(
             rms_dev_m: rms,
             max_dev_m: max,
             damping_ratio: xi,
-            recover_s: recover_time(r, start),
+            recover_s: recovery_time(&r.trace, start).unwrap_or(f64::NAN),
             post_shock_mode: snake_name(&s.analysis.post_shock_mode),
         }
     };
@@ -345,4 +335,137 @@ pub fn stability_maps(
         )?;
     }
     Ok(points)
+}
+
+/// One law of a law comparison (`plant compare --laws`).
+#[derive(Clone, Debug)]
+pub struct LawRow {
+    /// Law name.
+    pub law: String,
+    /// Controller mode the scene ran in.
+    pub mode: String,
+    /// How the run ended.
+    pub status: String,
+    /// Time from the shock start to the last rotor – race contact (s); NaN if still touching at the end.
+    pub recovery_s: f64,
+    /// Post-shock mode.
+    pub post_shock_mode: String,
+    /// Peak rotor – race force (N).
+    pub max_contact_force_n: f64,
+    /// Time in contact (s).
+    pub contact_time_s: f64,
+    /// Contact fraction over the last 200 revolutions.
+    pub steady_contact_fraction: f64,
+    /// Whirl frequency of the steady response (Hz, negative backward).
+    pub whirl_hz: f64,
+}
+
+/// Runs the scene once per law (in the scene's controller mode, so a co-simulation scene runs
+/// the controller process), and writes `laws.csv` and overlaid plots of the whole run.
+pub fn compare_laws(
+    scene_path: &Path,
+    sets: &[String],
+    laws: &[String],
+    out: &Path,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<LawRow>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let mut rows = Vec::new();
+    let mut runs: Vec<(String, RunResult)> = Vec::new();
+    let mut probe = None;
+    for law in laws {
+        let scene = with(scene_path, &base, &[format!("controller.law=\"{law}\"")])?;
+        let r = run(&scene, &mut Quiet)?;
+        let s = Summary::new(&scene, &r);
+        let row = LawRow {
+            law: law.clone(),
+            mode: snake_name(&scene.controller.mode),
+            status: s.status.to_string(),
+            recovery_s: s.recovery_s.unwrap_or(f64::NAN),
+            post_shock_mode: snake_name(&s.analysis.post_shock_mode),
+            max_contact_force_n: s.max_contact_force_n,
+            contact_time_s: s.contact_time_s,
+            steady_contact_fraction: s.analysis.steady_contact_fraction,
+            whirl_hz: s.analysis.whirl_hz,
+        };
+        log(&format!(
+            "{law} ({}): {}, recovered after {:.4} s, {}, peak force {:.0} N, {:.4} s in contact, whirl {:.1} Hz",
+            row.mode,
+            row.status,
+            row.recovery_s,
+            row.post_shock_mode,
+            row.max_contact_force_n,
+            row.contact_time_s,
+            row.whirl_hz
+        ));
+        rows.push(row);
+        runs.push((law.clone(), r));
+        probe = Some(scene);
+    }
+    let mut csv = String::from(
+        "law,mode,status,recovery_s,post_shock_mode,max_contact_force_n,contact_time_s,steady_contact_fraction,whirl_hz\n",
+    );
+    for r in &rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:e},{},{:e},{:e},{:e},{:e}",
+            r.law,
+            r.mode,
+            r.status,
+            r.recovery_s,
+            r.post_shock_mode,
+            r.max_contact_force_n,
+            r.contact_time_s,
+            r.steady_contact_fraction,
+            r.whirl_hz
+        );
+    }
+    std::fs::write(out.join("laws.csv"), csv).context("writing laws.csv")?;
+    if let Some(scene) = probe {
+        law_plots(out, &runs, &scene)?;
+    }
+    Ok(rows)
+}
+
+fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow::Result<()> {
+    let name = &scene.name;
+    let gap_um = scene.params.contact.gap * 1e6;
+    let radius: Vec<Vec<f64>> = runs.iter().map(|(_, r)| r.trace.radius().iter().map(|v| v * 1e6).collect()).collect();
+    let current: Vec<Vec<f64>> =
+        runs.iter().map(|(_, r)| r.trace.ix_a.iter().zip(&r.trace.iy_a).map(|(x, y)| x.hypot(*y)).collect()).collect();
+    let series = |ys: &[Vec<f64>]| -> Vec<(String, Vec<f64>, Vec<f64>)> {
+        runs.iter().zip(ys).map(|((l, r), y)| (l.clone(), r.trace.t_s.clone(), y.clone())).collect()
+    };
+    for (file, title, ylabel, data) in [
+        ("laws_radius.png", format!("{name}: rotor radius by law (air gap {gap_um:.0} µm)"), "radius (µm)", &radius),
+        ("laws_current.png", format!("{name}: coil current magnitude by law"), "|i| (A)", &current),
+    ] {
+        let d = series(data);
+        let s: Vec<Series> = d.iter().map(|(l, x, y)| Series { label: l, x, y }).collect();
+        plot::lines(&out.join(file), &title, "time (s)", ylabel, &s, Scale::Linear)?;
+    }
+    let start = scene.first_shock_start();
+    let orbits: Vec<(String, Vec<f64>, Vec<f64>)> = runs
+        .iter()
+        .map(|(l, r)| {
+            let tr = &r.trace;
+            let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start).collect();
+            (
+                l.clone(),
+                idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
+                idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+            )
+        })
+        .collect();
+    let groups: Vec<PointGroup> = orbits.iter().map(|(l, x, y)| PointGroup { label: l, x, y }).collect();
+    plot::scatter(
+        &out.join("laws_orbit.png"),
+        &format!("{name}: orbits after the shock, by law"),
+        "x (µm)",
+        "y (µm)",
+        &groups,
+        true,
+    )?;
+    Ok(())
 }

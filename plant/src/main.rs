@@ -82,6 +82,10 @@ enum Command {
         /// Also draw the stability maps (rate × damping ratio, rate × delay).
         #[arg(long)]
         maps: bool,
+        /// Compare control laws instead of rates: run the scene as it is (its mode and rate)
+        /// once per law, e.g. `pd_delay,relev`; writes laws.csv and laws_*.png.
+        #[arg(long, value_delimiter = ',', conflicts_with = "maps")]
+        laws: Vec<String>,
     },
     /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
     /// classification; updates summary.json and writes the analysis plots.
@@ -244,19 +248,24 @@ fn main() -> ExitCode {
             bench_ipc(samples, warmup, pin_cores, spin_us, controller.launch(run_id))
         }
         Command::Analyze { dir } => analyze_dir(&dir),
-        Command::Compare { scene, rates, out, set, no_cosim, maps } => {
+        Command::Compare { scene, rates, out, set, no_cosim, maps, laws } => {
             let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")));
             let mut log = |l: &str| eprintln!("plant compare: {l}");
-            let result = plant::compare::compare(&scene, &set, &rates, !no_cosim, &dir, &mut log).and_then(|rows| {
-                if maps {
-                    plant::compare::stability_maps(&scene, &set, &rates, &dir, &mut log)?;
-                }
-                Ok(rows)
-            });
+            let (result, written) = if laws.is_empty() {
+                let result = plant::compare::compare(&scene, &set, &rates, !no_cosim, &dir, &mut log).and_then(|_| {
+                    if maps {
+                        plant::compare::stability_maps(&scene, &set, &rates, &dir, &mut log)?;
+                    }
+                    Ok(())
+                });
+                (result, "compare.csv")
+            } else {
+                (plant::compare::compare_laws(&scene, &set, &laws, &dir, &mut log).map(|_| ()), "laws.csv")
+            };
             match result {
-                Ok(_) => {
-                    eprintln!("plant compare: wrote {}", dir.join("compare.csv").display());
+                Ok(()) => {
+                    eprintln!("plant compare: wrote {}", dir.join(written).display());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

@@ -77,6 +77,11 @@ pub struct Summary {
     pub max_contact_force_n: f64,
     /// Largest race speed (rpm).
     pub max_race_speed_rpm: f64,
+    /// Time from the first shock's start to the last trace sample with rotor – race contact (s):
+    /// 0 without contact after the shock, `null` if the rotor is still touching at the end.
+    pub recovery_s: Option<f64>,
+    /// Time in rotor – race contact over the whole run (s), counted on the trace samples.
+    pub contact_time_s: f64,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -127,6 +132,8 @@ impl Summary {
             steady_window_start_s: window_start,
             max_contact_force_n: max(trace.contact_force_n.iter().copied()),
             max_race_speed_rpm: max(trace.race_speed_rad_s.iter().map(|w| w.abs() * 60.0 / std::f64::consts::TAU)),
+            recovery_s: recovery_time(trace, scene.first_shock_start()),
+            contact_time_s: contact_fraction(trace, 0.0) * result.simulated,
             steps: result.stats.steps,
             rejected_steps: result.stats.rejected,
             rhs_evals: result.stats.rhs_evals,
@@ -167,6 +174,17 @@ pub fn analysis_setting(scene: &Scene) -> Setting {
 
 fn max(values: impl Iterator<Item = f64>) -> f64 {
     values.filter(|v| v.is_finite()).fold(0.0, f64::max)
+}
+
+/// Time from `start` (s) to the last trace sample with a positive contact force: 0 if there
+/// is none after `start`, `None` if the last sample is in contact (the rotor never left).
+pub fn recovery_time(trace: &Trace, start: f64) -> Option<f64> {
+    let last = trace.t_s.iter().zip(&trace.contact_force_n).rposition(|(t, f)| *t >= start && *f > 0.0);
+    match last {
+        None => Some(0.0),
+        Some(i) if i + 1 >= trace.len() => None,
+        Some(i) => Some(trace.t_s[i] - start),
+    }
 }
 
 /// Fraction of samples at or after `from` (s) with a positive contact force.
