@@ -175,6 +175,10 @@ enum BenchCommand {
         /// Python interpreter for the peer.
         #[arg(long, default_value = "bench/peer/.venv/bin/python")]
         peer_python: PathBuf,
+        /// Draw the peer rows of an earlier `accuracy.csv` (e.g. docs/charts/accuracy.csv) on the
+        /// charts instead of running the peer; they keep their own timings.
+        #[arg(long, conflicts_with = "peer")]
+        peer_rows: Option<PathBuf>,
     },
     /// Error and speed of each model simplification (lumped race support, fixed balls, speed
     /// held, linear bearing) against the most detailed model, on the same three scenes.
@@ -265,12 +269,14 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Bench { what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python } } => {
+        Command::Bench {
+            what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows },
+        } => {
             let peer = peer.then(|| plant::bench::Peer {
                 script: config.join("..").join("bench").join("peer").join("run_peer.py"),
                 python: peer_python,
             });
-            bench_accuracy(out, &config, repeats, quick, peer.as_ref())
+            bench_accuracy(out, &config, repeats, quick, peer.as_ref(), peer_rows.as_deref())
         }
         Command::Bench { what: BenchCommand::Models { out, config, repeats } } => {
             let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-models"));
@@ -489,16 +495,32 @@ fn bench_accuracy(
     repeats: usize,
     quick: bool,
     peer: Option<&plant::bench::Peer>,
+    peer_rows: Option<&std::path::Path>,
 ) -> ExitCode {
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-accuracy"));
     let mut log = |line: &str| eprintln!("plant bench: {line}");
-    let report = match plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log) {
+    // Read the earlier rows first: they may live in the output folder.
+    let earlier = match peer_rows.map(plant::bench::read_rows).transpose() {
+        Ok(rows) => rows.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::BAD_INPUT);
+        }
+    };
+    let mut report = match plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("plant: error: {e:#}");
             return ExitCode::from(exit::IO);
         }
     };
+    if !earlier.is_empty() {
+        report.rows.extend(earlier.into_iter().filter(|r| !r.implementation.starts_with("rust")));
+        if let Err(e) = plant::bench::write_rows(&dir.join("accuracy.csv"), &report.rows) {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::IO);
+        }
+    }
     match plant::bench::charts(&dir, &report.rows, &report.floors) {
         Ok(files) => {
             for f in files {
