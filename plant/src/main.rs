@@ -193,6 +193,20 @@ enum BenchCommand {
         #[arg(long, default_value_t = 5)]
         repeats: usize,
     },
+    /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
+    /// of full-length impact and rub runs for each method at a representative setting, against a
+    /// DOP853 reference.
+    Engineering {
+        /// Output folder (default: runs/bench-engineering).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Scene folder holding paper-3g.toml and paper-10g.toml.
+        #[arg(long, default_value = "config")]
+        config: PathBuf,
+        /// Timed runs per setting; the minimum counts.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+    },
 }
 
 /// Progress on stderr about once a second, and the Ctrl-C flag.
@@ -283,6 +297,20 @@ fn main() -> ExitCode {
             match plant::bench::models(&config, &dir, repeats.max(1), &mut |l| eprintln!("plant bench: {l}")) {
                 Ok(_) => {
                     eprintln!("plant bench: wrote {}", dir.join("models.csv").display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("plant: error: {e:#}");
+                    ExitCode::from(exit::IO)
+                }
+            }
+        }
+        Command::Bench { what: BenchCommand::Engineering { out, config, repeats } } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-engineering"));
+            let mut log = |l: &str| eprintln!("plant bench: {l}");
+            match plant::bench::engineering::engineering(&config, &dir, repeats.max(1), &mut log) {
+                Ok(_) => {
+                    eprintln!("plant bench: wrote {}", dir.join("engineering.csv").display());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

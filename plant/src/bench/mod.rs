@@ -17,6 +17,7 @@
 //!   r_0, angles by 2π, velocities by r_0 Ω and angular speeds by Ω
 //!   (Ω the rotor speed): `atol_i = rtol × scale_i`.
 
+pub mod engineering;
 pub mod peer;
 
 use crate::config::{load_scene, Scene};
@@ -598,7 +599,7 @@ pub const VARIANTS: &[Variant] = &[
     Variant { name: "linear bearing", sets: &["amb.force_law=\"linear\""] },
     Variant { name: "race parked when clear", sets: &["touchdown.race_when_clear=\"parked\""] },
     Variant {
-        name: "race parked, released where held",
+        name: "race parked (released where held)",
         sets: &["touchdown.race_when_clear=\"parked\"", "touchdown.race_release=\"held\""],
     },
     Variant { name: "study model", sets: &["rotor.spin=\"held\"", "amb.force_law=\"linear\""] },
