@@ -28,6 +28,9 @@
 //! under gravity and the current housing acceleration ([`Release::Equilibrium`], what the free
 //! race does during a slow shock, so it does not start ringing), or where it was parked, at
 //! rest ([`Release::Held`]). `plant bench models` measures both.
+//!
+//! While parked the trace's ball force is zero (the support kernel is not evaluated) and the
+//! race's position is the held one; only the rotor's rows are the model's.
 
 use crate::model::{ix, Model, Params, Release, State};
 
