@@ -19,7 +19,12 @@ fn model() -> (Model, plant::config::Scene) {
     };
     let scene = validate(raw, Path::new(".")).expect("scene");
     let gains = design_gains(&scene).expect("gains");
-    let model = Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Continuous(gains) };
+    let model = Model {
+        params: scene.params.clone(),
+        base: scene.base.clone(),
+        control: Control::Continuous(gains),
+        race_parked: false,
+    };
     (model, scene)
 }
 

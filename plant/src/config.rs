@@ -8,7 +8,7 @@
 use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
 use crate::integrate::Method;
-use crate::model::{Cage, Params, Spin, Support};
+use crate::model::{Cage, Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
 use serde::{Deserialize, Serialize};
 use shock_table::{Programme, ShockSpec};
@@ -166,6 +166,14 @@ pub struct RawTouchdown {
     pub palmgren_viscosity_cst: f64,
     /// Palmgren f_1. Default 5e-4.
     pub palmgren_f1: f64,
+    /// What the race does while the rotor – race gap is open by a safe margin: `free` (default:
+    /// always integrated on its supports) or `parked` (held in the housing frame, support and
+    /// contact kernels skipped; see [`crate::park`]).
+    pub race_when_clear: String,
+    /// With `race_when_clear = "parked"`: the state the race is released with when the gap may
+    /// close: `equilibrium` (default: at rest on its supports under gravity and the current
+    /// housing acceleration) or `held` (where it was parked, at rest).
+    pub race_release: String,
 }
 defaults!(RawTouchdown {
     air_gap_mm: f64 = 0.15,
@@ -187,6 +195,8 @@ defaults!(RawTouchdown {
     palmgren_f0: f64 = 2.0,
     palmgren_viscosity_cst: f64 = 20.0,
     palmgren_f1: f64 = 5e-4,
+    race_when_clear: String = "free".into(),
+    race_release: String = "equilibrium".into(),
 });
 
 /// `[housing]`.
@@ -373,13 +383,16 @@ pub struct RawIntegrator {
     pub atol_angular_speed_rad_s: Option<f64>,
     /// Substeps per controller period (fixed-step). Default 16.
     pub substeps: u32,
+    /// Substeps per controller period while the race is free, with
+    /// `touchdown.race_when_clear = "parked"` (fixed-step); 0 (default) = `substeps`.
+    pub contact_substeps: u32,
     /// The run stops as diverged when the rotor or race leaves the clearance by more than this (mm). Default 0.5.
     pub radius_guard_mm: f64,
 }
 defaults!(RawIntegrator {
     method: Method = Method::Dp5, rtol: f64 = 1e-6, atol: f64 = 1e-9, atol_position_m: Option<f64> = None,
     atol_velocity_m_s: Option<f64> = None, atol_angle_rad: Option<f64> = None, atol_angular_speed_rad_s: Option<f64> = None,
-    substeps: u32 = 16, radius_guard_mm: f64 = 0.5,
+    substeps: u32 = 16, contact_substeps: u32 = 0, radius_guard_mm: f64 = 0.5,
 });
 
 /// `[initial]`.
@@ -515,6 +528,8 @@ pub struct IntegratorSettings {
     pub atol: [f64; crate::model::N],
     /// Substeps per macro step (fixed-step methods).
     pub substeps: u32,
+    /// Substeps per macro step while the race is free (fixed-step methods, parked race); ≥ 1.
+    pub contact_substeps: u32,
     /// Largest allowed excursion beyond the clearances (m).
     pub radius_guard: f64,
 }
@@ -856,6 +871,30 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         )),
         other => return Err(range("touchdown.support", format!("\"{other}\""), "", "must be \"balls\" or \"lumped\"")),
     };
+    let release = match td.race_release.as_str() {
+        "equilibrium" => Release::Equilibrium,
+        "held" => Release::Held,
+        other => {
+            return Err(range(
+                "touchdown.race_release",
+                format!("\"{other}\""),
+                "",
+                "must be \"equilibrium\" or \"held\"",
+            ))
+        }
+    };
+    let race_when_clear = match td.race_when_clear.as_str() {
+        "free" => RaceWhenClear::Free,
+        "parked" => RaceWhenClear::Parked(release),
+        other => {
+            return Err(range(
+                "touchdown.race_when_clear",
+                format!("\"{other}\""),
+                "",
+                "must be \"free\" or \"parked\"",
+            ))
+        }
+    };
     let ki = positive("amb.ki_n_per_a", amb.ki_n_per_a, "N/A")?;
     let ks = non_negative("amb.ks_n_per_m", amb.ks_n_per_m, "N/m")?;
     let amb_law = match amb.force_law.as_str() {
@@ -929,11 +968,20 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     if !(1..=100_000).contains(&int.substeps) {
         return Err(range("integrator.substeps", int.substeps, "", "must be between 1 and 100000"));
     }
+    if int.contact_substeps > 100_000 {
+        return Err(range(
+            "integrator.contact_substeps",
+            int.contact_substeps,
+            "",
+            "must be between 0 (= substeps) and 100000",
+        ));
+    }
     let integrator = IntegratorSettings {
         method: int.method,
         rtol,
         atol: [ap, ap, aa, ap, ap, aa, av, av, aw, av, av, aw],
         substeps: int.substeps,
+        contact_substeps: if int.contact_substeps == 0 { int.substeps } else { int.contact_substeps },
         radius_guard: positive("integrator.radius_guard_mm", int.radius_guard_mm, "mm")? * 1e-3,
     };
 
@@ -974,6 +1022,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
         contact,
         balls,
         support,
+        race_when_clear,
         drag,
         amb: amb_law,
         loop_constants,

@@ -19,6 +19,7 @@ pub mod initial;
 pub mod integrate;
 pub mod model;
 pub mod output;
+pub mod park;
 pub mod plot;
 pub mod run;
 pub mod sensor;

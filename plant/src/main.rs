@@ -179,6 +179,10 @@ enum BenchCommand {
         /// Python interpreter for the peer.
         #[arg(long, default_value = "bench/peer/.venv/bin/python")]
         peer_python: PathBuf,
+        /// Draw the peer rows of an earlier `accuracy.csv` (e.g. docs/charts/accuracy.csv) on the
+        /// charts instead of running the peer; they keep their own timings.
+        #[arg(long, conflicts_with = "peer")]
+        peer_rows: Option<PathBuf>,
     },
     /// Error and speed of each model simplification (lumped race support, fixed balls, speed
     /// held, linear bearing) against the most detailed model, on the same three scenes.
@@ -191,6 +195,20 @@ enum BenchCommand {
         config: PathBuf,
         /// Timed runs per variant; the minimum counts.
         #[arg(long, default_value_t = 5)]
+        repeats: usize,
+    },
+    /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
+    /// of full-length impact and rub runs for each method at a representative setting, against a
+    /// DOP853 reference.
+    Engineering {
+        /// Output folder (default: runs/bench-engineering).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Scene folder holding paper-3g.toml and paper-10g.toml.
+        #[arg(long, default_value = "config")]
+        config: PathBuf,
+        /// Timed runs per setting; the minimum counts.
+        #[arg(long, default_value_t = 3)]
         repeats: usize,
     },
 }
@@ -274,18 +292,34 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Bench { what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python } } => {
+        Command::Bench {
+            what: BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows },
+        } => {
             let peer = peer.then(|| plant::bench::Peer {
                 script: config.join("..").join("bench").join("peer").join("run_peer.py"),
                 python: peer_python,
             });
-            bench_accuracy(out, &config, repeats, quick, peer.as_ref())
+            bench_accuracy(out, &config, repeats, quick, peer.as_ref(), peer_rows.as_deref())
         }
         Command::Bench { what: BenchCommand::Models { out, config, repeats } } => {
             let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-models"));
             match plant::bench::models(&config, &dir, repeats.max(1), &mut |l| eprintln!("plant bench: {l}")) {
                 Ok(_) => {
                     eprintln!("plant bench: wrote {}", dir.join("models.csv").display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("plant: error: {e:#}");
+                    ExitCode::from(exit::IO)
+                }
+            }
+        }
+        Command::Bench { what: BenchCommand::Engineering { out, config, repeats } } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-engineering"));
+            let mut log = |l: &str| eprintln!("plant bench: {l}");
+            match plant::bench::engineering::engineering(&config, &dir, repeats.max(1), &mut log) {
+                Ok(_) => {
+                    eprintln!("plant bench: wrote {}", dir.join("engineering.csv").display());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
@@ -498,16 +532,32 @@ fn bench_accuracy(
     repeats: usize,
     quick: bool,
     peer: Option<&plant::bench::Peer>,
+    peer_rows: Option<&std::path::Path>,
 ) -> ExitCode {
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-accuracy"));
     let mut log = |line: &str| eprintln!("plant bench: {line}");
-    let report = match plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log) {
+    // Read the earlier rows first: they may live in the output folder.
+    let earlier = match peer_rows.map(plant::bench::read_rows).transpose() {
+        Ok(rows) => rows.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::BAD_INPUT);
+        }
+    };
+    let mut report = match plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("plant: error: {e:#}");
             return ExitCode::from(exit::IO);
         }
     };
+    if !earlier.is_empty() {
+        report.rows.extend(earlier.into_iter().filter(|r| !r.implementation.starts_with("rust")));
+        if let Err(e) = plant::bench::write_rows(&dir.join("accuracy.csv"), &report.rows) {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::IO);
+        }
+    }
     match plant::bench::charts(&dir, &report.rows, &report.floors) {
         Ok(files) => {
             for f in files {

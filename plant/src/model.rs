@@ -106,6 +106,26 @@ pub enum Support {
     Lumped(LumpedSupport),
 }
 
+/// What the race does while the rotor – race gap is open by a safe margin ([`crate::park`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(tag = "race_when_clear", content = "release", rename_all = "snake_case")]
+pub enum RaceWhenClear {
+    /// Always integrated on its supports (the study's model, default).
+    Free,
+    /// Held in the housing frame while the gap is clear; released with the given state.
+    Parked(Release),
+}
+
+/// The state a parked race is released with when the gap may close.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Release {
+    /// At rest on its supports under gravity and the current housing acceleration (default).
+    Equilibrium,
+    /// Where it was parked, at rest relative to the housing.
+    Held,
+}
+
 /// Physical parameters, validated, SI.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Params {
@@ -137,6 +157,8 @@ pub struct Params {
     pub balls: BallSet,
     /// What carries the race: the balls, or a lumped ring.
     pub support: Support,
+    /// Whether the race is parked while the gap is clear.
+    pub race_when_clear: RaceWhenClear,
     /// Race drag.
     pub drag: RaceDrag,
     /// Bearing force law.
@@ -159,6 +181,14 @@ impl Params {
     }
 }
 
+/// The cage angle (rad) for race angle `theta_b` (rad): see [`Cage`].
+pub fn cage_angle(p: &Params, theta_b: f64) -> f64 {
+    match p.cage {
+        Cage::Rotating => p.cage_phase + p.cage_ratio * theta_b,
+        Cage::Fixed => p.cage_phase,
+    }
+}
+
 /// Where the coil current comes from during a derivative evaluation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Control {
@@ -177,6 +207,11 @@ pub struct Model {
     pub base: Programme,
     /// Control during the current macro step.
     pub control: Control,
+    /// The race is parked during the current macro step: its translation is frozen in the
+    /// housing frame (derivative zero), the support and rotor – race kernels are skipped, and
+    /// only its spin runs down under the drag (load: its weight under gravity and the housing
+    /// acceleration). Set by the run loop ([`crate::park`]); `false` gives the full model.
+    pub race_parked: bool,
 }
 
 /// Everything one evaluation computes; `dy` is the derivative.
@@ -214,6 +249,9 @@ impl Model {
             Control::Held(i) => i,
         };
         let amb_force = p.amb.force(delta, current);
+        if self.race_parked {
+            return self.evaluate_parked(t, y, a_h, current, amb_force);
+        }
 
         let contact = p.contact.force([y[XR] - y[XB], y[YR] - y[YB]], [y[VXR] - y[VXB], y[VYR] - y[VYB]], y[WR], y[WB]);
         let (cage, cage_rate) = match p.cage {
@@ -250,6 +288,47 @@ impl Model {
         dy[VYB] = (balls.on_race[1] - contact.on_rotor[1]) / mb - g - a_h[1];
         dy[WB] = race_torque / p.race_inertia;
         Evaluation { dy, contact, balls, current, amb_force, housing_accel: a_h }
+    }
+}
+
+impl Model {
+    /// [`Model::evaluate`] with the race parked: no contact, no support forces; the race's
+    /// translation is frozen, its spin decays under the drag.
+    #[inline]
+    fn evaluate_parked(&self, _t: f64, y: &State, a_h: [f64; 2], current: [f64; 2], amb_force: [f64; 2]) -> Evaluation {
+        use ix::*;
+        let p = &self.params;
+        let (m, e, g) = (p.rotor_mass, p.eccentricity, p.gravity);
+        let (s, c) = y[TR].sin_cos();
+        let w = y[WR];
+        let r1 = m * e * w * w * c + amb_force[0] - m * a_h[0];
+        let r2 = m * e * w * w * s + amb_force[1] - m * (g + a_h[1]);
+        let spin_accel = match p.spin {
+            Spin::Held => 0.0,
+            Spin::Free { drive_gain, torque_limit } => {
+                let drive = (drive_gain * (p.speed - w)).clamp(-torque_limit, torque_limit);
+                let r3 = drive - m * e * ((g + a_h[1]) * c - a_h[0] * s);
+                (r3 + e * (s * r1 - c * r2)) / p.rotor_inertia
+            }
+        };
+        let load = p.race_mass * a_h[0].hypot(g + a_h[1]);
+        let mut dy = [0.0; N];
+        dy[XR] = y[VXR];
+        dy[YR] = y[VYR];
+        dy[TR] = y[WR];
+        dy[TB] = y[WB];
+        dy[VXR] = (r1 + m * e * s * spin_accel) / m;
+        dy[VYR] = (r2 - m * e * c * spin_accel) / m;
+        dy[WR] = spin_accel;
+        dy[WB] = p.drag.torque(y[WB], load) / p.race_inertia;
+        Evaluation {
+            dy,
+            contact: RotorRaceForce::default(),
+            balls: BallForce::default(),
+            current,
+            amb_force,
+            housing_accel: a_h,
+        }
     }
 }
 

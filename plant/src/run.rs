@@ -13,7 +13,7 @@ use crate::config::{ControlMode, Scene};
 use crate::cosim::{CosimError, CosimReport, Launch, Session, Stop};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
-use crate::model::{ix, Control, Model, State};
+use crate::model::{ix, Control, Model, RaceWhenClear, State};
 use crate::sensor::Sensor;
 use crate::trace::Trace;
 use controller::{build_law, saturate, ControlLaw, LawSpec, PdDesign, PdGains, Sample};
@@ -113,6 +113,8 @@ pub struct RunResult {
     pub final_state: State,
     /// Co-simulation figures (`lockstep`, `realtime`).
     pub cosim: Option<CosimReport>,
+    /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
+    pub parked_steps: u64,
 }
 
 /// Continuous PD gains for a scene's controller design.
@@ -185,6 +187,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
             Source::Continuous => Control::Continuous(gains),
             _ => Control::Held(bias),
         },
+        race_parked: false,
     };
     let mut integrator = Integrator::new(integrator_settings(scene));
     let mut y = initial_state(scene);
@@ -209,6 +212,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
     let guards = Guards::new(scene);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
+    let mut parked_steps = 0u64;
 
     let start = std::time::Instant::now();
     let mut outcome = Outcome::Completed;
@@ -236,6 +240,21 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
             if let Some(applied) = queue.pop_front() {
                 model.control = Control::Held(applied);
             }
+        }
+        if let RaceWhenClear::Parked(release) = scene.params.race_when_clear {
+            let clear = crate::park::clear(&model, t0, t1 - t0, &y);
+            if clear && !model.race_parked {
+                crate::park::park(&mut y);
+                model.race_parked = true;
+                integrator.set_substeps(scene.integrator.substeps);
+            } else if !clear && (model.race_parked || k == 0) {
+                if model.race_parked {
+                    crate::park::release(&model, t0, &mut y, release);
+                }
+                model.race_parked = false;
+                integrator.set_substeps(scene.integrator.contact_substeps);
+            }
+            parked_steps += u64::from(model.race_parked);
         }
         out_times.clear();
         while (next_out as f64) * out_dt <= t1 + 1e-9 * out_dt {
@@ -267,7 +286,16 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
         Source::Cosim(session) => Some(session.finish(t, (t / period).round() as u64)),
         _ => None,
     };
-    Ok(RunResult { trace, stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim })
+    Ok(RunResult {
+        trace,
+        stats: integrator.stats(),
+        simulated: t,
+        wall_time,
+        outcome,
+        final_state: y,
+        cosim,
+        parked_steps,
+    })
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

@@ -3,8 +3,15 @@
 //! known to blow up. `plant bench accuracy` measures the real limits and
 //! prints them next to these estimates (README, "Speed against accuracy").
 
+//!
+//! With `touchdown.race_when_clear = "parked"` the race rests in the housing frame while the gap
+//! is clear, and the stiff race-on-balls mode is gone: the fixed step then only has to resolve
+//! the rotor on its bearing (hundreds of rad/s). The limits below apply to the step taken while
+//! the race is free, `integrator.contact_substeps`.
+
 use crate::config::Scene;
 use crate::integrate::Method;
+use crate::model::RaceWhenClear;
 
 /// Stability estimate of a fixed-step method: the largest step `c / ω_max`, with `ω_max` the
 /// race's frequency on its contacts linearised at the reference's peak contact force (or on
@@ -38,6 +45,18 @@ pub fn estimate(scene: &Scene, method: Method, peak_contact_force: f64) -> f64 {
 /// study's 10 – 20 G scenes are 8 – 11 kN.
 pub const REFERENCE_CONTACT_FORCE: f64 = 1e4;
 
+/// Substeps per controller period that keep `method` within the estimated limit under a
+/// [`REFERENCE_CONTACT_FORCE`] contact (1 for the adaptive methods and explicit Euler, which has no
+/// limit to meet).
+pub fn safe_contact_substeps(scene: &Scene, method: Method) -> u32 {
+    let limit = estimate(scene, method, REFERENCE_CONTACT_FORCE);
+    if limit > 0.0 && !method.is_adaptive() {
+        (scene.controller.period / limit).ceil().max(1.0) as u32
+    } else {
+        1
+    }
+}
+
 /// What the plant says about a scene's integrator before running it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Verdict {
@@ -55,7 +74,13 @@ pub fn check(scene: &Scene) -> Verdict {
     if !matches!(m, Method::ExplicitEuler | Method::SymplecticEuler | Method::Rk4) {
         return Verdict::Fine;
     }
-    let h = scene.controller.period / f64::from(scene.integrator.substeps);
+    // The stiff modes exist only while the race is free: with a parked race that is the step of
+    // `contact_substeps`.
+    let (key, steps) = match scene.params.race_when_clear {
+        RaceWhenClear::Free => ("integrator.substeps", scene.integrator.substeps),
+        RaceWhenClear::Parked(_) => ("integrator.contact_substeps", scene.integrator.contact_substeps),
+    };
+    let h = scene.controller.period / f64::from(steps);
     let name = crate::summary::snake_name(&m);
     let free = estimate(scene, m, 0.0);
     let contact = estimate(scene, m, REFERENCE_CONTACT_FORCE);
@@ -69,17 +94,16 @@ pub fn check(scene: &Scene) -> Verdict {
     }
     if h > free {
         return Verdict::Refuse(format!(
-            "integrator.substeps = {} gives a step of {h:.3e} s, beyond the estimated stability limit {free:.3e} s of \
+            "{key} = {steps} gives a step of {h:.3e} s, beyond the estimated stability limit {free:.3e} s of \
              {name} for the race resting on its balls: the run would blow up before any contact; use \
-             integrator.substeps >= {} or method \"dp5\"",
-            scene.integrator.substeps,
+             {key} >= {} or method \"dp5\"",
             substeps(free)
         ));
     }
     if h > contact {
         return Verdict::Warn(format!(
             "a step of {h:.3e} s exceeds the estimated stability limit {contact:.3e} s of {name} under a {:.0} kN \
-             contact: a hard impact will likely blow up (integrator.substeps >= {} is safe)",
+             contact: a hard impact will likely blow up ({key} >= {} is safe)",
             REFERENCE_CONTACT_FORCE / 1e3,
             substeps(contact)
         ));

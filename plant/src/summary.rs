@@ -25,6 +25,11 @@ pub struct ModelInfo {
     pub race_drag: String,
     /// `balls` or `lumped`.
     pub race_support: String,
+    /// `free` or `parked`: the race while the gap is clear (`touchdown.race_when_clear`).
+    pub race_when_clear: String,
+    /// With a parked race: `equilibrium` or `held`, the state it is released with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub race_release: Option<String>,
     /// `linear` or `nonlinear`.
     pub amb_force: String,
     /// Number of balls.
@@ -50,6 +55,8 @@ pub struct IntegratorInfo {
     pub atol: Vec<f64>,
     /// Substeps per controller period (fixed-step methods).
     pub substeps: u32,
+    /// Substeps per controller period while the race is free (fixed-step methods, parked race).
+    pub contact_substeps: u32,
     /// Macro step (s).
     pub macro_step_s: f64,
 }
@@ -82,6 +89,8 @@ pub struct Summary {
     pub recovery_s: Option<f64>,
     /// Time in rotor – race contact over the whole run (s), counted on the trace samples.
     pub contact_time_s: f64,
+    /// Fraction of macro steps run with the race parked (0 unless `race_when_clear = "parked"`).
+    pub parked_fraction: f64,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -134,6 +143,14 @@ impl Summary {
             max_race_speed_rpm: max(trace.race_speed_rad_s.iter().map(|w| w.abs() * 60.0 / std::f64::consts::TAU)),
             recovery_s: recovery_time(trace, scene.first_shock_start()),
             contact_time_s: contact_fraction(trace, 0.0) * result.simulated,
+            parked_fraction: {
+                let ticks = (result.simulated / c.period).round();
+                if ticks > 0.0 {
+                    result.parked_steps as f64 / ticks
+                } else {
+                    0.0
+                }
+            },
             steps: result.stats.steps,
             rejected_steps: result.stats.rejected,
             rhs_evals: result.stats.rhs_evals,
@@ -147,6 +164,11 @@ impl Summary {
                 cage: p.cage,
                 race_drag: scene.raw.touchdown.drag.clone(),
                 race_support: scene.raw.touchdown.support.clone(),
+                race_when_clear: scene.raw.touchdown.race_when_clear.clone(),
+                race_release: match p.race_when_clear {
+                    crate::model::RaceWhenClear::Free => None,
+                    crate::model::RaceWhenClear::Parked(r) => Some(snake_name(&r)),
+                },
                 amb_force: scene.raw.amb.force_law.clone(),
                 balls: p.balls.count(),
                 control_mode: c.mode,
@@ -159,6 +181,7 @@ impl Summary {
                 rtol: scene.integrator.rtol,
                 atol: scene.integrator.atol.to_vec(),
                 substeps: scene.integrator.substeps,
+                contact_substeps: scene.integrator.contact_substeps,
                 macro_step_s: c.period,
             },
             analysis: analyze(trace, &analysis_setting(scene)),

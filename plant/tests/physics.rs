@@ -358,3 +358,33 @@ fn rk4_blows_up_just_above_the_estimated_limit_on_the_balls_and_not_below() {
     assert_eq!(at(0.8), Outcome::Completed);
     assert!(matches!(at(1.2), Outcome::Diverged(_)), "stable above the estimate");
 }
+
+/// The levitation scene class ships RK4 with one step per 50 µs tick and the race parked while
+/// the gap is clear (config/levitation-1g.toml). Without contact the race does not act on the
+/// rotor, so the parked model's rotor must follow the full model's: within 1e-4 of the gap of
+/// a tight DOP853 run of the full model (free race on its balls) over the 50 ms after the shock.
+/// The stiff mode is gone while parked, so the stability check has nothing to say; with the
+/// released race on one step per tick it must still warn about contact.
+#[test]
+fn levitation_scene_setting_is_within_1e4_of_the_full_model_and_passes_the_stability_check() {
+    use plant::bench::{window_error, with_integrator, Setting};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/levitation-1g.toml");
+    let probe = plant::config::load_scene(&path, &[]).expect("scene loads");
+    let start = probe.first_shock_start();
+    let sets = [format!("scene.duration_s={:?}", start + 0.05), "output.rate_hz=20000.0".to_string()];
+    let shipped = plant::config::load_scene(&path, &sets).expect("scene loads");
+    assert_eq!(plant::stability::check(&shipped), plant::stability::Verdict::Fine);
+    let parked = completed(&shipped);
+    let ticks = (shipped.duration / shipped.controller.period).round() as u64;
+    assert_eq!(parked.parked_steps, ticks, "the race should stay parked: the 1 G shock leaves the gap clear");
+
+    let mut full = shipped.clone();
+    full.params.race_when_clear = plant::model::RaceWhenClear::Free;
+    let reference = completed(&with_integrator(&full, Method::Dop853, Setting::Rtol(1e-11)));
+    let (rms, max) = window_error(&parked.trace, &reference.trace, start, start + 0.05, shipped.params.contact.gap);
+    assert!(rms <= 1e-4 && max <= 1e-3, "error rms {rms:.2e}, max {max:.2e} of the gap");
+
+    let mut one_step_in_contact = shipped.clone();
+    one_step_in_contact.integrator.contact_substeps = 1;
+    assert!(matches!(plant::stability::check(&one_step_in_contact), plant::stability::Verdict::Warn(_)));
+}

@@ -252,6 +252,16 @@ fn bad_shock_exits_2_naming_key_value_and_unit() {
 }
 
 #[test]
+fn bad_race_when_clear_exits_2_naming_key_and_value() {
+    assert_bad_input(
+        "bad-race-when-clear",
+        &scene("paper-3g.toml"),
+        &["touchdown.race_when_clear=\"asleep\""],
+        &["touchdown.race_when_clear", "asleep", "parked"],
+    );
+}
+
+#[test]
 fn malformed_set_exits_2_naming_the_argument() {
     assert_bad_input("malformed-set", &scene("paper-10g.toml"), &["novalue"], &["--set", "novalue", "KEY=VALUE"]);
 }

@@ -202,7 +202,12 @@ pub fn spec(scene: &Scene, samples: usize, seed: u64, atol_scale: Option<[f64; N
         }));
     }
     let y0 = initial_state(scene);
-    let model = Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Continuous(gains) };
+    let model = Model {
+        params: scene.params.clone(),
+        base: scene.base.clone(),
+        control: Control::Continuous(gains),
+        race_parked: false,
+    };
     let samples_json: Vec<Value> = sample_states(scene, &y0, samples, seed)
         .into_iter()
         .chain(std::iter::once(("initial".to_string(), 0.0, y0)))

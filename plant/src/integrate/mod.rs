@@ -597,6 +597,12 @@ impl<const N: usize> Integrator<N> {
         &self.settings
     }
 
+    /// Changes the substeps of a fixed-step method for the next macro steps (ignored by the
+    /// adaptive methods); `substeps` is at least 1.
+    pub fn set_substeps(&mut self, substeps: u32) {
+        self.settings.substeps = substeps.max(1);
+    }
+
     /// Work counters since creation or the last [`Integrator::reset_stats`].
     pub fn stats(&self) -> Stats {
         self.stats

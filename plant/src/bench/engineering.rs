@@ -1,0 +1,166 @@
+//! Engineering figures across integrators on full-length runs (`plant bench engineering`).
+//!
+//! The 50 ms trajectory error of `plant bench accuracy` is a strict measure: after repeated
+//! impacts small differences grow. What a study reads off a long run are its figures: the peak
+//! rotor – race contact force, the largest rotor radius, the contact fraction over the last 200
+//! revolutions and the post-shock mode. This bench runs the full-length impact (3 G) and rub
+//! (10 G) scenes with each method at a representative setting (including each scene's shipped
+//! default and the parked race), and compares those figures with a reference run (DOP853 at
+//! rtol 1e-12 with scaled absolute tolerances, free race).
+
+use super::{measure, with_integrator, Setting};
+use crate::config::{load_scene, Scene};
+use crate::integrate::Method;
+use crate::model::{RaceWhenClear, Release};
+use crate::run::Outcome;
+use crate::summary::{snake_name, Summary};
+use anyhow::Context;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One run's figures.
+#[derive(Clone, Debug)]
+pub struct Figures {
+    /// Scene.
+    pub scene: String,
+    /// What ran (method, setting, model).
+    pub label: String,
+    /// `completed` or `diverged`.
+    pub status: String,
+    /// Peak contact force (N).
+    pub peak_contact_force_n: f64,
+    /// Largest rotor radius (m).
+    pub max_radius_m: f64,
+    /// Contact fraction over the last 200 revolutions.
+    pub contact_fraction: f64,
+    /// Post-shock mode.
+    pub post_shock_mode: String,
+    /// Steady class of the end of the run.
+    pub steady_class: String,
+    /// Wall seconds per simulated second (fastest of the repeats).
+    pub wall_s_per_sim_s: f64,
+}
+
+fn figures(scene_name: &str, label: String, scene: &Scene, repeats: usize) -> anyhow::Result<Figures> {
+    let m = measure(scene, repeats)?;
+    let s = Summary::new(scene, &m.result);
+    Ok(Figures {
+        scene: scene_name.into(),
+        label,
+        status: if m.result.outcome == Outcome::Completed { "completed".into() } else { "diverged".into() },
+        peak_contact_force_n: s.max_contact_force_n,
+        max_radius_m: s.max_radius_m,
+        contact_fraction: s.contact_fraction,
+        post_shock_mode: snake_name(&s.analysis.post_shock_mode),
+        steady_class: snake_name(&s.analysis.steady_class),
+        wall_s_per_sim_s: m.best_wall / scene.duration,
+    })
+}
+
+fn parked(scene: &Scene, method: Method) -> Scene {
+    let mut s = scene.clone();
+    s.params.race_when_clear = RaceWhenClear::Parked(Release::Equilibrium);
+    s.raw.touchdown.race_when_clear = "parked".into();
+    s.integrator.contact_substeps = s.integrator.substeps.max(crate::stability::safe_contact_substeps(&s, method));
+    s
+}
+
+/// The settings compared on each scene: (label, scene).
+fn settings(scene: &Scene) -> Vec<(String, Scene)> {
+    let d = &scene.integrator;
+    let default = match d.method {
+        m if m.is_adaptive() => format!("shipped default: {} rtol={:e}", snake_name(&m), d.rtol),
+        m => format!("shipped default: {} substeps={}", snake_name(&m), d.substeps),
+    };
+    let mut v = vec![(default, scene.clone())];
+    for (method, setting) in [
+        (Method::Dp5, Setting::Rtol(1e-6)),
+        (Method::Dp5, Setting::Rtol(1e-9)),
+        (Method::Dop853, Setting::Rtol(1e-9)),
+        (Method::Rk4, Setting::Substeps(4)),
+        (Method::Rk4, Setting::Substeps(16)),
+        (Method::SymplecticEuler, Setting::Substeps(8)),
+        (Method::SymplecticEuler, Setting::Substeps(64)),
+    ] {
+        v.push((format!("{} {setting}", snake_name(&method)), with_integrator(scene, method, setting)));
+    }
+    let dp5 = with_integrator(scene, Method::Dp5, Setting::Rtol(1e-9));
+    v.push(("parked race + dp5 rtol=1e-9".into(), parked(&dp5, Method::Dp5)));
+    let rk4 = with_integrator(scene, Method::Rk4, Setting::Substeps(1));
+    let rk4 = parked(&rk4, Method::Rk4);
+    v.push((format!("parked race + rk4 substeps=1 (contact_substeps={})", rk4.integrator.contact_substeps), rk4));
+    v
+}
+
+/// Runs the comparison and writes `engineering.csv` into `out`.
+pub fn engineering(
+    config_dir: &Path,
+    out: &Path,
+    repeats: usize,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<Figures>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut rows = Vec::new();
+    for (name, file) in [("impact", "paper-3g.toml"), ("rub", "paper-10g.toml")] {
+        let path = config_dir.join(file);
+        let scene = load_scene(&path, &["output.plots=false".to_string()])
+            .with_context(|| format!("loading {}", path.display()))?;
+        let mut reference = with_integrator(&scene, Method::Dop853, Setting::Rtol(1e-12));
+        reference.params.race_when_clear = RaceWhenClear::Free;
+        log(&format!("{name}: reference (DOP853 rtol 1e-12, {} s)", scene.duration));
+        let r = figures(name, "reference: dop853 rtol=1e-12".into(), &reference, 1)?;
+        anyhow::ensure!(r.status == "completed", "{name}: the reference did not complete");
+        log(&format!(
+            "{name}: reference: peak contact {:.1} N, max radius {:.2} µm, contact fraction {:.4}, mode {}, {:.3e} s/s",
+            r.peak_contact_force_n,
+            r.max_radius_m * 1e6,
+            r.contact_fraction,
+            r.post_shock_mode,
+            r.wall_s_per_sim_s
+        ));
+        rows.push(r);
+        for (label, s) in settings(&scene) {
+            let f = figures(name, label, &s, repeats)?;
+            log(&format!(
+                "{name}: {}: {}, peak contact {:.0} N, max radius {:.1} µm, contact fraction {:.3}, mode {}, {:.3e} s/s",
+                f.label,
+                f.status,
+                f.peak_contact_force_n,
+                f.max_radius_m * 1e6,
+                f.contact_fraction,
+                f.post_shock_mode,
+                f.wall_s_per_sim_s
+            ));
+            rows.push(f);
+        }
+    }
+    let mut s = String::from(
+        "scene,setting,status,peak_contact_force_n,max_radius_m,contact_fraction,post_shock_mode,steady_class,\
+         wall_s_per_sim_s,peak_force_rel_diff,max_radius_rel_diff,contact_fraction_diff,same_mode\n",
+    );
+    for r in &rows {
+        let Some(reference) = rows.iter().find(|x| x.scene == r.scene && x.label.starts_with("reference")) else {
+            continue;
+        };
+        let rel = |a: f64, b: f64| if b != 0.0 { (a - b) / b } else { a - b };
+        let _ = writeln!(
+            s,
+            "{},{},{},{:e},{:e},{:e},{},{},{:e},{:e},{:e},{:e},{}",
+            r.scene,
+            r.label,
+            r.status,
+            r.peak_contact_force_n,
+            r.max_radius_m,
+            r.contact_fraction,
+            r.post_shock_mode,
+            r.steady_class,
+            r.wall_s_per_sim_s,
+            rel(r.peak_contact_force_n, reference.peak_contact_force_n),
+            rel(r.max_radius_m, reference.max_radius_m),
+            r.contact_fraction - reference.contact_fraction,
+            r.post_shock_mode == reference.post_shock_mode && r.steady_class == reference.steady_class
+        );
+    }
+    std::fs::write(out.join("engineering.csv"), s).context("writing engineering.csv")?;
+    Ok(rows)
+}
