@@ -22,6 +22,7 @@ pub mod output;
 pub mod plot;
 pub mod run;
 pub mod sensor;
+pub mod soak;
 pub mod stability;
 pub mod summary;
 pub mod sweep;
