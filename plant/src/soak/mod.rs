@@ -587,16 +587,18 @@ fn write_plots(dir: &Path, prog: &Programme, figures: &[ShockFigures], rss: &[Rs
     let (mut mx, mut my) = (Vec::new(), Vec::new());
     for s in prog.shocks.iter().filter(|s| s.start_s <= t_end) {
         mx.extend([s.start_s, s.start_s, f64::NAN]);
-        my.extend([0.0, 1.15 * gap_um, f64::NAN]);
+        // A short tick below the zero line, drawn first so the radius stays on top.
+        my.extend([-0.1 * gap_um, 0.0, f64::NAN]);
     }
-    let mut series = vec![
-        Series { label: "rotor radius (max per 5 ms)", x: &t, y: &r_um },
-        Series { label: "air gap r0", x: &t, y: &gap_line },
-        Series { label: "clear radius", x: &t, y: &clear_line },
-    ];
+    let mut series = Vec::new();
     if !mx.is_empty() {
         series.push(Series { label: "shock start", x: &mx, y: &my });
     }
+    series.extend([
+        Series { label: "rotor radius (max per 5 ms)", x: &t, y: &r_um },
+        Series { label: "air gap r0", x: &t, y: &gap_line },
+        Series { label: "clear radius", x: &t, y: &clear_line },
+    ]);
     plot::lines(
         &dir.join("radius.png"),
         &format!("{name} — rotor radius through the soak"),
