@@ -267,7 +267,8 @@ impl SplitMix64 {
 }
 
 /// Rounds to 6 significant digits, so that generated values read well in
-/// `scene.toml` and `soak.csv`.
+/// `scene.toml` and `soak.csv` (a start near 100 s moves by up to 50 µs; the
+/// spacing check runs on the rounded starts).
 fn tidy(v: f64) -> f64 {
     format!("{v:.5e}").parse().unwrap_or(v)
 }
@@ -482,8 +483,9 @@ mod tests {
             let ShockSpec::DoubleHalfSine { peak_g: Some(p), start_s, direction_deg, .. } = s else { panic!() };
             assert!((1.0..=20.0).contains(p) && (0.0..=360.0).contains(direction_deg));
             if let Some(l) = last {
+                // Starts are rounded to 6 significant digits: within 5e-5 s below 100 s.
                 let gap: f64 = start_s - l;
-                assert!((1.0 - 1e-5..=2.0 + 1e-5).contains(&gap), "spacing {gap}");
+                assert!((1.0 - 1e-4..=2.0 + 1e-4).contains(&gap), "spacing {gap}");
             }
             last = Some(*start_s);
         }
