@@ -23,6 +23,7 @@ pub mod park;
 pub mod plot;
 pub mod run;
 pub mod sensor;
+pub mod soak;
 pub mod stability;
 pub mod summary;
 pub mod sweep;

@@ -23,6 +23,8 @@ mod exit {
     /// Co-simulation: the controller process was lost (or never answered) and none took
     /// its place; results up to that point were written.
     pub const PEER_LOST: u8 = 4;
+    /// `plant soak`: the run completed but a criterion of the programme failed.
+    pub const CRITERION_FAILED: u8 = 5;
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     pub const INTERRUPTED: u8 = 130;
 }
@@ -56,6 +58,21 @@ enum Command {
         /// Co-simulation run id (names the shared-memory services); default: a fresh one.
         #[arg(long)]
         run_id: Option<String>,
+    },
+    /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
+    /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.
+    Soak {
+        /// Programme file (TOML).
+        programme: PathBuf,
+        /// Output folder (default: runs/soak-<programme file stem>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a key of the programme's scene, after the programme's own `set` (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress display.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Measurements of the testbed itself.
     Bench {
@@ -266,6 +283,7 @@ fn main() -> ExitCode {
             bench_ipc(samples, warmup, pin_cores, spin_us, controller.launch(run_id))
         }
         Command::Analyze { dir } => analyze_dir(&dir),
+        Command::Soak { programme, out, set, quiet } => soak_cmd(&programme, out, &set, quiet),
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws } => {
             let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")));
@@ -399,6 +417,107 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool,
             ExitCode::from(exit::PEER_LOST)
         }
     }
+}
+
+fn soak_cmd(path: &std::path::Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> ExitCode {
+    let prog = match plant::soak::programme::load(path, set) {
+        Ok(p) => p,
+        Err(e) => return bad_input(&e),
+    };
+    match plant::stability::check(&prog.scene) {
+        plant::stability::Verdict::Fine => {}
+        plant::stability::Verdict::Warn(w) => eprintln!("plant: warning: {w}"),
+        plant::stability::Verdict::Refuse(why) => {
+            eprintln!("plant: error: {why}");
+            return ExitCode::from(exit::BAD_INPUT);
+        }
+    }
+    let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("plant: warning: cannot install the Ctrl-C handler: {e}");
+    }
+    let progress = match (quiet, std::io::stderr().is_terminal()) {
+        (true, _) => plant::soak::Progress::Quiet,
+        (false, true) => plant::soak::Progress::Bar,
+        (false, false) => plant::soak::Progress::Lines,
+    };
+    eprintln!(
+        "plant soak: {} shocks over {} s simulated ({}), results in {}",
+        prog.shocks.len(),
+        prog.scene.duration,
+        snake(&prog.scene.controller.mode),
+        dir.display()
+    );
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress };
+    let done = match plant::soak::run(&prog, path, opts) {
+        Ok(d) => d,
+        Err(plant::soak::SoakError::Setup(SetupError::Law(e))) => return bad_input(&ConfigError::Law(e)),
+        Err(plant::soak::SoakError::Setup(SetupError::Cosim(e))) => return cosim_failed(&e),
+        Err(plant::soak::SoakError::Io(e)) => {
+            eprintln!("plant: error: {e:#}");
+            return ExitCode::from(exit::IO);
+        }
+    };
+    let r = &done.report;
+    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    let rss = |p: &Option<plant::soak::ProcessRss>| {
+        p.as_ref().map_or("not measured".to_string(), |p| {
+            format!(
+                "{:.1} -> {:.1} MiB (max {:.1})",
+                p.start_kib as f64 / 1024.0,
+                p.end_kib as f64 / 1024.0,
+                p.max_kib as f64 / 1024.0
+            )
+        })
+    };
+    eprintln!(
+        "plant soak: {} {:.1} of {:.1} s simulated in {:.1} s; recovered {}/{} shocks (recovery s: min {}, median {}, max {}); \
+         max contact force {:.0} N; sequence gaps {}, deadline misses {} ({:.2e}); RSS plant {}, controller {}",
+        r.status,
+        r.simulated_s,
+        r.planned_s,
+        r.wall_time_s,
+        r.recovered,
+        r.shocks,
+        fmt(r.recovery_s.min),
+        fmt(r.recovery_s.median),
+        fmt(r.recovery_s.max),
+        r.max_contact_force_n,
+        r.sequence_gaps,
+        r.deadline_misses,
+        r.deadline_miss_fraction,
+        rss(&r.rss.plant),
+        rss(&r.rss.controller),
+    );
+    let failed: Vec<_> = r.criteria.iter().filter(|v| !v.passed).collect();
+    for v in &failed {
+        eprintln!("plant soak: criterion failed: {v}");
+    }
+    match done.outcome {
+        Outcome::Completed if failed.is_empty() => {
+            eprintln!("plant soak: all {} criteria met; results in {}", r.criteria.len(), dir.display());
+            ExitCode::SUCCESS
+        }
+        Outcome::Completed => ExitCode::from(exit::CRITERION_FAILED),
+        Outcome::Diverged(e) => {
+            eprintln!("plant: error: {e}; results up to t = {} s were written", r.simulated_s);
+            ExitCode::from(exit::DIVERGED)
+        }
+        Outcome::Interrupted => {
+            eprintln!("plant: interrupted; results up to t = {} s were written", r.simulated_s);
+            ExitCode::from(exit::INTERRUPTED)
+        }
+        Outcome::PeerLost(why) => {
+            eprintln!("plant: error: {why}; results up to t = {} s were written", r.simulated_s);
+            ExitCode::from(exit::PEER_LOST)
+        }
+    }
+}
+
+fn snake<T: serde::Serialize>(v: &T) -> String {
+    plant::summary::snake_name(v)
 }
 
 /// Exit code and message for a co-simulation that could not start.

@@ -90,6 +90,29 @@ pub trait Hooks {
     /// A message for the user (co-simulation: waiting for a controller, a
     /// lost controller); the loop itself never prints.
     fn note(&mut self, _message: &str) {}
+    /// Co-simulation: a controller process connected (at the start, or after a
+    /// reconnection), with its process id from the handshake.
+    fn controller_connected(&mut self, _pid: u32) {}
+}
+
+/// Where the loop's output samples go (at the scene's output rate, from the
+/// integrator's dense output): a [`Trace`] for `plant run`, an online monitor
+/// for runs too long to keep (`plant soak`).
+pub trait Sink {
+    /// The state `y` at time `t` (s); `model` holds the command applied then.
+    fn sample(&mut self, model: &Model, t: f64, y: &State);
+    /// `true` when the sink keeps nothing per sample: the loop then reserves no
+    /// per-tick storage either (co-simulation latencies go to fixed-size
+    /// histograms), so memory stays flat however long the run. Default `false`.
+    fn bounded(&self) -> bool {
+        false
+    }
+}
+
+impl Sink for Trace {
+    fn sample(&mut self, model: &Model, t: f64, y: &State) {
+        self.push(model, t, y);
+    }
 }
 
 /// Hooks that do nothing.
@@ -158,6 +181,47 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError
 
 /// Runs a scene from its initial state, launching a co-simulation as `launch` says.
 pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
+    let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
+    let r = run_into(scene, launch, hooks, &mut trace)?;
+    Ok(RunResult {
+        trace,
+        stats: r.stats,
+        simulated: r.simulated,
+        wall_time: r.wall_time,
+        outcome: r.outcome,
+        final_state: r.final_state,
+        cosim: r.cosim,
+        parked_steps: r.parked_steps,
+    })
+}
+
+/// A run whose samples went to a [`Sink`]: a [`RunResult`] without the trace.
+#[derive(Clone, Debug)]
+pub struct SinkRun {
+    /// Integrator statistics.
+    pub stats: Stats,
+    /// Simulated time reached (s).
+    pub simulated: f64,
+    /// Wall time of the loop (s).
+    pub wall_time: f64,
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Final state.
+    pub final_state: State,
+    /// Co-simulation figures (`lockstep`, `realtime`).
+    pub cosim: Option<CosimReport>,
+    /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
+    pub parked_steps: u64,
+}
+
+/// Runs a scene from its initial state, sending every output sample (from
+/// `t = 0`, at the scene's output rate) to `sink`.
+pub fn run_into(
+    scene: &Scene,
+    launch: &Launch,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
     let gains = design_gains(scene)?;
     let limit = scene.params.current_limit;
     let bias = saturate(gains.bias_a, limit);
@@ -194,13 +258,19 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
     let period = scene.controller.period;
     let ticks = (scene.duration / period).ceil() as u64;
     let out_dt = scene.output_interval;
-    let mut trace = Trace::with_capacity((scene.duration / out_dt).ceil() as usize + 2);
-    trace.push(&model, 0.0, &y);
+    sink.sample(&model, 0.0, &y);
     let mut next_out: u64 = 1;
     let mut out_times: Vec<f64> = Vec::with_capacity((period / out_dt).ceil() as usize + 2);
     let inherent = match &mut source {
         Source::Cosim(session) => {
-            session.reserve(ticks as usize);
+            if sink.bounded() {
+                session.bounded_figures();
+            } else {
+                session.reserve(ticks as usize);
+            }
+            if let Some(pid) = session.controller_pid() {
+                hooks.controller_connected(pid);
+            }
             session.inherent_delay()
         }
         _ => 0,
@@ -214,6 +284,10 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
     let mut next_breakpoint = 0;
     let mut parked_steps = 0u64;
 
+    let mut controller_pid = match &source {
+        Source::Cosim(session) => session.controller_pid(),
+        _ => None,
+    };
     let start = std::time::Instant::now();
     let mut outcome = Outcome::Completed;
     let mut t = 0.0;
@@ -225,7 +299,16 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
             Source::Continuous => None,
             Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),
             Source::Cosim(session) => match session.command(&sample, hooks) {
-                Ok(cmd) => Some(cmd),
+                Ok(cmd) => {
+                    let pid = session.controller_pid();
+                    if pid != controller_pid {
+                        controller_pid = pid;
+                        if let Some(pid) = pid {
+                            hooks.controller_connected(pid);
+                        }
+                    }
+                    Some(cmd)
+                }
                 Err(stop) => {
                     outcome = match stop {
                         Stop::Lost(why) => Outcome::PeerLost(why),
@@ -268,7 +351,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
             &mut y,
             &out_times,
             (&breakpoints, &mut next_breakpoint),
-            |ts, ys| trace.push(&model, ts, ys),
+            |ts, ys| sink.sample(&model, ts, ys),
         );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
@@ -286,16 +369,7 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
         Source::Cosim(session) => Some(session.finish(t, (t / period).round() as u64)),
         _ => None,
     };
-    Ok(RunResult {
-        trace,
-        stats: integrator.stats(),
-        simulated: t,
-        wall_time,
-        outcome,
-        final_state: y,
-        cosim,
-        parked_steps,
-    })
+    Ok(SinkRun { stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim, parked_steps })
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

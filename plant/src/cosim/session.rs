@@ -61,6 +61,8 @@ pub struct Session {
     first_seq: u64,
     last_cmd: [f64; 2],
     controller: String,
+    /// Process id of the connected controller (from its handshake ack).
+    controller_pid: Option<u32>,
     // Realtime.
     start: Option<Instant>,
     sent_ns: [u64; RING],
@@ -198,6 +200,7 @@ impl Session {
             first_seq: 0,
             last_cmd: bias,
             controller: String::new(),
+            controller_pid: None,
             start: None,
             sent_ns: [0; RING],
             last_heard: Instant::now(),
@@ -237,6 +240,22 @@ impl Session {
         if self.mode == ControlMode::Lockstep {
             self.round_trip = Latencies::with_capacity(ticks);
         }
+    }
+
+    /// Keeps the latency figures in fixed-size histograms (percentiles
+    /// within 0.1 %) instead of one entry per tick: for runs whose memory must
+    /// not grow with their length (`plant soak`). Call before the loop.
+    pub fn bounded_figures(&mut self) {
+        self.latency = Latencies::binned();
+        if self.mode == ControlMode::Lockstep {
+            self.round_trip = Latencies::binned();
+        }
+    }
+
+    /// Process id of the controller now connected, as its handshake ack gave it
+    /// (`None` while none is connected).
+    pub fn controller_pid(&self) -> Option<u32> {
+        self.controller_pid.filter(|_| self.connected)
     }
 
     /// The run id.
@@ -297,6 +316,7 @@ impl Session {
                         return Some(Err(CosimError::Refused { reason: Refusal::describe(ack.status), message }));
                     }
                     self.controller = format!("{message} (pid {})", ack.controller_pid);
+                    self.controller_pid = Some(ack.controller_pid);
                     self.connected = true;
                     self.lost_since = None;
                     self.last_heard = Instant::now();

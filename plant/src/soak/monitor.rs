@@ -1,0 +1,288 @@
+//! Online per-shock figures of a soak, from the output samples (rotor radius
+//! relative to the housing and rotor–race normal force), in constant memory.
+//!
+//! Shock `j` owns the window `[s_j, s_{j+1})` (the last one ends with the
+//! run). In its window:
+//!
+//! - **contact**: a sample with normal force `> 0`; `contact_time_s` is the
+//!   number of contact samples times the sample interval, `contact_episodes`
+//!   the number of transitions into contact, `max_contact_force_n` the
+//!   largest sampled force;
+//! - **clear**: no contact and radius `< clear_radius`;
+//! - **recovered**: the samples from some time `c` to the window's last
+//!   sample are all clear, and that last sample is at least `hold` after `c`;
+//!   `recovery_s = max(c − s_j, 0)`: from the shock's start to the start of
+//!   that final clear stretch (0 when the rotor never left the clear zone).
+//!
+//! Samples are taken at the output rate, so contacts shorter than one sample
+//! interval can be missed and times are resolved to one interval.
+
+use serde::Serialize;
+
+/// The figures of one shock's window.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShockFigures {
+    /// Shock index (0-based).
+    pub index: usize,
+    /// Window start: the shock's start (s).
+    pub start_s: f64,
+    /// Time of the window's last sample (s).
+    pub end_s: f64,
+    /// Recovered before the window's end (see the module docs).
+    pub recovered: bool,
+    /// Shock start to the start of the final clear stretch (s); NaN if not recovered.
+    pub recovery_s: f64,
+    /// Largest rotor–race normal force in the window (N).
+    pub max_contact_force_n: f64,
+    /// Time in contact (s).
+    pub contact_time_s: f64,
+    /// Transitions into contact.
+    pub contact_episodes: u64,
+    /// Largest rotor radius relative to the housing (m).
+    pub max_radius_m: f64,
+    /// The window ran to its planned end (false: the run stopped inside it).
+    pub complete: bool,
+}
+
+/// Accumulates [`ShockFigures`] window by window.
+#[derive(Clone, Debug)]
+pub struct ShockTracker {
+    starts: Vec<f64>,
+    end: f64,
+    clear_radius: f64,
+    hold: f64,
+    dt: f64,
+    /// Window in progress (`None` before the first shock).
+    current: Option<usize>,
+    acc: Acc,
+    /// Start of the current clear stretch.
+    clear_since: Option<f64>,
+    in_contact: bool,
+    last_t: f64,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Acc {
+    max_force: f64,
+    contact_samples: u64,
+    episodes: u64,
+    max_radius: f64,
+}
+
+impl ShockTracker {
+    /// Tracker for shocks starting at `starts` (ascending, s) in a run ending at `end` (s),
+    /// sampled every `dt` (s); clear below `clear_radius` (m), recovered after `hold` (s).
+    pub fn new(starts: Vec<f64>, end: f64, dt: f64, clear_radius: f64, hold: f64) -> Self {
+        Self {
+            starts,
+            end,
+            clear_radius,
+            hold,
+            dt,
+            current: None,
+            acc: Acc::default(),
+            clear_since: None,
+            in_contact: false,
+            last_t: 0.0,
+        }
+    }
+
+    /// One sample at `t` (s): rotor radius (m) and contact normal force (N). Each window that
+    /// this sample closes is passed to `closed`.
+    pub fn sample(&mut self, t: f64, radius: f64, force: f64, closed: &mut dyn FnMut(ShockFigures)) {
+        // Windows that start at or before t close the previous one.
+        loop {
+            let next = self.current.map_or(0, |j| j + 1);
+            if next >= self.starts.len() || t < self.starts[next] {
+                break;
+            }
+            if let Some(j) = self.current {
+                closed(self.close(j, true));
+            }
+            self.current = Some(next);
+            self.acc = Acc::default();
+        }
+        let contact = force > 0.0;
+        if contact && !self.in_contact && self.current.is_some() {
+            self.acc.episodes += 1;
+        }
+        self.in_contact = contact;
+        if contact || radius >= self.clear_radius || !radius.is_finite() {
+            self.clear_since = None;
+        } else if self.clear_since.is_none() {
+            self.clear_since = Some(t);
+        }
+        if self.current.is_some() {
+            let a = &mut self.acc;
+            a.max_force = a.max_force.max(force);
+            a.max_radius = a.max_radius.max(radius);
+            a.contact_samples += u64::from(contact);
+        }
+        self.last_t = t;
+    }
+
+    /// Closes the window in progress at the end of the run (or where it stopped).
+    pub fn finish(&mut self) -> Option<ShockFigures> {
+        let j = self.current.take()?;
+        let complete = self.last_t >= self.end - 0.5 * self.dt;
+        Some(self.close(j, complete))
+    }
+
+    fn close(&self, j: usize, complete: bool) -> ShockFigures {
+        let start = self.starts[j];
+        let recovered_from = self.clear_since.filter(|c| self.last_t - c >= self.hold - 1e-9 * self.hold);
+        ShockFigures {
+            index: j,
+            start_s: start,
+            end_s: self.last_t,
+            recovered: recovered_from.is_some(),
+            recovery_s: recovered_from.map_or(f64::NAN, |c| (c - start).max(0.0)),
+            max_contact_force_n: self.acc.max_force,
+            contact_time_s: self.acc.contact_samples as f64 * self.dt,
+            contact_episodes: self.acc.episodes,
+            max_radius_m: self.acc.max_radius,
+            complete,
+        }
+    }
+}
+
+/// Per-bin maxima of the radius and the contact force: the coarse trace of a soak.
+#[derive(Clone, Debug)]
+pub struct Envelope {
+    bin: f64,
+    index: u64,
+    max_radius: f64,
+    max_force: f64,
+    any: bool,
+}
+
+/// One bin of an [`Envelope`]: its start (s) and maxima.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvelopeRow {
+    /// Bin start (s).
+    pub t_s: f64,
+    /// Largest rotor radius (m).
+    pub max_radius_m: f64,
+    /// Largest contact force (N).
+    pub max_contact_force_n: f64,
+}
+
+impl Envelope {
+    /// Bins of `bin` seconds from t = 0.
+    pub fn new(bin: f64) -> Self {
+        Self { bin, index: 0, max_radius: 0.0, max_force: 0.0, any: false }
+    }
+
+    /// One sample; returns the bin it completes, if any.
+    pub fn sample(&mut self, t: f64, radius: f64, force: f64) -> Option<EnvelopeRow> {
+        let index = (t / self.bin).floor().max(0.0) as u64;
+        let done = (index > self.index && self.any).then(|| self.row());
+        if index > self.index {
+            self.index = index;
+            self.any = false;
+            self.max_radius = 0.0;
+            self.max_force = 0.0;
+        }
+        self.any = true;
+        self.max_radius = self.max_radius.max(radius);
+        self.max_force = self.max_force.max(force);
+        done
+    }
+
+    /// The last, partial bin.
+    pub fn finish(&mut self) -> Option<EnvelopeRow> {
+        let row = self.any.then(|| self.row());
+        self.any = false;
+        row
+    }
+
+    fn row(&self) -> EnvelopeRow {
+        EnvelopeRow {
+            t_s: self.index as f64 * self.bin,
+            max_radius_m: self.max_radius,
+            max_contact_force_n: self.max_force,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Feeds a piecewise signal sampled every `dt`: returns the closed windows.
+    fn run(tracker: &mut ShockTracker, dt: f64, end: f64, signal: impl Fn(f64) -> (f64, f64)) -> Vec<ShockFigures> {
+        let mut out = Vec::new();
+        let n = (end / dt).round() as usize;
+        for i in 0..=n {
+            let t = i as f64 * dt;
+            let (r, f) = signal(t);
+            tracker.sample(t, r, f, &mut |w| out.push(w));
+        }
+        out.extend(tracker.finish());
+        out
+    }
+
+    #[test]
+    fn recovery_contact_time_and_episodes_per_window() {
+        let dt = 1e-3;
+        // Shock 0 at 1 s: two contacts (1.010–1.019, 1.100–1.109 s), then clear from 1.110 s.
+        // Shock 1 at 2 s: contact from 2.5 s to the end: never recovers.
+        let signal = |t: f64| {
+            let touching = (1.0095..1.0195).contains(&t) || (1.0995..1.1095).contains(&t) || t > 2.4995;
+            if touching {
+                (150e-6, 100.0 + t)
+            } else if (1.0..1.2).contains(&t) {
+                (100e-6, 0.0)
+            } else {
+                (5e-6, 0.0)
+            }
+        };
+        let mut tr = ShockTracker::new(vec![1.0, 2.0], 3.0, dt, 75e-6, 0.2);
+        let w = run(&mut tr, dt, 3.0, signal);
+        assert_eq!(w.len(), 2);
+        let (a, b) = (&w[0], &w[1]);
+        assert!(a.recovered && a.complete);
+        // Clear (radius < 75 µm, no contact) from 1.200 s: above the radius until then.
+        assert!((a.recovery_s - 0.2).abs() < 1e-9, "{a:?}");
+        assert_eq!(a.contact_episodes, 2);
+        assert!((a.contact_time_s - 0.020).abs() < 1e-9, "{a:?}");
+        assert!((a.max_contact_force_n - 101.109).abs() < 1e-6);
+        assert!((a.max_radius_m - 150e-6).abs() < 1e-15);
+        assert!(!b.recovered && b.recovery_s.is_nan() && b.complete);
+        assert_eq!(b.contact_episodes, 1);
+        assert!((b.contact_time_s - 0.501).abs() < 1e-9, "{b:?}");
+    }
+
+    #[test]
+    fn a_clear_stretch_shorter_than_the_hold_is_not_recovery() {
+        let dt = 1e-3;
+        // Contact until 1.85 s, the next shock at 2.0 s: only 0.15 s clear with a 0.2 s hold.
+        let signal = |t: f64| if (1.0..1.85).contains(&t) { (150e-6, 10.0) } else { (1e-6, 0.0) };
+        let mut tr = ShockTracker::new(vec![1.0, 2.0], 2.5, dt, 75e-6, 0.2);
+        let w = run(&mut tr, dt, 2.5, signal);
+        assert!(!w[0].recovered);
+        assert!(w[1].recovered && w[1].recovery_s == 0.0 && w[1].contact_time_s == 0.0);
+    }
+
+    #[test]
+    fn a_run_stopped_inside_a_window_marks_it_incomplete() {
+        let mut tr = ShockTracker::new(vec![0.5], 2.0, 1e-3, 75e-6, 0.2);
+        let w = run(&mut tr, 1e-3, 1.0, |_| (1e-6, 0.0));
+        assert_eq!(w.len(), 1);
+        assert!(!w[0].complete && w[0].recovered);
+    }
+
+    #[test]
+    fn envelope_keeps_bin_maxima() {
+        let mut e = Envelope::new(0.01);
+        let mut rows = Vec::new();
+        for i in 0..25 {
+            let t = i as f64 * 1e-3;
+            rows.extend(e.sample(t, i as f64, 2.0 * i as f64));
+        }
+        rows.extend(e.finish());
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows[0], EnvelopeRow { t_s: 0.0, max_radius_m: 9.0, max_contact_force_n: 18.0 });
+        assert_eq!(rows[2].max_radius_m, 24.0);
+    }
+}

@@ -1,0 +1,161 @@
+//! End-to-end tests of `plant soak` (issue 6 §3): both processes over
+//! iceoryx2 through a short programme of shocks.
+//!
+//! What is pinned: `soak.csv` has one row per shock and agrees with
+//! `soak.json` (recovered count, largest force, contact time); a lockstep
+//! soak loses no message and misses no deadline; the RSS of both processes
+//! is sampled (the controller's is a process other than the plant's); a
+//! shock strong enough to reach the race shows contact time and force; the
+//! 2 G shock of `soak-short` recovers and the 10 G one leaves the rotor
+//! rubbing (cosim-10g with the naive PD); a criterion that cannot be met
+//! exits 5 naming it with its measured value; a malformed programme exits 2
+//! naming the key.
+
+mod common;
+
+use common::{assert_exit, controller_bin, num, output, plant_bin, read_json, stderr, workspace_root, Csv, TempDir};
+use std::path::Path;
+use std::process::Command;
+
+fn soak(programme: &Path, out: &Path, sets: &[&str]) -> Command {
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("soak").arg(programme).arg("--out").arg(out).arg("--quiet");
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    cmd
+}
+
+fn short_programme() -> std::path::PathBuf {
+    workspace_root().join("config").join("soak").join("soak-short.toml")
+}
+
+#[test]
+fn short_soak_writes_consistent_per_shock_and_overall_figures() {
+    controller_bin();
+    let dir = TempDir::new("soak-short");
+    let out = dir.join("out");
+    let run = output(&mut soak(&short_programme(), &out, &[]));
+    assert_exit(&run, 0);
+
+    let shocks = Csv::read(&out.join("soak.csv"));
+    let json = read_json(&out.join("soak.json"));
+    assert_eq!(json["status"], "completed");
+    assert_eq!(shocks.rows.len(), 2, "one row per shock");
+    assert_eq!(num(&json, "shocks") as usize, 2);
+    assert_eq!(shocks.column("index"), [0.0, 1.0]);
+    assert_eq!(shocks.column("start_s"), [0.02, 0.45]);
+    assert_eq!(shocks.column("peak_g"), [2.0, 10.0]);
+    assert!(shocks.column("complete").iter().all(|c| *c == 1.0));
+
+    // soak.csv and soak.json agree.
+    let recovered = shocks.column("recovered");
+    assert_eq!(recovered.iter().sum::<f64>(), num(&json, "recovered"));
+    let force = shocks.column("max_contact_force_n");
+    assert_eq!(force.iter().copied().fold(0.0, f64::max), num(&json, "max_contact_force_n"));
+    let contact = shocks.column("contact_time_s");
+    assert!((contact.iter().sum::<f64>() - num(&json, "contact_time_s")).abs() < 1e-12);
+
+    // Both shocks reach the race (2 G already pushes the rotor past the 150 µm gap on k_e = 1e6 N/m).
+    for (i, (&f, &c)) in force.iter().zip(&contact).enumerate() {
+        assert!(f > 0.0 && c > 0.0, "shock {i}: force {f} N, contact {c} s");
+    }
+    let recovery = shocks.column("recovery_s");
+    // 2 G: a few impacts, then clear well before the 10 G shock.
+    assert_eq!(recovered[0], 1.0);
+    assert!(recovery[0] > 0.0 && recovery[0] < 0.43 - 0.1, "recovery {}", recovery[0]);
+    assert!(contact[0] < recovery[0]);
+    // 10 G: the naive PD leaves the rotor rubbing to the end.
+    assert_eq!(recovered[1], 0.0);
+    assert!(recovery[1].is_nan());
+    assert!(contact[1] > 0.1 && force[1] > force[0], "contact {} s, force {} N", contact[1], force[1]);
+    assert_eq!(json["recovery_s"]["max"].as_f64(), Some(recovery[0]));
+
+    // Lockstep: every message answered, no deadline to miss.
+    assert_eq!(num(&json, "sequence_gaps"), 0.0);
+    assert_eq!(num(&json, "deadline_misses"), 0.0);
+    let cosim = &json["cosim"];
+    assert_eq!(num(cosim, "messages_sent"), num(cosim, "messages_received"));
+    let ticks = (num(&json, "planned_s") * 20_000.0).ceil();
+    assert_eq!(num(cosim, "messages_sent"), ticks);
+
+    // RSS of both processes, sampled over the whole run.
+    let rss = Csv::read(&out.join("rss.csv"));
+    let t = rss.column("t_sim_s");
+    assert!(rss.rows.len() >= 10, "{} RSS samples", rss.rows.len());
+    assert!(t.windows(2).all(|w| w[1] > w[0]));
+    assert!(t[0] < 0.01 && (t[t.len() - 1] - num(&json, "planned_s")).abs() < 1e-9);
+    for col in ["plant_rss_kib", "controller_rss_kib"] {
+        assert!(rss.column(col).iter().all(|k| *k > 1000.0), "{col}: {:?}", rss.column(col));
+    }
+    assert_eq!(num(&json["rss"], "samples") as usize, rss.rows.len());
+    assert_eq!(num(&json["rss"]["controller"], "end_kib"), rss.column("controller_rss_kib")[t.len() - 1]);
+    let controller = cosim["controller"].as_str().unwrap_or_default();
+    assert!(controller.contains("(pid "), "{controller}");
+
+    let criteria = json["criteria"].as_array().expect("criteria");
+    assert_eq!(criteria.len(), 3);
+    assert!(criteria.iter().all(|c| c["passed"] == true), "{criteria:#?}");
+    assert_eq!(json["passed"], true);
+    for f in ["scene.toml", "envelope.csv", "radius.png", "recovery.png", "max_force.png", "rss.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+}
+
+#[test]
+fn an_impossible_criterion_exits_5_and_names_it() {
+    controller_bin();
+    let dir = TempDir::new("soak-criterion");
+    // One 3 G shock, 0.25 s: it reaches the race, so no contact force of 1 N or less.
+    let programme = dir.join("one.toml");
+    let scene = workspace_root().join("config").join("cosim-10g.toml");
+    std::fs::write(
+        &programme,
+        format!(
+            "scene = {scene:?}\nset = [\"output.plots=false\"]\nsettle_s = 0.15\nrss_every_s = 0.05\n\
+             [recovery]\nhold_s = 0.05\n\
+             [[shock]]\nkind = \"double_half_sine\"\npeak_g = 3.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.02\n\
+             [criteria]\nmax_contact_force_n = 1.0\nmax_sequence_gaps = 0\n"
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let run = output(&mut soak(&programme, &out, &[]));
+    assert_exit(&run, 5);
+    let err = stderr(&run);
+    let json = read_json(&out.join("soak.json"));
+    let force = num(&json, "max_contact_force_n");
+    assert!(force > 1.0);
+    assert!(err.contains("criterion failed: max_contact_force_n: measured"), "{err}");
+    assert!(err.contains("limit <= 1 N"), "{err}");
+    assert!(!err.contains("criterion failed: max_sequence_gaps"), "{err}");
+    assert_eq!(json["passed"], false);
+    let verdicts = json["criteria"].as_array().unwrap();
+    let v = verdicts.iter().find(|v| v["criterion"] == "max_contact_force_n").unwrap();
+    assert_eq!((v["passed"].as_bool(), v["measured"].as_f64()), (Some(false), Some(force)));
+    // No plots when the scene says so.
+    assert!(!out.join("radius.png").exists());
+}
+
+#[test]
+fn malformed_programmes_exit_2_naming_the_key() {
+    let dir = TempDir::new("soak-bad");
+    let scene = workspace_root().join("config").join("cosim-10g.toml");
+    let cases: [(&str, &str); 4] = [
+        ("settle_s = 1.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\nbogus = 3\n", "bogus"),
+        ("settle_s = 1.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [0.1, 0.2]\n", "random.spacing_s"),
+        (
+            "settle_s = 1.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\npeak_g = [5.0, 2.0]\n",
+            "random.peak_g = [5, 2] G",
+        ),
+        ("settle_s = 1.0\nmode = \"fast\"\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\n", "mode = \"fast\""),
+    ];
+    for (i, (body, needle)) in cases.iter().enumerate() {
+        let programme = dir.join(&format!("bad{i}.toml"));
+        std::fs::write(&programme, format!("scene = {scene:?}\n{body}")).unwrap();
+        let run = output(&mut soak(&programme, &dir.join("out"), &[]));
+        assert_exit(&run, 2);
+        assert!(stderr(&run).contains(needle), "case {i}: expected {needle:?} in:\n{}", stderr(&run));
+    }
+    assert!(!dir.join("out").exists(), "nothing runs on bad input");
+}
