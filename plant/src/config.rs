@@ -640,7 +640,8 @@ fn parse_literal(text: &str) -> toml::Value {
         .unwrap_or_else(|| toml::Value::String(text.to_string()))
 }
 
-fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
+/// An out-of-range error naming the key, the value and its unit.
+pub(crate) fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
     ConfigError::Range {
         key: key.to_string(),
         value: value.to_string(),
@@ -650,7 +651,7 @@ fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> Con
 }
 
 /// Checks `value > 0` and finite.
-fn positive(key: &str, value: f64, unit: &str) -> Result<f64, ConfigError> {
+pub(crate) fn positive(key: &str, value: f64, unit: &str) -> Result<f64, ConfigError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {

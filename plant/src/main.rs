@@ -402,21 +402,27 @@ fn run_scene(path: PathBuf, out: Option<PathBuf>, set: Vec<String>, quiet: bool,
         summary.max_contact_force_n,
         dir.display()
     );
-    match result.outcome {
-        Outcome::Completed => ExitCode::SUCCESS,
+    stopped(&result.outcome, summary.simulated_s).unwrap_or(ExitCode::SUCCESS)
+}
+
+/// The message and exit code of a run that did not complete (`None` if it did).
+fn stopped(outcome: &Outcome, simulated_s: f64) -> Option<ExitCode> {
+    let code = match outcome {
+        Outcome::Completed => return None,
         Outcome::Diverged(e) => {
-            eprintln!("plant: error: {e}");
-            ExitCode::from(exit::DIVERGED)
+            eprintln!("plant: error: {e}; results up to t = {simulated_s} s were written");
+            exit::DIVERGED
         }
         Outcome::Interrupted => {
-            eprintln!("plant: interrupted; results up to t = {} s were written", summary.simulated_s);
-            ExitCode::from(exit::INTERRUPTED)
+            eprintln!("plant: interrupted; results up to t = {simulated_s} s were written");
+            exit::INTERRUPTED
         }
         Outcome::PeerLost(why) => {
-            eprintln!("plant: error: {why}; results up to t = {} s were written", summary.simulated_s);
-            ExitCode::from(exit::PEER_LOST)
+            eprintln!("plant: error: {why}; results up to t = {simulated_s} s were written");
+            exit::PEER_LOST
         }
-    }
+    };
+    Some(ExitCode::from(code))
 }
 
 fn soak_cmd(path: &std::path::Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> ExitCode {
@@ -495,24 +501,12 @@ fn soak_cmd(path: &std::path::Path, out: Option<PathBuf>, set: &[String], quiet:
     for v in &failed {
         eprintln!("plant soak: criterion failed: {v}");
     }
-    match done.outcome {
-        Outcome::Completed if failed.is_empty() => {
+    match (&done.outcome, failed.is_empty()) {
+        (Outcome::Completed, true) => {
             eprintln!("plant soak: all {} criteria met; results in {}", r.criteria.len(), dir.display());
             ExitCode::SUCCESS
         }
-        Outcome::Completed => ExitCode::from(exit::CRITERION_FAILED),
-        Outcome::Diverged(e) => {
-            eprintln!("plant: error: {e}; results up to t = {} s were written", r.simulated_s);
-            ExitCode::from(exit::DIVERGED)
-        }
-        Outcome::Interrupted => {
-            eprintln!("plant: interrupted; results up to t = {} s were written", r.simulated_s);
-            ExitCode::from(exit::INTERRUPTED)
-        }
-        Outcome::PeerLost(why) => {
-            eprintln!("plant: error: {why}; results up to t = {} s were written", r.simulated_s);
-            ExitCode::from(exit::PEER_LOST)
-        }
+        (outcome, _) => stopped(outcome, r.simulated_s).unwrap_or(ExitCode::from(exit::CRITERION_FAILED)),
     }
 }
 

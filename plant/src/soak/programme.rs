@@ -36,7 +36,7 @@
 //! each range, in the order start spacing, peak, direction per shock), so a
 //! programme is the same on every machine.
 
-use crate::config::{validate, ConfigError, ControlMode, RawScene, Scene};
+use crate::config::{positive, range, validate, ConfigError, ControlMode, RawScene, Scene};
 use serde::{Deserialize, Serialize};
 use shock_table::ShockSpec;
 use std::path::{Path, PathBuf};
@@ -208,23 +208,6 @@ pub struct Programme {
     pub criteria: Criteria,
     /// The file as written.
     pub raw: RawProgramme,
-}
-
-fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
-    ConfigError::Range {
-        key: key.to_string(),
-        value: value.to_string(),
-        unit: if unit.is_empty() { String::new() } else { format!(" {unit}") },
-        why: why.to_string(),
-    }
-}
-
-fn positive(key: &str, v: f64, unit: &str) -> Result<f64, ConfigError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(range(key, v, unit, "must be a finite number > 0"))
-    }
 }
 
 /// A `[lo, hi]` range with `lo <= hi`, both finite and inside `[min, max]`.
