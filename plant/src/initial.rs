@@ -21,24 +21,9 @@ pub fn unbalance_amplitude(mass: f64, e: f64, omega: f64, k_e: f64, c_e: f64) ->
 }
 
 /// The race centre's height when it rests on the balls under its weight (m,
-/// negative: below the housing centre), found by bisection on the ball law.
+/// negative: below the housing centre): [`crate::park::rest_position`] under gravity.
 pub fn race_sag(p: &Params) -> f64 {
-    let weight = p.race_mass * p.gravity;
-    if weight == 0.0 {
-        return 0.0;
-    }
-    let cage = p.cage_phase;
-    let support = |y: f64| p.race_support([0.0, y], [0.0; 2], cage, 0.0).on_race[1];
-    let (mut lo, mut hi) = (-(p.balls.clearance + 1e-3), -p.balls.clearance);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if support(mid) > weight {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    crate::park::rest_position(p, [0.0, -p.gravity], p.cage_phase)[1]
 }
 
 /// The initial state of a scene.
