@@ -180,7 +180,9 @@ fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
     let rogue = rogue_bin().display().to_string();
     let controller = controller_bin().display().to_string();
     let plain = plain.display().to_string();
-    let cases: Vec<(Vec<&str>, Option<&str>, i32, &str, Vec<&str>)> = vec![
+    // (command, an extra override, exit code, status, what stderr must name)
+    type Case<'a> = (Vec<&'a str>, Option<&'a str>, i32, &'a str, Vec<&'a str>);
+    let cases: Vec<Case> = vec![
         (vec!["/no/such/controller"], None, 2, "not_started", vec!["controller.command", "/no/such/controller"]),
         (vec![&plain], None, 2, "not_started", vec!["not executable", "plain.sh"]),
         (vec!["false"], None, 4, "not_started", vec!["exited before the handshake", "`false`"]),
