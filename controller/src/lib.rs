@@ -14,7 +14,7 @@
 //! The process side lives here too, so that both binaries link one crate:
 //! [`wire`] holds the `#[repr(C)]` message types of the plant ⇄ controller
 //! protocol, [`link`] the iceoryx2 plumbing, [`file`] the controller's
-//! `--config` file, [`lock`] the one-process-per-run-id lock, and [`serve`]
+//! `--config` file, [`lock`] the one-process-per-run-id lock, and [`mod@serve`]
 //! the whole controller process: a crate of your own that calls
 //! `controller::serve(&[MY_LAW])` from its `main` is a controller the plant
 //! can start (`[controller] command`). The `controller` binary is that call
