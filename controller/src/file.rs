@@ -31,6 +31,10 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "connect_timeout_ms",
     "spin_us",
     "pin_cores",
+    "command",
+    "lockstep_timeout_ms",
+    "realtime_priority",
+    "max_miss_fraction",
 ];
 
 /// `[controller]` keys the controller process uses (the `relev_*` ones are deprecated aliases
@@ -172,11 +176,16 @@ pub enum FileError {
     },
 }
 
-/// Reads the `[controller]` table of a file.
+/// Reads the `[controller]` table of a file (a `law` must be of the registry).
 pub fn load(path: &Path) -> Result<LawOverrides, FileError> {
+    load_for(path, &crate::registry::law_names())
+}
+
+/// Reads the `[controller]` table of a file for a controller that serves the laws `served`.
+pub fn load_for(path: &Path, served: &[&str]) -> Result<LawOverrides, FileError> {
     let shown = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| FileError::Read { path: shown.clone(), source })?;
-    parse(&text).map_err(|message| FileError::Invalid { path: shown, message })
+    parse_for(&text, served).map_err(|message| FileError::Invalid { path: shown, message })
 }
 
 /// Parses the `[controller]` table of a TOML text.
@@ -187,6 +196,11 @@ pub fn load(path: &Path) -> Result<LawOverrides, FileError> {
 /// assert!(controller::file::parse("[controller]\nbogus = 1\n").unwrap_err().contains("controller.bogus"));
 /// ```
 pub fn parse(text: &str) -> Result<LawOverrides, String> {
+    parse_for(text, &crate::registry::law_names())
+}
+
+/// [`parse`] for a controller that serves the laws `served` (a `law` must be one of them).
+pub fn parse_for(text: &str, served: &[&str]) -> Result<LawOverrides, String> {
     let table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
     let mut out = LawOverrides::default();
     let Some(section) = table.get("controller") else {
@@ -217,8 +231,11 @@ pub fn parse(text: &str) -> Result<LawOverrides, String> {
         match key.as_str() {
             "law" => {
                 let law = value.as_str().ok_or_else(|| format!("{name} = {value}: expected a string"))?;
-                if crate::registry::find_law(law).is_none() {
-                    return Err(crate::LawError::Unknown { name: law.to_string() }.to_string());
+                if !served.contains(&law) {
+                    return Err(format!(
+                        "{name} = {law:?}: unknown law (this controller serves {})",
+                        served.join(", ")
+                    ));
                 }
                 out.law = Some(law.to_string());
             }

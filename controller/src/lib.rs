@@ -14,7 +14,11 @@
 //! The process side lives here too, so that both binaries link one crate:
 //! [`wire`] holds the `#[repr(C)]` message types of the plant ⇄ controller
 //! protocol, [`link`] the iceoryx2 plumbing, [`file`] the controller's
-//! `--config` file; the `controller` binary is the process adapter.
+//! `--config` file, [`lock`] the one-process-per-run-id lock, and [`mod@serve`]
+//! the whole controller process: a crate of your own that calls
+//! `controller::serve(&[MY_LAW])` from its `main` is a controller the plant
+//! can start (`[controller] command`). The `controller` binary is that call
+//! with the registry's laws.
 #![warn(missing_docs)]
 
 pub mod discrete_pd;
@@ -23,12 +27,16 @@ pub mod file;
 pub mod law;
 #[cfg(feature = "ipc")]
 pub mod link;
+#[cfg(feature = "ipc")]
+pub mod lock;
 pub mod params;
 pub mod pd;
 pub mod pd_delay;
 pub mod pid;
 pub mod registry;
 pub mod relev;
+#[cfg(feature = "ipc")]
+pub mod serve;
 #[cfg(test)]
 mod test_plant;
 #[cfg(feature = "ipc")]
@@ -41,3 +49,5 @@ pub use pd::{PdDesign, PdGains, SampledPd};
 pub use pid::{PidDesign, PidGains, SampledPid};
 pub use registry::{build_law, find_law, law_names, LawEntry, LAWS};
 pub use relev::{Relev, RelevSpec};
+#[cfg(feature = "ipc")]
+pub use serve::{serve, ServeOptions};

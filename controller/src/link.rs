@@ -227,6 +227,11 @@ pub struct Endpoint<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy 
     spin: Duration,
     /// Blocking waits since creation (how often the spin budget ran out).
     blocks: u64,
+    /// Blocking waits the peer ended with a notification.
+    woken: u64,
+    /// Blocking waits that found a frame after a slice ran out without a notification: the
+    /// frame had been published, but the peer did not wake this side although it asked.
+    unwoken: u64,
 }
 
 impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend + 'static> Endpoint<Tx, Rx> {
@@ -251,7 +256,7 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
             .subscriber_builder()
             .create()
             .map_err(|e| ipc_err(format!("subscriber on {}", wire::name(run_id, &wake_tx)))(&e))?;
-        Ok(Self { mail, notifier, listener, wake_out, wake_in, spin_max: spin, spin, blocks: 0 })
+        Ok(Self { mail, notifier, listener, wake_out, wake_in, spin_max: spin, spin, blocks: 0, woken: 0, unwoken: 0 })
     }
 
     /// Sets the busy-poll budget before blocking.
@@ -263,6 +268,18 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
     /// How many waits ran out of their spin budget and blocked.
     pub fn blocks(&self) -> u64 {
         self.blocks
+    }
+
+    /// How many blocked waits the peer ended by notifying this side.
+    pub fn woken(&self) -> u64 {
+        self.woken
+    }
+
+    /// How many blocked waits found their frame only after a slice had run out without a
+    /// notification: a peer that never serves wake requests shows here (each such wait
+    /// costs a whole timed slice, which iceoryx2 may stretch well past the one asked for).
+    pub fn unwoken(&self) -> u64 {
+        self.unwoken
     }
 
     /// Publishes a frame, then notifies the peer if it asked to be woken.
@@ -344,12 +361,19 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
             if let Some(frame) = self.try_receive()? {
                 return Ok(Some(frame));
             }
-            match self.listener.timed_wait(|_| {}, slice) {
+            let mut notified = false;
+            match self.listener.timed_wait(|_| notified = true, slice) {
                 // A signal (SIGINT/SIGTERM for the ctrlc flag) ends the slice early: `keep_waiting` decides.
                 Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
                 Err(e) => return Err(ipc_err(format!("waiting on {}", self.mail.rx_name))(&e)),
             }
+            if notified {
+                self.woken += 1;
+            }
             if let Some(frame) = self.try_receive()? {
+                if !notified {
+                    self.unwoken += 1;
+                }
                 return Ok(Some(frame));
             }
             if !keep_waiting() {
@@ -375,6 +399,59 @@ pub fn pin_to_core(core: usize) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Puts the calling thread under `SCHED_FIFO` at `priority` (1 to 99) and locks the
+/// process's memory (`mlockall(MCL_CURRENT | MCL_FUTURE)`), so that neither ordinary
+/// processes nor page faults delay it. Each step that the system refuses (no
+/// `CAP_SYS_NICE`, an `RLIMIT_RTPRIO` or `RLIMIT_MEMLOCK` too low) is reported in the
+/// returned list; the other steps still apply.
+pub fn realtime(priority: i32) -> Vec<String> {
+    let mut refused = Vec::new();
+    if let Err(e) = set_fifo(0, priority) {
+        refused.push(e);
+    }
+    // SAFETY: mlockall has no memory-safety preconditions.
+    if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } != 0 {
+        refused.push(format!("mlockall: {}", std::io::Error::last_os_error()));
+    }
+    refused
+}
+
+/// Puts thread `pid` (0: the calling thread) under `SCHED_FIFO` at `priority`, unless it
+/// already is.
+pub fn set_fifo(pid: u32, priority: i32) -> Result<(), String> {
+    let pid = libc::pid_t::try_from(pid).map_err(|_| format!("pid {pid} is out of range"))?;
+    // SAFETY: sched_getscheduler/sched_setscheduler read and write only `param`, a valid
+    // sched_param; they have no other preconditions.
+    unsafe {
+        if libc::sched_getscheduler(pid) == libc::SCHED_FIFO {
+            return Ok(());
+        }
+        let param = libc::sched_param { sched_priority: priority };
+        if libc::sched_setscheduler(pid, libc::SCHED_FIFO, &param) != 0 {
+            return Err(format!(
+                "SCHED_FIFO at priority {priority}{}: {}",
+                if pid == 0 { String::new() } else { format!(" for pid {pid}") },
+                std::io::Error::last_os_error()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The scheduling policy of thread `pid` (0: the calling thread): `fifo`, `rr`, `other`, ….
+pub fn policy(pid: u32) -> &'static str {
+    let Ok(pid) = libc::pid_t::try_from(pid) else { return "unknown" };
+    // SAFETY: sched_getscheduler has no preconditions.
+    match unsafe { libc::sched_getscheduler(pid) } {
+        libc::SCHED_FIFO => "fifo",
+        libc::SCHED_RR => "rr",
+        libc::SCHED_OTHER => "other",
+        libc::SCHED_BATCH => "batch",
+        libc::SCHED_IDLE => "idle",
+        _ => "unknown",
+    }
 }
 
 /// Number of CPU cores online.

@@ -45,9 +45,11 @@
 //!    deadline miss. Every frame carries the run's token; each side ignores
 //!    frames with another token (another run under the same id, a stale
 //!    process), before looking at anything else in them.
-//! 3. A [`SensorFrame`] with [`SensorFrame::STOP`] ends the run (the
-//!    controller exits 0); a [`CommandFrame`] with [`CommandFrame::STOPPING`]
-//!    tells the plant that the controller was asked to stop (SIGINT/SIGTERM).
+//! 3. A [`SensorFrame`] with [`SensorFrame::STOP`] and the run's token ends
+//!    the run, whatever its session (the controller exits 0); a
+//!    [`CommandFrame`] with [`CommandFrame::STOPPING`] tells the plant that
+//!    the controller was asked to stop (SIGINT/SIGTERM). Checks on a received
+//!    frame, in order: token, then STOP, then session.
 //!
 //! # Waking a blocked peer
 //!
@@ -57,9 +59,17 @@
 //! receiver publishes a [`WakeRequest`], issues a sequentially-consistent
 //! fence and polls once more; the sender, after publishing a frame, issues
 //! the same fence and notifies if it finds a wake request. One of the two
-//! always sees the other (Dekker), so no wake-up is lost. A controller that
-//! never blocks may ignore the wake services; one that blocks must publish a
-//! wake request first (or wake up on its own at least every millisecond).
+//! always sees the other (Dekker), so no wake-up is lost. **Serving the
+//! plant's wake requests is mandatory** (after publishing a command frame:
+//! fence, drain `command/wake`, notify if it held any): a controller that
+//! does not leaves every late reply waiting for the plant's timed wait, which
+//! iceoryx2 may stretch to several milliseconds (the plant warns). A
+//! controller that blocks must also publish its own wake request on
+//! `sensor/wake` before it does; one that never blocks may skip that half.
+//! Open every service (the `sensor` subscriber included) before answering
+//! the hello: the plant sends frame 0 right after the ack, and subscribers
+//! get no history. `docs/wire-protocol.md` says the rest (the order of the
+//! checks, liveness, the exact form of the shipped laws).
 
 use crate::law::{Design, LoopConstants};
 use crate::params::{ParamsError, PARAMS_LEN};

@@ -8,10 +8,11 @@
 //! |---|---|
 //! | 0 | success |
 //! | 1 | an output could not be written, or the system refused a resource |
-//! | 2 | bad input (scene, programme, sweep file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol) |
+//! | 2 | bad input (scene, programme, sweep or ensemble file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol, a controller `command` that does not exist or is not executable, a run id in use) |
 //! | 3 | numerical divergence |
-//! | 4 | the controller process was lost (died, stopped by a signal, exited before the handshake, never answered) |
+//! | 4 | the controller process was lost (died, stopped by a signal, silent past `controller.lockstep_timeout_ms`, exited before the handshake, never answered) |
 //! | 5 | `plant soak`: completed, but a criterion failed |
+//! | 6 | realtime: the deadline-miss budget `controller.max_miss_fraction` was exceeded |
 //! | 7 | `--merge` (sweep or ensemble): points or members missing or corrupt (they are listed) |
 //! | 130 | interrupted (SIGINT or SIGTERM to the plant) |
 
@@ -41,6 +42,8 @@ mod exit {
     pub const PEER_LOST: u8 = 4;
     /// `plant soak`: the run completed but a criterion of the programme failed.
     pub const CRITERION_FAILED: u8 = 5;
+    /// Realtime: the deadline-miss budget was exceeded.
+    pub const MISS_BUDGET: u8 = 6;
     // 7 (`--merge` with points or members missing or corrupt) and the other codes of
     // `plant sweep` / `plant ensemble` come from `plant::sweep::SweepError::exit_code`.
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
@@ -78,6 +81,7 @@ enum StopKind {
     Diverged,
     Interrupted,
     PeerLost,
+    MissBudget,
 }
 
 fn main() -> ExitCode {
@@ -115,6 +119,7 @@ fn exit_code(err: &anyhow::Error) -> u8 {
                 Ending::BadArgument(_) => exit::BAD_INPUT,
                 Ending::Stopped { kind: StopKind::Diverged, .. } => exit::DIVERGED,
                 Ending::Stopped { kind: StopKind::PeerLost, .. } => exit::PEER_LOST,
+                Ending::Stopped { kind: StopKind::MissBudget, .. } => exit::MISS_BUDGET,
                 Ending::Stopped { kind: StopKind::Interrupted, .. } => exit::INTERRUPTED,
                 Ending::CriteriaFailed(_) => exit::CRITERION_FAILED,
             };
@@ -142,19 +147,23 @@ fn exit_code(err: &anyhow::Error) -> u8 {
 /// The exit code of a co-simulation that could not start.
 fn cosim_code(e: &CosimError) -> u8 {
     use controller::link::LinkError;
+    use controller::lock::LockError;
     match e {
         CosimError::Refused { .. }
         | CosimError::RunId(_)
         | CosimError::Pin(_)
         | CosimError::Params(_)
         | CosimError::Protocol(_)
+        | CosimError::Command { .. }
+        | CosimError::Lock(LockError::InUse { .. })
         | CosimError::Link(LinkError::Incompatible { .. }) => exit::BAD_INPUT,
         CosimError::ControllerExited { code: Some(2), .. } => exit::BAD_INPUT,
         CosimError::NoController { .. } | CosimError::ControllerExited { .. } => exit::PEER_LOST,
         CosimError::Interrupted => exit::INTERRUPTED,
-        CosimError::ControllerMissing { .. } | CosimError::Spawn { .. } | CosimError::Link(LinkError::Ipc { .. }) => {
-            exit::IO
-        }
+        CosimError::ControllerMissing { .. }
+        | CosimError::Spawn { .. }
+        | CosimError::Lock(LockError::Io { .. })
+        | CosimError::Link(LinkError::Ipc { .. }) => exit::IO,
     }
 }
 
@@ -163,6 +172,7 @@ fn not_started_status(e: &SetupError) -> &'static str {
     match e {
         SetupError::Law(_) | SetupError::Overrides(_) => "refused",
         SetupError::Cosim(CosimError::Interrupted) => "interrupted",
+        SetupError::Cosim(CosimError::Command { .. }) => "not_started",
         SetupError::Cosim(c) if cosim_code(c) == exit::BAD_INPUT => "refused",
         SetupError::Cosim(_) => "not_started",
     }
@@ -333,6 +343,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
         Outcome::Diverged(e) => (StopKind::Diverged, e.to_string()),
         Outcome::Interrupted => (StopKind::Interrupted, "interrupted".to_string()),
         Outcome::PeerLost(why) => (StopKind::PeerLost, why.clone()),
+        Outcome::MissBudget(why) => (StopKind::MissBudget, why.clone()),
     };
     Err(Ending::Stopped { kind, why, simulated_s }.into())
 }
@@ -552,8 +563,21 @@ mod tests {
             (SetupError::Cosim(CosimError::Interrupted).into(), 130),
             (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
             (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
-            (CosimError::ControllerExited { status: "x".into(), code: Some(2) }.into(), 2),
-            (CosimError::ControllerExited { status: "x".into(), code: Some(1) }.into(), 4),
+            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
+            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
+            (stopped(StopKind::MissBudget), 6),
+            (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
+            (CosimError::Protocol("version 4".into()).into(), 2),
+            (
+                CosimError::Lock(controller::lock::LockError::InUse {
+                    run_id: "r".into(),
+                    role: "plant".into(),
+                    holder: "pid 1".into(),
+                    path: "p".into(),
+                })
+                .into(),
+                2,
+            ),
             (
                 plant::output::AnalyzeError::Trace(plant::trace::TraceError::TooShort {
                     path: "trace.csv".into(),

@@ -10,7 +10,7 @@
 //! rate (dense output inside macro steps).
 
 use crate::config::{ControlMode, Scene};
-use crate::cosim::{CosimError, CosimReport, Launch, Session, Stop};
+use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
@@ -79,6 +79,8 @@ pub enum Outcome {
     Interrupted,
     /// The controller process was lost and none took its place (co-simulation).
     PeerLost(String),
+    /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
+    MissBudget(String),
 }
 
 /// Why a run could not start.
@@ -197,8 +199,11 @@ pub fn run_into(
         ControlMode::Continuous => Source::Continuous,
         ControlMode::Sampled => Source::InProcess(build_law(&scene.controller.law, &design, params)?),
         ControlMode::Lockstep | ControlMode::Realtime => {
-            // A design the controller would refuse is bad input here, before any process starts.
-            build_law(&scene.controller.law, &design, params)?;
+            // A design the controller would refuse is bad input here, before any process starts
+            // (a controller command checks the laws it serves itself, in the handshake).
+            if scene.controller.cosim.command.is_none() {
+                build_law(&scene.controller.law, &design, params)?;
+            }
             Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
         }
     };
@@ -277,10 +282,11 @@ pub fn run_into(
                     }
                     Some(cmd)
                 }
-                Err(stop) => {
-                    outcome = match stop {
-                        Stop::Lost(why) => Outcome::PeerLost(why),
-                        Stop::Interrupted(_) => Outcome::Interrupted,
+                Err(halt) => {
+                    outcome = match halt {
+                        Halt::Lost(why) => Outcome::PeerLost(why),
+                        Halt::Interrupted(_) => Outcome::Interrupted,
+                        Halt::MissBudget(why) => Outcome::MissBudget(why),
                     };
                     break;
                 }
@@ -334,7 +340,15 @@ pub fn run_into(
     }
     let wall_time = start.elapsed().as_secs_f64();
     let cosim = match source {
-        Source::Cosim(session) => Some(session.finish(t, (t / period).round() as u64)),
+        Source::Cosim(session) => {
+            // A realtime run that completed is judged over all its ticks.
+            if outcome == Outcome::Completed {
+                if let Some(why) = session.miss_budget_exceeded(1) {
+                    outcome = Outcome::MissBudget(why);
+                }
+            }
+            Some(session.finish(t, (t / period).round() as u64))
+        }
         _ => None,
     };
     Ok(SinkRun { stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim, parked_steps })

@@ -53,6 +53,7 @@ impl Outcome {
             Outcome::Diverged(_) => Status::Diverged,
             Outcome::Interrupted => Status::Interrupted,
             Outcome::PeerLost(_) => Status::PeerLost,
+            Outcome::MissBudget(_) => Status::MissBudget,
         }
     }
 
@@ -62,7 +63,7 @@ impl Outcome {
             Outcome::Completed => None,
             Outcome::Diverged(e) => Some(e.to_string()),
             Outcome::Interrupted => Some("interrupted by a signal".to_string()),
-            Outcome::PeerLost(why) => Some(why.clone()),
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) => Some(why.clone()),
         }
     }
 

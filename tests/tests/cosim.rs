@@ -12,18 +12,27 @@
 //!
 //! Scenes are 50 ms slices of `paper-10g.toml` (1000 ticks at 20 kHz) with
 //! the shock at 10 ms, so the file stays well under a minute in debug.
+//! Every process is bounded in time (`output` here is `output_within`, and
+//! [`Proc`] waits at most a minute for a line or an exit).
 
 mod common;
 
 use common::{
-    assert_exit, controller_bin, num, output, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv,
+    assert_exit, controller_bin, num, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv, Proc,
     TempDir, SHORT,
 };
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{channel, Receiver};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+/// The most any one command of this file may take (debug build, a loaded 2-core machine);
+/// a hang fails the test instead of stalling the suite.
+const LIMIT: Duration = Duration::from_secs(180);
+
+/// Runs a command within [`LIMIT`].
+fn output(cmd: &mut Command) -> std::process::Output {
+    output_within(cmd, LIMIT)
+}
 
 /// Ticks of a `SHORT` scene at 20 kHz.
 const TICKS: u64 = 1000;
@@ -39,77 +48,6 @@ fn sets<'a>(extra: &[&'a str]) -> Vec<&'a str> {
 /// parallel test runs never share services.
 fn run_id(name: &str) -> String {
     format!("t{}-{name}", std::process::id())
-}
-
-/// A child process whose stderr lines arrive on a channel; killed on drop.
-struct Proc {
-    child: Child,
-    lines: Receiver<String>,
-    log: Vec<String>,
-}
-
-impl Proc {
-    fn spawn(cmd: &mut Command) -> Self {
-        let mut child =
-            cmd.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
-        let pipe = child.stderr.take().expect("piped stderr");
-        let (tx, lines) = channel();
-        std::thread::spawn(move || {
-            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Self { child, lines, log: Vec::new() }
-    }
-
-    /// Waits (up to 60 s) for a stderr line containing `needle`.
-    fn wait_line(&mut self, needle: &str) -> String {
-        let deadline = Instant::now() + Duration::from_secs(60);
-        loop {
-            match self.lines.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-                Ok(line) => {
-                    self.log.push(line.clone());
-                    if line.contains(needle) {
-                        return line;
-                    }
-                }
-                Err(_) => panic!("no line with {needle:?} within 60 s; stderr so far:\n{}", self.log.join("\n")),
-            }
-        }
-    }
-
-    /// Waits (up to 30 s) for the exit; returns the exit code and all of stderr.
-    fn finish(mut self) -> (Option<i32>, String) {
-        let deadline = Instant::now() + Duration::from_secs(30);
-        let status = loop {
-            if let Some(s) = self.child.try_wait().unwrap() {
-                break s;
-            }
-            assert!(Instant::now() < deadline, "process did not exit within 30 s:\n{}", self.log.join("\n"));
-            std::thread::sleep(Duration::from_millis(10));
-        };
-        // The reader thread ends at EOF.
-        let end = Instant::now() + Duration::from_secs(5);
-        while let Ok(line) = self.lines.recv_timeout(end.saturating_duration_since(Instant::now())) {
-            self.log.push(line);
-        }
-        (status.code(), self.log.join("\n"))
-    }
-
-    fn signal(&self, signal: libc::c_int) {
-        let pid = libc::pid_t::try_from(self.child.id()).unwrap();
-        // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
-        assert_eq!(unsafe { libc::kill(pid, signal) }, 0, "kill({pid}, {signal})");
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
 }
 
 /// `controller --run-id ID` plus arguments (not started).
@@ -666,4 +604,221 @@ fn a_peer_of_another_protocol_version_is_refused_with_exit_2() {
     assert_eq!(code, Some(2), "{log}");
     assert!(log.contains("other message types") && log.contains("another protocol version"), "{log}");
     assert_eq!(read_json(&out.join("summary.json"))["status"], "refused");
+}
+
+/// `--set` overrides giving a scene the rogue controller in `mode` as its command.
+fn rogue(mode: &str) -> String {
+    format!("controller.command=[{:?}, \"--mode\", {mode:?}]", common::rogue_bin().display().to_string())
+}
+
+/// Issue 11 item 1: two runs under one run id exchanged each other's frames. A run id in use
+/// is refused (exit 2) naming the live plant, before any service is touched; the kernel
+/// frees the id when that plant dies, even by SIGKILL.
+#[cfg(unix)]
+#[test]
+fn a_run_id_in_use_is_refused_naming_the_live_run() {
+    controller_bin();
+    let id = run_id("in-use");
+    let dir = TempDir::new("cosim-in-use");
+    let mut first =
+        Proc::spawn(&mut external_plant(&dir.join("first"), &id, &["controller.mode=lockstep", "scene.duration_s=30"]));
+    first.wait_line("waiting up to");
+    let out = dir.join("second");
+    let mut second = plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=lockstep"]));
+    second.args(["--run-id", &id]);
+    let run = output(&mut second);
+    assert_exit(&run, 2);
+    let err = stderr(&run);
+    assert!(err.contains(&id) && err.contains("in use") && err.contains(&format!("pid {}", first.id())), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "refused", "{s:#}");
+    // A second controller under the live run id is refused too, naming the first.
+    let mut ctl = Proc::spawn(&mut controller(&id, &[]));
+    ctl.wait_line("serving run");
+    let again = output(controller(&id, &[]).stdout(Stdio::null()));
+    assert_exit(&again, 2);
+    assert!(stderr(&again).contains(&format!("pid {}", ctl.id())), "{}", stderr(&again));
+    first.signal(libc::SIGKILL);
+    let _ = first.finish();
+    let _ = ctl.finish();
+    // The dead plant's lock is gone with it.
+    assert_exit(&output(&mut second), 0);
+}
+
+/// Issue 11 item 1: a third process publishing on a live run's services (acks and command
+/// frames with tokens of its own, as fast as it can) never feeds the run: the trace is the
+/// in-process law's, and its frames are counted.
+#[test]
+fn a_foreign_publisher_never_feeds_the_run() {
+    use controller::link::{self, Mailbox};
+    use controller::wire::{self, Ack, CommandFrame};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    controller_bin();
+    let id = run_id("intruder");
+    let dir = TempDir::new("cosim-intruder");
+    let done = Arc::new(AtomicBool::new(false));
+    let intruder = {
+        let (id, done) = (id.clone(), done.clone());
+        std::thread::spawn(move || {
+            let node = link::node(&id, "intruder").expect("node");
+            // Publishers only: the receiving sides are unused.
+            let acks: Mailbox<Ack, Ack> = Mailbox::open(&node, &id, "ack", "intruder-acks").expect("ack service");
+            let commands: Mailbox<CommandFrame, CommandFrame> =
+                Mailbox::open(&node, &id, "command", "intruder-commands").expect("command service");
+            let mut sent = 0u64;
+            let deadline = Instant::now() + LIMIT;
+            while !done.load(Ordering::Relaxed) && Instant::now() < deadline {
+                let token = 0xbad0_0000 + sent;
+                acks.send(Ack::new(1, token, 0, "pd", "intruder")).expect("ack");
+                let frame = CommandFrame {
+                    seq: sent % 1000,
+                    token,
+                    session: 1,
+                    axes: wire::AXES,
+                    current_a: wire::axes_of([1.9, -1.9]),
+                    ..Default::default()
+                };
+                commands.send(frame).expect("command");
+                sent += 1;
+                // Slower than the plant reads: a flood faster than that could push the
+                // controller's reply out of the plant's 16-frame buffer (a denial of service,
+                // which the token does not prevent; what it prevents is a foreign frame applied).
+                std::thread::sleep(Duration::from_millis(2));
+            }
+            sent
+        })
+    };
+    let out = dir.join("run");
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=lockstep"]));
+    cmd.args(["--run-id", &id]);
+    let run = output(&mut cmd);
+    done.store(true, Ordering::Relaxed);
+    assert!(intruder.join().expect("intruder thread") > 0);
+    assert_exit(&run, 0);
+    let s = read_json(&out.join("summary.json"));
+    assert!(num(&s["cosim"], "foreign_frames") > 0.0, "{s:#}");
+    let sampled = dir.join("sampled");
+    assert_exit(&output(&mut plant_run(&scene("paper-10g.toml"), &sampled, &sets(&["controller.mode=sampled"]))), 0);
+    assert!(
+        std::fs::read(out.join("trace.csv")).unwrap() == std::fs::read(sampled.join("trace.csv")).unwrap(),
+        "a foreign frame reached the run"
+    );
+}
+
+/// Issue 11 item 2: a lockstep plant waited forever, silently, on a controller that was alive
+/// but stopped. With `controller.lockstep_timeout_ms` it says what it saw (nothing), treats
+/// the controller as lost, and a new controller carries the run on.
+#[cfg(unix)]
+#[test]
+fn a_stopped_controller_is_lost_at_the_lockstep_timeout_and_replaced() {
+    let id = run_id("sigstop");
+    let dir = TempDir::new("cosim-sigstop");
+    let out = dir.join("run");
+    let extra = [
+        "controller.mode=lockstep",
+        "scene.duration_s=0.3",
+        "controller.lockstep_timeout_ms=300",
+        "controller.reconnect_timeout_ms=60000",
+    ];
+    let mut plant = Proc::spawn(&mut external_plant(&out, &id, &extra));
+    plant.wait_line("waiting up to");
+    let mut stopped = Proc::spawn(&mut controller(&id, &[]));
+    stopped.wait_line("serving run");
+    stopped.signal(libc::SIGSTOP);
+    let lost = plant.wait_line("controller lost");
+    assert!(lost.contains("lockstep_timeout_ms = 300 ms") && lost.contains("sent nothing"), "{lost}");
+    plant.wait_line("to reconnect");
+    // The stopped one still holds the controller lock of the run id: it must go first.
+    stopped.signal(libc::SIGKILL);
+    let _ = stopped.finish();
+    let fresh = Proc::spawn(&mut controller(&id, &[]));
+    let (code, log) = plant.finish();
+    assert_eq!(code, Some(0), "{log}");
+    assert_eq!(fresh.finish().0, Some(0));
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "completed");
+    assert_eq!(event_kinds(&s), ["connected", "lost", "reconnected"]);
+    assert!(s["cosim"]["peer_events"][1]["detail"].as_str().unwrap().contains("sent nothing"), "{s:#}");
+    assert_sampled_rows(&out, 0.3);
+}
+
+/// Issue 11 item 2: replies of another session are not the reply; at the deadline the plant
+/// names them, and without a reconnection exits 4.
+#[test]
+fn replies_of_another_session_are_named_at_the_deadline() {
+    let dir = TempDir::new("cosim-other-session");
+    let out = dir.join("run");
+    let extra =
+        ["controller.mode=lockstep".to_string(), "controller.lockstep_timeout_ms=200".into(), rogue("other-session")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 4);
+    let err = stderr(&run);
+    assert!(err.contains("another session (2)") && err.contains("lockstep_timeout_ms = 200 ms"), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "peer_lost", "{s:#}");
+    assert!(s["error"].as_str().unwrap().contains("another session"), "{s:#}");
+}
+
+/// Issue 11 item 10: a realtime run past its deadline-miss budget ends with exit 6 and status
+/// `miss_budget`. The controller answers every other frame, so about half the ticks miss
+/// whatever the machine's load.
+#[test]
+fn a_realtime_run_past_its_miss_budget_exits_6() {
+    let dir = TempDir::new("cosim-miss-budget");
+    let out = dir.join("run");
+    let extra =
+        ["controller.mode=realtime".to_string(), "controller.max_miss_fraction=0.1".into(), rogue("every-other")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 6);
+    let err = stderr(&run);
+    assert!(err.contains("max_miss_fraction = 0.1") && err.contains("deadline misses"), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "miss_budget", "{s:#}");
+    assert!(num(&s["cosim"], "deadline_miss_fraction") > 0.1, "{s:#}");
+}
+
+/// Issue 11 item 10: `controller.realtime_priority` puts both processes under SCHED_FIFO
+/// where the system permits it, and says so with a warning where it does not; either way the
+/// run completes and `summary.json` tells which.
+#[test]
+fn realtime_priority_is_applied_or_refused_with_a_warning() {
+    controller_bin();
+    let dir = TempDir::new("cosim-priority");
+    let out = dir.join("run");
+    let run = output(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=realtime", "controller.realtime_priority=10"]),
+    ));
+    assert_exit(&run, 0);
+    let sched = &read_json(&out.join("summary.json"))["cosim"]["scheduling"];
+    assert_eq!(num(sched, "realtime_priority"), 10.0, "{sched:#}");
+    let refused = sched["refused"].as_array().map_or(0, Vec::len);
+    if refused == 0 {
+        assert_eq!((sched["plant"].as_str(), sched["controller"].as_str()), (Some("fifo"), Some("fifo")), "{sched:#}");
+    } else {
+        assert!(stderr(&run).contains("warning: controller.realtime_priority = 10"), "{}", stderr(&run));
+    }
+}
+
+/// Issue 10 item 7: a controller that never serves the plant's wake requests makes every
+/// blocked wait of the plant run out its slice. The run completes (same trace), and the plant
+/// warns once, saying what is wrong.
+#[test]
+fn a_controller_that_never_wakes_the_plant_is_warned_about() {
+    let dir = TempDir::new("cosim-no-wake");
+    let out = dir.join("run");
+    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("no-wake")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 0);
+    let err = stderr(&run);
+    assert_eq!(err.matches("never wakes the plant").count(), 1, "{err}");
+    assert!(err.contains("command/wake"), "{err}");
+    let c = &read_json(&out.join("summary.json"))["cosim"];
+    assert_eq!(num(c, "woken_waits"), 0.0, "{c:#}");
+    assert!(num(c, "blocking_waits") >= 50.0, "{c:#}");
 }

@@ -123,6 +123,14 @@ pub struct CosimSettings {
     pub spin: f64,
     /// Cores for `[plant, controller]`.
     pub pin_cores: Option<[usize; 2]>,
+    /// Lockstep: the wait for a reply from a live controller before it is treated as lost (s).
+    pub lockstep_timeout: f64,
+    /// The controller process to start (argv, paths resolved), instead of the built-in one.
+    pub command: Option<Vec<String>>,
+    /// `SCHED_FIFO` priority for plant and controller; 0 = off.
+    pub realtime_priority: u32,
+    /// Realtime: the largest deadline-miss fraction before the run ends (exit 6).
+    pub max_miss_fraction: f64,
 }
 
 /// Integrator settings, validated (tolerances per state component).

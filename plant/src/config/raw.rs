@@ -421,6 +421,27 @@ pub struct RawController {
     pub spin_us: f64,
     /// Co-simulation: CPU cores to pin `[plant, controller]` to; empty (default) = no pinning.
     pub pin_cores: Vec<usize>,
+    /// Co-simulation: the controller process to start instead of the built-in `controller`:
+    /// a list of strings (`["python3", "my_controller.py", "--gain", "2"]`) or one string (a
+    /// path). The plant appends `--run-id ID` and sets `AMB_TESTBED_RUN_ID` and
+    /// `AMB_TESTBED_CONNECT_TIMEOUT_S`. An element that is a relative path naming an existing
+    /// file or folder in the scene file's folder is taken from there (written absolute in the
+    /// run folder's `scene.toml`); others are left as they are (`argv[0]` without a `/` is
+    /// looked up in `PATH`). With a command, the plant does not check `law` or `params`: the
+    /// controller does, in the handshake. Default: none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command: Option<toml::Value>,
+    /// Co-simulation, lockstep: how long the plant waits for a reply from a controller that
+    /// is alive (its node and process exist) before it treats it as lost (ms): a stopped
+    /// (SIGSTOP), hung or confused controller. Default 5000.
+    pub lockstep_timeout_ms: f64,
+    /// Co-simulation: `SCHED_FIFO` priority (1 to 99) for the plant's loop thread and the
+    /// controller, with memory locking; 0 (default) = the normal scheduler. Where the system
+    /// refuses it, the run goes on without, with a warning.
+    pub realtime_priority: u32,
+    /// Co-simulation, realtime: the largest deadline-miss fraction a run may have; past it
+    /// the run ends with status `miss_budget` (exit code 6). Default 1 (no limit).
+    pub max_miss_fraction: f64,
 }
 defaults!(RawController {
     mode: ControlMode = ControlMode::Continuous,
@@ -443,6 +464,10 @@ defaults!(RawController {
     connect_timeout_ms: f64 = 10_000.0,
     spin_us: f64 = 200.0,
     pin_cores: Vec<usize> = Vec::new(),
+    command: Option<toml::Value> = None,
+    lockstep_timeout_ms: f64 = 5000.0,
+    realtime_priority: u32 = 0,
+    max_miss_fraction: f64 = 1.0,
 });
 
 /// `[integrator]`.

@@ -125,6 +125,12 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
             ))
         }
     };
+    if ctl.realtime_priority > 99 {
+        return Err(range("controller.realtime_priority", ctl.realtime_priority, "", "must be 0 (off) to 99"));
+    }
+    if !(ctl.max_miss_fraction.is_finite() && (0.0..=1.0).contains(&ctl.max_miss_fraction)) {
+        return Err(range("controller.max_miss_fraction", ctl.max_miss_fraction, "", "must be between 0 and 1"));
+    }
     Ok(CosimSettings {
         fallback,
         reply_timeout: ms("controller.reply_timeout_ms", ctl.reply_timeout_ms, false)?,
@@ -132,7 +138,50 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
         connect_timeout: ms("controller.connect_timeout_ms", ctl.connect_timeout_ms, false)?,
         spin: ctl.spin_us * 1e-6,
         pin_cores,
+        lockstep_timeout: ms("controller.lockstep_timeout_ms", ctl.lockstep_timeout_ms, false)?,
+        command: ctl.command.as_ref().map(command_argv).transpose()?,
+        realtime_priority: ctl.realtime_priority,
+        max_miss_fraction: ctl.max_miss_fraction,
     })
+}
+
+/// `controller.command` as an argv: one string is a one-element command; a list must hold
+/// strings, the first not empty.
+fn command_argv(value: &toml::Value) -> Result<Vec<String>, ConfigError> {
+    let bad = |why: &str| range("controller.command", value, "", why);
+    let argv: Vec<String> = match value {
+        toml::Value::String(s) => vec![s.clone()],
+        toml::Value::Array(items) => items
+            .iter()
+            .map(|v| v.as_str().map(str::to_string))
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("must be a path (a string) or a list of strings"))?,
+        _ => return Err(bad("must be a path (a string) or a list of strings")),
+    };
+    if argv.first().is_none_or(|a| a.is_empty()) {
+        return Err(bad("must name a program (the first element is empty or missing)"));
+    }
+    Ok(argv)
+}
+
+/// Resolves `controller.command` against the scene's folder: an element that is a relative
+/// path naming something that exists there becomes that absolute path; the others are kept.
+/// The resolved list replaces the key, so that the resolved scene (`scene.toml` of a run
+/// folder) runs the same command from anywhere.
+fn resolve_command(ctl: &mut RawController, base_dir: &Path) -> Result<(), ConfigError> {
+    let Some(value) = &ctl.command else { return Ok(()) };
+    let argv = command_argv(value)?;
+    let resolved: Vec<toml::Value> = argv
+        .into_iter()
+        .map(|arg| {
+            let here = base_dir.join(&arg);
+            let local = !arg.is_empty() && Path::new(&arg).is_relative() && here.exists();
+            let arg = if local { std::path::absolute(&here).unwrap_or(here).display().to_string() } else { arg };
+            toml::Value::String(arg)
+        })
+        .collect();
+    ctl.command = Some(toml::Value::Array(resolved));
+    Ok(())
 }
 
 /// Validates a raw scene into SI parameter types. `base_dir` resolves relative file paths.
@@ -144,6 +193,7 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
 pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     let mut warnings = Vec::new();
     migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
+    resolve_command(&mut raw.controller, base_dir)?;
     let (r, td, ct, amb, ctl, int) =
         (&raw.rotor, &raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &raw.integrator);
     let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
@@ -445,7 +495,10 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
     };
     // The law validates its own parameters: a scene it refuses is bad input, before any run.
-    controller::build_law(&scene.controller.law, &scene.design(), &scene.controller.params)?;
+    // A controller command serves laws of its own: it checks them, in the handshake.
+    if scene.controller.cosim.command.is_none() {
+        controller::build_law(&scene.controller.law, &scene.design(), &scene.controller.params)?;
+    }
     Ok(scene)
 }
 

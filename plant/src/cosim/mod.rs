@@ -38,19 +38,31 @@
 //! plant treats it as a lost controller (fallback, reconnection, else
 //! `peer_lost`, exit code 4).
 //!
+//! A lockstep plant waiting on a controller that is alive but silent (stopped
+//! with SIGSTOP, hung, answering another session) gives up after
+//! `controller.lockstep_timeout_ms`, says what it saw in the meantime
+//! (nothing, replies of another session, frames of another run) and treats
+//! the controller as lost. A realtime run whose deadline-miss fraction
+//! exceeds `controller.max_miss_fraction` ends as `miss_budget` (exit 6).
+//!
 //! # Isolation
 //!
-//! Each run draws a random token ([`new_token`]) that the hello and every
-//! frame carry; a frame with another token (a second run under the same run
-//! id, a stale process) is never applied, and is counted in
+//! A plant holds its run id's lock ([`controller::lock`]) for its whole
+//! life: a second plant under a live run id is refused (exit 2, naming the
+//! first); the kernel releases the lock of a crashed plant. Each run draws a
+//! random token ([`new_token`]) that the hello and every frame carry; a frame
+//! or an ack with another token (a second run under the same run id, a stale
+//! or a foreign process) is never applied, and is counted in
 //! `foreign_frames`.
 
+mod bench;
 pub mod process;
 pub mod session;
 pub mod stats;
 
-pub use session::{bench_round_trips, Session, Stop};
-pub use stats::{Latencies, Misses, Percentiles};
+pub use bench::bench_round_trips;
+pub use session::{Halt, Session};
+pub use stats::{CosimReport, Latencies, Misses, Percentiles};
 
 use controller::link::LinkError;
 use serde::Serialize;
@@ -60,7 +72,8 @@ use std::sync::atomic::{AtomicU32, Ordering};
 /// Where the controller process comes from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum ControllerProcess {
-    /// The plant starts it: the given executable, or `controller` next to the running one.
+    /// The plant starts it: the given executable; else the scene's `controller.command`, if
+    /// any; else `controller` next to the running one.
     Spawn(Option<PathBuf>),
     /// The user starts `controller --run-id ID`; the plant waits for it.
     External,
@@ -134,13 +147,26 @@ pub enum CosimError {
         why: String,
     },
     /// The child exited before the handshake (its own message is above).
-    #[error("the controller process exited before the handshake ({status})")]
+    #[error("the controller process {program} exited before the handshake ({status}{hint})", hint = exit_hint(*code))]
     ControllerExited {
+        /// What was started.
+        program: String,
         /// Exit status as text.
         status: String,
         /// Exit code, if any.
         code: Option<i32>,
     },
+    /// `controller.command` does not exist or is not executable (nothing was started).
+    #[error("controller.command: cannot run {argv0:?}: {why}")]
+    Command {
+        /// The command's first element.
+        argv0: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// Another live plant (or controller) holds the run id.
+    #[error(transparent)]
+    Lock(#[from] controller::lock::LockError),
     /// The controller refused the hello.
     #[error("the controller refused the run ({reason}): {message}")]
     Refused {
@@ -174,9 +200,19 @@ pub enum CosimError {
     /// The law's parameter document does not fit the hello.
     #[error("{0}")]
     Params(#[from] controller::ParamsError),
-    /// The controller's handshake answer is malformed.
+    /// The controller's handshake answer is malformed, or of another protocol version.
     #[error("the controller's handshake answer is malformed: {0}")]
     Protocol(String),
+}
+
+/// What an early exit code of a controller says (the codes of `controller::serve`).
+fn exit_hint(code: Option<i32>) -> &'static str {
+    match code {
+        Some(2) => ": it refused the run, or found a peer of another protocol version (its message is above)",
+        Some(4) => ": it saw no plant",
+        Some(1) => ": an IPC failure on its side",
+        _ => "",
+    }
 }
 
 /// Something that happened to the peer, for `summary.json`.
@@ -192,52 +228,4 @@ pub struct PeerEvent {
     pub wall_s: f64,
     /// Details (the controller's description, the cause of a loss, the fallback applied).
     pub detail: String,
-}
-
-/// The `cosim` object of `summary.json`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct CosimReport {
-    /// `lockstep` or `realtime`.
-    pub mode: &'static str,
-    /// Run id (service names `amb-testbed/<run_id>/…`).
-    pub run_id: String,
-    /// What the (last) controller said it runs.
-    pub controller: String,
-    /// Handshakes made (1 + reconnections).
-    pub sessions: u32,
-    /// Sensor frames published.
-    pub messages_sent: u64,
-    /// Command frames received (current session's).
-    pub messages_received: u64,
-    /// Samples skipped in the sequence of replies (never answered).
-    pub sequence_gaps: u64,
-    /// Replies that came after their tick (realtime) or answered an older sample.
-    pub stale_replies: u64,
-    /// Replies with non-finite currents (the last current was held).
-    pub invalid_replies: u64,
-    /// Frames and handshake answers carrying another run's token (never applied).
-    pub foreign_frames: u64,
-    /// Ticks whose reply was missing (realtime).
-    pub deadline_misses: u64,
-    /// `deadline_misses` over the ticks that had a reply due.
-    pub deadline_miss_fraction: f64,
-    /// Longest run of consecutive misses.
-    pub longest_miss_burst: u64,
-    /// Realtime ticks that started more than one period late (the plant could not keep up).
-    pub plant_overruns: u64,
-    /// Ticks run on the fallback current while no controller was connected.
-    pub fallback_ticks: u64,
-    /// Waits of the plant that outlasted the spin budget and blocked.
-    pub blocking_waits: u64,
-    /// Sensor frame published → command frame published by the controller
-    /// (both stamped with `CLOCK_MONOTONIC`), µs.
-    pub latency_us: Percentiles,
-    /// Lockstep: sensor frame published → reply in the plant's hands, µs.
-    pub round_trip_us: Option<Percentiles>,
-    /// Connections, losses, reconnections, stops.
-    pub peer_events: Vec<PeerEvent>,
-    /// What the (last) controller ran differently from the scene (the `[controller]` table of
-    /// its handshake's overrides, from its `--config` or `--law`); absent if nothing.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub controller_overrides: Option<toml::Table>,
 }

@@ -1,16 +1,17 @@
-//! The plant's side of one co-simulation: handshake, one command per tick
-//! (lockstep or realtime), loss and reconnection, and the figures.
+//! The plant's side of one co-simulation: the handshake, one command per
+//! tick (lockstep or realtime), loss, silence and reconnection. The figures
+//! it keeps are in [`super::stats`], the IPC benchmark in `bench.rs`.
 
-use super::process::{self, Child};
-use super::stats::{Latencies, Misses, Percentiles};
-use super::{ControllerProcess, CosimError, CosimReport, Launch, PeerEvent};
+use super::process::{self, Child, Program};
+use super::stats::{CosimReport, Figures, Scheduling};
+use super::{ControllerProcess, CosimError, Launch, PeerEvent};
 use crate::config::{ControlMode, CosimSettings, Fallback, Scene};
 use crate::hooks::Hooks;
 use controller::link::{self, Endpoint, Ipc, Mailbox, Peer};
+use controller::lock::RunLock;
 use controller::wire::{self, mode, Ack, CommandFrame, Hello, Refusal, SensorFrame};
 use controller::{saturate, Sample};
 use iceoryx2::node::Node;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// Slice of a blocking wait: the longest a signal or a dead peer goes
@@ -22,14 +23,23 @@ const HELLO_EVERY: Duration = Duration::from_millis(5);
 const RING: usize = 64;
 /// How long a controller has to exit after the STOP frame before it is signalled.
 const EXIT_GRACE: Duration = Duration::from_secs(2);
+/// Blocked waits that the controller never ended with a notification before the plant
+/// warns that it does not serve wake requests.
+const UNWOKEN_WARNING: u64 = 50;
+/// Realtime ticks with a reply due before the miss budget is checked during the run (it is
+/// checked again at the end, over the whole run).
+const MISS_BUDGET_MIN_DUE: u64 = 1000;
 
 /// Why the loop must stop at this tick.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Stop {
-    /// The controller is gone and no other took its place.
+pub enum Halt {
+    /// The controller is gone (or silent past `controller.lockstep_timeout_ms`) and no other
+    /// took its place.
     Lost(String),
-    /// SIGINT/SIGTERM, to the plant or to the controller.
+    /// SIGINT/SIGTERM to the plant.
     Interrupted(String),
+    /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
+    MissBudget(String),
 }
 
 /// A handshake in progress.
@@ -38,17 +48,56 @@ struct Pending {
     last_hello: Option<Instant>,
 }
 
+/// What a lockstep wait saw besides the reply it waited for.
+#[derive(Default)]
+struct Seen {
+    foreign: u64,
+    other_session: u64,
+    sessions: Vec<u32>,
+    other_seq: u64,
+}
+
+impl Seen {
+    /// What the controller sent, in words.
+    fn describe(&self) -> String {
+        let mut parts = Vec::new();
+        if self.other_session > 0 {
+            let list: Vec<String> = self.sessions.iter().map(u32::to_string).collect();
+            parts.push(format!("{} replies of another session ({})", self.other_session, list.join(", ")));
+        }
+        if self.foreign > 0 {
+            parts.push(format!("{} frames of another run (another token)", self.foreign));
+        }
+        if self.other_seq > 0 {
+            parts.push(format!("{} replies to other samples", self.other_seq));
+        }
+        if parts.is_empty() {
+            "it sent nothing (stopped, e.g. by SIGSTOP, or hung)".into()
+        } else {
+            format!("it sent only {}", parts.join(", "))
+        }
+    }
+}
+
+/// What the liveness check decided about a missing reply.
+enum Verdict {
+    Wait,
+    Gone(String),
+    Silent,
+}
+
 /// The plant's side of a co-simulation.
 pub struct Session {
     mode: ControlMode,
-    run_id: String,
+    pub(super) run_id: String,
     settings: CosimSettings,
-    // Field order is drop order: ports before the node.
-    frames: Endpoint<SensorFrame, CommandFrame>,
+    // Field order is drop order: ports before the node, the run-id lock last.
+    pub(super) frames: Endpoint<SensorFrame, CommandFrame>,
     handshake: Mailbox<Hello, Ack>,
     _node: Node<Ipc>,
     child: Option<Child>,
-    exe: Option<PathBuf>,
+    program: Option<Program>,
+    _lock: RunLock,
     hello: Hello,
     limit: f64,
     bias: [f64; 2],
@@ -68,24 +117,12 @@ pub struct Session {
     sent_ns: [u64; RING],
     last_heard: Instant,
     next_check: Duration,
-    // Figures.
     wall_start: Instant,
-    sent: u64,
-    received: u64,
-    gaps: u64,
-    stale: u64,
-    invalid: u64,
-    foreign: u64,
     /// What the controller runs differently from the hello (its ack's `[controller]` table).
     overrides: Option<toml::Table>,
-    misses: Misses,
-    due: u64,
-    overruns: u64,
-    fallback_ticks: u64,
-    last_reply_seq: Option<u64>,
-    latency: Latencies,
-    round_trip: Latencies,
-    events: Vec<PeerEvent>,
+    figures: Figures,
+    scheduling: Scheduling,
+    wake_warned: bool,
 }
 
 /// The hello a scene sends: the scene's [`controller::Design`], law and parameter document,
@@ -141,7 +178,7 @@ impl Session {
         )
     }
 
-    fn open(
+    pub(super) fn open(
         mode: ControlMode,
         settings: CosimSettings,
         hello: Hello,
@@ -151,14 +188,33 @@ impl Session {
         hooks: &mut dyn Hooks,
     ) -> Result<Session, CosimError> {
         let run_id = wire::str_of(&hello.run_id).into_owned();
-        let exe = match &launch.controller {
-            ControllerProcess::Spawn(Some(path)) => Some(path.clone()),
-            ControllerProcess::Spawn(None) => Some(process::controller_exe_next_to_current()?),
+        let program = match &launch.controller {
+            ControllerProcess::Spawn(Some(path)) => Some(Program::Builtin(path.clone())),
+            ControllerProcess::Spawn(None) => Some(match &settings.command {
+                Some(argv) => process::resolve(argv)?,
+                None => Program::Builtin(process::controller_exe_next_to_current()?),
+            }),
             ControllerProcess::External => None,
         };
+        // Before any service of the run is opened: a second plant under a live run id never
+        // touches the first one's services.
+        let lock = controller::lock::acquire(&run_id, "plant")?;
         if let Some([plant_core, _]) = settings.pin_cores {
             link::pin_to_core(plant_core).map_err(CosimError::Pin)?;
         }
+        let mut scheduling = Scheduling { realtime_priority: settings.realtime_priority, ..Default::default() };
+        if settings.realtime_priority > 0 {
+            // Before the controller is started: it inherits the policy (and is told to lock its
+            // own memory through the environment).
+            for refused in link::realtime(settings.realtime_priority as i32) {
+                hooks.note(&format!(
+                    "warning: controller.realtime_priority = {}: the plant could not take {refused}; running without it",
+                    settings.realtime_priority
+                ));
+                scheduling.refused.push(format!("plant: {refused}"));
+            }
+        }
+        scheduling.plant = link::policy(0).to_string();
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
@@ -169,7 +225,8 @@ impl Session {
             handshake,
             _node: node,
             child: None,
-            exe,
+            program,
+            _lock: lock,
             hello,
             limit: hello.current_limit_a,
             bias,
@@ -186,24 +243,13 @@ impl Session {
             last_heard: Instant::now(),
             next_check: Duration::from_secs_f64(settings.reply_timeout),
             wall_start: Instant::now(),
-            sent: 0,
-            received: 0,
-            gaps: 0,
-            stale: 0,
-            invalid: 0,
-            foreign: 0,
             overrides: None,
-            misses: Misses::default(),
-            due: 0,
-            overruns: 0,
-            fallback_ticks: 0,
-            last_reply_seq: None,
-            latency: Latencies::binned(),
-            round_trip: Latencies::binned(),
-            events: Vec::new(),
+            figures: Figures::default(),
+            scheduling,
+            wake_warned: false,
             settings,
         };
-        if s.exe.is_none() {
+        if s.program.is_none() {
             hooks.note(&format!(
                 "waiting up to {} s for a controller: start `controller --run-id {}`",
                 s.settings.connect_timeout, s.run_id
@@ -217,13 +263,9 @@ impl Session {
     }
 
     /// Starts the latency figures afresh (after a warm-up). They live in
-    /// fixed-size histograms (percentiles within 0.1 %), so a run's memory
-    /// does not grow with its number of ticks.
+    /// fixed-size histograms, so a run's memory does not grow with its number of ticks.
     pub fn reset_figures(&mut self) {
-        self.latency = Latencies::binned();
-        if self.mode == ControlMode::Lockstep {
-            self.round_trip = Latencies::binned();
-        }
+        self.figures.reset_latencies();
     }
 
     /// What the connected controller runs differently from the scene (the `[controller]`
@@ -260,21 +302,38 @@ impl Session {
         }
     }
 
+    /// Realtime: `Some(why)` if the deadline-miss fraction of the run so far exceeds
+    /// `controller.max_miss_fraction` (checked over at least `min_due` ticks with a reply due).
+    pub fn miss_budget_exceeded(&self, min_due: u64) -> Option<String> {
+        let f = &self.figures;
+        let budget = self.settings.max_miss_fraction;
+        let over = self.mode == ControlMode::Realtime && f.due >= min_due.max(1) && f.miss_fraction() > budget;
+        over.then(|| {
+            format!(
+                "realtime: {} deadline misses in {} ticks ({:.3} %) exceed controller.max_miss_fraction = {budget}",
+                f.misses.total,
+                f.due,
+                100.0 * f.miss_fraction()
+            )
+        })
+    }
+
     fn spawn(&mut self) -> Result<(), CosimError> {
-        if let Some(exe) = &self.exe {
+        if let Some(program) = &self.program {
             let args = process::Args {
                 run_id: &self.run_id,
                 pin_core: self.settings.pin_cores.map(|c| c[1]),
                 connect_timeout_s: self.settings.connect_timeout.max(1.0),
+                realtime_priority: self.settings.realtime_priority,
             };
-            self.child = Some(Child::spawn(exe, &args)?);
+            self.child = Some(Child::spawn(program, &args)?);
         }
         Ok(())
     }
 
     fn event(&mut self, kind: &'static str, t_s: f64, seq: u64, detail: String) {
         let wall_s = self.wall_start.elapsed().as_secs_f64();
-        self.events.push(PeerEvent { kind, t_s, seq, wall_s, detail });
+        self.figures.events.push(PeerEvent { kind, t_s, seq, wall_s, detail });
     }
 
     /// Starts a handshake with a new session number.
@@ -284,7 +343,7 @@ impl Session {
     }
 
     /// Advances the pending handshake: `Some(Ok(()))` when accepted.
-    fn poll_handshake(&mut self) -> Option<Result<(), CosimError>> {
+    fn poll_handshake(&mut self, hooks: &mut dyn Hooks) -> Option<Result<(), CosimError>> {
         let pending = self.pending.as_mut()?;
         if pending.last_hello.is_none_or(|t| t.elapsed() >= HELLO_EVERY) {
             if let Err(e) = self.handshake.send(self.hello) {
@@ -297,12 +356,21 @@ impl Session {
                 Err(e) => return Some(Err(e.into())),
                 Ok(None) => return None,
                 Ok(Some(ack)) if ack.token != self.hello.token => {
-                    self.foreign += 1; // an answer to another run's hello (same run id)
+                    // An answer to another run's hello (same run id), or a foreign process's.
+                    self.figures.foreign += 1;
                     continue;
                 }
-                Ok(Some(ack)) if ack.session != self.hello.session => continue,
+                Ok(Some(ack)) if ack.session != self.hello.session => continue, // an earlier session's
                 Ok(Some(ack)) => {
                     self.pending = None;
+                    if ack.protocol_version != wire::PROTOCOL_VERSION {
+                        return Some(Err(CosimError::Protocol(format!(
+                            "it says protocol version {} (pid {}); this plant speaks version {}",
+                            ack.protocol_version,
+                            ack.controller_pid,
+                            wire::PROTOCOL_VERSION
+                        ))));
+                    }
                     let message = wire::str_of(&ack.message).into_owned();
                     if ack.status != 0 {
                         return Some(Err(CosimError::Refused { reason: Refusal::describe(ack.status), message }));
@@ -317,16 +385,32 @@ impl Session {
                     self.lost_since = None;
                     self.last_heard = Instant::now();
                     self.next_check = Duration::from_secs_f64(self.settings.reply_timeout);
+                    self.schedule_controller(ack.controller_pid, hooks);
                     return Some(Ok(()));
                 }
             }
         }
     }
 
+    /// With `controller.realtime_priority`, puts the controller under `SCHED_FIFO` too (a
+    /// controller the plant did not start, or one that did not take it itself).
+    fn schedule_controller(&mut self, pid: u32, hooks: &mut dyn Hooks) {
+        let priority = self.settings.realtime_priority;
+        if priority > 0 {
+            if let Err(refused) = link::set_fifo(pid, priority as i32) {
+                hooks.note(&format!(
+                    "warning: controller.realtime_priority = {priority}: cannot put the controller under {refused}; running without it"
+                ));
+                self.scheduling.refused.push(format!("controller: {refused}"));
+            }
+        }
+        self.scheduling.controller = link::policy(pid).to_string();
+    }
+
     fn handshake_blocking(&mut self, timeout: f64, hooks: &mut dyn Hooks) -> Result<(), CosimError> {
         self.begin_handshake();
         loop {
-            if let Some(done) = self.poll_handshake() {
+            if let Some(done) = self.poll_handshake(hooks) {
                 return done;
             }
             if hooks.cancelled() {
@@ -334,14 +418,18 @@ impl Session {
             }
             if let Some(child) = self.child.as_mut() {
                 if let Some(status) = child.exited() {
-                    return Err(CosimError::ControllerExited { status: status.to_string(), code: status.code() });
+                    return Err(CosimError::ControllerExited {
+                        program: child.program().describe(),
+                        status: status.to_string(),
+                        code: status.code(),
+                    });
                 }
             }
             let waited = self.pending.as_ref().map_or(0.0, |p| p.since.elapsed().as_secs_f64());
             if waited > timeout {
                 self.pending = None;
                 let hint = match &self.child {
-                    Some(c) => format!(" (the controller {} was started but did not answer)", c.exe().display()),
+                    Some(c) => format!(" (the controller {} was started but did not answer)", c.program().describe()),
                     None => format!("; start one with `controller --run-id {}`", self.run_id),
                 };
                 return Err(CosimError::NoController { waited_s: timeout, run_id: self.run_id.clone(), hint });
@@ -370,87 +458,125 @@ impl Session {
         if current.iter().all(|i| i.is_finite()) {
             self.last_cmd = saturate(current, self.limit);
         } else {
-            self.invalid += 1;
+            self.figures.invalid += 1;
         }
         self.last_cmd
     }
 
-    fn note_reply_seq(&mut self, seq: u64) {
-        if let Some(last) = self.last_reply_seq {
-            if seq > last + 1 {
-                self.gaps += seq - last - 1;
-            }
-        }
-        self.last_reply_seq = Some(seq);
-    }
-
     /// The command for sample `k` to push into the delay line: the reply to
     /// `k` (lockstep) or to `k − 1` (realtime), or a fallback.
-    pub fn command(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Stop> {
+    pub fn command(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
         match self.mode {
             ControlMode::Realtime => self.realtime(sample, hooks),
             _ => self.lockstep(sample, hooks),
         }
     }
 
-    fn lockstep(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Stop> {
+    pub(super) fn lockstep(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
         let k = sample.seq;
         let frame = self.frame(sample);
         let t0 = Instant::now();
-        self.frames.send(frame).map_err(|e| Stop::Lost(e.to_string()))?;
-        self.sent += 1;
+        if let Err(e) = self.frames.send(frame) {
+            return self.on_lost(sample, format!("IPC failure: {e}"), hooks);
+        }
+        self.figures.sent += 1;
         let session = self.hello.session;
         let timeout = Duration::from_secs_f64(self.settings.reply_timeout);
+        let deadline = Duration::from_secs_f64(self.settings.lockstep_timeout);
         let mut next_check = timeout;
-        let mut lost: Option<String> = None;
+        let mut verdict = Verdict::Wait;
+        let mut seen = Seen::default();
         loop {
             let (run_id, child) = (&self.run_id, &mut self.child);
             let waited = self.frames.wait(SLICE, || {
                 if hooks.cancelled() {
                     return false;
                 }
-                if t0.elapsed() >= next_check {
-                    next_check += timeout;
-                    if let Some(why) = controller_gone(run_id, child) {
-                        lost = Some(why);
-                        return false;
-                    }
-                }
-                true
+                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child);
+                matches!(verdict, Verdict::Wait)
             });
             let reply = match waited {
                 Ok(Some(r)) => r,
-                Ok(None) => match lost.take() {
-                    Some(why) => return self.on_lost(sample, why, hooks),
-                    None => return Err(Stop::Interrupted("interrupted by a signal".into())),
+                Ok(None) => match std::mem::replace(&mut verdict, Verdict::Wait) {
+                    Verdict::Gone(why) => return self.on_lost(sample, why, hooks),
+                    Verdict::Silent => return self.on_silent(sample, &seen, hooks),
+                    Verdict::Wait => return Err(Halt::Interrupted("interrupted by a signal".into())),
                 },
                 Err(e) => return self.on_lost(sample, format!("IPC failure: {e}"), hooks),
             };
-            if reply.token != self.hello.token {
-                self.foreign += 1; // another run's (same run id) or a stale process's: never applied
-                continue;
-            }
-            if reply.session != session {
-                continue;
-            }
-            if reply.status & CommandFrame::STOPPING != 0 {
+            // Token first: another run's frame (same run id), a stale or a foreign process's.
+            let applied = if reply.token != self.hello.token {
+                self.figures.foreign += 1;
+                seen.foreign += 1;
+                false
+            } else if reply.session != session {
+                seen.other_session += 1;
+                if !seen.sessions.contains(&reply.session) && seen.sessions.len() < 8 {
+                    seen.sessions.push(reply.session);
+                }
+                false
+            } else if reply.status & CommandFrame::STOPPING != 0 {
                 return self.on_lost(sample, STOPPED_BY_SIGNAL.into(), hooks);
+            } else {
+                self.figures.received += 1;
+                self.figures.note_reply_seq(reply.seq);
+                if reply.seq != k {
+                    self.figures.stale += 1;
+                    seen.other_seq += 1;
+                }
+                reply.seq == k
+            };
+            if !applied {
+                // A stream of frames that are not the reply keeps the wait from blocking, so
+                // the deadline is checked here too. Only the deadline: the node lookup costs
+                // milliseconds, and a plant that reads slower than another publisher sends
+                // would never reach the controller's reply (a subscriber takes from its first
+                // publisher with data first).
+                if t0.elapsed() < deadline {
+                    continue;
+                }
+                return match controller_gone(&self.run_id, &mut self.child) {
+                    Some(why) => self.on_lost(sample, why, hooks),
+                    None => self.on_silent(sample, &seen, hooks),
+                };
             }
-            self.received += 1;
-            self.note_reply_seq(reply.seq);
-            if reply.seq != k {
-                self.stale += 1;
-                continue;
-            }
-            self.round_trip.record(t0.elapsed().as_nanos() as u64);
-            self.latency.record(reply.sent_ns.saturating_sub(frame.sent_ns));
+            self.figures.round_trip.record(t0.elapsed().as_nanos() as u64);
+            self.figures.latency.record(reply.sent_ns.saturating_sub(frame.sent_ns));
+            self.warn_if_never_woken(hooks);
             return Ok(self.accept(&reply));
         }
     }
 
+    /// Warns once when the controller never serves the plant's wake requests: every reply
+    /// then waits for a timed wake-up of the plant (see docs/wire-protocol.md).
+    fn warn_if_never_woken(&mut self, hooks: &mut dyn Hooks) {
+        if !self.wake_warned && self.frames.woken() == 0 && self.frames.unwoken() >= UNWOKEN_WARNING {
+            self.wake_warned = true;
+            hooks.note(&format!(
+                "warning: the controller never wakes the plant: {} replies were found only after a timed wait ran out. \
+                 A controller must serve the plant's wake requests (`command/wake`: notify the `command` event \
+                 service after publishing a reply when a wake request is pending, docs/wire-protocol.md); \
+                 the run goes on, much slower",
+                self.frames.unwoken()
+            ));
+        }
+    }
+
+    /// A live controller that did not answer within `controller.lockstep_timeout_ms`.
+    fn on_silent(&mut self, sample: &Sample, seen: &Seen, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+        let pid = self.controller_pid.map(|p| format!(" (pid {p})")).unwrap_or_default();
+        let why = format!(
+            "no reply to sample {} within controller.lockstep_timeout_ms = {} ms although the controller{pid} is alive: {}",
+            sample.seq,
+            self.settings.lockstep_timeout * 1e3,
+            seen.describe()
+        );
+        self.on_lost(sample, why, hooks)
+    }
+
     /// A lost controller at sample `k`: record it, then the fallback, then
     /// (lockstep) a blocking reconnection or the end of the run.
-    fn on_lost(&mut self, sample: &Sample, why: String, hooks: &mut dyn Hooks) -> Result<[f64; 2], Stop> {
+    fn on_lost(&mut self, sample: &Sample, why: String, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
         self.connected = false;
         self.lost_since = Some(Instant::now());
         let (cmd, applied) = match self.settings.fallback {
@@ -464,11 +590,11 @@ impl Session {
             child.reap(Duration::ZERO);
         }
         if self.settings.fallback == Fallback::Stop || self.settings.reconnect_timeout <= 0.0 {
-            return Err(Stop::Lost(format!("controller lost at t = {} s (sample {}): {why}", sample.t_s, sample.seq)));
+            return Err(Halt::Lost(format!("controller lost at t = {} s (sample {}): {why}", sample.t_s, sample.seq)));
         }
         self.last_cmd = cmd;
         if let Err(e) = self.spawn() {
-            return Err(Stop::Lost(format!("{why}; cannot start a new controller: {e}")));
+            return Err(Halt::Lost(format!("{why}; cannot start a new controller: {e}")));
         }
         hooks.note(&format!(
             "waiting up to {} s for a controller to reconnect (run id {})",
@@ -476,37 +602,37 @@ impl Session {
         ));
         if self.mode == ControlMode::Realtime {
             self.begin_handshake();
-            self.fallback_ticks += 1;
+            self.figures.fallback_ticks += 1;
             return Ok(cmd);
         }
         match self.handshake_blocking(self.settings.reconnect_timeout, hooks) {
             Ok(()) => {
                 self.first_seq = sample.seq + 1;
-                self.last_reply_seq = None;
-                self.fallback_ticks += 1;
+                self.figures.last_reply_seq = None;
+                self.figures.fallback_ticks += 1;
                 let detail = self.controller.clone();
                 self.event("reconnected", sample.t_s, sample.seq, detail);
                 hooks.note(&format!("controller reconnected: {}", self.controller));
                 Ok(cmd)
             }
-            Err(CosimError::Interrupted) => Err(Stop::Interrupted("interrupted by a signal".into())),
-            Err(e) => Err(Stop::Lost(format!(
+            Err(CosimError::Interrupted) => Err(Halt::Interrupted("interrupted by a signal".into())),
+            Err(e) => Err(Halt::Lost(format!(
                 "controller lost at t = {} s (sample {}): {why}; no reconnection: {e}",
                 sample.t_s, sample.seq
             ))),
         }
     }
 
-    fn realtime(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Stop> {
+    fn realtime(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
         let k = sample.seq;
         let start = *self.start.get_or_insert_with(Instant::now);
         let deadline = start + Duration::from_secs_f64(k as f64 * self.period);
         pace_until(deadline);
         if Instant::now() > deadline + Duration::from_secs_f64(self.period) {
-            self.overruns += 1;
+            self.figures.overruns += 1;
         }
         if hooks.cancelled() {
-            return Err(Stop::Interrupted("interrupted by a signal".into()));
+            return Err(Halt::Interrupted("interrupted by a signal".into()));
         }
 
         // Replies that came in since the last tick.
@@ -519,7 +645,7 @@ impl Session {
                 Err(e) => return self.on_lost(sample, format!("IPC failure: {e}"), hooks),
             };
             if reply.token != self.hello.token {
-                self.foreign += 1;
+                self.figures.foreign += 1;
                 continue;
             }
             if reply.session != session || !self.connected {
@@ -528,35 +654,35 @@ impl Session {
             if reply.status & CommandFrame::STOPPING != 0 {
                 return self.on_lost(sample, STOPPED_BY_SIGNAL.into(), hooks);
             }
-            self.received += 1;
+            self.figures.received += 1;
             self.last_heard = Instant::now();
             self.next_check = Duration::from_secs_f64(self.settings.reply_timeout);
-            self.note_reply_seq(reply.seq);
+            self.figures.note_reply_seq(reply.seq);
             if reply.seq + (RING as u64) > k && reply.seq < k {
-                self.latency.record(reply.sent_ns.saturating_sub(self.sent_ns[reply.seq as usize % RING]));
+                self.figures.latency.record(reply.sent_ns.saturating_sub(self.sent_ns[reply.seq as usize % RING]));
             }
             if reply.seq + 1 == k {
                 fresh = Some(reply);
             } else {
-                self.stale += 1;
+                self.figures.stale += 1;
             }
         }
 
         let cmd = if !self.connected {
-            self.fallback_ticks += 1;
-            match self.poll_handshake() {
+            self.figures.fallback_ticks += 1;
+            match self.poll_handshake(hooks) {
                 Some(Ok(())) => {
                     self.first_seq = k;
-                    self.last_reply_seq = None;
+                    self.figures.last_reply_seq = None;
                     let detail = self.controller.clone();
                     self.event("reconnected", sample.t_s, k, detail);
                     hooks.note(&format!("controller reconnected: {}", self.controller));
                 }
-                Some(Err(e)) => return Err(Stop::Lost(format!("no reconnection: {e}"))),
+                Some(Err(e)) => return Err(Halt::Lost(format!("no reconnection: {e}"))),
                 None => {
                     let waited = self.lost_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
                     if waited > self.settings.reconnect_timeout {
-                        return Err(Stop::Lost(format!(
+                        return Err(Halt::Lost(format!(
                             "controller lost; none reconnected within {} s",
                             self.settings.reconnect_timeout
                         )));
@@ -567,14 +693,17 @@ impl Session {
         } else if k == 0 || k <= self.first_seq {
             self.last_cmd // nothing due yet: the bias (or the fallback after a reconnection)
         } else {
-            self.due += 1;
+            self.figures.due += 1;
             match fresh {
                 Some(reply) => {
-                    self.misses.record(false);
+                    self.figures.misses.record(false);
                     self.accept(&reply)
                 }
                 None => {
-                    self.misses.record(true);
+                    self.figures.misses.record(true);
+                    if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
+                        return Err(Halt::MissBudget(why));
+                    }
                     if self.last_heard.elapsed() >= self.next_check {
                         self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
                         if let Some(why) = controller_gone(&self.run_id, &mut self.child) {
@@ -592,7 +721,7 @@ impl Session {
             if let Err(e) = self.frames.send(frame) {
                 return self.on_lost(sample, format!("IPC failure: {e}"), hooks);
             }
-            self.sent += 1;
+            self.figures.sent += 1;
         }
         Ok(cmd)
     }
@@ -617,27 +746,33 @@ impl Session {
                 None => self.event("stopped", t_s, seq, "controller process could not be reaped".into()),
             }
         }
-        let due = self.due.max(1);
+        let f = std::mem::take(&mut self.figures);
         CosimReport {
             mode: if self.mode == ControlMode::Realtime { "realtime" } else { "lockstep" },
             run_id: self.run_id.clone(),
             controller: self.controller.clone(),
+            controller_command: match &self.program {
+                Some(Program::Command { argv, .. }) => Some(argv.clone()),
+                _ => None,
+            },
             sessions: self.hello.session,
-            messages_sent: self.sent,
-            messages_received: self.received,
-            sequence_gaps: self.gaps,
-            stale_replies: self.stale,
-            invalid_replies: self.invalid,
-            foreign_frames: self.foreign,
-            deadline_misses: self.misses.total,
-            deadline_miss_fraction: self.misses.total as f64 / due as f64,
-            longest_miss_burst: self.misses.longest_burst,
-            plant_overruns: self.overruns,
-            fallback_ticks: self.fallback_ticks,
+            messages_sent: f.sent,
+            messages_received: f.received,
+            sequence_gaps: f.gaps,
+            stale_replies: f.stale,
+            invalid_replies: f.invalid,
+            foreign_frames: f.foreign,
+            deadline_misses: f.misses.total,
+            deadline_miss_fraction: f.miss_fraction(),
+            longest_miss_burst: f.misses.longest_burst,
+            plant_overruns: f.overruns,
+            fallback_ticks: f.fallback_ticks,
             blocking_waits: self.frames.blocks(),
-            latency_us: self.latency.percentiles(),
-            round_trip_us: (self.mode == ControlMode::Lockstep).then(|| self.round_trip.percentiles()),
-            peer_events: std::mem::take(&mut self.events),
+            woken_waits: self.frames.woken(),
+            scheduling: self.scheduling.clone(),
+            latency_us: f.latency.percentiles(),
+            round_trip_us: (self.mode == ControlMode::Lockstep).then(|| f.round_trip.percentiles()),
+            peer_events: f.events,
             controller_overrides: self.overrides.take(),
         }
     }
@@ -656,6 +791,31 @@ fn controller_overrides(ack: &Ack) -> Result<Option<toml::Table>, String> {
     match doc.remove("controller") {
         Some(toml::Value::Table(t)) if doc.is_empty() => Ok(Some(t)),
         _ => Err(format!("its overrides must be one [controller] table, got: {text}")),
+    }
+}
+
+/// A lockstep reply is missing since `t0`: every `timeout` the controller's process and
+/// node are looked up (gone: a lost peer); past `deadline` a live one is silent.
+fn check_silence(
+    t0: Instant,
+    next_check: &mut Duration,
+    timeout: Duration,
+    deadline: Duration,
+    run_id: &str,
+    child: &mut Option<Child>,
+) -> Verdict {
+    let waited = t0.elapsed();
+    if waited < *next_check {
+        return Verdict::Wait;
+    }
+    *next_check = waited + timeout;
+    if let Some(why) = controller_gone(run_id, child) {
+        return Verdict::Gone(why);
+    }
+    if waited >= deadline {
+        Verdict::Silent
+    } else {
+        Verdict::Wait
     }
 }
 
@@ -689,50 +849,4 @@ fn pace_until(deadline: Instant) {
             std::hint::spin_loop();
         }
     }
-}
-
-/// `plant bench ipc`: `n` round trips with a controller process (lockstep,
-/// zero sensor values), after `warmup` unrecorded ones.
-pub fn bench_round_trips(
-    n: u64,
-    warmup: u64,
-    launch: &Launch,
-    pin_cores: Option<[usize; 2]>,
-    spin_us: f64,
-    hooks: &mut dyn Hooks,
-) -> Result<(Percentiles, Percentiles, u64), CosimError> {
-    let run_id = match &launch.run_id {
-        Some(id) => wire::valid_run_id(id).map_err(CosimError::RunId)?.to_string(),
-        None => super::new_run_id(),
-    };
-    let mut hello = Hello::example(&run_id);
-    hello.token = super::new_token();
-    hello.mode = mode::BENCH;
-    hello.spin_ns = (spin_us * 1e3) as u64;
-    hello.plant_pid = std::process::id();
-    let settings = CosimSettings {
-        fallback: Fallback::Stop,
-        reply_timeout: 0.001,
-        reconnect_timeout: 0.0,
-        connect_timeout: 10.0,
-        spin: spin_us * 1e-6,
-        pin_cores,
-    };
-    let bias = [0.0; 2];
-    let mut s = Session::open(ControlMode::Lockstep, settings, hello, launch, bias, hello.period_s, hooks)?;
-    for k in 0..(warmup + n) {
-        if k == warmup {
-            s.reset_figures();
-        }
-        let sample = Sample { seq: k, t_s: k as f64 * hello.period_s, sensor_v: [0.0; 2] };
-        if let Err(stop) = s.lockstep(&sample, hooks) {
-            let why = match stop {
-                Stop::Lost(w) | Stop::Interrupted(w) => w,
-            };
-            return Err(CosimError::NoController { waited_s: 0.0, run_id: s.run_id.clone(), hint: format!(": {why}") });
-        }
-    }
-    let blocks = s.frames.blocks();
-    let report = s.finish(0.0, warmup + n);
-    Ok((report.round_trip_us.unwrap_or_default(), report.latency_us, blocks))
 }

@@ -1,6 +1,17 @@
-//! Figures of a co-simulation: latency percentiles and deadline-miss bursts.
-//! Storage is reserved before the loop; recording is a push into it.
+//! Figures of a co-simulation: message counts, deadline misses and their
+//! bursts, latency percentiles, peer events, and the `cosim` object of
+//! `summary.json` they make ([`CosimReport`]).
+//!
+//! Latencies go to HDR histograms (the `hdrhistogram` crate) of fixed size,
+//! allocated once per session, so a run's memory does not grow with its
+//! number of ticks. Precision: three significant digits, i.e. a percentile is
+//! the upper end of the histogram bucket that holds the nearest-rank sample,
+//! at most 1/1024 (0.1 %) above the exact value and never below it; the
+//! maximum and the count are exact. Range: 1 ns to one hour (longer ones are
+//! recorded as one hour).
 
+use super::PeerEvent;
+use hdrhistogram::Histogram;
 use serde::Serialize;
 
 /// Latency percentiles (µs).
@@ -18,142 +29,56 @@ pub struct Percentiles {
     pub max: f64,
 }
 
-/// Latencies in nanoseconds. By default stored whole (exact percentiles),
-/// capacity reserved up front; [`Latencies::binned`] keeps a fixed-size
-/// histogram instead, for runs of unbounded length (`plant soak`), whose
-/// memory must not grow with the number of ticks.
-#[derive(Debug)]
-pub struct Latencies {
-    store: Store,
-}
+/// Largest latency a histogram holds (ns): one hour.
+const HIGHEST_NS: u64 = 3_600_000_000_000;
 
-#[derive(Debug)]
-enum Store {
-    /// Every sample.
-    Exact(Vec<u32>),
-    /// Counts per bin (see [`bin_of`]), the sample count and the largest sample.
-    Binned { counts: Vec<u64>, count: u64, max: u32 },
+/// Latencies in nanoseconds, in a fixed-size HDR histogram (about 270 kB, allocated once).
+#[derive(Debug, Clone)]
+pub struct Latencies {
+    histogram: Histogram<u64>,
+    /// The exact largest sample (ns).
+    max: u64,
 }
 
 impl Default for Latencies {
     fn default() -> Self {
-        Self::with_capacity(0)
+        Self::new()
     }
-}
-
-/// Bins of the binned store: values below 2048 ns have a bin each (exact);
-/// above, each power of two is split into 1024 bins, so a bin's lower bound
-/// is within 1/1024 (0.1 %) of any value in it. 23 552 bins cover `u32`.
-const EXACT_BELOW: u32 = 2048;
-const MANTISSA_BITS: u32 = 10;
-const BINS: usize = EXACT_BELOW as usize + (31 - 11 + 1) * (1 << MANTISSA_BITS);
-
-/// The bin of a latency (ns).
-fn bin_of(ns: u32) -> usize {
-    if ns < EXACT_BELOW {
-        return ns as usize;
-    }
-    let exponent = 31 - ns.leading_zeros(); // 11..=31
-    let shift = exponent - MANTISSA_BITS;
-    let mantissa = (ns >> shift) - (1 << MANTISSA_BITS); // 0..1024
-    EXACT_BELOW as usize + ((exponent - 11) as usize) * (1 << MANTISSA_BITS) + mantissa as usize
-}
-
-/// The lower bound of a bin (ns).
-fn bin_floor(bin: usize) -> u32 {
-    if bin < EXACT_BELOW as usize {
-        return bin as u32;
-    }
-    let rest = bin - EXACT_BELOW as usize;
-    let exponent = (rest >> MANTISSA_BITS) as u32 + 11;
-    let mantissa = (rest & ((1 << MANTISSA_BITS) - 1)) as u32 + (1 << MANTISSA_BITS);
-    mantissa << (exponent - MANTISSA_BITS)
 }
 
 impl Latencies {
-    /// Exact store with room for `n` samples without reallocation.
-    pub fn with_capacity(n: usize) -> Self {
-        Self { store: Store::Exact(Vec::with_capacity(n)) }
+    /// An empty store.
+    pub fn new() -> Self {
+        // Bounds and precision are constants that Histogram accepts (1 ≤ low, high ≥ 2 low, 3
+        // significant digits): this cannot fail.
+        let histogram = Histogram::new_with_bounds(1, HIGHEST_NS, 3).expect("valid histogram bounds");
+        Self { histogram, max: 0 }
     }
 
-    /// Fixed-size histogram (about 190 kB, allocated once): percentiles to
-    /// within 0.1 % (exact below 2.048 µs), the maximum exact.
-    ///
-    /// ```
-    /// let mut l = plant::cosim::stats::Latencies::binned();
-    /// for ns in [1000, 2000, 3000, 4000] { l.record(ns); }
-    /// let p = l.percentiles();
-    /// assert_eq!((p.p50, p.max, p.count), (2.0, 4.0, 4));
-    /// ```
-    pub fn binned() -> Self {
-        Self { store: Store::Binned { counts: vec![0; BINS], count: 0, max: 0 } }
-    }
-
-    /// Records one latency (ns); saturates at about 4.3 s.
+    /// Records one latency (ns); saturates at one hour.
     #[inline]
     pub fn record(&mut self, ns: u64) {
-        let ns = u32::try_from(ns).unwrap_or(u32::MAX);
-        match &mut self.store {
-            Store::Exact(v) => v.push(ns),
-            Store::Binned { counts, count, max } => {
-                counts[bin_of(ns)] += 1;
-                *count += 1;
-                *max = (*max).max(ns);
-            }
-        }
+        let ns = ns.clamp(1, HIGHEST_NS);
+        self.histogram.saturating_record(ns);
+        self.max = self.max.max(ns);
     }
 
-    /// Nearest-rank percentiles (binned: the lower bound of the rank's bin).
+    /// Nearest-rank percentiles, within 0.1 % (see the module doc); the maximum exact.
     ///
     /// ```
-    /// let mut l = plant::cosim::stats::Latencies::with_capacity(4);
+    /// let mut l = plant::cosim::stats::Latencies::new();
     /// for ns in [1000, 2000, 3000, 4000] { l.record(ns); }
     /// let p = l.percentiles();
-    /// assert_eq!((p.p50, p.max, p.count), (2.0, 4.0, 4));
+    /// assert_eq!((p.count, p.max), (4, 4.0));
+    /// assert!(p.p50 >= 2.0 && p.p50 <= 2.0 * (1.0 + 1.0 / 1024.0), "{}", p.p50);
     /// ```
     pub fn percentiles(&self) -> Percentiles {
-        let rank_of = |q: f64, n: u64| ((q * n as f64).ceil() as u64).clamp(1, n);
-        match &self.store {
-            Store::Exact(ns) => {
-                if ns.is_empty() {
-                    return Percentiles::default();
-                }
-                let mut sorted = ns.clone();
-                sorted.sort_unstable();
-                let n = sorted.len() as u64;
-                let rank = |q: f64| f64::from(sorted[(rank_of(q, n) - 1) as usize]) * 1e-3;
-                Percentiles {
-                    count: n,
-                    p50: rank(0.5),
-                    p99: rank(0.99),
-                    p999: rank(0.999),
-                    max: f64::from(*sorted.last().unwrap_or(&0)) * 1e-3,
-                }
-            }
-            Store::Binned { counts, count, max } => {
-                if *count == 0 {
-                    return Percentiles::default();
-                }
-                let rank = |q: f64| {
-                    let want = rank_of(q, *count);
-                    let mut seen = 0;
-                    for (bin, c) in counts.iter().enumerate() {
-                        seen += c;
-                        if seen >= want {
-                            return f64::from(bin_floor(bin).min(*max)) * 1e-3;
-                        }
-                    }
-                    f64::from(*max) * 1e-3
-                };
-                Percentiles {
-                    count: *count,
-                    p50: rank(0.5),
-                    p99: rank(0.99),
-                    p999: rank(0.999),
-                    max: f64::from(*max) * 1e-3,
-                }
-            }
+        let count = self.histogram.len();
+        if count == 0 {
+            return Percentiles::default();
         }
+        let at = |q: f64| self.histogram.value_at_quantile(q).min(self.max) as f64 * 1e-3;
+        Percentiles { count, p50: at(0.5), p99: at(0.99), p999: at(0.999), max: self.max as f64 * 1e-3 }
     }
 }
 
@@ -187,37 +112,180 @@ impl Misses {
     }
 }
 
+/// The counters of a session, kept as the run goes.
+#[derive(Debug, Default, Clone)]
+pub struct Figures {
+    /// Sensor frames published.
+    pub sent: u64,
+    /// Command frames of the current session received.
+    pub received: u64,
+    /// Samples skipped in the sequence of replies.
+    pub gaps: u64,
+    /// Replies to an older sample (or late, realtime).
+    pub stale: u64,
+    /// Replies with non-finite currents.
+    pub invalid: u64,
+    /// Frames and acks with another run's token.
+    pub foreign: u64,
+    /// Deadline misses (realtime).
+    pub misses: Misses,
+    /// Ticks that had a reply due (realtime).
+    pub due: u64,
+    /// Realtime ticks started more than a period late.
+    pub overruns: u64,
+    /// Ticks run on the fallback current.
+    pub fallback_ticks: u64,
+    /// The last reply's `seq` (for the gaps).
+    pub last_reply_seq: Option<u64>,
+    /// Sensor frame published → command frame published (ns).
+    pub latency: Latencies,
+    /// Sensor frame published → reply in the plant's hands (ns), lockstep.
+    pub round_trip: Latencies,
+    /// Connections, losses, reconnections, stops.
+    pub events: Vec<PeerEvent>,
+}
+
+impl Figures {
+    /// Notes a reply's `seq`, counting the samples skipped since the last one.
+    ///
+    /// ```
+    /// let mut f = plant::cosim::stats::Figures::default();
+    /// for seq in [0, 1, 4, 5] { f.note_reply_seq(seq); }
+    /// assert_eq!(f.gaps, 2);
+    /// ```
+    pub fn note_reply_seq(&mut self, seq: u64) {
+        if let Some(last) = self.last_reply_seq {
+            if seq > last + 1 {
+                self.gaps += seq - last - 1;
+            }
+        }
+        self.last_reply_seq = Some(seq);
+    }
+
+    /// The deadline-miss fraction so far (misses over the ticks that had a reply due).
+    pub fn miss_fraction(&self) -> f64 {
+        self.misses.total as f64 / self.due.max(1) as f64
+    }
+
+    /// Starts the latency figures afresh (after a warm-up).
+    pub fn reset_latencies(&mut self) {
+        self.latency = Latencies::new();
+        self.round_trip = Latencies::new();
+    }
+}
+
+/// The `cosim` object of `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CosimReport {
+    /// `lockstep` or `realtime`.
+    pub mode: &'static str,
+    /// Run id (service names `amb-testbed/<run_id>/…`).
+    pub run_id: String,
+    /// What the (last) controller said it runs.
+    pub controller: String,
+    /// The controller process's command line, when the scene gives one (`controller.command`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_command: Option<Vec<String>>,
+    /// Handshakes made (1 + reconnections).
+    pub sessions: u32,
+    /// Sensor frames published.
+    pub messages_sent: u64,
+    /// Command frames received (current session's).
+    pub messages_received: u64,
+    /// Samples skipped in the sequence of replies (never answered).
+    pub sequence_gaps: u64,
+    /// Replies that came after their tick (realtime) or answered an older sample.
+    pub stale_replies: u64,
+    /// Replies with non-finite currents (the last current was held).
+    pub invalid_replies: u64,
+    /// Frames and handshake answers carrying another run's token (never applied).
+    pub foreign_frames: u64,
+    /// Ticks whose reply was missing (realtime).
+    pub deadline_misses: u64,
+    /// `deadline_misses` over the ticks that had a reply due.
+    pub deadline_miss_fraction: f64,
+    /// Longest run of consecutive misses.
+    pub longest_miss_burst: u64,
+    /// Realtime ticks that started more than one period late (the plant could not keep up).
+    pub plant_overruns: u64,
+    /// Ticks run on the fallback current while no controller was connected.
+    pub fallback_ticks: u64,
+    /// Waits of the plant that outlasted the spin budget and blocked.
+    pub blocking_waits: u64,
+    /// Blocked waits of the plant that the controller ended by a notification (it served the
+    /// plant's wake request).
+    pub woken_waits: u64,
+    /// Scheduling of the plant's loop thread and of the controller (`fifo` with
+    /// `controller.realtime_priority`, else `other`).
+    pub scheduling: Scheduling,
+    /// Sensor frame published → command frame published by the controller (both stamped
+    /// with `CLOCK_MONOTONIC`), µs, from the first frame of the run (or after the warm-up of
+    /// `plant bench ipc`) to the last.
+    pub latency_us: Percentiles,
+    /// Lockstep: sensor frame published → reply in the plant's hands, µs.
+    pub round_trip_us: Option<Percentiles>,
+    /// Connections, losses, reconnections, stops.
+    pub peer_events: Vec<PeerEvent>,
+    /// What the (last) controller ran differently from the scene (the `[controller]` table of
+    /// its handshake's overrides, from its `--config` or `--law`); absent if nothing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_overrides: Option<toml::Table>,
+}
+
+/// Scheduling policies in force (`fifo`, `other`, …).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Scheduling {
+    /// `controller.realtime_priority` (0: off).
+    pub realtime_priority: u32,
+    /// The plant's loop thread.
+    pub plant: String,
+    /// The (last) controller's main thread, as the plant sees it.
+    pub controller: String,
+    /// What the system refused (no `SCHED_FIFO`, no memory locking), if anything.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub refused: Vec<String>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn bins_are_contiguous_and_floors_round_trip() {
-        assert_eq!(bin_of(u32::MAX), BINS - 1);
-        for bin in [0, 1, 2047, 2048, 2049, 5000, BINS - 1] {
-            assert_eq!(bin_of(bin_floor(bin)), bin, "bin {bin}");
-        }
-        for ns in [2047u32, 2048, 2049, 3071, 3072, 4095, 4096, 1_000_000, u32::MAX] {
-            let floor = bin_floor(bin_of(ns));
-            assert!(floor <= ns && f64::from(ns - floor) <= f64::from(ns) / 1024.0, "{ns} -> {floor}");
-        }
+    /// Nearest rank over the sorted samples, exactly.
+    fn exact(sorted: &[u64], q: f64) -> f64 {
+        let n = sorted.len() as f64;
+        let rank = ((q * n).ceil() as usize).clamp(1, sorted.len());
+        sorted[rank - 1] as f64 * 1e-3
     }
 
     #[test]
-    fn binned_percentiles_match_exact_within_a_tenth_of_a_percent() {
-        let (mut exact, mut binned) = (Latencies::with_capacity(0), Latencies::binned());
+    fn percentiles_are_within_a_tenth_of_a_percent_above_the_exact_ones() {
+        let mut l = Latencies::new();
+        let mut all = Vec::new();
         // A deterministic spread from 0.5 µs to about 5 ms.
         let mut rng = crate::rng::SplitMix64::new(12345);
         for _ in 0..20_000 {
             let x = rng.next_u64();
             let ns = 500 + (x >> 33) % 5_000_000 / (1 + (x >> 60));
-            exact.record(ns);
-            binned.record(ns);
+            l.record(ns);
+            all.push(ns);
         }
-        let (e, b) = (exact.percentiles(), binned.percentiles());
-        assert_eq!((e.count, e.max), (b.count, b.max));
-        for (pe, pb) in [(e.p50, b.p50), (e.p99, b.p99), (e.p999, b.p999)] {
-            assert!(pb <= pe && pe - pb <= pe / 1024.0 + 1e-12, "exact {pe} binned {pb}");
+        all.sort_unstable();
+        let p = l.percentiles();
+        assert_eq!(p.count, 20_000);
+        assert_eq!(p.max, *all.last().unwrap() as f64 * 1e-3);
+        for (q, got) in [(0.5, p.p50), (0.99, p.p99), (0.999, p.p999)] {
+            let want = exact(&all, q);
+            assert!(got >= want && got <= want * (1.0 + 1.0 / 1024.0), "q {q}: exact {want} µs, histogram {got} µs");
         }
+    }
+
+    #[test]
+    fn an_empty_store_gives_zeros_and_huge_values_saturate() {
+        assert_eq!(Latencies::new().percentiles(), Percentiles::default());
+        let mut l = Latencies::new();
+        l.record(u64::MAX);
+        l.record(0);
+        let p = l.percentiles();
+        assert_eq!((p.count, p.max), (2, HIGHEST_NS as f64 * 1e-3));
     }
 }

@@ -62,6 +62,13 @@ pub fn controller_bin() -> &'static Path {
     BIN.get_or_init(|| build_bin("controller", "controller"))
 }
 
+/// The `rogue-controller` test binary (a controller that misbehaves on purpose, see
+/// `tests/bin/rogue_controller.rs`), built once per test binary.
+pub fn rogue_bin() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| build_bin("testbed-tests", "rogue-controller"))
+}
+
 /// The `shock-table` binary, built once per test binary.
 pub fn shock_table_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
@@ -82,9 +89,106 @@ pub fn plant_run(scene: &Path, out: &Path, sets: &[&str]) -> Command {
     cmd
 }
 
-/// Runs a command to completion.
+/// Runs a command to completion (unbounded: prefer [`output_within`]).
 pub fn output(cmd: &mut Command) -> Output {
     cmd.output().unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"))
+}
+
+/// A child process whose stderr lines arrive on a channel, with bounded waits; killed on
+/// drop (a test that fails or hangs leaves no process behind).
+pub struct Proc {
+    child: std::process::Child,
+    lines: std::sync::mpsc::Receiver<String>,
+    log: Vec<String>,
+}
+
+impl Proc {
+    /// Starts `cmd` (stdout to /dev/null, stderr read line by line).
+    pub fn spawn(cmd: &mut Command) -> Self {
+        use std::io::BufRead;
+        let mut child = cmd
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
+        let pipe = child.stderr.take().expect("piped stderr");
+        let (tx, lines) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Self { child, lines, log: Vec::new() }
+    }
+
+    /// Process id.
+    pub fn id(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Waits (up to 60 s) for a stderr line containing `needle`.
+    pub fn wait_line(&mut self, needle: &str) -> String {
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        loop {
+            match self.lines.recv_timeout(deadline.saturating_duration_since(std::time::Instant::now())) {
+                Ok(line) => {
+                    self.log.push(line.clone());
+                    if line.contains(needle) {
+                        return line;
+                    }
+                }
+                Err(_) => panic!("no line with {needle:?} within 60 s; stderr so far:\n{}", self.log.join("\n")),
+            }
+        }
+    }
+
+    /// Waits (up to `limit`) for the exit; returns the exit code and all of stderr.
+    pub fn finish_within(mut self, limit: std::time::Duration) -> (Option<i32>, String) {
+        let deadline = std::time::Instant::now() + limit;
+        let status = loop {
+            if let Some(s) = self.child.try_wait().expect("waiting for the child") {
+                break s;
+            }
+            if std::time::Instant::now() > deadline {
+                let _ = self.child.kill();
+                let _ = self.child.wait();
+                while let Ok(line) = self.lines.try_recv() {
+                    self.log.push(line);
+                }
+                panic!("process did not exit within {limit:?} (killed):\n{}", self.log.join("\n"));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        };
+        // The reader thread ends at EOF.
+        let end = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        while let Ok(line) = self.lines.recv_timeout(end.saturating_duration_since(std::time::Instant::now())) {
+            self.log.push(line);
+        }
+        (status.code(), self.log.join("\n"))
+    }
+
+    /// Waits (up to 60 s) for the exit; returns the exit code and all of stderr.
+    pub fn finish(self) -> (Option<i32>, String) {
+        self.finish_within(std::time::Duration::from_secs(60))
+    }
+
+    /// Sends a signal.
+    #[cfg(unix)]
+    pub fn signal(&self, signal: libc::c_int) {
+        let pid = libc::pid_t::try_from(self.child.id()).expect("pid");
+        // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
+        assert_eq!(unsafe { libc::kill(pid, signal) }, 0, "kill({pid}, {signal})");
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
 }
 
 /// Runs a command to completion within `limit`, killing it (and failing the test) if it takes

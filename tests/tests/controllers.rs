@@ -1,0 +1,275 @@
+//! End-to-end tests of controllers from anywhere (issue 10, items 3, 4 and 6):
+//! a controller crate outside the workspace, built and run in lockstep; any
+//! executable as `controller.command`, with the contract it gets (argument,
+//! environment, paths, respawn) and the bad ones refused with a message, an
+//! exit code and `summary.json`; the C header checked against `wire.rs`.
+//! Every process is bounded in time.
+
+mod common;
+
+use common::{
+    assert_exit, controller_bin, num, output_within, plant_run, read_json, rogue_bin, scene, stderr, workspace_root,
+    Csv, TempDir, SHORT,
+};
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+/// The example crate's law, compiled here from its own source: the trace of the out-of-tree
+/// controller process is checked against this code run in this process.
+#[allow(dead_code)]
+#[path = "../../examples/rust-controller/src/lib.rs"]
+mod pd_notch;
+
+/// The most any one command of this file may take (debug build, a loaded 2-core machine).
+const LIMIT: Duration = Duration::from_secs(300);
+
+fn output(cmd: &mut Command) -> std::process::Output {
+    output_within(cmd, LIMIT)
+}
+
+/// `SHORT` plus extra overrides.
+fn sets(extra: &[String]) -> Vec<String> {
+    SHORT.iter().map(|s| s.to_string()).chain(extra.iter().cloned()).collect()
+}
+
+fn as_strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+/// `controller.command=[…]` as a `--set` override.
+fn command_set(argv: &[&str]) -> String {
+    let items: Vec<String> = argv.iter().map(|a| format!("{a:?}")).collect();
+    format!("controller.command=[{}]", items.join(", "))
+}
+
+/// The target folder this test binary was built in (`<target>/<profile>/deps/<test>`).
+fn target_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's own path");
+    exe.ancestors().nth(3).expect("<target>/<profile>/deps/<test>").to_path_buf()
+}
+
+/// Issue 10 item 3: a controller crate outside the workspace, depending on `controller` by
+/// path, is built (offline, locked, into the workspace's target folder so the shared
+/// dependencies are reused) and run by the plant through `controller.command` in lockstep.
+/// Its trace is what its law gives: the example's own code, run here on the trace's sensor
+/// samples, reproduces every applied current bit for bit (delay 1: the current computed from
+/// sample k is in row k + 2), and differs from the plain PD's.
+#[test]
+fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace() {
+    let crate_dir = workspace_root().join("examples").join("rust-controller");
+    let started = Instant::now();
+    let mut build = Command::new(env!("CARGO"));
+    build.current_dir(&crate_dir).env("CARGO_TARGET_DIR", target_dir()).args([
+        "build",
+        "--offline",
+        "--locked",
+        "-q",
+        "--message-format=json",
+        "--bin",
+        "pd-notch-controller",
+    ]);
+    if !cfg!(debug_assertions) {
+        build.arg("--release");
+    }
+    let built = output(&mut build);
+    assert!(built.status.success(), "building the example crate: {}", stderr(&built));
+    let exe = String::from_utf8_lossy(&built.stdout)
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "pd-notch-controller")
+        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
+        .expect("the example's executable");
+    eprintln!("example crate built in {:.1} s", started.elapsed().as_secs_f64());
+
+    let dir = TempDir::new("out-of-tree");
+    let out = dir.join("run");
+    let scene_file = crate_dir.join("pd-notch-10g.toml");
+    let extra = sets(&[command_set(&[&exe.display().to_string()])]);
+    let run = output(&mut plant_run(&scene_file, &out, &as_strs(&extra)));
+    assert_exit(&run, 0);
+    let s = read_json(&out.join("summary.json"));
+    assert!(s["cosim"]["controller"].as_str().unwrap().starts_with("pd_notch:"), "{s:#}");
+    assert_eq!(s["cosim"]["controller_command"][0].as_str(), Some(exe.display().to_string().as_str()));
+
+    let scene = plant::config::load_scene(&scene_file, &extra).expect("the scene");
+    let design = scene.design();
+    let mut law = pd_notch::build(&design, &scene.controller.params).expect("the law");
+    let mut pd = controller::build_law("pd", &design, &controller::Params::default()).unwrap();
+    let trace = Csv::read(&out.join("trace.csv"));
+    let (t, dx, dy) = (trace.column("t_s"), trace.column("dx_m"), trace.column("dy_m"));
+    let (ix, iy) = (trace.column("ix_a"), trace.column("iy_a"));
+    let (gain, limit, period) = (design.constants.sensor_gain_v_per_m, design.current_limit_a, design.period_s);
+    let ticks = t.len() - 1;
+    assert_eq!(ticks, 1000);
+    let mut largest_difference_from_pd: f64 = 0.0;
+    for k in 0..ticks - 1 {
+        assert!((t[k] - k as f64 * period).abs() < 1e-12, "row {k} at t = {}", t[k]);
+        let sample =
+            controller::Sample { seq: k as u64, t_s: k as f64 * period, sensor_v: [gain * dx[k], gain * dy[k]] };
+        let i = controller::saturate(law.update(&sample), limit);
+        assert!(
+            ix[k + 2].to_bits() == i[0].to_bits() && iy[k + 2].to_bits() == i[1].to_bits(),
+            "sample {k}: the process applied ({}, {}) A, the law gives ({}, {}) A",
+            ix[k + 2],
+            iy[k + 2],
+            i[0],
+            i[1]
+        );
+        let p = controller::saturate(pd.update(&sample), limit);
+        largest_difference_from_pd = largest_difference_from_pd.max((p[0] - i[0]).abs()).max((p[1] - i[1]).abs());
+    }
+    assert!(largest_difference_from_pd > 1e-3, "the notch changed nothing: {largest_difference_from_pd} A");
+}
+
+/// Issue 10 item 4: the contract a command gets. The plant runs it exactly, with `--run-id
+/// ID` appended and `AMB_TESTBED_RUN_ID`, `AMB_TESTBED_CONNECT_TIMEOUT_S` set; a relative
+/// path that exists in the scene's folder is taken from there (and written absolute in the
+/// run folder's `scene.toml`); a command that dies is respawned, as the built-in one.
+#[cfg(unix)]
+#[test]
+fn a_command_gets_the_run_id_and_is_respawned_after_a_crash() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("command-contract");
+    let scene_file = dir.join("scene.toml");
+    std::fs::copy(scene("paper-10g.toml"), &scene_file).unwrap();
+    let wrapper = dir.join("wrap.sh");
+    let log = dir.join("calls.txt");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\nprintf 'args %s | env %s %s\\n' \"$*\" \"$AMB_TESTBED_RUN_ID\" \"$AMB_TESTBED_CONNECT_TIMEOUT_S\" >> {log:?}\nexec {:?} \"$@\"\n",
+            controller_bin().display().to_string()
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let out = dir.join("run");
+    let id = format!("t{}-contract", std::process::id());
+    let extra = sets(&[
+        "controller.mode=lockstep".into(),
+        "controller.reconnect_timeout_ms=20000".into(),
+        command_set(&["wrap.sh", "--quiet"]),
+    ]);
+    let mut cmd = plant_run(&scene_file, &out, &as_strs(&extra));
+    cmd.args(["--run-id", &id]).env("AMB_CONTROLLER_CRASH_AT_SEQ", "300");
+    let run = output(&mut cmd);
+    assert_exit(&run, 0);
+    let calls = std::fs::read_to_string(&log).unwrap();
+    let expected = format!("args --quiet --run-id {id} | env {id} 10\n");
+    assert_eq!(calls, expected.repeat(2), "one call, then the respawn after the crash");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(num(&s["cosim"], "sessions"), 2.0, "{s:#}");
+    let absolute = std::path::absolute(&wrapper).unwrap().display().to_string();
+    assert_eq!(s["cosim"]["controller_command"][0].as_str(), Some(absolute.as_str()), "{s:#}");
+    let recorded = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+    assert!(recorded.contains(&absolute), "{recorded}");
+}
+
+/// Issue 10, bad input: a command that does not exist, is not executable, exits at once,
+/// answers with another protocol version or other message types, or does not serve the
+/// scene's law: each is named, with its exit code and the run folder's `summary.json`.
+#[cfg(unix)]
+#[test]
+fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("bad-commands");
+    let plain = dir.join("plain.sh");
+    std::fs::write(&plain, "#!/bin/sh\nexit 0\n").unwrap();
+    std::fs::set_permissions(&plain, std::fs::Permissions::from_mode(0o644)).unwrap();
+    let rogue = rogue_bin().display().to_string();
+    let controller = controller_bin().display().to_string();
+    let plain = plain.display().to_string();
+    // (command, an extra override, exit code, status, what stderr must name)
+    type Case<'a> = (Vec<&'a str>, Option<&'a str>, i32, &'a str, Vec<&'a str>);
+    let cases: Vec<Case> = vec![
+        (vec!["/no/such/controller"], None, 2, "not_started", vec!["controller.command", "/no/such/controller"]),
+        (vec![&plain], None, 2, "not_started", vec!["not executable", "plain.sh"]),
+        (vec!["false"], None, 4, "not_started", vec!["exited before the handshake", "`false`"]),
+        (
+            vec![&rogue, "--mode", "types"],
+            None,
+            2,
+            "refused",
+            vec!["other message types", "exited before the handshake"],
+        ),
+        (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 4", "speaks version 3"]),
+        (vec![&controller], Some("controller.law=\"nope\""), 2, "refused", vec!["law `nope` is not served"]),
+    ];
+    for (i, (argv, law, code, status, needles)) in cases.iter().enumerate() {
+        let out = dir.join(&format!("run{i}"));
+        let mut extra = vec!["controller.mode=lockstep".to_string(), command_set(argv)];
+        extra.extend(law.map(str::to_string));
+        let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &as_strs(&sets(&extra))));
+        assert_exit(&run, *code);
+        let err = stderr(&run);
+        for n in needles {
+            assert!(err.contains(n), "{argv:?}: no {n:?} in\n{err}");
+        }
+        let s = read_json(&out.join("summary.json"));
+        assert_eq!(s["status"], *status, "{argv:?}: {s:#}");
+        assert!(!s["error"].as_str().unwrap_or_default().is_empty(), "{argv:?}: {s:#}");
+        assert!(out.join("scene.toml").is_file());
+    }
+}
+
+/// Issue 10 item 6: `controller/include/amb_testbed_wire.h` compiles (its `_Static_assert`s
+/// hold) and gives every field of every message the size and offset `wire.rs` gives it.
+#[test]
+fn the_c_header_matches_the_rust_layout() {
+    use controller::wire::{Ack, CommandFrame, Hello, SensorFrame, WakeRequest};
+    use std::mem::{offset_of, size_of, size_of_val};
+    macro_rules! fields {
+        ($out:ident, $t:ident, $v:expr; $($f:ident),*) => {{
+            let v = $v;
+            $( $out.push((stringify!($t), stringify!($f), offset_of!($t, $f), size_of_val(&v.$f))); )*
+            $out.push((stringify!($t), "-", 0, size_of::<$t>()));
+        }};
+    }
+    let mut rust: Vec<(&str, &str, usize, usize)> = Vec::new();
+    fields!(rust, SensorFrame, SensorFrame::default(); seq, t_s, token, sent_ns, status, session, axes, reserved, sensor_v);
+    fields!(rust, CommandFrame, CommandFrame::default();
+        seq, token, received_ns, sent_ns, status, session, axes, reserved, current_a);
+    fields!(rust, WakeRequest, WakeRequest::default(); seq);
+    fields!(rust, Hello, Hello::example("x");
+        protocol_version, axes, units, session, token, rate_hz, period_s, run_id, law, stiffness_n_per_m,
+        damping_ratio, ki_n_per_a, ks_n_per_m, amp_gain_a_per_v, sensor_gain_v_per_m, rotor_mass_kg, gravity_m_s2,
+        current_limit_a, air_gap_m, delay_samples, gravity_bias, spin_ns, mode, plant_pid, params_len, reserved, params);
+    fields!(rust, Ack, Ack::new(1, 1, 0, "pd", "");
+        protocol_version, session, status, controller_pid, token, law, message, overrides_len, reserved, overrides);
+
+    let mut program = String::from("#include <stdio.h>\n#include \"amb_testbed_wire.h\"\nint main(void) {\n");
+    for (t, f, _, _) in &rust {
+        let ty = format!("amb_testbed_{t}");
+        if *f == "-" {
+            program += &format!("    printf(\"{t} - 0 %zu\\n\", sizeof({ty}));\n");
+        } else {
+            program += &format!("    printf(\"{t} {f} %zu %zu\\n\", offsetof({ty}, {f}), sizeof((({ty} *)0)->{f}));\n");
+        }
+    }
+    program += "    return 0;\n}\n";
+    let dir = TempDir::new("c-header");
+    std::fs::write(dir.join("layout.c"), program).unwrap();
+    let include = workspace_root().join("controller").join("include");
+    let exe = dir.join("layout");
+    let compiled = output(
+        Command::new("cc")
+            .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-I"])
+            .arg(&include)
+            .arg(dir.join("layout.c"))
+            .arg("-o")
+            .arg(&exe),
+    );
+    assert!(compiled.status.success(), "cc failed:\n{}", stderr(&compiled));
+    let ran = output(&mut Command::new(&exe));
+    assert!(ran.status.success());
+    let c: Vec<String> = String::from_utf8_lossy(&ran.stdout).lines().map(str::to_string).collect();
+    let expected: Vec<String> = rust.iter().map(|(t, f, o, s)| format!("{t} {f} {o} {s}")).collect();
+    assert_eq!(c, expected);
+    // And the sizes the protocol table promises.
+    let total = |name: &str| expected.iter().find(|l| l.starts_with(&format!("{name} - "))).cloned().unwrap();
+    assert_eq!(
+        ["SensorFrame", "CommandFrame", "WakeRequest", "Hello", "Ack"].map(total),
+        ["SensorFrame - 0 112", "CommandFrame - 0 112", "WakeRequest - 0 8", "Hello - 0 4312", "Ack - 0 4416"]
+    );
+}
