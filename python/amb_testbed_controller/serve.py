@@ -10,8 +10,8 @@ code  meaning
 ====  =====================================================================
 0     the plant ended the run (a STOP frame)
 1     an IPC failure
-2     bad input: a bad argument, a refused hello (it was told why), a plant
-      of another protocol version
+2     bad input: a bad argument, a run id held by another live controller, a
+      refused hello (it was told why), a plant of another protocol version
 4     the plant is gone (its node died or vanished), or no hello came in time
 130   SIGINT or SIGTERM (the plant is told with a STOPPING frame)
 ====  =====================================================================
@@ -23,6 +23,7 @@ plant sets for a ``controller.command``), ``--connect-timeout-s S`` (default
 
 import argparse
 import contextlib
+import fcntl
 import math
 import os
 import signal
@@ -185,8 +186,42 @@ def _ack(hello: wire.Hello, status: int, law: str, message: str) -> wire.Ack:
     )
 
 
+def lock_run_id(run_id: str, role: str = "controller"):
+    """Takes ``<lock dir>/<run_id>.<role>.lock`` with an exclusive ``flock``, as the Rust side does
+    (``controller/src/lock.rs``): one live controller per run id. The lock dir is
+    ``$AMB_TESTBED_LOCK_DIR``, else ``$TMPDIR/amb-testbed`` (``/tmp/amb-testbed``). The kernel
+    releases the lock when the process ends, however it ends. Returns the open file (keep it).
+    """
+    folder = os.environ.get("AMB_TESTBED_LOCK_DIR") or os.path.join(os.environ.get("TMPDIR") or "/tmp", "amb-testbed")
+    path = os.path.join(folder, f"{run_id}.{role}.lock")
+    try:
+        if not os.path.isdir(folder):
+            os.makedirs(folder, exist_ok=True)
+            with contextlib.suppress(OSError):
+                os.chmod(folder, 0o1777)  # machine-wide like /tmp: any user may add a lock
+        file = open(path, "a+")
+    except OSError as e:
+        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    try:
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        file.seek(0)
+        holder = file.read().strip() or "a process that has not written its name yet"
+        file.close()
+        raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
+                       "pick another --run-id or stop that process") from None
+    except OSError as e:
+        file.close()
+        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    file.truncate(0)
+    file.write(f"pid {os.getpid()} ({' '.join(sys.argv)})\n")
+    file.flush()
+    return file
+
+
 def _serve(laws, o: argparse.Namespace, signals: _Signals) -> None:
     run_id = o.run_id
+    _lock = lock_run_id(run_id)  # held while the process serves
     node = link.node(run_id, "controller")
     handshake = link.Mailbox(node, run_id, "ack", "hello", wire.Ack, wire.Hello)
     frames = link.Endpoint(node, run_id, "command", "sensor", wire.CommandFrame, wire.SensorFrame, 200_000)
