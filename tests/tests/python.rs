@@ -189,6 +189,18 @@ impl TestPlant {
         }
     }
 
+    /// The next command frame within `limit`, polled without ever asking to be woken.
+    fn poll_reply_within(&self, limit: Duration) -> Option<CommandFrame> {
+        let until = Instant::now() + limit;
+        while Instant::now() < until {
+            if let Some(reply) = self.frames.try_receive().expect("receive") {
+                return Some(reply);
+            }
+            std::thread::sleep(Duration::from_micros(100));
+        }
+        None
+    }
+
     /// The next command frame within `limit`, if any.
     fn reply_within(&mut self, limit: Duration) -> Option<CommandFrame> {
         let until = Instant::now() + limit;
@@ -488,6 +500,14 @@ fn python_law_parameters_are_checked_with_the_rust_messages() {
     assert_eq!(python, rust);
 }
 
+/// The kit's own examples (doctests) hold.
+#[test]
+fn the_kit_doctests_pass() {
+    let script = "import doctest, sys, amb_testbed_controller.law as m\nr = doctest.testmod(m)\nprint(r)\nsys.exit(r.failed > 0 or r.attempted == 0)";
+    let out = output_within(Command::new(python()).args(["-c", script]), LIMIT);
+    assert_exit(&out, 0);
+}
+
 /// SIGTERM: the controller tells the plant with a STOPPING frame, then exits 130.
 #[test]
 fn sigterm_to_the_python_controller_sends_stopping_and_exits_130() {
@@ -569,4 +589,83 @@ fn a_second_python_controller_under_a_live_run_id_is_refused() {
         LIMIT,
     );
     assert_exit(&third, 4); // the lock was free again: it waited for a hello
+}
+
+/// The wake protocol on the controller's side, watched through extra ports on the run's
+/// services: the controller notifies the `command` event service after a reply only when
+/// the plant asked (a `WakeRequest` on `command/wake`), and asks to be woken (a
+/// `WakeRequest` on `sensor/wake`) before it blocks.
+#[test]
+fn the_python_controller_serves_and_makes_wake_requests() {
+    use iceoryx2::prelude::*;
+    let id = run_id("wake");
+    let plant = TestPlant::open(&id);
+    let ctl = Proc::spawn(&mut python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "60"]));
+    let h = hello(&id);
+    assert_eq!(plant.handshake(h).status, 0);
+    let service = |what: &str| ServiceName::new(&wire::name(&id, what)).unwrap();
+    let pubsub = |what: &str| {
+        plant
+            ._node
+            .service_builder(&service(what))
+            .publish_subscribe::<wire::WakeRequest>()
+            .subscriber_max_buffer_size(link::BUFFER)
+            .history_size(0)
+            .enable_safe_overflow(true)
+            .max_publishers(link::MAX_PORTS)
+            .max_subscribers(link::MAX_PORTS)
+            .max_nodes(link::MAX_NODES)
+            .open_or_create()
+            .expect("wake service")
+    };
+    let asks = pubsub("command/wake").publisher_builder().create().unwrap();
+    let requests = pubsub("sensor/wake").subscriber_builder().create().unwrap();
+    let events = plant
+        ._node
+        .service_builder(&service("command"))
+        .event()
+        .max_notifiers(link::MAX_PORTS)
+        .max_listeners(link::MAX_PORTS)
+        .max_nodes(link::MAX_NODES)
+        .open_or_create()
+        .expect("event service")
+        .listener_builder()
+        .create()
+        .unwrap();
+    let notified = || {
+        let mut n = 0;
+        events.try_wait(|_| n += 1).unwrap();
+        n
+    };
+    // Idle past its spin budget (0.2 ms), the controller has asked to be woken.
+    let until = Instant::now() + Duration::from_secs(30);
+    while requests.receive().unwrap().is_none() {
+        assert!(Instant::now() < until, "the idle controller published no wake request within 30 s");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    while requests.receive().unwrap().is_some() {}
+    notified();
+    // Not asked: no notification. Asked: one.
+    for (seq, ask) in [(0, false), (1, true), (2, false), (3, true)] {
+        if ask {
+            asks.send_copy(wire::WakeRequest { seq }).unwrap();
+        }
+        plant.frames.send_and_wake(sensor_frame(&h, seq, h.token, [0.01, 0.02])).unwrap();
+        let reply = plant.poll_reply_within(Duration::from_secs(30)).expect("a reply");
+        assert_eq!(reply.seq, seq);
+        // The notification follows the reply: wait for it when asked; else give it time to show.
+        let until = Instant::now() + if ask { Duration::from_secs(30) } else { Duration::from_millis(50) };
+        let mut n = 0;
+        while n == 0 && Instant::now() < until {
+            n += notified();
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        assert_eq!(n > 0, ask, "frame {seq}: asked {ask}, notified {n} times");
+    }
+    plant
+        .frames
+        .send_and_wake(SensorFrame { status: SensorFrame::STOP, ..sensor_frame(&h, 0, h.token, [0.0; 2]) })
+        .unwrap();
+    let (code, log) = ctl.finish_within(Duration::from_secs(30));
+    assert_eq!(code, Some(0), "{log}");
 }
