@@ -18,11 +18,16 @@ code  meaning
 
 Command line: ``--run-id ID`` (default: ``$AMB_TESTBED_RUN_ID``, which the
 plant sets for a ``controller.command``), ``--connect-timeout-s S`` (default
-``$AMB_TESTBED_CONNECT_TIMEOUT_S``, else 30), ``--quiet``.
+``$AMB_TESTBED_CONNECT_TIMEOUT_S``, else 30), ``--quiet``. With
+``AMB_TESTBED_REALTIME_PRIORITY=N`` (1 to 99; 0 is off) the process puts
+itself under ``SCHED_FIFO`` at N and locks its memory, with a warning for
+each step the system refuses.
 """
 
 import argparse
 import contextlib
+import ctypes
+import ctypes.util
 import fcntl
 import math
 import os
@@ -133,7 +138,32 @@ def _options(prog: str, argv) -> argparse.Namespace:
         raise BadInput(f"--connect-timeout-s {o.connect_timeout_s} s: must be a finite number > 0 and <= 1e6")
     o.connect_timeout_s = t
     o.prog = prog
+    text = os.environ.get(REALTIME_PRIORITY_ENV, "0")
+    try:
+        o.realtime_priority = int(text)
+    except ValueError:
+        o.realtime_priority = -1
+    if not 0 <= o.realtime_priority <= 99:
+        raise BadInput(f"{REALTIME_PRIORITY_ENV}={text}: must be an integer from 0 (off) to 99")
     return o
+
+
+REALTIME_PRIORITY_ENV = "AMB_TESTBED_REALTIME_PRIORITY"
+
+
+def realtime(priority: int) -> list[str]:
+    """``SCHED_FIFO`` at ``priority`` and ``mlockall``: what the system refused, step by step."""
+    refused = []
+    try:
+        if os.sched_getscheduler(0) != os.SCHED_FIFO:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except OSError as e:
+        refused.append(f"SCHED_FIFO at priority {priority}: {e.strerror}")
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+    mcl_current, mcl_future = 1, 2  # <sys/mman.h> on Linux
+    if libc.mlockall(mcl_current | mcl_future) != 0:
+        refused.append(f"mlockall: {os.strerror(ctypes.get_errno())}")
+    return refused
 
 
 def _check_hello(h: wire.Hello, run_id: str):
@@ -222,6 +252,10 @@ def lock_run_id(run_id: str, role: str = "controller"):
 def _serve(laws, o: argparse.Namespace, signals: _Signals) -> None:
     run_id = o.run_id
     _lock = lock_run_id(run_id)  # held while the process serves
+    if o.realtime_priority > 0:
+        for refused in realtime(o.realtime_priority):
+            print(f"{o.prog}: warning: {REALTIME_PRIORITY_ENV}={o.realtime_priority}: {refused}; carrying on without it",
+                  file=sys.stderr)
     node = link.node(run_id, "controller")
     handshake = link.Mailbox(node, run_id, "ack", "hello", wire.Ack, wire.Hello)
     frames = link.Endpoint(node, run_id, "command", "sensor", wire.CommandFrame, wire.SensorFrame, 200_000)

@@ -548,6 +548,16 @@ fn the_python_controller_exits_4_without_a_plant_and_2_on_bad_arguments() {
     let bad = output_within(&mut python_controller("pd.py", &["--run-id", "a/b"]), LIMIT);
     assert_exit(&bad, 2);
     assert!(stderr(&bad).contains("run id 'a/b'"), "{}", stderr(&bad));
+    let rt = output_within(
+        python_controller("pd.py", &["--run-id", &run_id("rt")]).env("AMB_TESTBED_REALTIME_PRIORITY", "120"),
+        LIMIT,
+    );
+    assert_exit(&rt, 2);
+    assert!(
+        stderr(&rt).contains("AMB_TESTBED_REALTIME_PRIORITY=120: must be an integer from 0 (off) to 99"),
+        "{}",
+        stderr(&rt)
+    );
     let env = output_within(
         python_controller("pd.py", &["--connect-timeout-s", "0.3"]).env("AMB_TESTBED_RUN_ID", run_id("env")),
         LIMIT,
