@@ -1,0 +1,359 @@
+"""``serve(Law)``: a complete controller process for one run of the plant.
+
+Handshake (hello → ack, refusals with their codes and messages), one reply
+per sensor frame with the wake protocol, liveness of the plant's node,
+signals and exit codes, as the Rust ``controller`` binary
+(``controller/src/main.rs``):
+
+====  =====================================================================
+code  meaning
+====  =====================================================================
+0     the plant ended the run (a STOP frame)
+1     an IPC failure
+2     bad input: a bad argument, a run id held by another live controller, a
+      refused hello (it was told why), a plant of another protocol version
+4     the plant is gone (its node died or vanished), or no hello came in time
+130   SIGINT or SIGTERM (the plant is told with a STOPPING frame)
+====  =====================================================================
+
+Command line: ``--run-id ID`` (default: ``$AMB_TESTBED_RUN_ID``, which the
+plant sets for a ``controller.command``), ``--connect-timeout-s S`` (default
+``$AMB_TESTBED_CONNECT_TIMEOUT_S``, else 30), ``--quiet``. With
+``AMB_TESTBED_REALTIME_PRIORITY=N`` (1 to 99; 0 is off) the process puts
+itself under ``SCHED_FIFO`` at N and locks its memory, with a warning for
+each step the system refuses.
+"""
+
+import argparse
+import contextlib
+import ctypes
+import ctypes.util
+import fcntl
+import math
+import os
+import signal
+import sys
+import time
+import traceback
+
+import iceoryx2 as iox2
+
+from . import link, wire
+from .law import Design, DesignError, ParamError, Params, Sample, saturate
+
+OK, IO, BAD_INPUT, PLANT_LOST, INTERRUPTED = 0, 1, 2, 4, 130
+
+LIVENESS_EVERY_NS = 20_000_000
+"""How often a silent plant is looked up by its node (a directory listing)."""
+SLICE = iox2.Duration.from_millis(1)
+"""Slice of a blocking wait: the longest a signal goes unnoticed while blocked."""
+HELLO_POLL_S = 0.001
+
+
+class Ending(Exception):
+    """An ending that is not a success, with its exit code."""
+
+    code = IO
+
+
+class BadInput(Ending):
+    code = BAD_INPUT
+
+
+class PlantLost(Ending):
+    code = PLANT_LOST
+
+
+class Interrupted(Ending):
+    code = INTERRUPTED
+
+
+class _Signals:
+    """SIGINT/SIGTERM set a flag, polled by the loops (as the Rust binary's ctrlc handler)."""
+
+    def __init__(self):
+        self.stop = False
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, self._handle)
+
+    def _handle(self, signum, frame):
+        self.stop = True
+
+
+def serve(*laws, argv=None) -> None:
+    """Serves one run of the plant with the law the hello names among ``laws`` (classes), then exits.
+
+    A law class has a ``name`` (its ``controller.law``), is built as
+    ``Law(design, params)`` and answers ``update(sample) -> (i_x, i_y)``.
+    """
+    sys.exit(run(laws, argv))
+
+
+def run(laws, argv=None) -> int:
+    """As :func:`serve`, returning the exit code instead of exiting."""
+    prog = os.path.basename(sys.argv[0]) or "controller"
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Fatal)
+    signals = _Signals()
+    try:
+        options = _options(prog, argv)
+        _serve(laws, options, signals)
+        return OK
+    except link.Incompatible as e:
+        code, text = BAD_INPUT, f"error: {e}"
+    except link.LinkError as e:
+        code, text = IO, f"error: {e}"
+    except (PlantLost, Interrupted) as e:
+        code, text = e.code, str(e)
+    except Ending as e:
+        code, text = e.code, f"error: {e}"
+    except IOX2_ERRORS as e:
+        code, text = IO, f"error: IPC failure: {type(e).__name__}: {e}"
+    print(f"{prog}: {text}", file=sys.stderr)
+    return code
+
+
+IOX2_ERRORS = tuple(
+    c for c in vars(iox2).values()
+    if isinstance(c, type) and issubclass(c, Exception) and c.__module__.startswith("iceoryx2")
+)
+"""The exception classes of the iceoryx2 bindings: an IPC failure (exit code 1)."""
+
+
+def _options(prog: str, argv) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog=prog, description="AMB controller process (Python): serves one plant run over iceoryx2")
+    parser.add_argument("--run-id", default=os.environ.get("AMB_TESTBED_RUN_ID"),
+                        help="the run id (default: $AMB_TESTBED_RUN_ID)")
+    parser.add_argument("--connect-timeout-s", type=float, default=os.environ.get("AMB_TESTBED_CONNECT_TIMEOUT_S", "30"),
+                        help="how long to wait for the plant's hello, s (default: $AMB_TESTBED_CONNECT_TIMEOUT_S, else 30)")
+    parser.add_argument("--quiet", action="store_true", help="no start-up and end lines")
+    o = parser.parse_args(argv)  # exits 2 with a usage message on a bad argument
+    if o.run_id is None:
+        raise BadInput("--run-id: missing (and AMB_TESTBED_RUN_ID is not set)")
+    try:
+        wire.valid_run_id(o.run_id)
+    except ValueError as e:
+        raise BadInput(str(e)) from None
+    t = float(o.connect_timeout_s)
+    if not (math.isfinite(t) and 0.0 < t <= 1e6):
+        raise BadInput(f"--connect-timeout-s {o.connect_timeout_s} s: must be a finite number > 0 and <= 1e6")
+    o.connect_timeout_s = t
+    o.prog = prog
+    text = os.environ.get(REALTIME_PRIORITY_ENV, "0")
+    try:
+        o.realtime_priority = int(text)
+    except ValueError:
+        o.realtime_priority = -1
+    if not 0 <= o.realtime_priority <= 99:
+        raise BadInput(f"{REALTIME_PRIORITY_ENV}={text}: must be an integer from 0 (off) to 99")
+    return o
+
+
+REALTIME_PRIORITY_ENV = "AMB_TESTBED_REALTIME_PRIORITY"
+
+
+def realtime(priority: int) -> list[str]:
+    """``SCHED_FIFO`` at ``priority`` and ``mlockall``: what the system refused, step by step."""
+    refused = []
+    try:
+        if os.sched_getscheduler(0) != os.SCHED_FIFO:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except OSError as e:
+        refused.append(f"SCHED_FIFO at priority {priority}: {e.strerror}")
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+    mcl_current, mcl_future = 1, 2  # <sys/mman.h> on Linux
+    if libc.mlockall(mcl_current | mcl_future) != 0:
+        refused.append(f"mlockall: {os.strerror(ctypes.get_errno())}")
+    return refused
+
+
+def _check_hello(h: wire.Hello, run_id: str):
+    """``(refusal code, message)`` if this controller cannot serve the hello, else ``None``."""
+    if h.protocol_version != wire.PROTOCOL_VERSION:
+        return wire.VERSION, (f"protocol version {h.protocol_version} from the plant, "
+                              f"this controller speaks {wire.PROTOCOL_VERSION}")
+    if h.axes != wire.AXES:
+        return wire.AXES_MISMATCH, f"the plant has {h.axes} axes, this controller drives {wire.AXES}"
+    if h.units != wire.UNITS_SI:
+        return wire.UNITS, f"units code {h.units} from the plant, this controller uses {wire.UNITS_SI} (SI)"
+    got = wire.str_of(h.run_id)
+    if got != run_id:
+        return wire.RUN_ID, f"hello for run id {got!r}, this controller serves {run_id!r}"
+    return None
+
+
+def _build(laws, hello: wire.Hello):
+    """The law the hello asks for, built; or ``(refusal code, message)``."""
+    name = wire.str_of(hello.law)
+    by_name = {law.name: law for law in laws}
+    if name not in by_name:
+        return None, (wire.LAW, f"unknown controller law `{name}` (this controller serves {', '.join(by_name)})")
+    try:
+        params = Params.parse(name, hello.params_text())
+        law = by_name[name](Design.from_hello(hello), params)
+        params.finish()
+        return law, None
+    except UnicodeDecodeError as e:
+        return None, (wire.PARAMS, f"the [controller.params] document is not UTF-8: {e}")
+    except ParamError as e:
+        return None, (wire.PARAMS, str(e))
+    except DesignError as e:
+        return None, (wire.LAW, f"law {name}: {e}")
+    except Exception as e:
+        traceback.print_exc()
+        return None, (wire.LAW, f"law {name} could not be built: {type(e).__name__}: {e}")
+
+
+def _ack(hello: wire.Hello, status: int, law: str, message: str) -> wire.Ack:
+    return wire.Ack(
+        protocol_version=wire.PROTOCOL_VERSION,
+        session=hello.session,
+        status=status,
+        controller_pid=os.getpid() & 0xFFFF_FFFF,
+        token=hello.token,
+        law=wire.fixed_str(law, wire.LAW_NAME_LEN),
+        message=wire.fixed_str(message, wire.MESSAGE_LEN),
+        overrides_len=0,  # this kit runs what the hello asks, nothing else
+    )
+
+
+def lock_run_id(run_id: str, role: str = "controller"):
+    """Takes ``<lock dir>/<run_id>.<role>.lock`` with an exclusive ``flock``, as the Rust side does
+    (``controller/src/lock.rs``): one live controller per run id. The lock dir is
+    ``$AMB_TESTBED_LOCK_DIR``, else ``$TMPDIR/amb-testbed`` (``/tmp/amb-testbed``). The kernel
+    releases the lock when the process ends, however it ends. Returns the open file (keep it).
+    """
+    folder = os.environ.get("AMB_TESTBED_LOCK_DIR") or os.path.join(os.environ.get("TMPDIR") or "/tmp", "amb-testbed")
+    path = os.path.join(folder, f"{run_id}.{role}.lock")
+    try:
+        if not os.path.isdir(folder):
+            os.makedirs(folder, exist_ok=True)
+            with contextlib.suppress(OSError):
+                os.chmod(folder, 0o1777)  # machine-wide like /tmp: any user may add a lock
+        file = open(path, "a+")
+    except OSError as e:
+        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    try:
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        file.seek(0)
+        holder = file.read().strip() or "a process that has not written its name yet"
+        file.close()
+        raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
+                       "pick another --run-id or stop that process") from None
+    except OSError as e:
+        file.close()
+        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    file.truncate(0)
+    file.write(f"pid {os.getpid()} ({' '.join(sys.argv)})\n")
+    file.flush()
+    return file
+
+
+def _serve(laws, o: argparse.Namespace, signals: _Signals) -> None:
+    run_id = o.run_id
+    _lock = lock_run_id(run_id)  # held while the process serves
+    if o.realtime_priority > 0:
+        for refused in realtime(o.realtime_priority):
+            print(f"{o.prog}: warning: {REALTIME_PRIORITY_ENV}={o.realtime_priority}: {refused}; carrying on without it",
+                  file=sys.stderr)
+    node = link.node(run_id, "controller")
+    handshake = link.Mailbox(node, run_id, "ack", "hello", wire.Ack, wire.Hello)
+    frames = link.Endpoint(node, run_id, "command", "sensor", wire.CommandFrame, wire.SensorFrame, 200_000)
+
+    # Hello: wait for the plant.
+    deadline = time.monotonic() + o.connect_timeout_s
+    while (received := handshake.try_receive()) is None:
+        if signals.stop:
+            raise Interrupted(f"interrupted; stopped before run {run_id} began")
+        if time.monotonic() > deadline:
+            raise PlantLost(
+                f"no hello from a plant with run id {run_id} within {o.connect_timeout_s} s "
+                f"(start it with `plant run SCENE --controller external --run-id {run_id}`); exiting"
+            )
+        time.sleep(HELLO_POLL_S)
+    hello = wire.Hello.from_buffer_copy(received)
+
+    refusal = _check_hello(hello, run_id)
+    law = None
+    if refusal is None:
+        law, refusal = _build(laws, hello)
+    if refusal is not None:
+        code, message = refusal
+        handshake.send(_ack(hello, code, "", message))
+        raise BadInput(f"refused the plant's hello ({wire.REFUSAL[code]}): {message}")
+
+    design = Design.from_hello(hello)
+    limit = design.current_limit_a
+    description = (f"{law.name} (Python): k_e = {design.stiffness_n_per_m} N/m, xi_e = {design.damping_ratio}, "
+                   f"i_max = {limit} A at {hello.rate_hz} Hz")
+    handshake.send(_ack(hello, wire.ACCEPTED, law.name, description))
+    frames.set_spin(hello.spin_ns)
+    if not o.quiet:
+        print(f"{o.prog}: serving run {run_id} (session {hello.session}, pid {os.getpid()}): {description}",
+              file=sys.stderr)
+    _loop(law, frames, hello.session, hello.token, limit, run_id, o, signals)
+
+
+def _loop(law, frames: link.Endpoint, session: int, token: int, limit: float, run_id: str, o, signals) -> None:
+    """One reply per sensor frame until STOP (returns), a signal or a lost plant (raises)."""
+    now = time.monotonic_ns
+    state = {"heard": now(), "checked": now(), "lost": None}
+
+    def keep_waiting() -> bool:
+        if signals.stop:
+            return False
+        t = now()
+        if t - state["checked"] >= LIVENESS_EVERY_NS and t - state["heard"] >= LIVENESS_EVERY_NS:
+            state["checked"] = t
+            seen = link.peer(run_id, "plant")
+            if seen != link.ALIVE:
+                state["lost"] = (f"the plant of run {run_id} died (its node is dead)" if seen == link.DEAD
+                                 else f"the plant of run {run_id} is gone (its node no longer exists)")
+                return False
+        return True
+
+    reply = wire.CommandFrame(token=token, session=session, axes=wire.AXES)
+    current = reply.current_a
+    update = law.update
+    stop_bit = wire.SensorFrame.STOP
+    answered = 0
+    try:
+        while True:
+            if signals.stop:
+                frames.send_and_wake(wire.CommandFrame(status=wire.CommandFrame.STOPPING, session=session,
+                                                       token=token, axes=wire.AXES, sent_ns=now()))
+                raise Interrupted(f"interrupted; told the plant (run {run_id}) and stopped")
+            frame = frames.wait(SLICE, keep_waiting)
+            if frame is None:
+                if state["lost"] is not None:
+                    raise PlantLost(f"{state['lost']}; exiting")
+                continue  # a signal: answered at the top of the loop
+            if frame.token != token:
+                continue  # another run's frame (same run id), or a stale process's: never applied
+            state["heard"] = now()
+            if frame.status & stop_bit:
+                if not o.quiet:
+                    print(f"{o.prog}: run {run_id} ended: answered {answered} frames, blocked {frames.blocks} times",
+                          file=sys.stderr)
+                return
+            if frame.session != session:
+                continue  # a frame of an earlier session, still in the buffer
+            received_ns = now()
+            sensor = frame.sensor_v
+            ix, iy = update(Sample(frame.seq, frame.t_s, (sensor[0], sensor[1])))
+            current[0] = saturate(ix, limit)
+            current[1] = saturate(iy, limit)
+            reply.seq = frame.seq
+            reply.received_ns = received_ns
+            reply.sent_ns = now()
+            frames.send(reply)
+            answered += 1
+    except (Ending, link.LinkError, *IOX2_ERRORS):
+        raise
+    except BaseException:
+        # A failing law: tell the plant at once (it treats STOPPING as a lost controller), then
+        # let the traceback end the process (exit code 1).
+        with contextlib.suppress(Exception):
+            frames.send_and_wake(wire.CommandFrame(status=wire.CommandFrame.STOPPING, session=session,
+                                                   token=token, axes=wire.AXES, sent_ns=now()))
+        raise
