@@ -33,7 +33,11 @@ fn main() {
     iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Fatal);
     let args: Vec<String> = std::env::args().collect();
     let arg = |flag: &str, default: u64| {
-        args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1)).and_then(|v| v.parse().ok()).unwrap_or(default)
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
     };
     let (slices, slice_us) = (arg("--slices", 500), arg("--slice-us", 1000));
     let run_id = format!("timed-wait-{}", std::process::id());
