@@ -402,7 +402,7 @@ fn rk4_blows_up_just_above_the_estimated_limit_on_the_balls_and_not_below() {
 /// released race on one step per tick it must still warn about contact.
 #[test]
 fn levitation_scene_setting_is_within_1e4_of_the_full_model_and_passes_the_stability_check() {
-    use plant::bench::{window_error, with_integrator, Setting};
+    use plant::bench::{window_error, with_integrator, IntegratorSetting};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/levitation-1g.toml");
     let probe = plant::config::load_scene(&path, &[]).expect("scene loads");
     let start = probe.first_shock_start();
@@ -415,7 +415,7 @@ fn levitation_scene_setting_is_within_1e4_of_the_full_model_and_passes_the_stabi
 
     let mut full = shipped.clone();
     full.params.race_when_clear = plant::model::RaceWhenClear::Free;
-    let reference = completed(&with_integrator(&full, Method::Dop853, Setting::Rtol(1e-11)));
+    let reference = completed(&with_integrator(&full, Method::Dop853, IntegratorSetting::Rtol(1e-11)));
     let (rms, max) = window_error(&parked.trace, &reference.trace, start, start + 0.05, shipped.params.contact.gap);
     assert!(rms <= 1e-4 && max <= 1e-3, "error rms {rms:.2e}, max {max:.2e} of the gap");
 
