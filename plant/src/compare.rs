@@ -8,34 +8,46 @@
 //! no unbalance, 20 µm initial offset; log decrement of the peaks), the time
 //! to recover (from the shock start to the last rotor – race contact) and the
 //! post-shock mode.
+//!
+//! Also stability maps of the sampled law ([`stability_maps`]) and a
+//! comparison of control laws on one scene ([`compare_laws`]). Each table
+//! is one row type, its fields the columns in order: `compare.csv`
+//! ([`RateRow`]), `stability_map.csv` ([`MapPoint`]), `laws.csv`
+//! ([`LawRow`]).
 
 use crate::config::{load_scene, Scene};
 use crate::plot::{self, PointGroup, Scale, Series};
 use crate::run::{run, Outcome, Quiet, RunResult};
 use crate::summary::{recovery_time, snake_name, Summary};
+use crate::table::{plain, sci};
 use anyhow::Context;
-use std::fmt::Write as _;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// Window after the shock for the deviation (s).
 pub const WINDOW: f64 = 0.1;
 
-/// One compared configuration.
-#[derive(Clone, Debug)]
-pub struct Row {
+/// One compared configuration: a row of `compare.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RateRow {
     /// Controller rate (Hz); 0 for the continuous run.
+    #[serde(with = "plain")]
     pub rate_hz: f64,
     /// `continuous`, `sampled` or `lockstep`.
     pub mode: &'static str,
     /// How the run ended.
     pub status: String,
     /// RMS deviation of the rotor displacement from the continuous run (m).
+    #[serde(with = "sci")]
     pub rms_dev_m: f64,
     /// Max deviation (m).
+    #[serde(with = "sci")]
     pub max_dev_m: f64,
     /// Damping ratio of the levitated loop measured from a free decay.
+    #[serde(with = "sci")]
     pub damping_ratio: f64,
     /// Time from the shock start to the last contact (s); NaN if still in contact at the end.
+    #[serde(with = "sci")]
     pub recover_s: f64,
     /// Post-shock mode.
     pub post_shock_mode: String,
@@ -101,7 +113,7 @@ pub fn compare(
     cosim: bool,
     out: &Path,
     log: &mut dyn FnMut(&str),
-) -> anyhow::Result<Vec<Row>> {
+) -> anyhow::Result<Vec<RateRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
     let continuous = with(scene_path, &base, &["controller.mode=\"continuous\"".into()])?;
@@ -113,7 +125,7 @@ pub fn compare(
     let row = |rate: f64, mode: &'static str, r: &RunResult, scene: &Scene, xi: f64| {
         let (rms, max) = if mode == "continuous" { (0.0, 0.0) } else { deviation(r, &reference, start) };
         let s = Summary::new(scene, r);
-        Row {
+        RateRow {
             rate_hz: rate,
             mode,
             status: s.status.to_string(),
@@ -146,22 +158,13 @@ pub fn compare(
             }
         }
     }
-    write_csv(&out.join("compare.csv"), &rows)?;
+    crate::table::write_with_header(&out.join("compare.csv"), COMPARE_HEADER, &rows)?;
     plots(out, &traces, start, continuous.params.contact.gap, &continuous.name)?;
     Ok(rows)
 }
 
-fn write_csv(path: &PathBuf, rows: &[Row]) -> anyhow::Result<()> {
-    let mut s = String::from("rate_hz,mode,status,rms_dev_m,max_dev_m,damping_ratio,recover_s,post_shock_mode\n");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{},{},{:e},{:e},{:e},{:e},{}",
-            r.rate_hz, r.mode, r.status, r.rms_dev_m, r.max_dev_m, r.damping_ratio, r.recover_s, r.post_shock_mode
-        );
-    }
-    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
-}
+/// Header of `compare.csv`.
+pub const COMPARE_HEADER: &str = "rate_hz,mode,status,rms_dev_m,max_dev_m,damping_ratio,recover_s,post_shock_mode";
 
 /// The first [`WINDOW`] after the shock of one run, in ms and µm.
 struct Window {
@@ -207,6 +210,45 @@ fn plots(out: &Path, traces: &[(String, RunResult)], start: f64, gap: f64, name:
     Ok(())
 }
 
+/// What `plant compare` was asked to do.
+pub struct Request<'a> {
+    /// The scene file.
+    pub scene: &'a Path,
+    /// `--set` overrides.
+    pub set: &'a [String],
+    /// Controller rates of the sampled (and lockstep) runs (Hz).
+    pub rates: &'a [f64],
+    /// Output folder (default `runs/compare-<scene file stem>`).
+    pub out: Option<&'a Path>,
+    /// Also run each rate over iceoryx2 (lockstep).
+    pub cosim: bool,
+    /// Also draw the stability maps.
+    pub maps: bool,
+    /// Compare these laws instead of rates.
+    pub laws: &'a [String],
+}
+
+/// `plant compare`: the rate comparison (and maps), or the law comparison; `warn` gets the
+/// scene's own warnings once (deprecated keys), not once per compared run. Returns the table
+/// written.
+pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&str)) -> anyhow::Result<PathBuf> {
+    for w in &load_scene(req.scene, req.set)?.warnings {
+        warn(w);
+    }
+    let stem = req.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = req.out.map_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")), Path::to_path_buf);
+    if req.laws.is_empty() {
+        compare(req.scene, req.set, req.rates, req.cosim, &dir, log)?;
+        if req.maps {
+            stability_maps(req.scene, req.set, req.rates, &dir, log)?;
+        }
+        Ok(dir.join("compare.csv"))
+    } else {
+        compare_laws(req.scene, req.set, req.laws, &dir, log)?;
+        Ok(dir.join("laws.csv"))
+    }
+}
+
 /// Parses `5k,10k,20000` into rates in Hz.
 pub fn parse_rates(text: &str) -> Result<Vec<f64>, String> {
     text.split(',')
@@ -245,20 +287,26 @@ mod tests {
     }
 }
 
-/// One point of a stability map.
-#[derive(Clone, Debug)]
+/// One point of a stability map: a row of `stability_map.csv`.
+#[derive(Clone, Debug, Serialize)]
 pub struct MapPoint {
     /// `rate_damping` or `rate_delay`.
     pub map: &'static str,
     /// Controller rate (Hz).
+    #[serde(with = "plain")]
     pub rate_hz: f64,
     /// Design damping ratio or delay in samples.
+    #[serde(with = "plain")]
     pub value: f64,
     /// Damping ratio measured on the free decay (NaN if it diverged).
+    #[serde(with = "sci")]
     pub damping_measured: f64,
     /// `unstable`, or `stable (<post-shock mode>)`.
     pub class: String,
 }
+
+/// Header of `stability_map.csv`.
+pub const MAP_HEADER: &str = "map,rate_hz,value,damping_measured,class";
 
 /// Stability maps of the sampled law: rate × design damping ratio and rate × delay (samples).
 /// A point is unstable when its free decay grows (or diverges); a stable point is labelled
@@ -307,11 +355,7 @@ pub fn stability_maps(
             }
         }
     }
-    let mut csv = String::from("map,rate_hz,value,damping_measured,class\n");
-    for p in &points {
-        let _ = writeln!(csv, "{},{},{},{:e},{}", p.map, p.rate_hz, p.value, p.damping_measured, p.class);
-    }
-    std::fs::write(out.join("stability_map.csv"), csv).context("writing stability_map.csv")?;
+    crate::table::write_with_header(&out.join("stability_map.csv"), MAP_HEADER, &points)?;
     for (map, ylabel) in [("rate_damping", "design damping ratio ξ_e"), ("rate_delay", "delay (samples)")] {
         let mut classes: Vec<String> = points.iter().filter(|p| p.map == map).map(|p| p.class.clone()).collect();
         classes.sort();
@@ -337,8 +381,8 @@ pub fn stability_maps(
     Ok(points)
 }
 
-/// One law of a law comparison (`plant compare --laws`).
-#[derive(Clone, Debug)]
+/// One law of a law comparison (`plant compare --laws`): a row of `laws.csv`.
+#[derive(Clone, Debug, Serialize)]
 pub struct LawRow {
     /// Law name.
     pub law: String,
@@ -347,18 +391,27 @@ pub struct LawRow {
     /// How the run ended.
     pub status: String,
     /// Time from the shock start to the last rotor – race contact (s); NaN if still touching at the end.
+    #[serde(with = "sci")]
     pub recovery_s: f64,
     /// Post-shock mode.
     pub post_shock_mode: String,
     /// Peak rotor – race force (N).
+    #[serde(with = "sci")]
     pub max_contact_force_n: f64,
     /// Time in contact (s).
+    #[serde(with = "sci")]
     pub contact_time_s: f64,
     /// Contact fraction over the last 200 revolutions.
+    #[serde(with = "sci")]
     pub steady_contact_fraction: f64,
     /// Whirl frequency of the steady response (Hz, negative backward).
+    #[serde(with = "sci")]
     pub whirl_hz: f64,
 }
+
+/// Header of `laws.csv`.
+pub const LAWS_HEADER: &str =
+    "law,mode,status,recovery_s,post_shock_mode,max_contact_force_n,contact_time_s,steady_contact_fraction,whirl_hz";
 
 /// Runs the scene once per law (in the scene's controller mode, so a co-simulation scene runs
 /// the controller process), and writes `laws.csv` and overlaid plots of the whole run. The
@@ -411,25 +464,7 @@ pub fn compare_laws(
         runs.push((law.clone(), r));
         probe = Some(scene);
     }
-    let mut csv = String::from(
-        "law,mode,status,recovery_s,post_shock_mode,max_contact_force_n,contact_time_s,steady_contact_fraction,whirl_hz\n",
-    );
-    for r in &rows {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{:e},{},{:e},{:e},{:e},{:e}",
-            r.law,
-            r.mode,
-            r.status,
-            r.recovery_s,
-            r.post_shock_mode,
-            r.max_contact_force_n,
-            r.contact_time_s,
-            r.steady_contact_fraction,
-            r.whirl_hz
-        );
-    }
-    std::fs::write(out.join("laws.csv"), csv).context("writing laws.csv")?;
+    crate::table::write_with_header(&out.join("laws.csv"), LAWS_HEADER, &rows)?;
     if let Some(scene) = probe {
         law_plots(out, &runs, &scene)?;
     }

@@ -36,4 +36,5 @@ pub mod stability;
 pub mod status;
 pub mod summary;
 pub mod sweep;
+pub mod table;
 pub mod trace;

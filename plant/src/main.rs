@@ -134,6 +134,7 @@ fn exit_code(err: &anyhow::Error) -> u8 {
             || cause.is::<controller::LawError>()
             || cause.is::<controller::ParamsError>()
             || cause.is::<shock_table::ShockError>()
+            || cause.is::<plant::bench::BadArgument>()
         {
             return exit::BAD_INPUT;
         }
@@ -198,7 +199,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Soak { programme, out, set, quiet } => soak_cmd(&programme, out, &set, quiet),
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws } => {
-            compare_cmd(&scene, &rates, out, &set, no_cosim, maps, &laws)
+            let req = plant::compare::Request {
+                scene: &scene,
+                set: &set,
+                rates: &rates,
+                out: out.as_deref(),
+                cosim: !no_cosim,
+                maps,
+                laws: &laws,
+            };
+            let written = plant::compare::command(&req, &mut |l| eprintln!("plant compare: {l}"), &mut |w| warn(w))?;
+            eprintln!("plant compare: wrote {}", written.display());
+            Ok(())
         }
         Command::Analyze { dir } => analyze_cmd(&dir),
         Command::Sweep(args) => plant::sweep::command(&args),
@@ -211,27 +223,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 bench_ipc(samples, warmup, pin_cores, spin_us, controller, run_id)
             }
             BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows } => {
-                let peer = peer.then(|| plant::bench::Peer {
-                    script: config.join("..").join("bench").join("peer").join("run_peer.py"),
-                    python: peer_python,
-                });
-                bench_accuracy(out, &config, repeats, quick, peer.as_ref(), peer_rows.as_deref())
+                let req = plant::bench::accuracy::Request {
+                    out: out.as_deref(),
+                    config: &config,
+                    repeats,
+                    quick,
+                    peer_python: peer.then_some(peer_python.as_path()),
+                    peer_rows: peer_rows.as_deref(),
+                };
+                bench_wrote(plant::bench::accuracy::command(&req, &mut bench_log)?)
             }
             BenchCommand::Models { out, config, repeats } => {
-                let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-models"));
-                plant::bench::models(&config, &dir, repeats.max(1), &mut |l| eprintln!("plant bench: {l}"))?;
-                eprintln!("plant bench: wrote {}", dir.join("models.csv").display());
-                Ok(())
+                bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
             }
             BenchCommand::Engineering { out, config, repeats } => {
-                let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-engineering"));
-                let mut log = |l: &str| eprintln!("plant bench: {l}");
-                plant::bench::engineering::engineering(&config, &dir, repeats.max(1), &mut log)?;
-                eprintln!("plant bench: wrote {}", dir.join("engineering.csv").display());
-                Ok(())
+                bench_wrote([plant::bench::engineering::command(out.as_deref(), &config, repeats, &mut bench_log)?])
             }
         },
     }
+}
+
+/// A progress line of `plant bench`.
+fn bench_log(line: &str) {
+    eprintln!("plant bench: {line}");
+}
+
+/// Names the files a bench wrote.
+fn bench_wrote(files: impl IntoIterator<Item = PathBuf>) -> anyhow::Result<()> {
+    for f in files {
+        eprintln!("plant bench: wrote {}", f.display());
+    }
+    Ok(())
 }
 
 /// Loads a scene, prints its warnings and the stability check's; a scene the check refuses
@@ -322,18 +344,8 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
     for chart in &written.skipped_charts {
         eprintln!("plant: {chart} not drawn: nothing to draw");
     }
-    let summary = &written.summary;
-    eprintln!(
-        "plant: {} {} s simulated in {:.2} s ({:.2}x real time); max radius {:.1} µm, max contact force {:.0} N; results in {}",
-        summary.status,
-        summary.simulated_s,
-        summary.wall_time_s,
-        summary.realtime_factor,
-        summary.max_radius_m * 1e6,
-        summary.max_contact_force_n,
-        dir.display()
-    );
-    stopped(&written.run.outcome, summary.simulated_s)
+    eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
+    stopped(&written.run.outcome, written.summary.simulated_s)
 }
 
 /// `Err` for a run that did not complete (its results were written).
@@ -373,36 +385,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
         Err(plant::soak::SoakError::Io(e)) => return Err(e),
     };
     let r = &done.report;
-    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-    let rss = |p: &Option<plant::soak::ProcessRss>| {
-        p.as_ref().map_or("not measured".to_string(), |p| {
-            format!(
-                "{:.1} -> {:.1} MiB (max {:.1})",
-                p.start_kib as f64 / 1024.0,
-                p.end_kib as f64 / 1024.0,
-                p.max_kib as f64 / 1024.0
-            )
-        })
-    };
-    eprintln!(
-        "plant soak: {} {:.1} of {:.1} s simulated in {:.1} s; recovered {}/{} shocks (recovery s: min {}, median {}, max {}); \
-         max contact force {:.0} N; sequence gaps {}, deadline misses {} ({:.2e}); RSS plant {}, controller {}",
-        r.status,
-        r.simulated_s,
-        r.planned_s,
-        r.wall_time_s,
-        r.recovered,
-        r.shocks,
-        fmt(r.recovery_s.min),
-        fmt(r.recovery_s.median),
-        fmt(r.recovery_s.max),
-        r.max_contact_force_n,
-        r.sequence_gaps,
-        r.deadline_misses,
-        r.deadline_miss_fraction,
-        rss(&r.rss.plant),
-        rss(&r.rss.controller),
-    );
+    eprintln!("plant soak: {}", r.headline());
     let failed: Vec<_> = r.criteria.iter().filter(|v| !v.passed).collect();
     for v in &failed {
         eprintln!("plant soak: criterion failed: {v}");
@@ -412,37 +395,6 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
         return Err(Ending::CriteriaFailed(failed.len()).into());
     }
     eprintln!("plant soak: all {} criteria met; results in {}", r.criteria.len(), dir.display());
-    Ok(())
-}
-
-/// `plant compare`.
-fn compare_cmd(
-    scene: &Path,
-    rates: &[f64],
-    out: Option<PathBuf>,
-    set: &[String],
-    no_cosim: bool,
-    maps: bool,
-    laws: &[String],
-) -> anyhow::Result<()> {
-    // The scene's own warnings once (deprecated keys), not once per compared run.
-    for w in &load_scene(scene, set)?.warnings {
-        warn(w);
-    }
-    let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")));
-    let mut log = |l: &str| eprintln!("plant compare: {l}");
-    let written = if laws.is_empty() {
-        plant::compare::compare(scene, set, rates, !no_cosim, &dir, &mut log)?;
-        if maps {
-            plant::compare::stability_maps(scene, set, rates, &dir, &mut log)?;
-        }
-        "compare.csv"
-    } else {
-        plant::compare::compare_laws(scene, set, laws, &dir, &mut log)?;
-        "laws.csv"
-    };
-    eprintln!("plant compare: wrote {}", dir.join(written).display());
     Ok(())
 }
 
@@ -516,33 +468,6 @@ fn bench_ipc(
     Ok(())
 }
 
-/// `plant bench accuracy`.
-fn bench_accuracy(
-    out: Option<PathBuf>,
-    config: &Path,
-    repeats: usize,
-    quick: bool,
-    peer: Option<&plant::bench::Peer>,
-    peer_rows: Option<&Path>,
-) -> anyhow::Result<()> {
-    let dir = out.unwrap_or_else(|| PathBuf::from("runs").join("bench-accuracy"));
-    let mut log = |line: &str| eprintln!("plant bench: {line}");
-    // Read the earlier rows first: they may live in the output folder.
-    let earlier = peer_rows
-        .map(|p| plant::bench::read_rows(p).map_err(|e| Ending::BadArgument(format!("--peer-rows: {e:#}"))))
-        .transpose()?
-        .unwrap_or_default();
-    let mut report = plant::bench::accuracy(config, &dir, quick, repeats.max(1), peer, &mut log)?;
-    if !earlier.is_empty() {
-        report.rows.extend(earlier.into_iter().filter(|r| !r.implementation.starts_with("rust")));
-        plant::bench::write_rows(&dir.join("accuracy.csv"), &report.rows)?;
-    }
-    for f in plant::bench::charts(&dir, &report.rows, &report.floors)? {
-        eprintln!("plant bench: wrote {}", f.display());
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -557,6 +482,7 @@ mod tests {
             (stopped(StopKind::Interrupted), 130),
             (Ending::CriteriaFailed(1).into(), 5),
             (Ending::BadArgument("diverged".into()).into(), 2),
+            (anyhow::Error::from(plant::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
             (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),
             (anyhow::Error::from(SetupError::Law(law)).context("the run"), 2),
             (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),

@@ -147,6 +147,19 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// One line of what the run did: status, time, speed, largest radius and force.
+    pub fn headline(&self) -> String {
+        format!(
+            "{} {} s simulated in {:.2} s ({:.2}x real time); max radius {:.1} µm, max contact force {:.0} N",
+            self.status,
+            self.simulated_s,
+            self.wall_time_s,
+            self.realtime_factor,
+            self.max_radius_m * 1e6,
+            self.max_contact_force_n,
+        )
+    }
+
     /// Figures of a run whose trace is in memory.
     pub fn new(scene: &Scene, result: &RunResult) -> Self {
         let mut figures = FiguresBuilder::new(scene.first_shock_start());

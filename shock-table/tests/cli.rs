@@ -4,8 +4,43 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// Runs the binary to completion within a minute (far more than any of these calls needs,
+/// even in a debug build on a loaded machine); past it the child is killed and the test fails,
+/// so that a hang cannot stall the suite.
 fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shock-table")).args(args).output().expect("the shock-table binary runs")
+    use std::io::Read;
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let limit = Duration::from_secs(60);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shock-table"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the shock-table binary runs");
+    let drain = |mut pipe: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            bytes
+        })
+    };
+    let out = drain(Box::new(child.stdout.take().expect("piped stdout")));
+    let err = drain(Box::new(child.stderr.take().expect("piped stderr")));
+    let deadline = Instant::now() + limit;
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("waiting for shock-table") {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("shock-table {args:?} did not finish within {limit:?} (killed)");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    Output { status, stdout: out.join().unwrap_or_default(), stderr: err.join().unwrap_or_default() }
 }
 
 fn stdout(o: &Output) -> String {

@@ -169,3 +169,21 @@ fn a_run_that_cannot_start_leaves_scene_and_summary() {
     assert!(s["error"].as_str().unwrap_or_default().contains("no controller answered"), "{s:#}");
     assert!(out.join("scene.toml").is_file());
 }
+
+/// Found by the property test (`properties.rs`): keys read by one choice only took NaN,
+/// infinities and negatives while another choice was made, and a stiffness of 1e300 N/m ran
+/// a 5 ms scene for minutes (the loop chattered).
+#[test]
+fn keys_of_a_choice_not_made_and_absurd_stiffness_are_refused_at_load() {
+    let paper = scene("paper-10g.toml"); // linear bearing, held spin, constant drag, balls
+    for (set, needles) in [
+        ("amb.nominal_gap_mm=nan", &["amb.nominal_gap_mm", "mm", "> 0"][..]),
+        ("amb.magnet_force_limit_n=-1", &["amb.magnet_force_limit_n = -1 N", "> 0"]),
+        ("rotor.drive_gain_n_m_s=inf", &["rotor.drive_gain_n_m_s", "N·m·s/rad"]),
+        ("touchdown.palmgren_f0=-1", &["touchdown.palmgren_f0 = -1", ">= 0"]),
+        ("touchdown.lumped_reference_mm=nan", &["touchdown.lumped_reference_mm", "mm"]),
+        ("controller.stiffness_n_per_m=1e300", &["controller.stiffness_n_per_m", "N/m", "<= 1e12 N/m"]),
+    ] {
+        refused(&format!("choice-{}", set.split('=').next().unwrap()), &paper, &sets(&[set]), needles);
+    }
+}

@@ -6,16 +6,17 @@
 //! revolutions and the post-shock mode. This bench runs the full-length impact (3 G) and rub
 //! (10 G) scenes with each method at a representative setting (including each scene's shipped
 //! default and the parked race), and compares those figures with a reference run (DOP853 at
-//! rtol 1e-12 with scaled absolute tolerances, free race).
+//! rtol 1e-12 with scaled absolute tolerances, free race). Writes
+//! `engineering.csv` (columns in [`super::rows::EngineeringRow`]).
 
-use super::{measure, with_integrator, Setting};
+use super::rows::{EngineeringRow, ENGINEERING_HEADER};
+use super::{measure, with_integrator, IntegratorSetting};
 use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::run::Outcome;
 use crate::summary::{snake_name, Summary};
 use anyhow::Context;
-use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// One run's figures.
 #[derive(Clone, Debug)]
@@ -73,22 +74,49 @@ fn settings(scene: &Scene) -> anyhow::Result<Vec<(String, Scene)>> {
     };
     let mut v = vec![(default, scene.clone())];
     for (method, setting) in [
-        (Method::Dp5, Setting::Rtol(1e-6)),
-        (Method::Dp5, Setting::Rtol(1e-9)),
-        (Method::Dop853, Setting::Rtol(1e-9)),
-        (Method::Rk4, Setting::Substeps(4)),
-        (Method::Rk4, Setting::Substeps(16)),
-        (Method::SymplecticEuler, Setting::Substeps(8)),
-        (Method::SymplecticEuler, Setting::Substeps(64)),
+        (Method::Dp5, IntegratorSetting::Rtol(1e-6)),
+        (Method::Dp5, IntegratorSetting::Rtol(1e-9)),
+        (Method::Dop853, IntegratorSetting::Rtol(1e-9)),
+        (Method::Rk4, IntegratorSetting::Substeps(4)),
+        (Method::Rk4, IntegratorSetting::Substeps(16)),
+        (Method::SymplecticEuler, IntegratorSetting::Substeps(8)),
+        (Method::SymplecticEuler, IntegratorSetting::Substeps(64)),
     ] {
         v.push((format!("{} {setting}", snake_name(&method)), with_integrator(scene, method, setting)));
     }
-    let dp5 = with_integrator(scene, Method::Dp5, Setting::Rtol(1e-9));
+    let dp5 = with_integrator(scene, Method::Dp5, IntegratorSetting::Rtol(1e-9));
     v.push(("parked race + dp5 rtol=1e-9".into(), parked(&dp5, Method::Dp5)?));
-    let rk4 = with_integrator(scene, Method::Rk4, Setting::Substeps(1));
+    let rk4 = with_integrator(scene, Method::Rk4, IntegratorSetting::Substeps(1));
     let rk4 = parked(&rk4, Method::Rk4)?;
     v.push((format!("parked race + rk4 substeps=1 (contact_substeps={})", rk4.integrator.contact_substeps), rk4));
     Ok(v)
+}
+
+/// Each run's figures as a row of `engineering.csv`, with their differences from the
+/// reference run of the same scene (rows of a scene without one are left out).
+pub fn table(figures: &[Figures]) -> Vec<EngineeringRow> {
+    let rel = |a: f64, b: f64| if b != 0.0 { (a - b) / b } else { a - b };
+    figures
+        .iter()
+        .filter_map(|r| {
+            let reference = figures.iter().find(|x| x.scene == r.scene && x.label.starts_with("reference"))?;
+            Some(EngineeringRow {
+                scene: r.scene.clone(),
+                setting: r.label.clone(),
+                status: r.status.clone(),
+                peak_contact_force_n: r.peak_contact_force_n,
+                max_radius_m: r.max_radius_m,
+                contact_fraction: r.contact_fraction,
+                post_shock_mode: r.post_shock_mode.clone(),
+                steady_class: r.steady_class.clone(),
+                wall_s_per_sim_s: r.wall_s_per_sim_s,
+                peak_force_rel_diff: rel(r.peak_contact_force_n, reference.peak_contact_force_n),
+                max_radius_rel_diff: rel(r.max_radius_m, reference.max_radius_m),
+                contact_fraction_diff: r.contact_fraction - reference.contact_fraction,
+                same_mode: r.post_shock_mode == reference.post_shock_mode && r.steady_class == reference.steady_class,
+            })
+        })
+        .collect()
 }
 
 /// Runs the comparison and writes `engineering.csv` into `out`.
@@ -97,15 +125,15 @@ pub fn engineering(
     out: &Path,
     repeats: usize,
     log: &mut dyn FnMut(&str),
-) -> anyhow::Result<Vec<Figures>> {
+) -> anyhow::Result<Vec<EngineeringRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut rows = Vec::new();
+    let mut runs = Vec::new();
     for (name, file) in [("impact", "paper-3g.toml"), ("rub", "paper-10g.toml")] {
         let path = config_dir.join(file);
         let scene = load_scene(&path, &["output.plots=false".to_string()])
             .with_context(|| format!("loading {}", path.display()))?;
         let free = scene.reload(&["touchdown.race_when_clear=\"free\"".to_string()])?;
-        let reference = with_integrator(&free, Method::Dop853, Setting::Rtol(1e-12));
+        let reference = with_integrator(&free, Method::Dop853, IntegratorSetting::Rtol(1e-12));
         log(&format!("{name}: reference (DOP853 rtol 1e-12, {} s)", scene.duration));
         let r = figures(name, "reference: dop853 rtol=1e-12".into(), &reference, 1)?;
         anyhow::ensure!(r.status == "completed", "{name}: the reference did not complete");
@@ -117,7 +145,7 @@ pub fn engineering(
             r.post_shock_mode,
             r.wall_s_per_sim_s
         ));
-        rows.push(r);
+        runs.push(r);
         for (label, s) in settings(&scene)? {
             let f = figures(name, label, &s, repeats)?;
             log(&format!(
@@ -130,36 +158,63 @@ pub fn engineering(
                 f.post_shock_mode,
                 f.wall_s_per_sim_s
             ));
-            rows.push(f);
+            runs.push(f);
         }
     }
-    let mut s = String::from(
-        "scene,setting,status,peak_contact_force_n,max_radius_m,contact_fraction,post_shock_mode,steady_class,\
-         wall_s_per_sim_s,peak_force_rel_diff,max_radius_rel_diff,contact_fraction_diff,same_mode\n",
-    );
-    for r in &rows {
-        let Some(reference) = rows.iter().find(|x| x.scene == r.scene && x.label.starts_with("reference")) else {
-            continue;
-        };
-        let rel = |a: f64, b: f64| if b != 0.0 { (a - b) / b } else { a - b };
-        let _ = writeln!(
-            s,
-            "{},{},{},{:e},{:e},{:e},{},{},{:e},{:e},{:e},{:e},{}",
-            r.scene,
-            r.label,
-            r.status,
-            r.peak_contact_force_n,
-            r.max_radius_m,
-            r.contact_fraction,
-            r.post_shock_mode,
-            r.steady_class,
-            r.wall_s_per_sim_s,
-            rel(r.peak_contact_force_n, reference.peak_contact_force_n),
-            rel(r.max_radius_m, reference.max_radius_m),
-            r.contact_fraction - reference.contact_fraction,
-            r.post_shock_mode == reference.post_shock_mode && r.steady_class == reference.steady_class
-        );
-    }
-    std::fs::write(out.join("engineering.csv"), s).context("writing engineering.csv")?;
+    let rows = table(&runs);
+    crate::table::write_with_header(&out.join("engineering.csv"), ENGINEERING_HEADER, &rows)?;
     Ok(rows)
+}
+
+/// `plant bench engineering`: runs the comparison into `out` (default
+/// `runs/bench-engineering`); returns the table written.
+pub fn command(
+    out: Option<&Path>,
+    config: &Path,
+    repeats: usize,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<PathBuf> {
+    let dir = super::out_dir(out, "bench-engineering");
+    engineering(config, &dir, repeats.max(1), log)?;
+    Ok(dir.join("engineering.csv"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(scene: &str, label: &str, force: f64, radius: f64, fraction: f64, mode: &str) -> Figures {
+        Figures {
+            scene: scene.into(),
+            label: label.into(),
+            status: "completed".into(),
+            peak_contact_force_n: force,
+            max_radius_m: radius,
+            contact_fraction: fraction,
+            post_shock_mode: mode.into(),
+            steady_class: "periodic".into(),
+            wall_s_per_sim_s: 0.1,
+        }
+    }
+
+    #[test]
+    fn each_row_is_compared_with_its_own_scenes_reference() {
+        let figures = [
+            run("impact", "reference: dop853 rtol=1e-12", 1000.0, 2e-4, 0.0, "recovered"),
+            run("rub", "reference: dop853 rtol=1e-12", 4000.0, 3e-4, 0.5, "dry_whirl"),
+            run("impact", "rk4 substeps=4", 1010.0, 1.9e-4, 0.0, "recovered"),
+            run("rub", "rk4 substeps=4", 3000.0, 3e-4, 0.75, "recovered"),
+            run("orphan", "rk4 substeps=4", 1.0, 1.0, 1.0, "recovered"),
+        ];
+        let rows = table(&figures);
+        assert_eq!(rows.len(), 4, "a scene without a reference has no row");
+        assert_eq!((rows[0].peak_force_rel_diff, rows[0].max_radius_rel_diff, rows[0].same_mode), (0.0, 0.0, true));
+        let impact = &rows[2];
+        assert!((impact.peak_force_rel_diff - 0.01).abs() < 1e-15, "{}", impact.peak_force_rel_diff);
+        assert!((impact.max_radius_rel_diff + 0.05).abs() < 1e-12, "{}", impact.max_radius_rel_diff);
+        assert!(impact.same_mode);
+        let rub = &rows[3];
+        assert_eq!((rub.peak_force_rel_diff, rub.contact_fraction_diff, rub.same_mode), (-0.25, 0.25, false));
+        assert_eq!(rub.setting, "rk4 substeps=4");
+    }
 }

@@ -14,8 +14,13 @@
 //! | `output.rate_hz` | ≤ [`MAX_OUTPUT_RATE_HZ`] |
 //! | output rows, `duration_s × output.rate_hz` | ≤ [`MAX_OUTPUT_ROWS`] |
 //! | `[controller.params]` as TOML text | ≤ [`controller::PARAMS_LEN`] bytes |
+//! | `controller.stiffness_n_per_m` | ≤ [`MAX_STIFFNESS_N_PER_M`] |
 //!
 //! A run with fewer than [`FEW_TICKS`] controller ticks is allowed, with a warning.
+//!
+//! Every key is checked whatever the choices that read it: a NaN
+//! `amb.nominal_gap_mm` is refused with the linear bearing too, and a NaN
+//! `touchdown.palmgren_f0` with the constant drag.
 
 use super::raw::*;
 use super::{ConfigError, ControllerSettings, CosimSettings, InitialSettings, IntegratorSettings, Scene, Source};
@@ -37,8 +42,28 @@ pub const MAX_TICKS: f64 = 1e9;
 pub const MAX_OUTPUT_RATE_HZ: f64 = 1e7;
 /// Most trace rows in a run: `scene.duration_s × output.rate_hz` (1000 s at 10 kHz).
 pub const MAX_OUTPUT_ROWS: f64 = 1e7;
+/// Stiffest loop the controller may be designed for (N/m): a closed-loop natural frequency
+/// √(k_e / m_r) near 50 kHz for the study's rotor, six decades above the study's largest k_e.
+/// The integrators must resolve the loop, so their work grows as √k_e; far beyond this the
+/// current saturates within nanometres of the centre and the loop chatters: a 5 ms run at
+/// k_e = 1e300 took minutes of computing and a full-length one would not end.
+pub const MAX_STIFFNESS_N_PER_M: f64 = 1e12;
 /// Fewer controller ticks than this in a run gets a warning.
 pub const FEW_TICKS: f64 = 10.0;
+
+/// `controller.stiffness_n_per_m`: > 0 and at most [`MAX_STIFFNESS_N_PER_M`].
+fn stiffness(k_e: f64) -> Result<f64, ConfigError> {
+    let k_e = positive("controller.stiffness_n_per_m", k_e, "N/m")?;
+    if k_e > MAX_STIFFNESS_N_PER_M {
+        return Err(range(
+            "controller.stiffness_n_per_m",
+            k_e,
+            "N/m",
+            &format!("must be <= {MAX_STIFFNESS_N_PER_M:e} N/m (the loop would chatter and the run not end)"),
+        ));
+    }
+    Ok(k_e)
+}
 
 /// An out-of-range error naming the key, the value and its unit.
 pub fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
@@ -208,12 +233,11 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
     let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
     let rotor_radius = positive("rotor.radius_mm", r.radius_mm, "mm")? * 1e-3;
     let speed = non_negative("rotor.speed_hz", r.speed_hz, "Hz")? * std::f64::consts::TAU;
+    let drive_gain = non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?;
+    let torque_limit = non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?;
     let spin = match r.spin {
         SpinChoice::Held => Spin::Held,
-        SpinChoice::Free => Spin::Free {
-            drive_gain: non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?,
-            torque_limit: non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?,
-        },
+        SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
     };
 
     let gap = positive("touchdown.air_gap_mm", td.air_gap_mm, "mm")? * 1e-3;
@@ -238,18 +262,13 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
     let cage_phase = finite("touchdown.cage_phase_deg", td.cage_phase_deg, "deg")?.to_radians();
     let (r_in, r_out) = (dm / 2.0 - ball_d / 2.0, dm / 2.0 + ball_d / 2.0);
     let reg_speed = positive("touchdown.drag_smoothing_rad_s", td.drag_smoothing_rad_s, "rad/s")?;
+    let torque = non_negative("touchdown.drag_torque_n_m", td.drag_torque_n_m, "N·m")?;
+    let f0 = non_negative("touchdown.palmgren_f0", td.palmgren_f0, "")?;
+    let nu0_cst = positive("touchdown.palmgren_viscosity_cst", td.palmgren_viscosity_cst, "cSt")?;
+    let f1 = non_negative("touchdown.palmgren_f1", td.palmgren_f1, "")?;
     let drag = match td.drag {
-        DragChoice::Constant => RaceDrag::Constant {
-            torque: non_negative("touchdown.drag_torque_n_m", td.drag_torque_n_m, "N·m")?,
-            reg_speed,
-        },
-        DragChoice::Palmgren => RaceDrag::Palmgren {
-            f0: non_negative("touchdown.palmgren_f0", td.palmgren_f0, "")?,
-            nu0_cst: positive("touchdown.palmgren_viscosity_cst", td.palmgren_viscosity_cst, "cSt")?,
-            f1: non_negative("touchdown.palmgren_f1", td.palmgren_f1, "")?,
-            pitch_diameter_mm: dm,
-            reg_speed,
-        },
+        DragChoice::Constant => RaceDrag::Constant { torque, reg_speed },
+        DragChoice::Palmgren => RaceDrag::Palmgren { f0, nu0_cst, f1, pitch_diameter_mm: dm, reg_speed },
     };
 
     let damping_depth = positive("contact.damping_depth_mm", ct.damping_depth_mm, "mm")? * 1e-3;
@@ -285,12 +304,10 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         damping_depth,
     );
 
+    let lumped_reference = positive("touchdown.lumped_reference_mm", td.lumped_reference_mm, "mm")? * 1e-3;
     let support = match td.support {
         SupportChoice::Balls => Support::Balls,
-        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(
-            &balls,
-            positive("touchdown.lumped_reference_mm", td.lumped_reference_mm, "mm")? * 1e-3,
-        )),
+        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(&balls, lumped_reference)),
     };
     let release = match td.race_release {
         ReleaseChoice::Equilibrium => Release::Equilibrium,
@@ -302,6 +319,8 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
     };
     let ki = positive("amb.ki_n_per_a", amb.ki_n_per_a, "N/A")?;
     let ks = non_negative("amb.ks_n_per_m", amb.ks_n_per_m, "N/m")?;
+    let s0 = positive("amb.nominal_gap_mm", amb.nominal_gap_mm, "mm")? * 1e-3;
+    let magnet_force_limit = positive("amb.magnet_force_limit_n", amb.magnet_force_limit_n, "N")?;
     let amb_law = match amb.force_law {
         ForceLaw::Linear => AmbLaw::Linear { ki, ks },
         ForceLaw::Nonlinear => {
@@ -313,7 +332,6 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
                     "must be > 0 for the nonlinear law (it sets the bias current)",
                 ));
             }
-            let s0 = positive("amb.nominal_gap_mm", amb.nominal_gap_mm, "mm")? * 1e-3;
             if s0 <= gap + clearance {
                 return Err(range(
                     "amb.nominal_gap_mm",
@@ -322,7 +340,7 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
                     "must exceed the touchdown gap plus ball clearance",
                 ));
             }
-            AmbLaw::nonlinear_matching(ki, ks, s0, positive("amb.magnet_force_limit_n", amb.magnet_force_limit_n, "N")?)
+            AmbLaw::nonlinear_matching(ki, ks, s0, magnet_force_limit)
         }
     };
     let loop_constants = LoopConstants {
@@ -377,7 +395,7 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         law: ctl.law.clone(),
         rate_hz: rate,
         period: 1.0 / rate,
-        stiffness: positive("controller.stiffness_n_per_m", ctl.stiffness_n_per_m, "N/m")?,
+        stiffness: stiffness(ctl.stiffness_n_per_m)?,
         damping_ratio: non_negative("controller.damping_ratio", ctl.damping_ratio, "")?,
         delay_samples: ctl.delay_samples,
         gravity_bias: ctl.gravity_bias,

@@ -174,7 +174,7 @@ fn stride_keeps_first_and_last() {
 }
 
 #[test]
-fn nan_input_does_not_panic() {
+fn nan_input_draws_the_finite_data() {
     let dir = temp_dir("nan");
     let x = [0.0, 1.0, f64::NAN, 3.0, 4.0, f64::INFINITY];
     let y = [1.0, f64::NAN, 2.0, 3.0, f64::NEG_INFINITY, 5.0];
@@ -183,13 +183,25 @@ fn nan_input_does_not_panic() {
     lines(&p, "nan", "x", "y", &s, Scale::Linear).unwrap();
     // The finite samples survive: a dot at x = 0 and the segment from 3 to... its line.
     assert!(Image::read(&p).count_inside(colour(0)) > 10);
-    assert!(lines(&dir.join("nan-log.png"), "nan", "x", "y", &s, Scale::Log10).is_ok());
+    // Each chart draws its finite data and leaves the rest out.
+    let drawn = |p: &Path, c: RGBColor| Image::read(p).count_inside(c);
+    let p = dir.join("nan-log.png");
+    lines(&p, "nan", "x", "y", &s, Scale::Log10).unwrap();
+    assert!(drawn(&p, colour(0)) > 0, "log lines: nothing drawn");
     let o = [1e-5, f64::NAN, 2e-5, 3e-5];
-    assert!(orbit(&dir.join("nan-orbit.png"), "o", &o, &o, f64::NAN).is_ok());
+    let p = dir.join("nan-orbit.png");
+    orbit(&p, "o", &o, &o, f64::NAN).unwrap();
+    assert!(drawn(&p, colour(0)) > 0, "orbit: nothing drawn");
     let g = [PointGroup { label: "g", x: &x, y: &y }];
-    assert!(scatter(&dir.join("nan-scatter.png"), "s", "x", "y", &g, true).is_ok());
+    let p = dir.join("nan-scatter.png");
+    scatter(&p, "s", "x", "y", &g, true).unwrap();
+    assert!(drawn(&p, colour(0)) > 0, "scatter: nothing drawn");
     let z = vec![vec![f64::NAN, 1.0], vec![2.0, f64::INFINITY]];
-    assert!(heatmap(&dir.join("nan-heat.png"), "h", "x", "y", &[0.0, 1.0], &[0.0, 1.0], &z, "z").is_ok());
+    let p = dir.join("nan-heat.png");
+    heatmap(&p, "h", "x", "y", &[0.0, 1.0], &[0.0, 1.0], &z, "z").unwrap();
+    // The two finite cells span the colour map: the lowest at its bottom, the highest at its top.
+    let (low, high) = (drawn(&p, super::heatmap::viridis(0.0)), drawn(&p, super::heatmap::viridis(1.0)));
+    assert!(low > 100 && high > 100, "heat map cells: {low} and {high} pixels");
     // All non-finite is no data, not a panic.
     let all_nan = [f64::NAN; 4];
     let s = [Series { label: "s", x: &all_nan, y: &all_nan }];
@@ -275,8 +287,11 @@ fn constant_series_gets_a_nonzero_range() {
     let x = [0.0, 1.0, 2.0];
     let y = [2.5; 3];
     let s = [Series { label: "c", x: &x, y: &y }];
-    lines(&dir.join("c.png"), "c", "x", "y", &s, Scale::Linear).unwrap();
-    lines(&dir.join("cl.png"), "c", "x", "y", &s, Scale::Log10).unwrap();
+    // The constant line is drawn across the plot, on both scales.
+    for (name, scale) in [("c.png", Scale::Linear), ("cl.png", Scale::Log10)] {
+        lines(&dir.join(name), "c", "x", "y", &s, scale).unwrap();
+        assert_drawn(&dir.join(name), WIDE_SIZE, colour(0), 500);
+    }
 }
 
 #[test]

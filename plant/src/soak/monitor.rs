@@ -156,8 +156,9 @@ pub struct Envelope {
     any: bool,
 }
 
-/// One bin of an [`Envelope`]: its start (s) and maxima.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One bin of an [`Envelope`]: its start (s) and maxima; a row of `envelope.csv`
+/// (read back by column name).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
 pub struct EnvelopeRow {
     /// Bin start (s).
     pub t_s: f64,

@@ -5,21 +5,11 @@ use super::monitor::{EnvelopeRow, ShockFigures};
 use super::programme::Programme;
 use super::sink::RssSample;
 use crate::plot::{self, PointGroup, Scale, Series};
-use anyhow::Context;
 use std::path::Path;
 
-/// Reads `envelope.csv` back (written by this module, through the `csv` crate).
+/// Reads `envelope.csv` back (written by this module, through the `csv` crate), by column name.
 fn read_envelope(path: &Path) -> anyhow::Result<Vec<EnvelopeRow>> {
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut rows = Vec::new();
-    for record in reader.records() {
-        let record = record.with_context(|| format!("reading {}", path.display()))?;
-        let v: Vec<f64> = record.iter().filter_map(|x| x.parse().ok()).collect();
-        if let [t_s, max_radius_m, max_contact_force_n] = v[..] {
-            rows.push(EnvelopeRow { t_s, max_radius_m, max_contact_force_n });
-        }
-    }
-    Ok(rows)
+    crate::table::read(path)
 }
 
 pub(crate) fn write_plots(

@@ -126,6 +126,42 @@ pub struct Report {
     pub cosim: Option<CosimReport>,
 }
 
+impl Report {
+    /// One line of what the soak did: status, time, recoveries, force, messages, memory.
+    pub fn headline(&self) -> String {
+        let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+        let rss = |p: &Option<ProcessRss>| {
+            p.as_ref().map_or("not measured".to_string(), |p| {
+                format!(
+                    "{:.1} -> {:.1} MiB (max {:.1})",
+                    p.start_kib as f64 / 1024.0,
+                    p.end_kib as f64 / 1024.0,
+                    p.max_kib as f64 / 1024.0
+                )
+            })
+        };
+        format!(
+            "{} {:.1} of {:.1} s simulated in {:.1} s; recovered {}/{} shocks (recovery s: min {}, median {}, max {}); \
+             max contact force {:.0} N; sequence gaps {}, deadline misses {} ({:.2e}); RSS plant {}, controller {}",
+            self.status,
+            self.simulated_s,
+            self.planned_s,
+            self.wall_time_s,
+            self.recovered,
+            self.shocks,
+            fmt(self.recovery_s.min),
+            fmt(self.recovery_s.median),
+            fmt(self.recovery_s.max),
+            self.max_contact_force_n,
+            self.sequence_gaps,
+            self.deadline_misses,
+            self.deadline_miss_fraction,
+            rss(&self.rss.plant),
+            rss(&self.rss.controller),
+        )
+    }
+}
+
 /// A soak's outcome: how the run ended and the report written.
 pub struct Finished {
     /// How the run ended.
