@@ -89,9 +89,14 @@ pub fn plant_run(scene: &Path, out: &Path, sets: &[&str]) -> Command {
     cmd
 }
 
-/// Runs a command to completion (unbounded: prefer [`output_within`]).
+/// The limit of a command run by [`output`]: far above any test's command in a debug build on
+/// a loaded 2-core machine, so that only a hang reaches it.
+pub const DEFAULT_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
+
+/// Runs a command to completion within [`DEFAULT_LIMIT`] (a hang fails the test); prefer
+/// [`output_within`] with a limit of the command's own.
 pub fn output(cmd: &mut Command) -> Output {
-    cmd.output().unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"))
+    output_within(cmd, DEFAULT_LIMIT)
 }
 
 /// A child process whose stderr lines arrive on a channel, with bounded waits; killed on
