@@ -69,9 +69,18 @@ fn stiffness(k_e: f64) -> Result<f64, ConfigError> {
 pub fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
     ConfigError::Range {
         key: key.to_string(),
-        value: value.to_string(),
+        value: readable(value.to_string()),
         unit: if unit.is_empty() { String::new() } else { format!(" {unit}") },
         why: why.to_string(),
+    }
+}
+
+/// A number as it reads best in a message: Rust prints `1e300_f64` as 301 digits, so a long
+/// decimal becomes scientific notation (`1e300`); anything else is kept as written.
+fn readable(value: String) -> String {
+    match value.parse::<f64>() {
+        Ok(v) if value.len() > 16 && v.is_finite() => format!("{v:e}"),
+        _ => value,
     }
 }
 
@@ -552,4 +561,21 @@ fn migrate_relev_aliases(ctl: &mut RawController, warnings: &mut Vec<String>) ->
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::range;
+
+    #[test]
+    fn huge_values_read_in_scientific_notation_and_others_as_written() {
+        assert_eq!(
+            range("scene.duration_s", 1e300, "s", "too long").to_string(),
+            "scene.duration_s = 1e300 s: too long"
+        );
+        assert_eq!(range("a.b", 2.5e-20, "m", "w").to_string(), "a.b = 2.5e-20 m: w");
+        assert_eq!(range("a.b", 0.5, "m", "w").to_string(), "a.b = 0.5 m: w");
+        assert_eq!(range("a.b", f64::NAN, "m", "w").to_string(), "a.b = NaN m: w");
+        assert_eq!(range("a.b", "\"long\"", "ms", "w").to_string(), "a.b = \"long\" ms: w");
+    }
 }
