@@ -7,7 +7,7 @@
 //!
 //! Drawn with plotters directly (the band, the two panels and the fixed 0 … 1 colour scale are
 //! not among [`crate::plot`]'s kinds), in the same style: DejaVu Sans, white background,
-//! tab10 colours, viridis.
+//! tab10 colours, viridis (plotters' colour map, through `plot::viridis`).
 
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::point::PointStats;
@@ -16,11 +16,9 @@ use crate::plot::{self, PointGroup};
 use crate::sweep::{Spacing, Sweep};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 use std::path::Path;
-use std::sync::OnceLock;
 
-const FONT: &str = "sans-serif";
+const FONT: &str = plot::FONT_FAMILY;
 const BLUE: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
 const MODE_COLOURS: [(&str, RGBColor); 4] = [
     ("recovered", RGBColor(0x1f, 0x77, 0xb4)),
@@ -29,39 +27,9 @@ const MODE_COLOURS: [(&str, RGBColor); 4] = [
     ("diverged", RGBColor(0x7f, 0x7f, 0x7f)),
 ];
 const SENSITIVE: RGBColor = RGBColor(0xd6, 0x27, 0x28);
-const VIRIDIS: [(u8, u8, u8); 9] = [
-    (0x44, 0x01, 0x54),
-    (0x47, 0x2d, 0x7b),
-    (0x3b, 0x52, 0x8b),
-    (0x2c, 0x72, 0x8e),
-    (0x21, 0x91, 0x8c),
-    (0x28, 0xae, 0x80),
-    (0x5e, 0xc9, 0x62),
-    (0xad, 0xdc, 0x30),
-    (0xfd, 0xe7, 0x25),
-];
 
 /// Poincaré points of one mode: (mode, colour, points).
 type ModeGroup<'a> = (&'a str, RGBColor, Vec<(f64, f64)>);
-
-fn viridis(t: f64) -> RGBColor {
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
-    let s = t * (VIRIDIS.len() - 1) as f64;
-    let i = (s.floor() as usize).min(VIRIDIS.len() - 2);
-    let f = s - i as f64;
-    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
-    let mix = |p: u8, q: u8| (f64::from(p) + f * (f64::from(q) - f64::from(p))).round() as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
-}
-
-fn font() -> anyhow::Result<()> {
-    static OK: OnceLock<bool> = OnceLock::new();
-    if *OK.get_or_init(|| register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()) {
-        Ok(())
-    } else {
-        anyhow::bail!("could not register the embedded DejaVu Sans font")
-    }
-}
 
 fn draw_err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> anyhow::Error + '_ {
     move |e| anyhow::anyhow!("drawing {} failed: {e:?}", path.display())
@@ -183,7 +151,7 @@ pub fn sweep_charts(
     counted: &[(Vec<&MemberResult>, &'static str)],
     thresholds: &[Threshold],
 ) -> anyhow::Result<()> {
-    font()?;
+    plot::ensure_font(dir)?;
     let scene = sweep.scene_name();
     let Some((x, x_label)) = axis(sweep, 0) else { return Ok(()) };
     if let Some((y, y_label)) = axis(sweep, 1) {
@@ -309,7 +277,7 @@ fn probability_map(
     chart
         .draw_series(stats.iter().map(|s| {
             let (c, r) = (s.index % n1, s.index / n1);
-            Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], viridis(s.p_recovered).filled())
+            Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.p_recovered).filled())
         }))
         .map_err(draw_err(path))?;
     let crossed: Vec<(f64, f64)> =
@@ -339,7 +307,7 @@ fn probability_map(
         .map_err(draw_err(path))?;
     bc.draw_series((0..200).map(|k| {
         let (a, b) = (k as f64 / 200.0, (k + 1) as f64 / 200.0);
-        Rectangle::new([(0.0, a), (1.0, b)], viridis(0.5 * (a + b)).filled())
+        Rectangle::new([(0.0, a), (1.0, b)], plot::viridis(0.5 * (a + b)).filled())
     }))
     .map_err(draw_err(path))?;
     bc.configure_mesh()

@@ -51,6 +51,7 @@
 mod axes;
 mod decimate;
 mod heatmap;
+pub(crate) use heatmap::viridis;
 mod legend;
 mod lines;
 mod loglog;
