@@ -98,11 +98,28 @@ fn main() -> ExitCode {
 
 /// Prints an error once: `plant: error: …` (an interruption is not an error: `plant: …`).
 fn report(err: &anyhow::Error) {
+    let text = chain_text(err);
     if exit_code(err) == exit::INTERRUPTED {
-        eprintln!("plant: {err:#}");
+        eprintln!("plant: {text}");
     } else {
-        eprintln!("plant: error: {err:#}");
+        eprintln!("plant: error: {text}");
     }
+}
+
+/// The error and its causes, `outer: inner: …`, each said once: a wrapper that displays its
+/// cause (`#[error("{0}")]` with `#[from]`) would otherwise repeat it.
+fn chain_text(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let part = cause.to_string();
+        if !text.ends_with(&part) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&part);
+        }
+    }
+    text
 }
 
 /// A warning for the user.
@@ -519,5 +536,15 @@ mod tests {
         for (err, code) in cases {
             assert_eq!(exit_code(&err), code, "{err:#}");
         }
+    }
+
+    #[test]
+    fn each_cause_is_said_once() {
+        let setup = plant::run::SetupError::Cosim(CosimError::RunId("run id \"a b\": a space".into()));
+        let err = anyhow::Error::from(setup).context("starting the run");
+        assert_eq!(format!("{err:#}"), "starting the run: run id \"a b\": a space: run id \"a b\": a space");
+        assert_eq!(chain_text(&err), "starting the run: run id \"a b\": a space");
+        let plain = anyhow::anyhow!("disk full").context("writing trace.csv");
+        assert_eq!(chain_text(&plain), "writing trace.csv: disk full");
     }
 }

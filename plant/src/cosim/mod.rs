@@ -210,7 +210,7 @@ fn exit_hint(code: Option<i32>) -> &'static str {
     match code {
         Some(2) => ": it refused the run, or found a peer of another protocol version (its message is above)",
         Some(4) => ": it saw no plant",
-        Some(1) => ": an IPC failure on its side",
+        Some(1) => ": an IPC failure or an error of its own, its message is above",
         _ => "",
     }
 }
