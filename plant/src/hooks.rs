@@ -24,3 +24,12 @@ pub trait Hooks {
 /// Hooks that do nothing.
 pub struct Quiet;
 impl Hooks for Quiet {}
+
+/// Hooks that only stop the run when the flag is set (a sweep's or an ensemble's runs, stopped
+/// by SIGINT/SIGTERM).
+pub struct Cancel<'a>(pub &'a std::sync::atomic::AtomicBool);
+impl Hooks for Cancel<'_> {
+    fn cancelled(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}

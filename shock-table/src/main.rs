@@ -163,7 +163,7 @@ fn pulse_from_flags(peak_flag: &str, peak_g: f64, f1_hz: f64, f2_hz: f64) -> Res
 
 /// One row of the table, in the table's units.
 #[derive(Serialize)]
-struct Row {
+struct PulseRow {
     a1_g: f64,
     a2_g: f64,
     t1_s: f64,
@@ -178,7 +178,7 @@ struct TableJson<'a> {
     f1_hz: f64,
     f2_hz: f64,
     g_m_s2: f64,
-    rows: &'a [Row],
+    rows: &'a [PulseRow],
 }
 
 fn table(args: &TableArgs) -> Result<(), Failure> {
@@ -190,7 +190,7 @@ fn table(args: &TableArgs) -> Result<(), Failure> {
         .iter()
         .map(|&g| {
             let p = pulse_from_flags("--peaks-g", g, args.f1_hz, args.f2_hz)?;
-            Ok(Row {
+            Ok(PulseRow {
                 a1_g: p.a1 / G0_M_S2,
                 a2_g: p.a2 / G0_M_S2,
                 t1_s: p.t1,
@@ -212,7 +212,7 @@ fn table(args: &TableArgs) -> Result<(), Failure> {
     written.map_err(|e| io_failure(e, "writing to stdout".into()))
 }
 
-fn write_table(out: &mut impl Write, args: &TableArgs, rows: &[Row]) -> io::Result<()> {
+fn write_table(out: &mut impl Write, args: &TableArgs, rows: &[PulseRow]) -> io::Result<()> {
     writeln!(
         out,
         "# BV043/85 double half-sine: f1 = {} Hz, f2 = {} Hz, G = {G0_M_S2} m/s², \

@@ -31,8 +31,9 @@ pub struct BenchArgs {
     pub out: Option<PathBuf>,
 }
 
+/// One member of `bench.csv`.
 #[derive(Serialize)]
-struct Row<'a> {
+struct BenchCsvRow<'a> {
     member: usize,
     angle_deg: Option<f64>,
     fast_mode: &'a str,
@@ -128,7 +129,7 @@ pub fn bench(args: &BenchArgs, log: &mut dyn FnMut(&str)) -> anyhow::Result<Benc
         let agrees = f.run.mode == s.run.mode;
         report.agree += usize::from(agrees);
         report.agree_verified += usize::from(v.counted().mode == s.run.mode);
-        w.serialize(Row {
+        w.serialize(BenchCsvRow {
             member: f.member,
             angle_deg: f.angle_deg,
             fast_mode: &f.run.mode,

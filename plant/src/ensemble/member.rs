@@ -24,13 +24,14 @@
 
 use crate::config::{load_scene, Scene};
 use crate::ensemble::spec::{Draw, EnsembleSpec, MemberSetting};
+use crate::hooks::Cancel;
 use crate::integrate::Method;
-use crate::run::{run, Hooks, Outcome, RunResult};
+use crate::run::{run, Outcome, RunResult};
 use crate::summary::{snake_name, Summary};
 use serde::{Deserialize, Serialize};
 use shock_table::ShockSpec;
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 /// Members whose Poincaré points are kept (for the bifurcation diagrams and `poincare.csv`).
 pub const POINCARE_MEMBERS: usize = 8;
@@ -247,13 +248,6 @@ pub fn member_overrides(point: &Point, spec: &EnsembleSpec, j: usize) -> (Vec<St
     (sets, draw, drawn)
 }
 
-struct Stop<'a>(&'a AtomicBool);
-impl Hooks for Stop<'_> {
-    fn cancelled(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
 /// True when a run's outcome is close to a decision (see the module doc).
 pub fn close_to_decision(f: &Figures, shock_start: f64, spec: &EnsembleSpec) -> bool {
     let late = spec.verify_late;
@@ -277,7 +271,7 @@ pub fn run_member(
 ) -> anyhow::Result<Option<MemberResult>> {
     let (sets, draw, drawn) = member_overrides(point, spec, j);
     let scene = load_scene(point.path, &sets)?;
-    let result = run(&scene, &mut Stop(stop))?;
+    let result = run(&scene, &mut Cancel(stop))?;
     if result.run.outcome == Outcome::Interrupted {
         return Ok(None);
     }
@@ -289,7 +283,7 @@ pub fn run_member(
         sets.extend(verify_overrides(point.scene, spec.verify_rtol));
         sets.extend(drawn.iter().cloned());
         let reference = load_scene(point.path, &sets)?;
-        let result = run(&reference, &mut Stop(stop))?;
+        let result = run(&reference, &mut Cancel(stop))?;
         if result.run.outcome == Outcome::Interrupted {
             return Ok(None);
         }

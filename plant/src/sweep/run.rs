@@ -6,7 +6,8 @@ use super::{Shard, Sweep, SweepError};
 use crate::config::Scene;
 use crate::ensemble::member::{self, MemberResult, Point};
 use crate::ensemble::point::{progress, Progress};
-use crate::run::{run, Hooks, Outcome};
+use crate::hooks::Cancel;
+use crate::run::{run, Outcome};
 use crate::summary::{snake_name as name_of, Summary};
 use anyhow::Context;
 use rayon::prelude::*;
@@ -354,17 +355,10 @@ struct RunOutcome {
     waiting: usize,
 }
 
-struct Stop<'a>(&'a AtomicBool);
-impl Hooks for Stop<'_> {
-    fn cancelled(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
 /// Runs point `i` of a sweep of single runs; `None` when it was interrupted.
 pub fn run_point(sweep: &Sweep, i: usize, stop: &AtomicBool) -> anyhow::Result<Option<(Scene, PointResult)>> {
     let scene = sweep.scene_for(i)?;
-    let result = run(&scene, &mut Stop(stop))?;
+    let result = run(&scene, &mut Cancel(stop))?;
     if result.run.outcome == Outcome::Interrupted {
         return Ok(None);
     }
