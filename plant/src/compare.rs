@@ -237,6 +237,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&s
     }
     let stem = req.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = req.out.map_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")), Path::to_path_buf);
+    let _claim = crate::claim::claim(&dir, true)?;
     if req.laws.is_empty() {
         compare(req.scene, req.set, req.rates, req.cosim, &dir, log)?;
         if req.maps {

@@ -10,7 +10,7 @@
 //! while it runs); [`trace`] the rows of a run and `trace.csv`, [`record`]
 //! the one pass over them (bounded stores in [`bounded`]), [`summary`] and
 //! [`analysis`] their figures, [`status`] how a run ended, [`output`] the run
-//! folder and [`plot`] the charts.
+//! folder ([`claim`]: one live process per folder) and [`plot`] the charts.
 #![warn(missing_docs)]
 
 pub use plant_physics::{force, integrate, model, park};
@@ -19,6 +19,7 @@ pub mod analysis;
 pub mod atomic;
 pub mod bench;
 pub mod bounded;
+pub mod claim;
 pub mod compare;
 pub mod config;
 pub mod cosim;

@@ -8,7 +8,7 @@
 //! |---|---|
 //! | 0 | success |
 //! | 1 | an output could not be written, or the system refused a resource |
-//! | 2 | bad input (scene, programme, sweep or ensemble file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol, a controller `command` that does not exist or is not executable, a run id in use) |
+//! | 2 | bad input (scene, programme, sweep or ensemble file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol, a controller `command` that does not exist or is not executable, a run id or an output folder in use) |
 //! | 3 | numerical divergence |
 //! | 4 | the controller process was lost (died, stopped by a signal, silent past `controller.lockstep_timeout_ms`, exited before the handshake, never answered) |
 //! | 5 | `plant soak`: completed, but a criterion failed |
@@ -146,6 +146,12 @@ fn exit_code(err: &anyhow::Error) -> u8 {
         }
         if let Some(e) = cause.downcast_ref::<plant::sweep::SweepError>() {
             return e.exit_code();
+        }
+        if let Some(e) = cause.downcast_ref::<plant::claim::ClaimError>() {
+            return match e {
+                plant::claim::ClaimError::InUse { .. } => exit::BAD_INPUT,
+                plant::claim::ClaimError::Io { .. } => exit::IO,
+            };
         }
         if cause.is::<ConfigError>()
             || cause.is::<controller::LawError>()
@@ -336,6 +342,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
     let scene = load_scene(path, set)?;
     load_checked(&scene)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
+    let _claim = plant::claim::claim(&dir, true)?;
     let mut hooks = CliHooks {
         stop: stop_flag(),
         duration: scene.duration,
@@ -382,6 +389,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
     let prog = plant::soak::programme::load(path, set)?;
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
+    let _claim = plant::claim::claim(&dir, true)?;
     let stop = stop_flag();
     let progress = match (quiet, std::io::stderr().is_terminal()) {
         (true, _) => plant::soak::Progress::Quiet,
@@ -417,6 +425,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 
 /// `plant analyze`.
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
+    let _claim = plant::claim::claim(dir, false)?;
     let a = plant::output::analyze_dir(dir)?;
     eprintln!(
         "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",

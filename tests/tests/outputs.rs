@@ -3,8 +3,9 @@
 //! analyze` reads `trace.csv` strictly and writes nothing when it fails; a
 //! diverged run's maxima are over the rows before the failure, with the
 //! failing state on its own; a divergence at t = 0 exits 3 with its time and
-//! state; a reused output folder keeps no file of the previous run; the
-//! charts show the data (decoded, not just a PNG signature).
+//! state; a reused output folder keeps no file of the previous run; a folder
+//! in use by a live run is refused to a second command; the charts show the
+//! data (decoded, not just a PNG signature).
 
 mod common;
 
@@ -189,4 +190,58 @@ fn run_charts_show_the_data() {
         let n = png.count_in_plot(SERIES_BLUE);
         assert!(n >= min_pixels, "{chart}: {n} pixels of the data colour");
     }
+}
+
+/// Two commands on one `--out` at once used to mix their files (one run's `summary.json`
+/// beside the other's `trace.csv`, both exit 0). The first run here holds its folder while it
+/// waits for an external controller that never comes; a second `plant run` and a `plant
+/// analyze` on that folder are refused with exit 2 naming the holder, and leave the folder as
+/// the first run wrote it; the first, interrupted, writes its own summary.
+#[test]
+fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
+    use std::process::Stdio;
+    let dir = TempDir::new("claimed-out");
+    let out = dir.join("run");
+    let id = format!("claim{}", std::process::id());
+    let mut cmd = plant_run(&scene("cosim-10g.toml"), &out, &["controller.connect_timeout_ms=120000"]);
+    cmd.args(["--controller", "external", "--run-id", &id]);
+    let mut first = cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::null()).spawn().expect("plant starts");
+    let deadline = std::time::Instant::now() + LIMIT;
+    while !out.join("scene.toml").exists() {
+        assert!(std::time::Instant::now() < deadline, "the first run never prepared its folder");
+        assert!(first.try_wait().unwrap().is_none(), "the first run ended before the test could start");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let scene_before = std::fs::read(out.join("scene.toml")).unwrap();
+
+    let second = output_within(&mut plant_run(&scene("paper-3g.toml"), &out, &["scene.duration_s=0.01"]), LIMIT);
+    assert_exit(&second, 2);
+    let err = stderr(&second);
+    assert!(err.contains("in use by a live process") && err.contains(&format!("pid {}", first.id())), "{err}");
+    let analyzed = analyze(&out);
+    assert_exit(&analyzed, 2);
+    assert!(stderr(&analyzed).contains("in use by a live process"), "{}", stderr(&analyzed));
+    assert_eq!(std::fs::read(out.join("scene.toml")).unwrap(), scene_before, "the second run touched the folder");
+
+    // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
+    assert_eq!(unsafe { libc::kill(first.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let deadline = std::time::Instant::now() + LIMIT;
+    let status = loop {
+        if let Some(s) = first.try_wait().unwrap() {
+            break s;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = first.kill();
+            let _ = first.wait();
+            panic!("the first run did not end after SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["scene"], "cosim-10g", "{summary:#}");
+    assert_eq!(summary["status"], "interrupted", "{summary:#}");
+    // The folder is free again.
+    let again = analyze(&out);
+    assert!(!stderr(&again).contains("in use"), "{}", stderr(&again));
 }
