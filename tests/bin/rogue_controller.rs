@@ -10,6 +10,7 @@
 //! - `other-session`: accepts the hello, then answers every sensor frame
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
+//! - `nan`: answers with the law's currents, but NaN on x from sample 100 on;
 //! - `no-wake`: answers every frame with the law's currents but never wakes
 //!   the plant: it polls every millisecond, asks for no wake-up and does not
 //!   serve `command/wake`.
@@ -129,6 +130,10 @@ fn main() -> ExitCode {
         if mode == "every-other" && f.seq % 2 == 1 {
             continue;
         }
-        frames.send(reply(&mut law, &f)).expect("reply");
+        let mut r = reply(&mut law, &f);
+        if mode == "nan" && f.seq >= 100 {
+            r.current_a[0] = f64::NAN;
+        }
+        frames.send(r).expect("reply");
     }
 }

@@ -822,3 +822,37 @@ fn a_controller_that_never_wakes_the_plant_is_warned_about() {
     assert_eq!(num(c, "woken_waits"), 0.0, "{c:#}");
     assert!(num(c, "blocking_waits") >= 50.0, "{c:#}");
 }
+
+/// A controller that answers with a non-finite current: the plant holds the last valid
+/// current (docs/wire-protocol.md), counts every such reply, and says so once, naming the
+/// sample and its time, instead of completing silently.
+#[test]
+fn non_finite_currents_are_held_counted_and_said_once() {
+    let dir = TempDir::new("cosim-nan");
+    let out = dir.join("run");
+    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("nan")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 0);
+    let err = stderr(&run);
+    assert_eq!(err.matches("non-finite current").count(), 1, "{err}");
+    assert!(err.contains("sample 100 ") && err.contains("t = 0.005 s"), "{err}");
+    let c = &read_json(&out.join("summary.json"))["cosim"];
+    assert_eq!(num(c, "invalid_replies"), 100.0, "{c:#}");
+    // The held x current: finite throughout, and one value once the held command is applied
+    // (sample 100's command is due a tick later, through the one-sample delay line).
+    let trace = std::fs::read_to_string(out.join("trace.csv")).unwrap();
+    let mut lines = trace.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t, ix) = (col("t_s"), col("ix_a"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[t].parse().unwrap(), f[ix].parse().unwrap())
+        })
+        .collect();
+    assert!(rows.iter().all(|(_, i)| i.is_finite()), "a NaN current reached the trace");
+    let held: Vec<f64> = rows.iter().filter(|(t, _)| *t >= 0.0052).map(|(_, i)| *i).collect();
+    assert!(held.len() > 50 && held.iter().all(|i| *i == held[0]), "x current not held: {held:?}");
+}

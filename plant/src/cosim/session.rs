@@ -198,12 +198,20 @@ impl Session {
         }
     }
 
-    /// Checks a reply's currents; non-finite ones are counted and the last current held.
-    fn accept(&mut self, reply: &CommandFrame) -> [f64; 2] {
+    /// Checks a reply's currents; non-finite ones are counted and the last current held, and
+    /// the first one is said (a run that holds currents is not the law's run).
+    fn accept(&mut self, reply: &CommandFrame, sample: &Sample, hooks: &mut dyn Hooks) -> [f64; 2] {
         let current = reply.current_xy();
         if current.iter().all(|i| i.is_finite()) {
             self.last_cmd = saturate(current, self.limit);
         } else {
+            if self.figures.invalid == 0 {
+                hooks.note(&format!(
+                    "warning: the controller sent a non-finite current {current:?} A for sample {} (t = {} s); \
+                     the last valid current is held for it and for every later non-finite reply (counted in summary.json, cosim.invalid_replies)",
+                    sample.seq, sample.t_s
+                ));
+            }
             self.figures.invalid += 1;
         }
         self.last_cmd
@@ -289,7 +297,7 @@ impl Session {
             self.figures.round_trip.record(t0.elapsed().as_nanos() as u64);
             self.figures.latency.record(reply.sent_ns.saturating_sub(frame.sent_ns));
             self.warn_if_never_woken(hooks);
-            return Ok(self.accept(&reply));
+            return Ok(self.accept(&reply, sample, hooks));
         }
     }
 
@@ -443,7 +451,7 @@ impl Session {
             match fresh {
                 Some(reply) => {
                     self.figures.misses.record(false);
-                    self.accept(&reply)
+                    self.accept(&reply, sample, hooks)
                 }
                 None => {
                     self.figures.misses.record(true);
