@@ -30,6 +30,7 @@ pub mod output;
 pub mod plot;
 pub mod record;
 pub mod rng;
+pub mod row_file;
 pub mod run;
 pub mod sensor;
 pub mod soak;

@@ -20,7 +20,6 @@ use crate::run::{run_into, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{TraceError, TraceWriter};
 use anyhow::Context;
-use std::fs::File;
 use std::path::Path;
 
 /// The files a run writes into its folder (and removes first when the folder is reused).
@@ -108,7 +107,7 @@ pub fn remove_stale(dir: &Path) -> anyhow::Result<()> {
 /// The sink of `plant run`: each row goes to `trace.csv` as it is made and
 /// to the [`Recorder`]; nothing is kept per row.
 pub struct RunFolder {
-    trace: TraceWriter<File>,
+    trace: TraceWriter,
     recorder: Recorder,
     error: Option<std::io::Error>,
 }

@@ -8,6 +8,7 @@
 //! that a trace read back is bit-identical to the run's samples.
 
 use crate::model::{ix, Model, State};
+use crate::row_file::RowFile;
 use std::path::{Path, PathBuf};
 
 macro_rules! columns {
@@ -165,41 +166,35 @@ impl Trace {
 }
 
 /// Streams rows to a `trace.csv` as they are made: the header at creation,
-/// then one record per row through the `csv` crate. Each number is
-/// formatted here with `{:e}` (the csv crate's own float format differs).
-pub struct TraceWriter<W: std::io::Write> {
-    csv: csv::Writer<W>,
+/// then one record per row through the `csv` crate, in whole rows
+/// ([`RowFile`]: a run killed by SIGKILL leaves a file that ends on a row, and
+/// `plant analyze` reads it). Each number is formatted here with `{:e}` (the
+/// csv crate's own float format differs).
+pub struct TraceWriter {
+    rows: RowFile,
     fields: [String; WIDTH],
 }
 
-impl TraceWriter<std::fs::File> {
+impl TraceWriter {
     /// Creates (truncates) `path` and writes the header.
     pub fn create(path: &Path) -> std::io::Result<Self> {
-        Self::new(std::fs::File::create(path)?)
-    }
-}
-
-impl<W: std::io::Write> TraceWriter<W> {
-    /// A writer on `w`; writes the header.
-    pub fn new(w: W) -> std::io::Result<Self> {
-        let mut csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(w);
-        csv.write_record(Trace::COLUMNS)?;
-        Ok(Self { csv, fields: std::array::from_fn(|_| String::with_capacity(32)) })
+        let rows = RowFile::create(path, Trace::COLUMNS)?;
+        Ok(Self { rows, fields: std::array::from_fn(|_| String::with_capacity(32)) })
     }
 
-    /// Appends one row (buffered).
+    /// Appends one row (in memory until a chunk of whole rows is written out).
     pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
         use std::fmt::Write as _;
         for (field, v) in self.fields.iter_mut().zip(row) {
             field.clear();
             let _ = write!(field, "{v:e}");
         }
-        Ok(self.csv.write_record(&self.fields)?)
+        self.rows.row(&self.fields)
     }
 
-    /// Flushes the rows written so far to the file.
+    /// Writes the rows gathered so far to the file.
     pub fn flush(&mut self) -> std::io::Result<()> {
-        self.csv.flush()
+        self.rows.flush()
     }
 }
 

@@ -245,3 +245,34 @@ fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
     let again = analyze(&out);
     assert!(!stderr(&again).contains("in use"), "{}", stderr(&again));
 }
+
+/// A run killed by SIGKILL at any moment leaves a `trace.csv` of whole rows that `plant
+/// analyze` reads (rows reach the file in whole-row chunks; a byte-counting buffer used to
+/// leave a row cut in the middle, which the strict reader rightly refuses).
+#[test]
+fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
+    use std::process::Stdio;
+    let dir = TempDir::new("killed-run");
+    for (i, bytes) in [150_000u64, 400_000, 700_000].into_iter().enumerate() {
+        let out = dir.join(&format!("run{i}"));
+        let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &["scene.duration_s=60", "output.plots=false"]);
+        let mut run = cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::null()).spawn().expect("plant");
+        let trace = out.join("trace.csv");
+        let deadline = std::time::Instant::now() + LIMIT;
+        while std::fs::metadata(&trace).map_or(0, |m| m.len()) < bytes {
+            if std::time::Instant::now() > deadline || run.try_wait().unwrap().is_some() {
+                let _ = run.kill();
+                let _ = run.wait();
+                panic!("the run did not write {bytes} bytes of trace in time");
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        run.kill().expect("SIGKILL");
+        let _ = run.wait();
+        let text = std::fs::read_to_string(&trace).unwrap();
+        assert!(text.ends_with('\n'), "run {i}: trace.csv ends inside a row");
+        assert!(text.lines().all(|l| l.split(',').count() == 19), "run {i}: a ragged row");
+        let analyzed = analyze(&out);
+        assert_exit(&analyzed, 0);
+    }
+}

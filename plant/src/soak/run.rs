@@ -3,10 +3,11 @@
 
 use super::programme::Programme;
 use super::report::{report, Finished};
-use super::sink::{RowFile, RssSample, SoakSink};
+use super::sink::{RssSample, SoakSink};
 use super::{monitor, rss, ENVELOPE_BIN_S, ENVELOPE_CSV_HEADER, RSS_CSV_HEADER, SOAK_CSV_HEADER};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
+use crate::row_file::RowFile;
 use crate::run::{run_into, SetupError};
 use anyhow::Context;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,80 @@
+//! A CSV file that only ever holds its header and whole rows, so that a
+//! process killed at any moment (SIGKILL included) leaves a file every reader
+//! can read to its last row: `trace.csv` and the soak's `soak.csv`,
+//! `envelope.csv` and `rss.csv`.
+//!
+//! Hand-written around the `csv` crate because neither it nor `BufWriter`
+//! does this: both flush at a byte count and cut a row in two.
+
+use std::fs::File;
+use std::io::Write;
+use std::path::Path;
+
+/// Pending bytes past which a [`RowFile`] writes its rows out.
+const FLUSH_BYTES: usize = 64 * 1024;
+
+/// A CSV file that only ever holds its header and whole rows: the `csv`
+/// crate formats each record into memory, and [`RowFile::flush`] hands the
+/// pending rows to the file in one `write` of whole rows (a SIGKILL lands
+/// between two writes, unless it arrives during one: microseconds in every
+/// 64 KiB). The header is written at creation.
+pub struct RowFile {
+    file: File,
+    csv: csv::Writer<Pending>,
+    pending: Pending,
+}
+
+/// The rows the `csv` writer has formatted, not yet in the file.
+#[derive(Clone, Default)]
+struct Pending(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+
+impl Write for Pending {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl RowFile {
+    /// Creates (truncates) `path` with its header row.
+    pub fn create(path: &Path, header: &[&str]) -> std::io::Result<Self> {
+        let file = File::create(path)?;
+        let pending = Pending::default();
+        let csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(pending.clone());
+        let mut f = Self { file, csv, pending };
+        f.csv.write_record(header)?;
+        f.flush()?;
+        Ok(f)
+    }
+
+    /// Appends a row (fields already formatted); written out past 64 KiB pending.
+    pub fn row<I, T>(&mut self, fields: I) -> std::io::Result<()>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        self.csv.write_record(fields)?;
+        // Out of the csv writer's own buffer after each record, so that `pending` holds
+        // whole rows only.
+        self.csv.flush()?;
+        if self.pending.0.borrow().len() >= FLUSH_BYTES {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Writes the pending whole rows to the file.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.csv.flush()?;
+        let mut pending = self.pending.0.borrow_mut();
+        if !pending.is_empty() {
+            self.file.write_all(&pending)?;
+            pending.clear();
+        }
+        Ok(())
+    }
+}
