@@ -1,35 +1,14 @@
 //! End-to-end tests of ensembles (`plant ensemble`, `[ensemble]` in sweep files) and of the
 //! checks of a sweep folder (manifest, keys, checksums: issue 11 item 3). Scenes are cut to
 //! 60 ms and ensembles to a few members so that the debug build runs them in seconds; every
-//! child is killed after a time limit.
+//! child is killed after a time limit (`output_within`).
 
 mod common;
 
 use common::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::Duration;
-
-/// Runs a command, killing it after `limit`.
-fn run_limited(cmd: &mut Command, limit: Duration) -> Output {
-    let mut child = cmd
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"));
-    let started = std::time::Instant::now();
-    loop {
-        if child.try_wait().expect("wait").is_some() {
-            return child.wait_with_output().expect("output");
-        }
-        if started.elapsed() > limit {
-            let _ = child.kill();
-            let o = child.wait_with_output().expect("output");
-            panic!("{cmd:?} did not finish in {limit:?}; stderr:\n{}", String::from_utf8_lossy(&o.stderr));
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
 
 const LIMIT: Duration = Duration::from_secs(240);
 
@@ -56,19 +35,9 @@ fn ensemble_sweep(dir: &TempDir, name: &str, points: usize, ensemble: &str) -> P
     path
 }
 
-fn sweep_cmd(file: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut cmd = Command::new(plant_bin());
-    cmd.arg("sweep").arg(file).arg("--out").arg(out).args(extra);
-    cmd
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
-}
-
 /// A CSV with words and numbers, as text: header and rows of fields.
 fn table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = read(path);
+    let text = read_text(path);
     let mut lines = text.lines();
     let header = lines.next().expect("header").split(',').map(str::to_string).collect();
     (header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect())
@@ -92,7 +61,7 @@ fn wilson(k: f64, n: f64) -> (f64, f64) {
 fn a_scene_ensemble_writes_statistics_members_and_verifies_close_calls() {
     let dir = TempDir::new("ensemble-scene");
     let out = dir.join("out");
-    let o = run_limited(
+    let o = output_within(
         &mut ensemble_cmd(
             &out,
             &["ensemble.members=4", "ensemble.seed=7", "ensemble.verify_rtol=1e-6", "ensemble.verify_rebound=1"],
@@ -145,21 +114,21 @@ fn sharded_rounds_merge_equal_to_one_machine() {
     // the round structure. Three shards over a shared folder, round by round.
     let file = ensemble_sweep(&dir, "s.toml", 2, "members = 4\nbatch = 2\nagree = 2\nseed = 3\nverify = false");
     let whole = dir.join("whole");
-    assert_exit(&run_limited(&mut sweep_cmd(&file, &whole, &["--jobs", "2"]), LIMIT), 0);
+    assert_exit(&output_within(&mut plant_sweep(&file, &whole, &["--jobs", "2"]), LIMIT), 0);
     let shared = dir.join("shared");
     for round in ["0", "1"] {
         for shard in ["0/3", "1/3", "2/3"] {
-            let o = run_limited(
-                &mut sweep_cmd(&file, &shared, &["--shard", shard, "--round", round, "--jobs", "1"]),
+            let o = output_within(
+                &mut plant_sweep(&file, &shared, &["--shard", shard, "--round", round, "--jobs", "1"]),
                 LIMIT,
             );
             assert_exit(&o, 0);
         }
     }
     // The last shard of the last round merged by itself; --merge rewrites the same.
-    assert_exit(&run_limited(&mut sweep_cmd(&file, &shared, &["--merge"]), LIMIT), 0);
+    assert_exit(&output_within(&mut plant_sweep(&file, &shared, &["--merge"]), LIMIT), 0);
     for f in ["points.csv", "members.csv", "poincare.csv", "sweep.json"] {
-        assert_eq!(read(&shared.join(f)), read(&whole.join(f)), "{f} differs");
+        assert_eq!(read_text(&shared.join(f)), read_text(&whole.join(f)), "{f} differs");
     }
     let (h, rows) = table(&whole.join("points.csv"));
     assert_eq!(
@@ -200,7 +169,7 @@ fn sharded_rounds_merge_equal_to_one_machine() {
 fn a_round_whose_earlier_round_is_missing_exits_7() {
     let dir = TempDir::new("ensemble-round");
     let file = ensemble_sweep(&dir, "s.toml", 1, "members = 4\nbatch = 2\nverify = false");
-    let o = run_limited(&mut sweep_cmd(&file, &dir.join("out"), &["--round", "1"]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &dir.join("out"), &["--round", "1"]), LIMIT);
     assert_exit(&o, 7);
     assert!(stderr(&o).contains("round 0"), "{}", stderr(&o));
 }
@@ -223,13 +192,13 @@ fn bad_ensembles_exit_2_naming_key_value_and_unit() {
     for (i, (ensemble, expected)) in cases.iter().enumerate() {
         let file = ensemble_sweep(&dir, &format!("bad{i}.toml"), 2, ensemble);
         let out = dir.join(&format!("out{i}"));
-        let o = run_limited(&mut sweep_cmd(&file, &out, &[]), LIMIT);
+        let o = output_within(&mut plant_sweep(&file, &out, &[]), LIMIT);
         assert_exit(&o, 2);
         assert!(stderr(&o).contains(expected), "{ensemble}: {}", stderr(&o));
         assert!(!out.join("points").exists(), "{ensemble}: nothing may run");
     }
     // The same through a scene's [ensemble] and --set.
-    let o = run_limited(&mut ensemble_cmd(&dir.join("s"), &["ensemble.members=0"], &[]), LIMIT);
+    let o = output_within(&mut ensemble_cmd(&dir.join("s"), &["ensemble.members=0"], &[]), LIMIT);
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("ensemble.members = 0 members"), "{}", stderr(&o));
 }
@@ -248,7 +217,7 @@ fn later_invalid_points_and_huge_maps_exit_2_before_running() {
     )
     .expect("write");
     let out = dir.join("out");
-    let o = run_limited(&mut sweep_cmd(&path, &out, &[]), LIMIT);
+    let o = output_within(&mut plant_sweep(&path, &out, &[]), LIMIT);
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("touchdown.air_gap_mm = -0.1 mm"), "{}", stderr(&o));
     assert!(!out.join("points").exists());
@@ -260,7 +229,7 @@ fn later_invalid_points_and_huge_maps_exit_2_before_running() {
         ),
     )
     .expect("write");
-    let o = run_limited(&mut sweep_cmd(&path, &out, &[]), Duration::from_secs(30));
+    let o = output_within(&mut plant_sweep(&path, &out, &[]), Duration::from_secs(30));
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("100000 × 100000 = 10000000000 points"), "{}", stderr(&o));
 }
@@ -284,45 +253,45 @@ fn resumes_refuse_edited_stale_and_misplaced_points_and_merges_list_what_is_miss
     let dir = TempDir::new("sweep-manifest");
     let file = plain_sweep(&dir, "");
     let out = dir.join("out");
-    assert_exit(&run_limited(&mut sweep_cmd(&file, &out, &[]), LIMIT), 0);
-    let original = read(&out.join("points.csv"));
+    assert_exit(&output_within(&mut plant_sweep(&file, &out, &[]), LIMIT), 0);
+    let original = read_text(&out.join("points.csv"));
     let p1 = out.join("points").join("00001.json");
 
     // A value edited by hand: refused naming the point, then re-run on request.
-    let text = read(&p1);
+    let text = read_text(&p1);
     let edited = text.replacen("\"max_radius_m\":", "\"max_radius_m\":1", 1);
     assert_ne!(edited, text);
     std::fs::write(&p1, &edited).expect("edit");
-    let o = run_limited(&mut sweep_cmd(&file, &out, &[]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &[]), LIMIT);
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("points/00001.json") && stderr(&o).contains("edited by hand"), "{}", stderr(&o));
-    let o = run_limited(&mut sweep_cmd(&file, &out, &["--rerun-mismatched"]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &["--rerun-mismatched"]), LIMIT);
     assert_exit(&o, 0);
     assert!(stderr(&o).contains("re-running points/00001.json"), "{}", stderr(&o));
-    assert_eq!(read(&out.join("points.csv")), original);
+    assert_eq!(read_text(&out.join("points.csv")), original);
 
     // A point under another index's name.
     std::fs::copy(out.join("points").join("00000.json"), &p1).expect("copy");
-    let o = run_limited(&mut sweep_cmd(&file, &out, &[]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &[]), LIMIT);
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("wrong index"), "{}", stderr(&o));
     // --merge lists it as corrupt and a deleted one as missing: exit 7.
     std::fs::remove_file(out.join("points").join("00002.json")).expect("remove");
-    let o = run_limited(&mut sweep_cmd(&file, &out, &["--merge"]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &["--merge"]), LIMIT);
     assert_exit(&o, 7);
     assert!(stderr(&o).contains("points/00002.json") && stderr(&o).contains("points/00001.json"), "{}", stderr(&o));
     // A truncated file is corrupt too.
-    let text = read(&out.join("points").join("00000.json"));
+    let text = read_text(&out.join("points").join("00000.json"));
     std::fs::write(out.join("points").join("00000.json"), &text[..text.len() / 2]).expect("truncate");
-    let o = run_limited(&mut sweep_cmd(&file, &out, &["--merge"]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &["--merge"]), LIMIT);
     assert_exit(&o, 7);
     assert!(stderr(&o).contains("points/00000.json"), "{}", stderr(&o));
-    assert_exit(&run_limited(&mut sweep_cmd(&file, &out, &["--rerun-mismatched"]), LIMIT), 0);
-    assert_eq!(read(&out.join("points.csv")), original);
+    assert_exit(&output_within(&mut plant_sweep(&file, &out, &["--rerun-mismatched"]), LIMIT), 0);
+    assert_eq!(read_text(&out.join("points.csv")), original);
 
     // The sweep's scene changed (another key): every old point is stale.
     let file = plain_sweep(&dir, ", \"contact.friction_dynamic=0.2\", \"contact.stribeck_dynamic_m_s=0.2\"");
-    let o = run_limited(&mut sweep_cmd(&file, &out, &[]), LIMIT);
+    let o = output_within(&mut plant_sweep(&file, &out, &[]), LIMIT);
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("changed since this folder was made (sweep definition, scene)"), "{}", stderr(&o));
     assert!(
@@ -341,7 +310,7 @@ fn bench_ensemble_compares_the_fast_setting_with_the_scenes_own() {
     for s in SHORT_SETS.iter().chain(&["ensemble.verify_rtol=1e-6"]) {
         cmd.args(["--set", s]);
     }
-    let o = run_limited(&mut cmd, LIMIT);
+    let o = output_within(&mut cmd, LIMIT);
     assert_exit(&o, 0);
     let (h, rows) = table(&out.join("bench.csv"));
     assert_eq!(rows.len(), 2);

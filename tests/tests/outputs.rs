@@ -199,17 +199,16 @@ fn run_charts_show_the_data() {
 /// the first run wrote it; the first, interrupted, writes its own summary.
 #[test]
 fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
-    use std::process::Stdio;
     let dir = TempDir::new("claimed-out");
     let out = dir.join("run");
     let id = format!("claim{}", std::process::id());
     let mut cmd = plant_run(&scene("cosim-10g.toml"), &out, &["controller.connect_timeout_ms=120000"]);
     cmd.args(["--controller", "external", "--run-id", &id]);
-    let mut first = cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::null()).spawn().expect("plant starts");
+    let mut first = Proc::spawn(&mut cmd);
     let deadline = std::time::Instant::now() + LIMIT;
     while !out.join("scene.toml").exists() {
         assert!(std::time::Instant::now() < deadline, "the first run never prepared its folder");
-        assert!(first.try_wait().unwrap().is_none(), "the first run ended before the test could start");
+        assert!(first.running(), "the first run ended before the test could start");
         std::thread::sleep(Duration::from_millis(20));
     }
     let scene_before = std::fs::read(out.join("scene.toml")).unwrap();
@@ -223,21 +222,9 @@ fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
     assert!(stderr(&analyzed).contains("in use by a live process"), "{}", stderr(&analyzed));
     assert_eq!(std::fs::read(out.join("scene.toml")).unwrap(), scene_before, "the second run touched the folder");
 
-    // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
-    assert_eq!(unsafe { libc::kill(first.id() as libc::pid_t, libc::SIGINT) }, 0);
-    let deadline = std::time::Instant::now() + LIMIT;
-    let status = loop {
-        if let Some(s) = first.try_wait().unwrap() {
-            break s;
-        }
-        if std::time::Instant::now() > deadline {
-            let _ = first.kill();
-            let _ = first.wait();
-            panic!("the first run did not end after SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    assert_eq!(status.code(), Some(130));
+    first.signal(libc::SIGINT);
+    let (code, log) = first.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
     let summary = read_json(&out.join("summary.json"));
     assert_eq!(summary["scene"], "cosim-10g", "{summary:#}");
     assert_eq!(summary["status"], "interrupted", "{summary:#}");
@@ -251,24 +238,23 @@ fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
 /// leave a row cut in the middle, which the strict reader rightly refuses).
 #[test]
 fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
-    use std::process::Stdio;
     let dir = TempDir::new("killed-run");
     for (i, bytes) in [150_000u64, 400_000, 700_000].into_iter().enumerate() {
         let out = dir.join(&format!("run{i}"));
         let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &["scene.duration_s=60", "output.plots=false"]);
-        let mut run = cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::null()).spawn().expect("plant");
+        let mut run = Proc::spawn(&mut cmd);
         let trace = out.join("trace.csv");
         let deadline = std::time::Instant::now() + LIMIT;
         while std::fs::metadata(&trace).map_or(0, |m| m.len()) < bytes {
-            if std::time::Instant::now() > deadline || run.try_wait().unwrap().is_some() {
-                let _ = run.kill();
-                let _ = run.wait();
-                panic!("the run did not write {bytes} bytes of trace in time");
-            }
+            assert!(
+                std::time::Instant::now() < deadline && run.running(),
+                "the run did not write {bytes} bytes of trace in time"
+            );
             std::thread::sleep(Duration::from_millis(5));
         }
-        run.kill().expect("SIGKILL");
-        let _ = run.wait();
+        run.signal(libc::SIGKILL);
+        let (code, _) = run.finish_within(LIMIT);
+        assert_eq!(code, None, "run {i}: not ended by SIGKILL");
         let text = std::fs::read_to_string(&trace).unwrap();
         assert!(text.ends_with('\n'), "run {i}: trace.csv ends inside a row");
         assert!(text.lines().all(|l| l.split(',').count() == 19), "run {i}: a ragged row");

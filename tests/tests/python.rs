@@ -16,13 +16,11 @@
 
 mod common;
 
-use common::{assert_exit, num, output_within, plant_run, read_json, scene, stderr, workspace_root, TempDir};
+use common::{assert_exit, num, output_within, plant_run, read_json, scene, stderr, workspace_root, Proc, TempDir};
 use controller::link::{self, Endpoint, Mailbox};
 use controller::wire::{self, Ack, CommandFrame, Hello, SensorFrame};
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{channel, Receiver};
+use std::process::Command;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -82,73 +80,6 @@ fn prepare_venv() -> PathBuf {
     assert_exit(&install, 0);
     std::fs::write(&stamp_file, stamp).expect("venv stamp");
     dir
-}
-
-/// A child process whose stderr lines arrive on a channel; killed on drop.
-struct Proc {
-    child: Child,
-    lines: Receiver<String>,
-    log: Vec<String>,
-}
-
-impl Proc {
-    fn spawn(cmd: &mut Command) -> Self {
-        let mut child = cmd
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
-        let pipe = child.stderr.take().expect("piped stderr");
-        let (tx, lines) = channel();
-        std::thread::spawn(move || {
-            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Self { child, lines, log: Vec::new() }
-    }
-
-    fn pid(&self) -> u32 {
-        self.child.id()
-    }
-
-    fn signal(&self, signal: libc::c_int) {
-        let pid = libc::pid_t::try_from(self.child.id()).unwrap();
-        // SAFETY: kill(2) has no memory-safety preconditions; the child is not reaped yet.
-        assert_eq!(unsafe { libc::kill(pid, signal) }, 0, "kill({pid}, {signal})");
-    }
-
-    /// Waits (up to `limit`) for the exit; returns the exit code and all of stderr.
-    fn finish_within(mut self, limit: Duration) -> (Option<i32>, String) {
-        let deadline = Instant::now() + limit;
-        let status = loop {
-            if let Some(s) = self.child.try_wait().unwrap() {
-                break s;
-            }
-            if Instant::now() > deadline {
-                let _ = self.child.kill();
-                let _ = self.child.wait();
-                let rest: Vec<String> = self.lines.try_iter().collect();
-                panic!("process did not exit within {limit:?}:\n{}\n{}", self.log.join("\n"), rest.join("\n"));
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        };
-        let end = Instant::now() + Duration::from_secs(5);
-        while let Ok(line) = self.lines.recv_timeout(end.saturating_duration_since(Instant::now())) {
-            self.log.push(line);
-        }
-        (status.code(), self.log.join("\n"))
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
 }
 
 /// `python examples/python/<script> ARGS` in the kit's venv (not started).
@@ -333,7 +264,7 @@ fn python_controller_answers_the_handshake_and_frames_as_the_rust_one() {
     let h = hello(&id);
     let ack = plant.handshake(h);
     assert_eq!((ack.status, ack.session, ack.token, ack.protocol_version), (0, h.session, h.token, 3));
-    assert_eq!((wire::str_of(&ack.law).as_ref(), ack.overrides_len, ack.controller_pid), ("pd", 0, ctl.pid()));
+    assert_eq!((wire::str_of(&ack.law).as_ref(), ack.overrides_len, ack.controller_pid), ("pd", 0, ctl.id()));
     assert!(wire::str_of(&ack.message).contains("(Python)"), "{}", wire::str_of(&ack.message));
 
     let mut law = controller::build_law("pd", &h.design(), &controller::Params::default()).unwrap();
@@ -578,7 +509,7 @@ fn a_second_python_controller_under_a_live_run_id_is_refused() {
     );
     let lock = dir.join("locks").join(format!("{id}.controller.lock"));
     let until = Instant::now() + Duration::from_secs(30);
-    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.contains(&format!("pid {}", first.pid()))) {
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.contains(&format!("pid {}", first.id()))) {
         assert!(Instant::now() < until, "the first controller did not take {}", lock.display());
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -589,7 +520,7 @@ fn a_second_python_controller_under_a_live_run_id_is_refused() {
     );
     assert_exit(&second, 2);
     let err = stderr(&second);
-    assert!(err.contains("is in use by a live controller") && err.contains(&format!("pid {}", first.pid())), "{err}");
+    assert!(err.contains("is in use by a live controller") && err.contains(&format!("pid {}", first.id())), "{err}");
     first.signal(libc::SIGTERM);
     let (code, log) = first.finish_within(Duration::from_secs(30));
     assert_eq!(code, Some(130), "{log}");

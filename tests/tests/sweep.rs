@@ -4,8 +4,6 @@
 mod common;
 
 use common::*;
-use std::path::Path;
-use std::process::Command;
 
 /// A sweep file over the 10 G scene's shock peak, kept short.
 fn sweep_file(dir: &TempDir, points: usize) -> std::path::PathBuf {
@@ -18,25 +16,15 @@ fn sweep_file(dir: &TempDir, points: usize) -> std::path::PathBuf {
     path
 }
 
-fn sweep(file: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut cmd = Command::new(plant_bin());
-    cmd.arg("sweep").arg(file).arg("--out").arg(out).args(extra);
-    cmd
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
-}
-
 #[test]
 fn tiny_sweep_writes_points_poincare_and_diagrams() {
     let dir = TempDir::new("sweep-tiny");
     let file = sweep_file(&dir, 2);
     let out = dir.join("out");
-    let o = output(&mut sweep(&file, &out, &[]));
+    let o = output(&mut plant_sweep(&file, &out, &[]));
     assert_exit(&o, 0);
     // points.csv mixes numbers and words: read it as text.
-    let text = read(&out.join("points.csv"));
+    let text = read_text(&out.join("points.csv"));
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     for col in [
@@ -75,18 +63,18 @@ fn shards_merged_equal_an_unsharded_sweep() {
     let dir = TempDir::new("sweep-shards");
     let file = sweep_file(&dir, 3);
     let (whole, a, b) = (dir.join("whole"), dir.join("a"), dir.join("b"));
-    assert_exit(&output(&mut sweep(&file, &whole, &[])), 0);
-    assert_exit(&output(&mut sweep(&file, &a, &["--shard", "0/2"])), 0);
-    assert_exit(&output(&mut sweep(&file, &b, &["--shard", "1/2"])), 0);
+    assert_exit(&output(&mut plant_sweep(&file, &whole, &[])), 0);
+    assert_exit(&output(&mut plant_sweep(&file, &a, &["--shard", "0/2"])), 0);
+    assert_exit(&output(&mut plant_sweep(&file, &b, &["--shard", "1/2"])), 0);
     assert!(!a.join("points.csv").exists(), "a shard alone must not claim the whole result");
     // "Another machine's" shard: copy its points in, then merge.
     for entry in std::fs::read_dir(b.join("points")).expect("shard b points") {
         let entry = entry.expect("entry");
         std::fs::copy(entry.path(), a.join("points").join(entry.file_name())).expect("copy");
     }
-    assert_exit(&output(&mut sweep(&file, &a, &["--merge"])), 0);
-    assert_eq!(read(&a.join("points.csv")), read(&whole.join("points.csv")));
-    assert_eq!(read(&a.join("poincare.csv")), read(&whole.join("poincare.csv")));
+    assert_exit(&output(&mut plant_sweep(&file, &a, &["--merge"])), 0);
+    assert_eq!(read_text(&a.join("points.csv")), read_text(&whole.join("points.csv")));
+    assert_eq!(read_text(&a.join("poincare.csv")), read_text(&whole.join("poincare.csv")));
 }
 
 #[test]
@@ -94,7 +82,7 @@ fn interrupted_sweep_keeps_its_points_and_resumes() {
     let dir = TempDir::new("sweep-resume");
     let file = sweep_file(&dir, 6);
     let out = dir.join("out");
-    let child = sweep(&file, &out, &["--jobs", "1"]).stderr(std::process::Stdio::piped()).spawn().expect("start");
+    let child = plant_sweep(&file, &out, &["--jobs", "1"]).stderr(std::process::Stdio::piped()).spawn().expect("start");
     // Wait for the first finished point, then interrupt.
     let first = out.join("points").join("00000.json");
     let started = std::time::Instant::now();
@@ -119,12 +107,12 @@ fn interrupted_sweep_keeps_its_points_and_resumes() {
     assert!((1..6).contains(&done), "{done} points kept");
     assert!(!out.join("points.csv").exists());
     // Resume: only the missing points run.
-    let o = output(&mut sweep(&file, &out, &[]));
+    let o = output(&mut plant_sweep(&file, &out, &[]));
     assert_exit(&o, 0);
     assert!(stderr(&o).contains(&format!("reused {done}")), "{}", stderr(&o));
     let whole = dir.join("whole");
-    assert_exit(&output(&mut sweep(&file, &whole, &[])), 0);
-    assert_eq!(read(&out.join("points.csv")), read(&whole.join("points.csv")));
+    assert_exit(&output(&mut plant_sweep(&file, &whole, &[])), 0);
+    assert_eq!(read_text(&out.join("points.csv")), read_text(&whole.join("points.csv")));
 }
 
 #[test]
@@ -139,7 +127,7 @@ fn bad_sweep_file_exits_2_naming_the_key() {
         ),
     )
     .expect("write");
-    let o = output(&mut sweep(&path, &dir.join("out"), &[]));
+    let o = output(&mut plant_sweep(&path, &dir.join("out"), &[]));
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("bogus"), "{}", stderr(&o));
     std::fs::write(
@@ -150,7 +138,7 @@ fn bad_sweep_file_exits_2_naming_the_key() {
         ),
     )
     .expect("write");
-    let o = output(&mut sweep(&path, &dir.join("out"), &[]));
+    let o = output(&mut plant_sweep(&path, &dir.join("out"), &[]));
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("points = 0"), "{}", stderr(&o));
 }
@@ -165,8 +153,8 @@ fn two_key_map_writes_value2_and_the_mode_map() {
     );
     std::fs::write(&path, text).expect("write");
     let out = dir.join("out");
-    assert_exit(&output(&mut sweep(&path, &out, &[])), 0);
-    let text = read(&out.join("points.csv"));
+    assert_exit(&output(&mut plant_sweep(&path, &out, &[])), 0);
+    let text = read_text(&out.join("points.csv"));
     let header: Vec<&str> = text.lines().next().expect("header").split(',').collect();
     let v2 = header.iter().position(|h| *h == "value2").expect("value2 column");
     let v1 = header.iter().position(|h| *h == "value").expect("value column");

@@ -89,6 +89,18 @@ pub fn plant_run(scene: &Path, out: &Path, sets: &[&str]) -> Command {
     cmd
 }
 
+/// `plant sweep FILE --out OUT EXTRA…` (not started).
+pub fn plant_sweep(file: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("sweep").arg(file).arg("--out").arg(out).args(extra);
+    cmd
+}
+
+/// A text file's contents; the test fails naming the file if it cannot be read.
+pub fn read_text(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+}
+
 /// The limit of a command run by [`output`]: far above any test's command in a debug build on
 /// a loaded 2-core machine, so that only a hang reaches it.
 pub const DEFAULT_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
@@ -132,6 +144,11 @@ impl Proc {
     /// Process id.
     pub fn id(&self) -> u32 {
         self.child.id()
+    }
+
+    /// True while the process has not exited.
+    pub fn running(&mut self) -> bool {
+        self.child.try_wait().expect("waiting for the child").is_none()
     }
 
     /// Waits (up to 60 s) for a stderr line containing `needle`.
