@@ -176,8 +176,6 @@ mod tests {
     use crate::pd::SampledPd;
     use crate::test_plant::{decay_measure, simulate, AxisZoh, Rig};
 
-    use crate::test_plant::constants;
-
     const KE: f64 = 1e6;
     const XI: f64 = 0.01;
 
@@ -188,7 +186,7 @@ mod tests {
     /// Free decay from 10 µm on x; peak amplitude ratio last/first and the
     /// measured (ξ, ω_d).
     fn free_decay(law: &mut dyn ControlLaw, rate_hz: f64, delay: usize) -> (f64, (f64, f64)) {
-        let c = constants();
+        let c = LoopConstants::study();
         let period = 1.0 / rate_hz;
         let ticks = (0.6 / period) as usize; // ≈ 28 cycles at 47 Hz
         let (xs, _) = simulate(law, &c, Rig { period, delay, limit: 1e9 }, [[1e-5, 0.0], [0.0; 2]], [0.0; 2], ticks);
@@ -225,7 +223,7 @@ mod tests {
 
     #[test]
     fn zoh_matches_rk4() {
-        let c = constants();
+        let c = LoopConstants::study();
         for t in [5e-5, 1e-4, 1e-3] {
             let (phi, gamma) = axis_zoh(c.rotor_mass_kg, c.ks_n_per_m, t);
             let rk = AxisZoh::new(c.rotor_mass_kg, c.ks_n_per_m, t, 2000);
@@ -240,7 +238,7 @@ mod tests {
 
     #[test]
     fn tends_to_the_continuous_pd() {
-        let c = constants();
+        let c = LoopConstants::study();
         let pd = PdGains::from_design(&design(), &c).unwrap();
         let g = DelayPdGains::from_design(&design(), &c, 1e-7, 0).unwrap();
         assert!((g.pd.kp / pd.kp - 1.0).abs() < 1e-3, "{} vs {}", g.pd.kp, pd.kp);
@@ -249,7 +247,7 @@ mod tests {
 
     #[test]
     fn naive_pd_grows_and_pd_delay_holds_the_design() {
-        let c = constants();
+        let c = LoopConstants::study();
         let wd = (KE / c.rotor_mass_kg).sqrt() * (1.0 - XI * XI).sqrt();
         for rate in [20_000.0, 10_000.0] {
             let period = 1.0 / rate;
@@ -278,7 +276,7 @@ mod tests {
 
     #[test]
     fn pd_delay_without_delay_also_holds_the_design() {
-        let c = constants();
+        let c = LoopConstants::study();
         let period = 1.0 / 5_000.0;
         let mut law = DelayPd::new(DelayPdGains::from_design(&design(), &c, period, 0).unwrap(), period);
         let (_, (xi, _)) = free_decay(&mut law, 5_000.0, 0);
@@ -287,7 +285,7 @@ mod tests {
 
     #[test]
     fn reset_and_name() {
-        let c = constants();
+        let c = LoopConstants::study();
         let mut law = DelayPd::new(DelayPdGains::from_design(&design(), &c, 5e-5, 1).unwrap(), 5e-5);
         assert_eq!(law.name(), "pd_delay");
         let s0 = Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, -0.2] };
@@ -300,7 +298,7 @@ mod tests {
     #[test]
     fn overdamped_design_is_refused() {
         let d = PdDesign { stiffness_n_per_m: KE, damping_ratio: 1.2, gravity_bias: false };
-        let e = DelayPdGains::from_design(&d, &constants(), 5e-5, 1).unwrap_err().to_string();
+        let e = DelayPdGains::from_design(&d, &LoopConstants::study(), 5e-5, 1).unwrap_err().to_string();
         assert!(e.contains("controller.damping_ratio"), "{e}");
     }
 }

@@ -21,6 +21,22 @@ pub struct LoopConstants {
     pub air_gap_m: f64,
 }
 
+impl LoopConstants {
+    /// The study's constants with the default magnetics (MODEL.md §7), as the default scene
+    /// has them: for examples and tests.
+    pub fn study() -> Self {
+        Self {
+            ki_n_per_a: 216.0,
+            ks_n_per_m: 4.32e5,
+            amp_gain_a_per_v: 1.0,
+            sensor_gain_v_per_m: 25_000.0,
+            rotor_mass_kg: 11.5,
+            gravity_m_s2: 9.80665,
+            air_gap_m: 150e-6,
+        }
+    }
+}
+
 /// The common loop design a law is built from: the closed loop asked for,
 /// the sampling, the amplifier, and the plant constants. The plant converts
 /// its scene into one (`Scene::design`), the wire carries it in the hello

@@ -155,11 +155,9 @@ impl ControlLaw for SampledPd {
 mod tests {
     use super::*;
 
-    use crate::test_plant::constants;
-
     #[test]
     fn gains_reproduce_stiffness_damping_and_bias() {
-        let c = constants();
+        let c = LoopConstants::study();
         let d = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: true };
         let g = PdGains::from_design(&d, &c).unwrap();
         // A static offset Δ gives F = k_i i + k_s Δ = k_i i_bias − k_e Δ.
@@ -176,7 +174,7 @@ mod tests {
 
     #[test]
     fn sampled_pd_uses_backward_difference() {
-        let c = constants();
+        let c = LoopConstants::study();
         let d = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: false };
         let g = PdGains::from_design(&d, &c).unwrap();
         let mut law = SampledPd::new(g, 1e-4);
@@ -191,7 +189,7 @@ mod tests {
     #[test]
     fn bad_design_names_key_value_unit() {
         let d = PdDesign { stiffness_n_per_m: -1.0, damping_ratio: 0.01, gravity_bias: true };
-        let e = PdGains::from_design(&d, &constants()).unwrap_err().to_string();
+        let e = PdGains::from_design(&d, &LoopConstants::study()).unwrap_err().to_string();
         assert!(e.contains("controller.stiffness_n_per_m") && e.contains("-1") && e.contains("N/m"), "{e}");
     }
 }

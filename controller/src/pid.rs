@@ -183,15 +183,13 @@ mod tests {
     use crate::law::saturate;
     use crate::test_plant::{simulate, Rig};
 
-    use crate::test_plant::constants;
-
     fn design(xi: f64, gravity_bias: bool) -> PidDesign {
         PidDesign { pd: PdDesign { stiffness_n_per_m: 1e6, damping_ratio: xi, gravity_bias }, integral_time_s: None }
     }
 
     #[test]
     fn gains_place_the_design_pair_and_the_integral_pole() {
-        let c = constants();
+        let c = LoopConstants::study();
         let g = PidGains::from_design(&design(0.01, false), &c).unwrap();
         let l = c.ki_n_per_a * c.amp_gain_a_per_v * c.sensor_gain_v_per_m;
         let (m, wn) = (c.rotor_mass_kg, (1e6 / c.rotor_mass_kg).sqrt());
@@ -214,7 +212,7 @@ mod tests {
 
     #[test]
     fn integral_removes_the_static_sag_without_gravity_bias() {
-        let c = constants();
+        let c = LoopConstants::study();
         let period = 5e-5;
         let g = -c.rotor_mass_kg * c.gravity_m_s2;
         let sag = c.rotor_mass_kg * c.gravity_m_s2 / 1e6;
@@ -236,7 +234,7 @@ mod tests {
 
     #[test]
     fn integral_starts_at_zero_with_gravity_bias_and_the_loop_is_stable() {
-        let c = constants();
+        let c = LoopConstants::study();
         let period = 5e-5;
         // ξ_e = 0.2: at ξ_e = 0.01, 20 kHz and d = 1 the PID's pair is as
         // unstable as the naive PD's (the same sampled-PD lag; see `pd_delay`).
@@ -278,7 +276,7 @@ mod tests {
 
     #[test]
     fn anti_windup_leaves_the_limit_promptly() {
-        let c = constants();
+        let c = LoopConstants::study();
         let limit = 2.0;
         let gains = PidGains::from_design(&design(0.2, false), &c).unwrap();
         let held = ticks_to_leave(&mut SampledPid::new(gains, 5e-5, limit), limit);
@@ -290,7 +288,7 @@ mod tests {
 
     #[test]
     fn reset_clears_the_state() {
-        let c = constants();
+        let c = LoopConstants::study();
         let gains = PidGains::from_design(&design(0.01, true), &c).unwrap();
         let mut law = SampledPid::new(gains, 5e-5, 2.0);
         assert_eq!(law.name(), "pid");
@@ -307,7 +305,7 @@ mod tests {
     #[test]
     fn bad_integral_time_is_refused() {
         let d = PidDesign { integral_time_s: Some(-1.0), ..design(0.01, true) };
-        let e = PidGains::from_design(&d, &constants()).unwrap_err().to_string();
+        let e = PidGains::from_design(&d, &LoopConstants::study()).unwrap_err().to_string();
         assert!(e.contains("controller.params.integral_time_s"), "{e}");
     }
 }

@@ -67,7 +67,7 @@ mod tests {
             gravity_bias: true,
             current_limit_a: 2.0,
             delay_samples: 1,
-            constants: crate::test_plant::constants(),
+            constants: crate::law::LoopConstants::study(),
         }
     }
 

@@ -249,18 +249,17 @@ impl ControlLaw for Relev {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_plant::constants;
 
     const PERIOD: f64 = 5e-5;
 
     fn law(hold_s: f64) -> Relev {
         let nominal = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: false };
         let rule = RelevSpec { enter_m: 100e-6, exit_m: 30e-6, damping_ratio: 0.2, hold_s, arm_s: 0.0 };
-        Relev::new(&nominal, &rule, &constants(), PERIOD, 1).unwrap()
+        Relev::new(&nominal, &rule, &LoopConstants::study(), PERIOD, 1).unwrap()
     }
 
     fn at(law: &mut Relev, k: u64, x_m: f64) -> [f64; 2] {
-        let u = [x_m * constants().sensor_gain_v_per_m, 0.0];
+        let u = [x_m * LoopConstants::study().sensor_gain_v_per_m, 0.0];
         law.update(&Sample { seq: k, t_s: k as f64 * PERIOD, sensor_v: u })
     }
 
@@ -296,7 +295,7 @@ mod tests {
     #[test]
     fn recovery_design_is_the_stronger_damper() {
         // Same displacement, same rate: the recovery gains push harder against the velocity.
-        let c = constants();
+        let c = LoopConstants::study();
         let (mut a, mut b) = (law(0.0), law(0.0));
         at(&mut a, 0, 10e-6);
         let slow = at(&mut a, 1, 11e-6);
@@ -331,7 +330,7 @@ mod tests {
     fn the_rule_waits_for_its_arming_time() {
         let nominal = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: false };
         let rule = RelevSpec { enter_m: 100e-6, exit_m: 30e-6, damping_ratio: 0.2, hold_s: 0.0, arm_s: 10.0 * PERIOD };
-        let mut l = Relev::new(&nominal, &rule, &constants(), PERIOD, 1).unwrap();
+        let mut l = Relev::new(&nominal, &rule, &LoopConstants::study(), PERIOD, 1).unwrap();
         for k in 0..10 {
             at(&mut l, k, 200e-6);
             assert_eq!(l.phase(), Phase::Nominal, "sample {k}, before arming");
@@ -395,7 +394,7 @@ mod tests {
             (RelevSpec { arm_s: -1.0, ..ok }, "controller.params.arm_ms"),
         ];
         for (rule, key) in cases {
-            let e = Relev::new(&nominal, &rule, &constants(), PERIOD, 1).unwrap_err().to_string();
+            let e = Relev::new(&nominal, &rule, &LoopConstants::study(), PERIOD, 1).unwrap_err().to_string();
             assert!(e.contains(key), "{e}");
         }
     }

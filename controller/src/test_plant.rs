@@ -123,16 +123,3 @@ pub(crate) fn decay_measure(x: &[f64], period: f64, skip_s: f64) -> (f64, f64) {
     let t_cycle = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
     (zeta, 2.0 * std::f64::consts::PI / t_cycle)
 }
-
-/// The study's loop constants with the default magnetics (MODEL.md §7).
-pub(crate) fn constants() -> crate::law::LoopConstants {
-    crate::law::LoopConstants {
-        ki_n_per_a: 216.0,
-        ks_n_per_m: 4.32e5,
-        amp_gain_a_per_v: 1.0,
-        sensor_gain_v_per_m: 25_000.0,
-        rotor_mass_kg: 11.5,
-        gravity_m_s2: 9.80665,
-        air_gap_m: 150e-6,
-    }
-}

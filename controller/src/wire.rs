@@ -613,15 +613,7 @@ impl Hello {
             gravity_bias: true,
             current_limit_a: 2.0,
             delay_samples: 1,
-            constants: LoopConstants {
-                ki_n_per_a: 216.0,
-                ks_n_per_m: 4.32e5,
-                amp_gain_a_per_v: 1.0,
-                sensor_gain_v_per_m: 25_000.0,
-                rotor_mass_kg: 11.5,
-                gravity_m_s2: 9.80665,
-                air_gap_m: 150e-6,
-            },
+            constants: LoopConstants::study(),
         };
         let mut h = Self::new(run_id, "pd", &design, 20_000.0, "").expect("an empty document fits");
         h.session = 1;

@@ -54,15 +54,7 @@ pub fn study_params() -> Params {
         race_when_clear: RaceWhenClear::Free,
         drag: RaceDrag::Constant { torque: 0.1, reg_speed: 1.0 },
         amb: AmbLaw::Linear { ki: 216.0, ks: 4.32e5 },
-        loop_constants: LoopConstants {
-            ki_n_per_a: 216.0,
-            ks_n_per_m: 4.32e5,
-            amp_gain_a_per_v: 1.0,
-            sensor_gain_v_per_m: 25_000.0,
-            rotor_mass_kg: 11.5,
-            gravity_m_s2: 9.80665,
-            air_gap_m: 0.15e-3,
-        },
+        loop_constants: LoopConstants::study(),
         current_limit: 2.0,
     }
 }
