@@ -64,8 +64,38 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), e)
 }
 
-fn csv_writer(path: &Path) -> anyhow::Result<(csv::Writer<Vec<u8>>, std::path::PathBuf)> {
-    Ok((csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new()), path.to_path_buf()))
+/// A CSV table gathered in memory (its header written by hand), for [`finish`].
+fn csv_writer() -> csv::Writer<Vec<u8>> {
+    csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new())
+}
+
+/// The leading columns of a `points.csv` row, [`SINGLE_COLUMNS`] in their order: a single
+/// run's point and an ensemble point (its modal figures) write the same ones.
+#[allow(clippy::too_many_arguments)]
+fn single_fields(
+    value: f64,
+    post_shock_mode: &str,
+    steady_class: &str,
+    period_k: Option<u32>,
+    contact_fraction: f64,
+    whirl_hz: f64,
+    max_radius_m: f64,
+    max_contact_force_n: f64,
+    status: &str,
+    index: usize,
+) -> Vec<String> {
+    vec![
+        e(value),
+        post_shock_mode.to_string(),
+        steady_class.to_string(),
+        period_k.map_or(String::new(), |k| k.to_string()),
+        e(contact_fraction),
+        e(whirl_hz),
+        e(max_radius_m),
+        e(max_contact_force_n),
+        status.to_string(),
+        index.to_string(),
+    ]
 }
 
 fn finish(w: csv::Writer<Vec<u8>>, path: &Path) -> anyhow::Result<()> {
@@ -79,9 +109,9 @@ fn finish(w: csv::Writer<Vec<u8>>, path: &Path) -> anyhow::Result<()> {
 pub fn write_single(sweep: &Sweep, dir: &Path, points: &[&PointResult]) -> anyhow::Result<()> {
     let map = sweep.axes.len() > 1;
     let second = |v: Option<f64>| if map { vec![opt(v)] } else { Vec::new() };
-    let (mut w, path) = csv_writer(&dir.join("points.csv"))?;
+    let mut w = csv_writer();
     let mut header: Vec<&str> = SINGLE_COLUMNS.to_vec();
-    let (mut pw, ppath) = csv_writer(&dir.join("poincare.csv"))?;
+    let mut pw = csv_writer();
     let mut pheader = vec!["value", "n", "x_m", "y_m"];
     if map {
         header.push("value2");
@@ -90,18 +120,18 @@ pub fn write_single(sweep: &Sweep, dir: &Path, points: &[&PointResult]) -> anyho
     w.write_record(&header)?;
     pw.write_record(&pheader)?;
     for p in points {
-        let mut row = vec![
-            e(p.value),
-            p.post_shock_mode.clone(),
-            p.steady_class.clone(),
-            p.period_k.map_or(String::new(), |k| k.to_string()),
-            e(p.contact_fraction),
-            e(p.whirl_hz),
-            e(p.max_radius_m),
-            e(p.max_contact_force_n),
-            p.status.clone(),
-            p.index.to_string(),
-        ];
+        let mut row = single_fields(
+            p.value,
+            &p.post_shock_mode,
+            &p.steady_class,
+            p.period_k,
+            p.contact_fraction,
+            p.whirl_hz,
+            p.max_radius_m,
+            p.max_contact_force_n,
+            &p.status,
+            p.index,
+        );
         row.extend(second(p.value2));
         w.write_record(&row)?;
         for (n, x, y) in &p.poincare {
@@ -110,8 +140,8 @@ pub fn write_single(sweep: &Sweep, dir: &Path, points: &[&PointResult]) -> anyho
             pw.write_record(&r)?;
         }
     }
-    finish(w, &path)?;
-    finish(pw, &ppath)?;
+    finish(w, &dir.join("points.csv"))?;
+    finish(pw, &dir.join("poincare.csv"))?;
     let owned: Vec<ModePoint> = points
         .iter()
         .map(|p| ModePoint { value: p.value, value2: p.value2, mode: &p.post_shock_mode, poincare: &p.poincare })
@@ -351,14 +381,14 @@ pub fn write_ensemble(
 
     // points.csv: the single-run columns, then the statistics.
     let map = sweep.axes.len() > 1;
-    let mut w = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+    let mut w = csv_writer();
     let mut header: Vec<&str> = SINGLE_COLUMNS.to_vec();
     if map {
         header.push("value2");
     }
     header.extend(ENSEMBLE_COLUMNS);
     w.write_record(&header)?;
-    let mut pw = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+    let mut pw = csv_writer();
     let mut pheader = vec!["value", "n", "x_m", "y_m"];
     if map {
         pheader.push("value2");
@@ -368,18 +398,18 @@ pub fn write_ensemble(
     for (s, (members, _)) in stats.iter().zip(counted) {
         let (v1, v2) = values[s.index];
         let v1 = v1.unwrap_or(f64::NAN);
-        let mut row = vec![
-            e(v1),
-            s.post_shock_mode.clone(),
-            s.steady_class.clone(),
-            s.period_k.map_or(String::new(), |k| k.to_string()),
-            e(s.contact_fraction),
-            e(s.whirl_hz),
-            e(s.max_radius_m),
-            e(s.worst_contact_force_n),
-            s.status.clone(),
-            s.index.to_string(),
-        ];
+        let mut row = single_fields(
+            v1,
+            &s.post_shock_mode,
+            &s.steady_class,
+            s.period_k,
+            s.contact_fraction,
+            s.whirl_hz,
+            s.max_radius_m,
+            s.worst_contact_force_n,
+            &s.status,
+            s.index,
+        );
         if map {
             row.push(opt(v2));
         }
