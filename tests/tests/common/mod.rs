@@ -343,36 +343,37 @@ pub fn num(v: &serde_json::Value, key: &str) -> f64 {
     v[key].as_f64().unwrap_or_else(|| panic!("`{key}` is not a number in {v:#}"))
 }
 
+/// The `peak-rss` helper (`tests/bin/peak_rss.rs`), built once per test binary.
+pub fn peak_rss_bin() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| build_bin("testbed-tests", "peak-rss"))
+}
+
 /// Runs a command to completion within `limit` (killed past it, failing the test) and
-/// returns its exit code and its peak resident memory (KiB, `ru_maxrss` of that child
-/// alone, from `wait4`).
+/// returns its exit code and its peak resident memory (KiB, `ru_maxrss` of that command
+/// alone). The command is started by the small `peak-rss` helper, not by this test process:
+/// a child this process started would carry this process's own memory peak (reads of large
+/// traces, other tests' threads) into its `ru_maxrss` (see `tests/bin/peak_rss.rs`).
 #[cfg(target_os = "linux")]
-#[allow(clippy::zombie_processes)] // reaped by `wait4` below, which std does not know of
 pub fn peak_rss_within(cmd: &mut Command, limit: std::time::Duration) -> (Option<i32>, u64) {
-    let mut child = cmd
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"));
-    let pid = child.id() as libc::pid_t;
-    let deadline = std::time::Instant::now() + limit;
-    loop {
-        let mut status = 0;
-        // SAFETY: plain syscall on our own child; `usage` is a valid out-parameter.
-        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-        let r = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
-        if r == pid {
-            let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
-            return (code, usage.ru_maxrss as u64);
-        }
-        assert!(r == 0, "wait4 failed: {}", std::io::Error::last_os_error());
-        if std::time::Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{cmd:?} did not finish within {limit:?}: killed");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
+    let mut helper = Command::new(peak_rss_bin());
+    helper.arg(cmd.get_program()).args(cmd.get_args());
+    for (key, value) in cmd.get_envs() {
+        match value {
+            Some(v) => helper.env(key, v),
+            None => helper.env_remove(key),
+        };
     }
+    if let Some(dir) = cmd.get_current_dir() {
+        helper.current_dir(dir);
+    }
+    let out = output_within(&mut helper, limit);
+    assert_exit(&out, 0);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let mut fields = text.split_whitespace();
+    let code = fields.next().and_then(|c| c.parse().ok());
+    let kib = fields.next().and_then(|k| k.parse().ok()).unwrap_or_else(|| panic!("peak-rss printed {text:?}"));
+    (code, kib)
 }
 
 /// A decoded PNG, as RGB pixels.
