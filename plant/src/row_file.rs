@@ -1,5 +1,5 @@
-//! A CSV file that only ever holds its header and whole rows, so that a
-//! process killed at any moment (SIGKILL included) leaves a file every reader
+//! A CSV file that holds its header and whole rows between its writes, so that
+//! a process killed between them (SIGKILL included) leaves a file every reader
 //! can read to its last row: `trace.csv` and the soak's `soak.csv`,
 //! `envelope.csv` and `rss.csv`.
 //!
@@ -15,9 +15,10 @@ const FLUSH_BYTES: usize = 64 * 1024;
 
 /// A CSV file that only ever holds its header and whole rows: the `csv`
 /// crate formats each record into memory, and [`RowFile::flush`] hands the
-/// pending rows to the file in one `write` of whole rows (a SIGKILL lands
-/// between two writes, unless it arrives during one: microseconds in every
-/// 64 KiB). The header is written at creation.
+/// pending rows to the file in one `write` of whole rows. A SIGKILL between two
+/// writes leaves whole rows; one that lands during a write can cut it at a page
+/// boundary (the kernel stops a write at a fatal signal), leaving a last line
+/// without its line end. The header is written at creation.
 pub struct RowFile {
     file: File,
     csv: csv::Writer<Pending>,

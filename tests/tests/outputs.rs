@@ -233,9 +233,11 @@ fn a_folder_in_use_by_a_live_run_is_refused_to_a_second_command() {
     assert!(!stderr(&again).contains("in use"), "{}", stderr(&again));
 }
 
-/// A run killed by SIGKILL at any moment leaves a `trace.csv` of whole rows that `plant
-/// analyze` reads (rows reach the file in whole-row chunks; a byte-counting buffer used to
-/// leave a row cut in the middle, which the strict reader rightly refuses).
+/// A run killed by SIGKILL between two writes of its trace leaves a `trace.csv` of whole
+/// rows that `plant analyze` reads: rows reach the file in whole-row chunks (a byte-counting
+/// buffer used to leave a row cut in the middle, which the strict reader rightly refuses).
+/// A kill that lands during a chunk's write can still cut it (row_file.rs): the test kills
+/// once the file has stopped growing, not at the moment it grows.
 #[test]
 fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
     let dir = TempDir::new("killed-run");
@@ -251,6 +253,17 @@ fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
                 "the run did not write {bytes} bytes of trace in time"
             );
             std::thread::sleep(Duration::from_millis(5));
+        }
+        // Between two writes: the size unchanged over 20 ms (writes come tenths of a second
+        // apart and last microseconds).
+        let mut size = std::fs::metadata(&trace).map_or(0, |m| m.len());
+        loop {
+            std::thread::sleep(Duration::from_millis(20));
+            let now = std::fs::metadata(&trace).map_or(0, |m| m.len());
+            if now == size {
+                break;
+            }
+            size = now;
         }
         run.signal(libc::SIGKILL);
         let (code, _) = run.finish_within(LIMIT);
