@@ -1,0 +1,286 @@
+//! The documentation holds together: every relative link between the pages,
+//! or to a file of the repository, resolves (with its `#anchor`, if any, to a
+//! heading of the page it names); every scene, sweep or programme file a page
+//! names exists; every page of the guide, the results and the developer notes
+//! is reachable from the README; and the README stays a short front door.
+//!
+//! Links are read as Markdown writes them, `[text](target)`; code spans and
+//! fenced blocks are skipped (their brackets are code, not links). Anchors
+//! follow GitHub's rule: the heading's text in lower case, every character
+//! other than a letter, a digit, `-`, `_` or a space dropped, spaces turned
+//! into `-`, and `-1`, `-2` … for repeated headings.
+
+mod common;
+
+use std::collections::{BTreeSet, HashMap};
+use std::fs;
+use std::path::{Component, Path, PathBuf};
+
+/// Every Markdown file of the repository that users or developers read.
+fn pages() -> Vec<PathBuf> {
+    let root = common::workspace_root();
+    let mut out = vec![root.join("README.md")];
+    let mut stack = vec![root.join("docs"), root.join("bench"), root.join("examples"), root.join("python")];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = fs::read_dir(&dir) else { continue };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let name = entry.file_name().to_string_lossy().to_string();
+            if path.is_dir() {
+                // Build outputs and virtual environments hold other projects' Markdown.
+                if !matches!(name.as_str(), "target" | ".venv" | "venv" | "node_modules") && !name.starts_with('.') {
+                    stack.push(path);
+                }
+            } else if name.ends_with(".md") {
+                out.push(path);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The text of a page with code spans and fenced blocks blanked (line structure kept).
+fn prose(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            out.push('\n');
+            continue;
+        }
+        if fenced {
+            out.push('\n');
+            continue;
+        }
+        let mut in_code = false;
+        for c in line.chars() {
+            if c == '`' {
+                in_code = !in_code;
+                out.push(' ');
+            } else {
+                out.push(if in_code { ' ' } else { c });
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The `(line, target)` of every `[text](target)` link of a page.
+fn links(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    for (n, line) in prose(text).lines().enumerate() {
+        let bytes = line.as_bytes();
+        let mut i = 0;
+        while let Some(off) = line[i..].find("](") {
+            let start = i + off + 2;
+            let mut depth = 1;
+            let mut end = start;
+            while end < bytes.len() {
+                match bytes[end] {
+                    b'(' => depth += 1,
+                    b')' => {
+                        depth -= 1;
+                        if depth == 0 {
+                            break;
+                        }
+                    }
+                    _ => {}
+                }
+                end += 1;
+            }
+            if end < bytes.len() {
+                let target = line[start..end].split_whitespace().next().unwrap_or("").to_string();
+                out.push((n + 1, target));
+            }
+            i = end.min(bytes.len().saturating_sub(1)).max(start);
+            if i >= line.len() {
+                break;
+            }
+        }
+    }
+    out
+}
+
+/// GitHub's anchors of a page's headings.
+fn anchors(text: &str) -> BTreeSet<String> {
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut out = BTreeSet::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced || !line.starts_with('#') {
+            continue;
+        }
+        let title = line.trim_start_matches('#').trim();
+        let slug: String = title
+            .to_lowercase()
+            .chars()
+            .filter(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | ' '))
+            .map(|c| if c == ' ' { '-' } else { c })
+            .collect();
+        let n = seen.entry(slug.clone()).or_insert(0);
+        out.insert(if *n == 0 { slug.clone() } else { format!("{slug}-{n}") });
+        *n += 1;
+    }
+    out
+}
+
+/// `path` with `.` and `..` resolved lexically.
+fn normalise(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+fn rel(path: &Path) -> String {
+    path.strip_prefix(common::workspace_root()).unwrap_or(path).display().to_string()
+}
+
+#[test]
+fn every_relative_link_resolves_to_a_file_and_heading() {
+    let mut broken = Vec::new();
+    let mut checked = 0;
+    for page in pages() {
+        let text = fs::read_to_string(&page).unwrap();
+        for (line, target) in links(&text) {
+            if target.is_empty()
+                || target.starts_with("http://")
+                || target.starts_with("https://")
+                || target.starts_with("mailto:")
+            {
+                continue;
+            }
+            checked += 1;
+            let (file, anchor) = match target.split_once('#') {
+                Some((f, a)) => (f, Some(a)),
+                None => (target.as_str(), None),
+            };
+            let dest = if file.is_empty() { page.clone() } else { normalise(&page.parent().unwrap().join(file)) };
+            if !dest.exists() {
+                broken.push(format!("{}:{line}: `{target}`: no file {}", rel(&page), rel(&dest)));
+                continue;
+            }
+            if let Some(anchor) = anchor {
+                if dest.extension().is_some_and(|e| e == "md") {
+                    let known = anchors(&fs::read_to_string(&dest).unwrap());
+                    if !known.contains(anchor) {
+                        broken.push(format!(
+                            "{}:{line}: `{target}`: {} has no heading `#{anchor}`",
+                            rel(&page),
+                            rel(&dest)
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 40, "only {checked} links found: the link reader is broken");
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+/// Paths like `config/x.toml`, `config/sweeps/y.toml` or `examples/python/z.toml` named in a
+/// page's text (code spans included: that is where commands name them).
+fn named_files(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        for prefix in ["config/", "examples/"] {
+            let mut from = 0;
+            while let Some(off) = line[from..].find(prefix) {
+                let start = from + off;
+                from = start + prefix.len();
+                // Part of a longer path (`docs/…/config/`, `plant/src/config/`): not a scene file.
+                if start > 0 && !matches!(line.as_bytes()[start - 1], b' ' | b'`' | b'(' | b'"' | b'\'' | b'=' | b'[') {
+                    continue;
+                }
+                let end = line[start..]
+                    .find(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '/' | '.' | '_' | '-')))
+                    .map_or(line.len(), |e| start + e);
+                let path = line[start..end].trim_end_matches('.');
+                // `config/sweeps/NAME.toml`: a placeholder, not a file.
+                let stem = path.rsplit('/').next().unwrap_or("").trim_end_matches(".toml");
+                let placeholder = stem.chars().all(|c| c.is_ascii_uppercase() || c == '_');
+                if path.ends_with(".toml") && !placeholder && !path.contains('*') && !path.contains('<') {
+                    out.push((n + 1, path.to_string()));
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_scene_file_a_page_names_exists() {
+    let root = common::workspace_root();
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for page in pages() {
+        let text = fs::read_to_string(&page).unwrap();
+        for (line, path) in named_files(&text) {
+            checked += 1;
+            // Paths are named from the repository's root; a page inside an example may name its
+            // own files from its folder.
+            let ok = root.join(&path).exists() || page.parent().unwrap().join(&path).exists();
+            if !ok {
+                missing.push(format!("{}:{line}: names {path}, which does not exist", rel(&page)));
+            }
+        }
+    }
+    assert!(checked > 20, "only {checked} scene files named: the reader is broken");
+    assert!(missing.is_empty(), "scene files named but missing:\n{}", missing.join("\n"));
+}
+
+#[test]
+fn every_guide_results_and_developer_page_is_linked_from_the_readme() {
+    let root = common::workspace_root();
+    let readme = fs::read_to_string(root.join("README.md")).unwrap();
+    let linked: BTreeSet<PathBuf> =
+        links(&readme).into_iter().map(|(_, t)| normalise(&root.join(t.split('#').next().unwrap()))).collect();
+    let mut orphans = Vec::new();
+    for dir in ["docs/guide", "docs/results", "docs/dev"] {
+        for entry in fs::read_dir(root.join(dir)).unwrap().flatten() {
+            let path = entry.path();
+            if path.extension().is_some_and(|e| e == "md") && !linked.contains(&path) {
+                orphans.push(rel(&path));
+            }
+        }
+    }
+    assert!(orphans.is_empty(), "pages a newcomer cannot find from the README: {orphans:?}");
+}
+
+#[test]
+fn the_readme_is_a_short_front_door_starting_with_the_two_commands() {
+    let readme = fs::read_to_string(common::workspace_root().join("README.md")).unwrap();
+    let lines = readme.lines().count();
+    assert!(lines <= 200, "README.md has {lines} lines; the guide pages hold the rest");
+    let first_block = readme.split("```sh").nth(1).and_then(|b| b.split("```").next()).unwrap_or("");
+    assert!(
+        first_block.contains("target/release/plant run") && first_block.contains("cargo test --workspace --locked"),
+        "the README's first code block must hold the main job and the test command:\n{first_block}"
+    );
+    let ci = fs::read_to_string(common::workspace_root().join(".ci/run")).unwrap();
+    assert!(ci.contains("cargo test --workspace --locked"), ".ci/run must run the README's test command");
+}
+
+#[test]
+fn the_link_reader_finds_links_and_skips_code() {
+    let text = "see [a](x.md) and [b](y.md#z) `[c](not.md)`\n```\n[d](no.md)\n```\n[e](w (1).md)";
+    let found: Vec<String> = links(text).into_iter().map(|(_, t)| t).collect();
+    assert_eq!(found, ["x.md", "y.md#z", "w"]);
+    let a = anchors("# The `plant` CLI\n## Bounds\n## Bounds\n### Big sweeps on a cluster (Slurm)");
+    assert!(a.contains("the-plant-cli") && a.contains("bounds") && a.contains("bounds-1"), "{a:?}");
+    assert!(a.contains("big-sweeps-on-a-cluster-slurm"), "{a:?}");
+}
