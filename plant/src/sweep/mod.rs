@@ -353,7 +353,7 @@ impl std::str::FromStr for Shard {
     }
 }
 
-/// Why a sweep or ensemble stopped short; [`SweepError::exit_code`] gives its exit code.
+/// Why a sweep or ensemble stopped short (its exit code: [`crate::exit`]).
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     /// Units made for another scene, definition, draw or program version, or damaged/edited
@@ -393,25 +393,4 @@ fn list(items: &[String]) -> String {
         s.push_str(&format!("\n  … and {} more", items.len() - SHOWN));
     }
     s
-}
-
-impl SweepError {
-    /// The exit code of this error (README, exit codes).
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            SweepError::Mismatch { .. } => 2,
-            SweepError::Failed { .. } => 3,
-            SweepError::Incomplete { .. } => 7,
-            SweepError::Interrupted => 130,
-        }
-    }
-}
-
-/// The exit code of an error from `plant sweep` / `plant ensemble`: 2 for bad input
-/// ([`ConfigError`]), the [`SweepError`]'s own, else `None` (an output could not be written: 1).
-pub fn exit_code(e: &anyhow::Error) -> Option<u8> {
-    if e.downcast_ref::<ConfigError>().is_some() {
-        return Some(2);
-    }
-    e.downcast_ref::<SweepError>().map(SweepError::exit_code)
 }

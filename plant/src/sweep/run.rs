@@ -16,7 +16,6 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 /// Options shared by `plant sweep` and `plant ensemble`.
 #[derive(clap::Args, Debug, Clone, Default)]
@@ -136,11 +135,7 @@ pub fn execute(sweep: &Sweep, dir: &Path, args: &RunArgs) -> anyhow::Result<()> 
     }
     manifest.write(dir)?;
 
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        eprintln!("plant: warning: cannot install the Ctrl-C handler: {e}");
-    }
+    let stop = crate::interrupt::stop_flag();
     let shard = args.shard.unwrap_or(Shard::ALL);
     let progress_bar = !args.quiet && std::io::stderr().is_terminal();
     let outcome = match &sweep.ensemble {
