@@ -17,10 +17,10 @@
 //! (continuous rubbing; its whirl frequency and direction come from the mean
 //! angular rate of the orbit), `rebound` otherwise (repeated impacts).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// How the steady response repeats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyClass {
     /// One Poincaré point.
@@ -36,6 +36,15 @@ pub enum SteadyClass {
 }
 
 impl SteadyClass {
+    /// Every class.
+    pub const ALL: [SteadyClass; 5] = [
+        SteadyClass::Periodic,
+        SteadyClass::KtPeriodic,
+        SteadyClass::QuasiPeriodic,
+        SteadyClass::Irregular,
+        SteadyClass::Unknown,
+    ];
+
     /// The name written in the outputs (`kt_periodic`, …).
     pub fn name(self) -> &'static str {
         match self {
@@ -49,7 +58,7 @@ impl SteadyClass {
 }
 
 /// What the rotor does after the shock.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MotionMode {
     /// Back on its small unbalance orbit, no contact.
@@ -268,13 +277,7 @@ mod tests {
 
     #[test]
     fn names_are_the_serialised_names() {
-        for c in [
-            SteadyClass::Periodic,
-            SteadyClass::KtPeriodic,
-            SteadyClass::QuasiPeriodic,
-            SteadyClass::Irregular,
-            SteadyClass::Unknown,
-        ] {
+        for c in SteadyClass::ALL {
             assert_eq!(serde_json::to_value(c).unwrap(), c.name());
         }
     }
