@@ -9,8 +9,8 @@
 use crate::claim::ClaimError;
 use crate::config::ConfigError;
 use crate::cosim::CosimError;
+use crate::grid::GridError;
 use crate::output::AnalyzeError;
-use crate::sweep::SweepError;
 
 /// An exit code of `plant`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,7 +92,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
     by_type!(
         Ending,
         CosimError,
-        SweepError,
+        GridError,
         ClaimError,
         ConfigError,
         controller::LawError,
@@ -175,13 +175,13 @@ impl HasExitCode for CosimError {
     }
 }
 
-impl HasExitCode for SweepError {
+impl HasExitCode for GridError {
     fn exit_code(&self) -> Code {
         match self {
-            SweepError::Mismatch { .. } => Code::BadInput,
-            SweepError::Failed { .. } => Code::Diverged,
-            SweepError::Incomplete { .. } => Code::Incomplete,
-            SweepError::Interrupted => Code::Interrupted,
+            GridError::Mismatch { .. } => Code::BadInput,
+            GridError::Failed { .. } => Code::Diverged,
+            GridError::Incomplete { .. } => Code::Incomplete,
+            GridError::Interrupted => Code::Interrupted,
         }
     }
 }
@@ -261,10 +261,10 @@ mod tests {
             ),
             (AnalyzeError::Trace(crate::trace::TraceError::TooShort { path: "trace.csv".into(), rows: 1 }).into(), 2),
             (AnalyzeError::Output(anyhow::anyhow!("read-only")).into(), 1),
-            (SweepError::Mismatch { dir: "d".into(), units: Vec::new() }.into(), 2),
-            (SweepError::Failed { failed: Vec::new() }.into(), 3),
+            (GridError::Mismatch { dir: "d".into(), units: Vec::new() }.into(), 2),
+            (GridError::Failed { failed: Vec::new() }.into(), 3),
             (
-                anyhow::Error::from(SweepError::Incomplete {
+                anyhow::Error::from(GridError::Incomplete {
                     dir: "d".into(),
                     missing: Vec::new(),
                     corrupt: Vec::new(),
@@ -272,7 +272,7 @@ mod tests {
                 .context("merging"),
                 7,
             ),
-            (SweepError::Interrupted.into(), 130),
+            (GridError::Interrupted.into(), 130),
             (ClaimError::InUse { path: "d".into(), holder: String::new() }.into(), 2),
             // An output that could not be written, whatever its message says.
             (anyhow::Error::from(std::io::Error::other("bad input")).context("writing summary.json"), 1),

@@ -25,6 +25,7 @@ pub mod config;
 pub mod cosim;
 pub mod ensemble;
 pub mod exit;
+pub mod grid;
 pub mod hooks;
 pub mod initial;
 pub mod interrupt;
