@@ -80,6 +80,10 @@ pub fn execute<W: Work>(grid: &Grid, work: &W, dir: &Path, args: &RunArgs) -> an
         }
     }
     std::fs::create_dir_all(dir.join("points")).with_context(|| format!("creating {}", dir.display()))?;
+    let removed = store::remove_temporaries(dir);
+    if !removed.is_empty() {
+        eprintln!("plant: note: removed {} temporary file(s) of writes a kill interrupted", removed.len());
+    }
     let manifest = Manifest::of(grid, work)?;
     match Manifest::read(dir) {
         Ok(Some(old)) if old != manifest => eprintln!(

@@ -140,6 +140,16 @@ pub fn read_unit<T: DeserializeOwned>(
     Found::Good(result)
 }
 
+/// Removes the temporaries of unit and output writes killed half-way (a SIGKILL during an
+/// atomic write) from the folder, its `points/` and each point's member folder, leaving those
+/// of live writers (another shard's); returns what it removed.
+pub fn remove_temporaries(dir: &Path) -> Vec<PathBuf> {
+    let points = dir.join("points");
+    let members = std::fs::read_dir(&points).into_iter().flatten().flatten().map(|e| e.path()).filter(|p| p.is_dir());
+    let folders: Vec<PathBuf> = [dir.to_path_buf(), points.clone()].into_iter().chain(members).collect();
+    folders.iter().flat_map(|f| crate::atomic::remove_stale(f)).collect()
+}
+
 /// The unit files present in a folder (temporary files of atomic writes are skipped), and
 /// the other files found under `points/`.
 pub fn present(dir: &Path) -> (Vec<Unit>, Vec<PathBuf>) {
