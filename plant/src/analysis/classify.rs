@@ -69,6 +69,29 @@ pub enum MotionMode {
     Rebound,
 }
 
+impl MotionMode {
+    /// The name written in the outputs (`recovered`, `dry_whirl`, `rebound`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionMode::Recovered => "recovered",
+            MotionMode::DryWhirl => "dry_whirl",
+            MotionMode::Rebound => "rebound",
+        }
+    }
+}
+
+impl std::fmt::Display for MotionMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::fmt::Display for SteadyClass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Largest period tested.
 pub const MAX_K: usize = 16;
 
@@ -279,6 +302,9 @@ mod tests {
     fn names_are_the_serialised_names() {
         for c in SteadyClass::ALL {
             assert_eq!(serde_json::to_value(c).unwrap(), c.name());
+        }
+        for m in [MotionMode::Recovered, MotionMode::DryWhirl, MotionMode::Rebound] {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.name());
         }
     }
 
