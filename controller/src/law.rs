@@ -1,5 +1,11 @@
-//! The control-law trait, the common loop design every law is built from,
-//! and why a law could not be built.
+//! The contract of a control law: the trait ([`ControlLaw`]), what it is built from (the
+//! common loop [`Design`] and its own [`Params`]), what it reads each tick ([`Sample`]), and
+//! the entry a law is known by ([`LawEntry`]: what the registry lists and what
+//! `controller::serve` is given). [`LawError`] (why a law could not be built) lives in
+//! [`crate::error`] and is re-exported here.
+
+pub use crate::error::LawError;
+use crate::params::Params;
 
 /// Plant constants a law needs for its design (SI units).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -63,13 +69,25 @@ pub struct Design {
 
 impl Design {
     /// The continuous PD design (k_e, ξ_e, gravity bias) of this loop.
-    pub fn pd(&self) -> crate::PdDesign {
-        crate::PdDesign {
+    pub fn pd(&self) -> PdDesign {
+        PdDesign {
             stiffness_n_per_m: self.stiffness_n_per_m,
             damping_ratio: self.damping_ratio,
             gravity_bias: self.gravity_bias,
         }
     }
+}
+
+/// A PD design: the closed-loop behaviour asked for (the part of a [`Design`] the PD-type
+/// laws are specified by; [`Design::pd`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PdDesign {
+    /// Closed-loop stiffness k_e (N/m), > 0.
+    pub stiffness_n_per_m: f64,
+    /// Closed-loop damping ratio ξ_e, ≥ 0.
+    pub damping_ratio: f64,
+    /// Add the gravity bias current on the y axis.
+    pub gravity_bias: bool,
 }
 
 /// One controller input: what the digital controller reads at a tick.
@@ -96,69 +114,26 @@ pub trait ControlLaw: Send {
     fn reset(&mut self);
 }
 
-/// Why a law could not be built.
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum LawError {
-    /// The name is not in the registry.
-    #[error("unknown controller law `{name}` (known laws: {known})", known = crate::registry::law_names().join(", "))]
-    Unknown {
-        /// The name asked for.
-        name: String,
-    },
-    /// A value of the common design is out of range.
-    #[error("{key} = {value} {unit}: {why}")]
-    Design {
-        /// Config key.
-        key: &'static str,
-        /// Offending value.
-        value: f64,
-        /// Unit of the value.
-        unit: &'static str,
-        /// What is wrong.
-        why: &'static str,
-    },
-    /// One of the law's own parameters (`[controller.params]`) is refused: wrong type or out
-    /// of range.
-    #[error("law {law}: controller.params.{key} = {value}{unit}: {why}", unit = unit_suffix(unit))]
-    Param {
-        /// The law.
-        law: &'static str,
-        /// The parameter's key inside `[controller.params]`.
-        key: String,
-        /// The value as given (TOML).
-        value: String,
-        /// Its unit (empty if dimensionless).
-        unit: &'static str,
-        /// What is wrong.
-        why: String,
-    },
-    /// `[controller.params]` holds a key the law does not read.
-    #[error("law {law}: unknown parameter controller.params.{key} = {value} (law {law} reads {known})", known = known_list(known))]
-    UnknownParam {
-        /// The law.
-        law: &'static str,
-        /// The key.
-        key: String,
-        /// Its value as given (TOML).
-        value: String,
-        /// The keys the law reads.
-        known: Vec<&'static str>,
-    },
+/// A law's constructor: from the common design and its own parameters.
+pub type BuildLaw = fn(&Design, &Params) -> Result<Box<dyn ControlLaw>, LawError>;
+
+/// A law as it is offered: its name, a one-line summary and its constructor. Each law's file
+/// defines one (`controller::pd::LAW`, …); the registry lists the built-in ones, and a crate
+/// of your own defines its own and hands it to `controller::serve`.
+#[derive(Clone, Copy)]
+pub struct LawEntry {
+    /// The name `controller.law` selects it by (what [`ControlLaw::name`] reports).
+    pub name: &'static str,
+    /// One line for help texts and the README.
+    pub summary: &'static str,
+    /// Builds the law from the common design and its own parameters; refuses parameters it
+    /// does not know or that are out of range.
+    pub build: BuildLaw,
 }
 
-fn unit_suffix(unit: &str) -> String {
-    if unit.is_empty() {
-        String::new()
-    } else {
-        format!(" {unit}")
-    }
-}
-
-fn known_list(known: &[&str]) -> String {
-    if known.is_empty() {
-        "no parameters".to_string()
-    } else {
-        known.join(", ")
+impl std::fmt::Debug for LawEntry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LawEntry").field("name", &self.name).field("summary", &self.summary).finish()
     }
 }
 

@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod discrete_pd;
+pub mod error;
 #[cfg(feature = "ipc")]
 pub mod file;
 pub mod law;
@@ -43,11 +44,11 @@ mod test_plant;
 pub mod wire;
 
 pub use discrete_pd::{DelayPd, DelayPdGains};
-pub use law::{saturate, ControlLaw, Design, LawError, LoopConstants, Sample};
+pub use law::{saturate, BuildLaw, ControlLaw, Design, LawEntry, LawError, LoopConstants, PdDesign, Sample};
 pub use params::{Check, ParamReader, Params, ParamsError, PARAMS_LEN};
-pub use pd::{PdDesign, PdGains, SampledPd};
+pub use pd::{PdGains, SampledPd};
 pub use pid::{PidDesign, PidGains, SampledPid};
-pub use registry::{build_law, find_law, law_names, LawEntry, LAWS};
+pub use registry::{build_law, find_law, law_names, LAWS};
 pub use relev::{Relev, RelevSpec};
 #[cfg(feature = "ipc")]
 pub use serve::{serve, ServeOptions};

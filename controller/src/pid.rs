@@ -40,10 +40,9 @@
 //! stays where it was when the limit was reached, and the current leaves the
 //! limit as soon as the error reverses.
 
-use crate::law::{ControlLaw, Design, LawError, LoopConstants, Sample};
+use crate::law::{ControlLaw, Design, LawEntry, LawError, LoopConstants, Sample};
 use crate::params::{Check, Params};
 use crate::pd::{BackwardDifference, PdDesign, PdGains};
-use crate::registry::LawEntry;
 
 /// `pid`: parameter `integral_time_s` (s, > 0; default `10/ω_n`).
 pub const LAW: LawEntry = LawEntry {

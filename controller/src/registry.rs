@@ -1,7 +1,9 @@
-//! The one list of control laws: the only place where the laws are named
-//! together. Each law's file defines its [`LawEntry`] (`pd::LAW`, …) with
-//! its name, a one-line summary and its constructor; adding a law is that
-//! file plus one line here.
+//! The one list of the built-in control laws: the only place where the laws
+//! are named together. Each law's file defines its [`LawEntry`] (`pd::LAW`,
+//! …; the type lives beside [`ControlLaw`] in [`crate::law`] and is
+//! re-exported here) with its name, a one-line summary and its constructor;
+//! adding a law is that file plus one line here. Nothing but this list and
+//! its look-ups lives here: the laws do not import the registry.
 //!
 //! ```
 //! use controller::{registry, Params};
@@ -11,29 +13,9 @@
 //! assert!(registry::build_law("nope", &design, &Params::default()).is_err());
 //! ```
 
+pub use crate::law::{BuildLaw, LawEntry};
 use crate::law::{ControlLaw, Design, LawError};
 use crate::params::Params;
-
-/// A law's constructor: from the common design and its own parameters.
-pub type BuildLaw = fn(&Design, &Params) -> Result<Box<dyn ControlLaw>, LawError>;
-
-/// A law of the registry.
-#[derive(Clone, Copy)]
-pub struct LawEntry {
-    /// The name `controller.law` selects it by (what [`ControlLaw::name`] reports).
-    pub name: &'static str,
-    /// One line for help texts and the README.
-    pub summary: &'static str,
-    /// Builds the law from the common design and its own parameters; refuses parameters it
-    /// does not know or that are out of range.
-    pub build: BuildLaw,
-}
-
-impl std::fmt::Debug for LawEntry {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("LawEntry").field("name", &self.name).field("summary", &self.summary).finish()
-    }
-}
 
 /// Every law, in the order help texts list them.
 pub const LAWS: &[LawEntry] = &[crate::pd::LAW, crate::pid::LAW, crate::pd_delay::LAW, crate::relev::LAW];
@@ -50,7 +32,7 @@ pub fn law_names() -> Vec<&'static str> {
 
 /// Builds law `name` from the common design and its parameters.
 pub fn build_law(name: &str, design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawError> {
-    let entry = find_law(name).ok_or_else(|| LawError::Unknown { name: name.to_string() })?;
+    let entry = find_law(name).ok_or_else(|| LawError::Unknown { name: name.to_string(), known: law_names() })?;
     (entry.build)(design, params)
 }
 

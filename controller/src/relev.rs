@@ -29,10 +29,9 @@
 //! estimate.
 
 use crate::discrete_pd::DelayPdGains;
-use crate::law::{ControlLaw, Design, LawError, LoopConstants, Sample};
+use crate::law::{ControlLaw, Design, LawEntry, LawError, LoopConstants, Sample};
 use crate::params::{Check, Params};
 use crate::pd::{BackwardDifference, PdDesign};
-use crate::registry::LawEntry;
 
 /// `relev` and its parameters (`[controller.params]`):
 ///

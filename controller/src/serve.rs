@@ -38,11 +38,10 @@
 //! warning for each step the system refuses.
 
 use crate::file::{self, Applied, LawOverrides};
+use crate::law::{saturate, ControlLaw, LawEntry, LawError, Sample};
 use crate::link::{self, Endpoint, LinkError, Mailbox, Peer};
 use crate::lock::{self, LockError};
-use crate::registry::LawEntry;
 use crate::wire::{self, Ack, CommandFrame, Expect, Hello, Refusal, SensorFrame};
-use crate::{saturate, ControlLaw, LawError, Sample};
 use clap::{CommandFactory, FromArgMatches, Parser};
 use std::ffi::OsString;
 use std::path::PathBuf;
@@ -490,10 +489,7 @@ fn accept(
         say(&format!("warning: {w}"));
     }
     let Some(entry) = laws.iter().find(|l| l.name == name) else {
-        return Err((
-            Refusal::Law,
-            format!("law `{name}` is not served by this controller (it serves {})", served.join(", ")),
-        ));
+        return Err((Refusal::Law, LawError::Unknown { name, known: served.to_vec() }.to_string()));
     };
     let law = (entry.build)(&design, &params).map_err(|e| match e {
         LawError::Param { .. } | LawError::UnknownParam { .. } => (Refusal::Params, e.to_string()),

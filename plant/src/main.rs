@@ -501,7 +501,7 @@ mod tests {
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
         let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
-        let law = controller::LawError::Unknown { name: "nope".into() };
+        let law = controller::LawError::Unknown { name: "nope".into(), known: vec!["pd"] };
         let cases: Vec<(anyhow::Error, u8)> = vec![
             (stopped(StopKind::Diverged), 3),
             (stopped(StopKind::PeerLost), 4),

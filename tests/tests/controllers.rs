@@ -194,7 +194,13 @@ fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
             vec!["other message types", "exited before the handshake"],
         ),
         (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 4", "speaks version 3"]),
-        (vec![&controller], Some("controller.law=\"nope\""), 2, "refused", vec!["law `nope` is not served"]),
+        (
+            vec![&controller],
+            Some("controller.law=\"nope\""),
+            2,
+            "refused",
+            vec!["unknown controller law `nope`", "known laws: pd, pid"],
+        ),
     ];
     for (i, (argv, law, code, status, needles)) in cases.iter().enumerate() {
         let out = dir.join(&format!("run{i}"));
