@@ -15,6 +15,17 @@ pub enum LawError {
         /// The names that were on offer.
         known: Vec<&'static str>,
     },
+    /// The law cannot drive a rotor with this many axes (a law of the two-plane rotor on the
+    /// planar model). A controller answers a hello with it by refusal code 3 (axes).
+    #[error("law {law} drives {drives}; this rotor has {axes} axes")]
+    Axes {
+        /// The law.
+        law: &'static str,
+        /// The rotor's axes.
+        axes: u32,
+        /// What the law drives, in words ("a two-plane rotor (4 axes)").
+        drives: &'static str,
+    },
     /// A value of the common design is out of range.
     #[error("{key} = {value} {unit}: {why}")]
     Design {

@@ -21,6 +21,7 @@
 //! with the registry's laws.
 #![warn(missing_docs)]
 
+pub mod design;
 pub mod discrete_pd;
 pub mod error;
 #[cfg(feature = "ipc")]
@@ -30,6 +31,7 @@ pub mod law;
 pub mod link;
 #[cfg(feature = "ipc")]
 pub mod lock;
+pub mod modal;
 pub mod params;
 pub mod pd;
 pub mod pd_delay;
@@ -44,11 +46,16 @@ mod test_plant;
 pub mod wire;
 
 pub use discrete_pd::{DelayPd, DelayPdGains};
-pub use law::{saturate, BuildLaw, ControlLaw, Design, LawEntry, LawError, LoopConstants, PdDesign, Sample};
+pub use law::{
+    build_among, saturate, saturate_axes, wrap_angle, AnyLaw, BuildLaw, BuildRotorLaw, ControlLaw, Decentralised,
+    Design, Geometry, LawEntry, LawError, LoopConstants, PdDesign, RotorDesign, RotorLaw, RotorLawEntry, RotorSample,
+    Sample, ROTOR_AXES,
+};
+pub use modal::{Modal, ModalGains, ModalSpec};
 pub use params::{Check, ParamReader, Params, ParamsError, PARAMS_LEN};
 pub use pd::{PdGains, SampledPd};
 pub use pid::{PidDesign, PidGains, SampledPid};
-pub use registry::{build_law, find_law, law_names, LAWS};
+pub use registry::{all_law_names, build_law, build_rotor_law, find_law, law_names, ALL_LAWS, LAWS, ROTOR_LAWS};
 pub use relev::{Relev, RelevSpec};
 #[cfg(feature = "ipc")]
 pub use serve::{serve, ServeOptions};

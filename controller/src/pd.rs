@@ -167,12 +167,12 @@ mod tests {
         let d = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: false };
         let g = PdGains::from_design(&d, &c).unwrap();
         let mut law = SampledPd::new(g, 1e-4);
-        let first = law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0] });
+        let first = law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0], ..Default::default() });
         assert_eq!(first, g.current([0.1, 0.0], [0.0; 2]));
-        let second = law.update(&Sample { seq: 1, t_s: 1e-4, sensor_v: [0.2, 0.0] });
+        let second = law.update(&Sample { seq: 1, t_s: 1e-4, sensor_v: [0.2, 0.0], ..Default::default() });
         assert_eq!(second, g.current([0.2, 0.0], [1000.0, 0.0]));
         law.reset();
-        assert_eq!(law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0] }), first);
+        assert_eq!(law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0], ..Default::default() }), first);
     }
 
     #[test]

@@ -453,7 +453,7 @@ pub fn run(
             unsafe { libc::kill(libc::getpid(), libc::SIGKILL) };
         }
         let received_ns = wire::monotonic_ns();
-        let sample = Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy() };
+        let sample = Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy(), ..Default::default() };
         let current = saturate(law.update(&sample), limit);
         answered += 1;
         frames.send(CommandFrame {

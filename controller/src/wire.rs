@@ -606,16 +606,7 @@ impl Hello {
     /// assert_eq!(h.params_text().unwrap(), "");
     /// ```
     pub fn example(run_id: &str) -> Self {
-        let design = Design {
-            stiffness_n_per_m: 1e6,
-            damping_ratio: 0.01,
-            period_s: 1.0 / 20_000.0,
-            gravity_bias: true,
-            current_limit_a: 2.0,
-            delay_samples: 1,
-            constants: LoopConstants::study(),
-        };
-        let mut h = Self::new(run_id, "pd", &design, 20_000.0, "").expect("an empty document fits");
+        let mut h = Self::new(run_id, "pd", &Design::study(), 20_000.0, "").expect("an empty document fits");
         h.session = 1;
         h.token = 1;
         h.spin_ns = 200_000;

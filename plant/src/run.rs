@@ -267,7 +267,7 @@ pub fn run_into(
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
+        let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]), ..Default::default() };
         let command = match &mut source {
             Source::Continuous => None,
             Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),

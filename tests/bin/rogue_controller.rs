@@ -81,7 +81,7 @@ fn main() -> ExitCode {
         session,
         axes: wire::AXES,
         current_a: wire::axes_of(controller::saturate(
-            law.update(&controller::Sample { seq: f.seq, t_s: f.t_s, sensor_v: f.sensor_xy() }),
+            law.update(&controller::Sample { seq: f.seq, t_s: f.t_s, sensor_v: f.sensor_xy(), ..Default::default() }),
             hello.current_limit_a,
         )),
         ..Default::default()

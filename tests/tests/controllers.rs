@@ -105,8 +105,12 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     let mut largest_difference_from_pd: f64 = 0.0;
     for k in 0..ticks - 1 {
         assert!((t[k] - k as f64 * period).abs() < 1e-12, "row {k} at t = {}", t[k]);
-        let sample =
-            controller::Sample { seq: k as u64, t_s: k as f64 * period, sensor_v: [gain * dx[k], gain * dy[k]] };
+        let sample = controller::Sample {
+            seq: k as u64,
+            t_s: k as f64 * period,
+            sensor_v: [gain * dx[k], gain * dy[k]],
+            ..Default::default()
+        };
         let i = controller::saturate(law.update(&sample), limit);
         assert!(
             ix[k + 2].to_bits() == i[0].to_bits() && iy[k + 2].to_bits() == i[1].to_bits(),

@@ -516,7 +516,8 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
         if frame.status & SensorFrame::STOP != 0 {
             break;
         }
-        let sample = controller::Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy() };
+        let sample =
+            controller::Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy(), ..Default::default() };
         let current = controller::saturate(law.update(&sample), hello.current_limit_a);
         let reply = CommandFrame {
             seq: frame.seq,

@@ -277,7 +277,7 @@ fn python_controller_answers_the_handshake_and_frames_as_the_rust_one() {
         let reply = plant.reply_within(Duration::from_secs(30)).expect("a reply");
         assert_eq!((reply.seq, reply.token, reply.session, reply.axes, reply.status), (seq, h.token, 1, 2, 0));
         let want = controller::saturate(
-            law.update(&controller::Sample { seq, t_s: seq as f64 * h.period_s, sensor_v: *v }),
+            law.update(&controller::Sample { seq, t_s: seq as f64 * h.period_s, sensor_v: *v, ..Default::default() }),
             h.current_limit_a,
         );
         let got = reply.current_xy();
