@@ -514,7 +514,11 @@ mod tests {
             (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),
             (SetupError::Cosim(CosimError::Interrupted).into(), 130),
             (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
-            (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
+            (
+                CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into(), peer_type: None })
+                    .into(),
+                2,
+            ),
             (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
             (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
             (stopped(StopKind::MissBudget), 6),

@@ -197,7 +197,7 @@ fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
             "refused",
             vec!["other message types", "exited before the handshake"],
         ),
-        (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 4", "speaks version 3"]),
+        (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 5", "speaks version 4"]),
         (
             vec![&controller],
             Some("controller.law=\"nope\""),
