@@ -505,6 +505,7 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
     let mut law = controller::build_law(&law_name, &hello.design(), &params).expect("law");
     handshake.send(Ack::new(hello.session, hello.token, 0, &law_name, "test controller")).expect("ack");
     let mut answered = 0u64;
+    let mut keyphasor: Vec<(f64, f64)> = Vec::new();
     loop {
         let frame = frames
             .wait(Duration::from_millis(1), || Instant::now() < deadline)
@@ -516,6 +517,7 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
         if frame.status & SensorFrame::STOP != 0 {
             break;
         }
+        keyphasor.push((frame.speed_rad_s, frame.angle_rad));
         let sample =
             controller::Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy(), ..Default::default() };
         let current = controller::saturate(law.update(&sample), hello.current_limit_a);
@@ -535,6 +537,21 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
     let (code, log) = plant.finish();
     assert_eq!(code, Some(0), "{log}");
     assert_eq!(answered, TICKS);
+    // Protocol 4's keyphasor: the rotor's speed (the scene's 500 Hz, held by the drive) and its
+    // angle in [0, 2π), advancing by the speed times the period from frame to frame.
+    let tau = std::f64::consts::TAU;
+    for (k, w) in keyphasor.windows(2).enumerate() {
+        let ((w0, a0), (w1, a1)) = (w[0], w[1]);
+        assert!((0.0..tau).contains(&a0) && (0.0..tau).contains(&a1), "frame {k}: angle {a0}, {a1}");
+        assert!((w0 / (tau * 500.0) - 1.0).abs() < 0.05, "frame {k}: speed {w0} rad/s");
+        let step = (a1 - a0 - 0.5 * (w0 + w1) * hello.period_s).rem_euclid(tau);
+        assert!(
+            step.min(tau - step) < 1e-6,
+            "frame {k}: the angle moved {} rad, the speed says {}",
+            a1 - a0,
+            w0 * hello.period_s
+        );
+    }
     let s = read_json(&out.join("summary.json"));
     assert_eq!(num(&s["cosim"], "foreign_frames") as u64, TICKS, "{s:#}");
     assert_eq!(num(&s["cosim"], "stale_replies"), 0.0, "{s:#}");
