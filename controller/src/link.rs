@@ -67,6 +67,9 @@ pub fn version_of(type_name: &str) -> Option<u32> {
 fn describe_peer(peer_type: Option<&str>) -> String {
     match peer_type {
         Some(t) => match version_of(t) {
+            Some(v) if v == wire::PROTOCOL_VERSION => {
+                format!("its type is {t}: this protocol version, but another message on this service")
+            }
             Some(v) => format!("the peer speaks protocol version {v}: its type is {t}"),
             None => format!("its type is {t}, not of this testbed's protocol"),
         },
