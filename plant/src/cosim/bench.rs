@@ -39,6 +39,7 @@ pub fn bench_round_trips(
         command: None,
         realtime_priority: 0,
         max_miss_fraction: 1.0,
+        max_overrun_fraction: 1.0,
     };
     let bias = [0.0; 2];
     let mut s = Session::open(ControlMode::Lockstep, settings, hello, launch, bias, hello.period_s, hooks)?;
