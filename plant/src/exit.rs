@@ -31,13 +31,15 @@ pub enum Code {
     MissBudget = 6,
     /// `plant sweep` / `plant ensemble` `--merge` (or `--round R`): units missing or corrupt.
     Incomplete = 7,
+    /// Realtime: the plant-overrun budget was exceeded (status `overrun_budget`).
+    OverrunBudget = 10,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     Interrupted = 130,
 }
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 8] = [
+    pub const ALL: [Code; 9] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -45,6 +47,7 @@ impl Code {
         Code::CriterionFailed,
         Code::MissBudget,
         Code::Incomplete,
+        Code::OverrunBudget,
         Code::Interrupted,
     ];
 }
@@ -59,6 +62,7 @@ const _: fn(Code) = |c| match c {
     | Code::CriterionFailed
     | Code::MissBudget
     | Code::Incomplete
+    | Code::OverrunBudget
     | Code::Interrupted => {}
 };
 
@@ -136,6 +140,8 @@ pub enum StopKind {
     PeerLost,
     /// Realtime: past the deadline-miss budget.
     MissBudget,
+    /// Realtime: past the plant-overrun budget.
+    OverrunBudget,
 }
 
 impl HasExitCode for Ending {
@@ -145,6 +151,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::Diverged, .. } => Code::Diverged,
             Ending::Stopped { kind: StopKind::PeerLost, .. } => Code::PeerLost,
             Ending::Stopped { kind: StopKind::MissBudget, .. } => Code::MissBudget,
+            Ending::Stopped { kind: StopKind::OverrunBudget, .. } => Code::OverrunBudget,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
         }
@@ -251,6 +258,7 @@ mod tests {
             (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
             (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
             (stopped(StopKind::MissBudget), 6),
+            (stopped(StopKind::OverrunBudget), 10),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),
             (

@@ -19,6 +19,11 @@ pub trait Hooks {
     /// Co-simulation: a controller process connected (at the start, or after a
     /// reconnection), with its process id from the handshake.
     fn controller_connected(&mut self, _pid: u32) {}
+    /// Measure the plant's execution time per tick in every mode (co-simulation runs always
+    /// do): `plant bench tick`.
+    fn time_ticks(&self) -> bool {
+        false
+    }
 }
 
 /// Hooks that do nothing.

@@ -10,6 +10,7 @@
 //! rate (dense output inside macro steps).
 
 use crate::config::{ControlMode, Scene};
+use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
@@ -19,6 +20,7 @@ use crate::sensor::Sensor;
 use crate::trace::Trace;
 use controller::{build_law, saturate, wrap_angle, ControlLaw, PdGains, Sample};
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 /// Why a run stopped before its end.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -81,6 +83,8 @@ pub enum Outcome {
     PeerLost(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
+    OverrunBudget(String),
 }
 
 /// Why a run could not start.
@@ -181,6 +185,17 @@ pub struct SinkRun {
     pub cosim: Option<CosimReport>,
     /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
     pub parked_steps: u64,
+    /// The cost of the ticks: the most model evaluations in one, and the execution times.
+    pub ticks: TickCost,
+}
+
+/// What the ticks of a run cost.
+#[derive(Clone, Debug, Default)]
+pub struct TickCost {
+    /// The most evaluations of the model the integrator made in one tick.
+    pub max_rhs_evals: u64,
+    /// The plant's execution time per tick (co-simulation runs, or [`Hooks::time_ticks`]).
+    pub tet: Option<Box<Tet>>,
 }
 
 /// Runs a scene from its initial state, sending every output sample (from
@@ -261,10 +276,15 @@ pub fn run_into(
         Source::Cosim(session) => session.controller_pid(),
         _ => None,
     };
-    let start = std::time::Instant::now();
+    let mut cost = TickCost {
+        max_rhs_evals: 0,
+        tet: (matches!(source, Source::Cosim(_)) || hooks.time_ticks()).then(|| Box::new(Tet::new(ticks))),
+    };
+    let start = Instant::now();
     let mut outcome = Outcome::Completed;
     let mut t = 0.0;
     for k in 0..ticks {
+        let tick_start = Instant::now();
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
         // The keyphasor: the rotor's speed and its angle wrapped to [0, 2π), from the state.
@@ -294,6 +314,7 @@ pub fn run_into(
                         Halt::Lost(why) => Outcome::PeerLost(why),
                         Halt::Interrupted(_) => Outcome::Interrupted,
                         Halt::MissBudget(why) => Outcome::MissBudget(why),
+                        Halt::OverrunBudget(why) => Outcome::OverrunBudget(why),
                     };
                     break;
                 }
@@ -305,6 +326,12 @@ pub fn run_into(
                 model.control = Control::Held(applied);
             }
         }
+        // A realtime tick starts when the plant wakes at its wall-clock time.
+        let tick_start = match &source {
+            Source::Cosim(session) => session.tick_started().unwrap_or(tick_start),
+            _ => tick_start,
+        };
+        let commanded = Instant::now();
         if let RaceWhenClear::Parked(release) = scene.params.race_when_clear {
             let clear = crate::park::clear(&model, t0, t1 - t0, &y);
             if clear && !model.race_parked {
@@ -325,6 +352,9 @@ pub fn run_into(
             out_times.push(((next_out as f64) * out_dt).min(t1));
             next_out += 1;
         }
+        let (evals, touching) = (integrator.stats().rhs_evals, cost.tet.is_some() && touching(&model, &y));
+        let mut rows = Duration::ZERO;
+        let integrating = Instant::now();
         let step = advance_across_breakpoints(
             &mut integrator,
             &model,
@@ -332,8 +362,30 @@ pub fn run_into(
             &mut y,
             &out_times,
             (&breakpoints, &mut next_breakpoint),
-            |ts, ys| sink.sample(&model, ts, ys),
+            |ts, ys| match cost.tet {
+                // The output rows' time is the sink's, not the integration's.
+                Some(_) => {
+                    let row = Instant::now();
+                    sink.sample(&model, ts, ys);
+                    rows += row.elapsed();
+                }
+                None => sink.sample(&model, ts, ys),
+            },
         );
+        cost.max_rhs_evals = cost.max_rhs_evals.max(integrator.stats().rhs_evals - evals);
+        if let Some(tet) = cost.tet.as_mut() {
+            let end = Instant::now();
+            let ns = |d: Duration| d.as_nanos() as u64;
+            tet.record(
+                k,
+                TickTime {
+                    command_ns: ns(commanded - tick_start),
+                    integration_ns: ns((end - integrating).saturating_sub(rows)),
+                    tick_ns: ns(end - tick_start),
+                    contact: touching || self::touching(&model, &y),
+                },
+            );
+        }
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
             outcome = Outcome::Diverged(e);
@@ -352,13 +404,33 @@ pub fn run_into(
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
+                } else if let Some(why) = session.overrun_budget_exceeded(1) {
+                    outcome = Outcome::OverrunBudget(why);
                 }
             }
-            Some(session.finish(t, (t / period).round() as u64))
+            let mut report = session.finish(t, (t / period).round() as u64);
+            report.tet_us = cost.tet.as_ref().map(|tet| tet.report());
+            Some(report)
         }
         _ => None,
     };
-    Ok(SinkRun { stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim, parked_steps })
+    Ok(SinkRun {
+        stats: integrator.stats(),
+        simulated: t,
+        wall_time,
+        outcome,
+        final_state: y,
+        cosim,
+        parked_steps,
+        ticks: cost,
+    })
+}
+
+/// The rotor touches its race (the rotor – race contact force is not zero).
+fn touching(model: &Model, y: &State) -> bool {
+    let (dx, dy) = (y[ix::XR] - y[ix::XB], y[ix::YR] - y[ix::YB]);
+    let gap = model.params.contact.gap;
+    dx * dx + dy * dy > gap * gap
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

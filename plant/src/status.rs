@@ -22,6 +22,8 @@ pub enum Status {
     NotStarted,
     /// Realtime: the deadline-miss budget was exceeded (exit 6).
     MissBudget,
+    /// Realtime: the plant-overrun budget was exceeded (exit 10).
+    OverrunBudget,
 }
 
 impl Status {
@@ -35,6 +37,7 @@ impl Status {
             Status::Refused => "refused",
             Status::NotStarted => "not_started",
             Status::MissBudget => "miss_budget",
+            Status::OverrunBudget => "overrun_budget",
         }
     }
 }
@@ -54,6 +57,7 @@ impl Outcome {
             Outcome::Interrupted => Status::Interrupted,
             Outcome::PeerLost(_) => Status::PeerLost,
             Outcome::MissBudget(_) => Status::MissBudget,
+            Outcome::OverrunBudget(_) => Status::OverrunBudget,
         }
     }
 
@@ -63,7 +67,7 @@ impl Outcome {
             Outcome::Completed => None,
             Outcome::Diverged(e) => Some(e.to_string()),
             Outcome::Interrupted => Some("interrupted by a signal".to_string()),
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) => Some(why.clone()),
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => Some(why.clone()),
         }
     }
 
@@ -90,6 +94,7 @@ mod tests {
             Status::Refused,
             Status::NotStarted,
             Status::MissBudget,
+            Status::OverrunBudget,
         ] {
             assert_eq!(serde_json::to_value(s).unwrap(), s.name());
         }

@@ -241,8 +241,9 @@ impl Scene {
     /// parked (the gap clear by a safe margin, [`crate::park`]), and while it is free the
     /// substeps the stability estimate gives under a
     /// [`plant_physics::stability::REFERENCE_CONTACT_FORCE`] contact (3 at 20 kHz on the study's
-    /// bearing). Its cost per tick is bounded: at most `4 × contact_substeps` evaluations of
-    /// the model (twice that in a tick split at a shock's breakpoint). The default of realtime
+    /// bearing). Its cost per tick is bounded: at most `4 × contact_substeps + 1` evaluations
+    /// of the model (the last for an output sample inside the last substep; twice that in a
+    /// tick split at a shock's breakpoint). The default of realtime
     /// runs (`integrator.realtime = "fixed"`) and the fast setting of ensemble members.
     pub fn fixed_step_overrides(&self) -> Vec<String> {
         let contact =

@@ -50,7 +50,7 @@ pub fn bench_round_trips(
         let sample = Sample { seq: k, t_s: k as f64 * hello.period_s, sensor_v: [0.0; 2], ..Default::default() };
         if let Err(halt) = s.lockstep(&sample, hooks) {
             let why = match halt {
-                Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) => w,
+                Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) | Halt::OverrunBudget(w) => w,
             };
             return Err(CosimError::NoController { waited_s: 0.0, run_id: s.run_id.clone(), hint: format!(": {why}") });
         }
