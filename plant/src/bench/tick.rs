@@ -13,6 +13,12 @@
 //! realtime run against these say what the controller and the host add. Also the run's
 //! figures (post-shock mode, peak contact force, largest radius, contact fraction), so that
 //! the two settings' answers sit beside their costs. Writes `tick.csv` ([`TickRow`]).
+//!
+//! What the host adds shows in one more measurement, `repeat.csv` ([`RepeatRow`]): the same
+//! tick in contact (the rotor 2 µm into its race, the race free, the realtime setting's
+//! substeps) integrated from the same state as many times as the run has ticks. The work is
+//! identical every time, so its spread is the machine's: interrupts, the hypervisor, caches,
+//! other processes.
 
 use crate::analysis::classify::MotionMode;
 use crate::config::{load_scene, Scene};
@@ -97,6 +103,67 @@ pub struct TickRow {
     /// The machine's load average over the last minute when the run ended (`/proc/loadavg`).
     #[serde(with = "sci")]
     pub load_1min: f64,
+}
+
+/// Header of `repeat.csv`.
+pub const REPEAT_HEADER: &str = "setting,repeats,rhs_evals,p50_us,p99_us,p999_us,max_us,scheduling,load_1min";
+
+/// The same tick integrated again and again: a row of `repeat.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RepeatRow {
+    /// What was repeated.
+    pub setting: String,
+    /// Repeats timed.
+    pub repeats: u64,
+    /// Model evaluations per repeat.
+    pub rhs_evals: u64,
+    /// Median (µs).
+    #[serde(with = "sci")]
+    pub p50_us: f64,
+    /// 99th percentile (µs).
+    #[serde(with = "sci")]
+    pub p99_us: f64,
+    /// 99.9th percentile (µs).
+    #[serde(with = "sci")]
+    pub p999_us: f64,
+    /// Largest (µs).
+    #[serde(with = "sci")]
+    pub max_us: f64,
+    /// The bench thread's scheduling.
+    pub scheduling: String,
+    /// The machine's load average over the last minute when it ended.
+    #[serde(with = "sci")]
+    pub load_1min: f64,
+}
+
+/// Integrates one contact tick of `scene` (the realtime setting) `repeats` times from the same
+/// state, timing each: identical work, so the spread is the host's.
+fn repeat_contact_tick(scene: &Scene, repeats: u64) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+    use crate::model::{ix, Control, Model};
+    let gains = crate::run::design_gains(scene)?;
+    let bias = controller::saturate(gains.bias_a, scene.params.current_limit);
+    let model = Model {
+        params: scene.params.clone(),
+        base: scene.base.clone(),
+        control: Control::Held(bias),
+        race_parked: false,
+    };
+    let mut y0 = crate::initial::initial_state(scene);
+    // The rotor 2 µm into its race, straight down (about a kilonewton of contact).
+    y0[ix::XR] = y0[ix::XB];
+    y0[ix::YR] = y0[ix::YB] - scene.params.contact.gap - 2e-6;
+    let mut integrator = crate::integrate::Integrator::new(crate::run::integrator_settings(scene));
+    integrator.set_substeps(scene.integrator.contact_substeps);
+    let (t0, t1) = (0.0, scene.controller.period);
+    let mut times = crate::cosim::Latencies::new();
+    for _ in 0..repeats {
+        let mut y = y0;
+        let start = std::time::Instant::now();
+        integrator.advance(&model, t0, t1, &mut y)?;
+        times.record(start.elapsed().as_nanos() as u64);
+        std::hint::black_box(&y);
+    }
+    Ok((times.percentiles(), integrator.stats().rhs_evals / repeats.max(1)))
 }
 
 /// The machine's load average over the last minute (`/proc/loadavg`), NaN where there is none.
@@ -223,5 +290,33 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     }
     let path = dir.join("tick.csv");
     crate::table::write_with_header(&path, TICK_HEADER, &rows)?;
+
+    let (label, fixed) = &settings[0];
+    let repeats = rows.first().map_or(1, |r| r.ticks.max(1));
+    let (p, rhs_evals) = repeat_contact_tick(fixed, repeats)?;
+    let repeat = RepeatRow {
+        setting: format!("one contact tick repeated, {label}"),
+        repeats: p.count,
+        rhs_evals,
+        p50_us: p.p50,
+        p99_us: p.p99,
+        p999_us: p.p999,
+        max_us: p.max,
+        scheduling: scheduling.clone(),
+        load_1min: load_average(),
+    };
+    log(&format!(
+        "{}: {} times, {} evaluations each: p50 {:.2} / p99 {:.2} / p99.9 {:.2} / max {:.2} µs (the same work: the \
+         spread is the host's); load {:.2}",
+        repeat.setting,
+        repeat.repeats,
+        repeat.rhs_evals,
+        repeat.p50_us,
+        repeat.p99_us,
+        repeat.p999_us,
+        repeat.max_us,
+        repeat.load_1min
+    ));
+    crate::table::write_with_header(&dir.join("repeat.csv"), REPEAT_HEADER, &[repeat])?;
     Ok(path)
 }
