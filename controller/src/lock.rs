@@ -110,7 +110,7 @@ fn acquire_in(dir: &std::path::Path, run_id: &str, role: &str) -> Result<RunLock
     let path = dir.join(format!("{run_id}.{role}.lock"));
     let io = |source| LockError::Io { run_id: run_id.to_string(), path: path.display().to_string(), source };
     if !dir.is_dir() {
-        std::fs::create_dir_all(&dir).map_err(io)?;
+        std::fs::create_dir_all(dir).map_err(io)?;
         // Machine-wide like /tmp: any user may add a lock; best effort.
         #[cfg(unix)]
         {
