@@ -33,6 +33,7 @@ pub mod rng;
 pub mod row_file;
 pub mod run;
 pub mod sensor;
+pub mod signal;
 pub mod soak;
 pub mod stability;
 pub mod status;

@@ -27,7 +27,6 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Exit codes, one per kind of ending (the table in the module doc).
@@ -162,7 +161,11 @@ fn exit_code(err: &anyhow::Error) -> u8 {
             return exit::BAD_INPUT;
         }
         if let Some(e) = cause.downcast_ref::<plant::output::AnalyzeError>() {
-            return if e.is_input() { exit::BAD_INPUT } else { exit::IO };
+            return match e {
+                plant::output::AnalyzeError::Interrupted(_) => exit::INTERRUPTED,
+                e if e.is_input() => exit::BAD_INPUT,
+                _ => exit::IO,
+            };
         }
     }
     exit::IO
@@ -202,14 +205,13 @@ fn not_started_status(e: &SetupError) -> &'static str {
     }
 }
 
-/// Installs the one SIGINT/SIGTERM handler; the flag it sets is polled by the commands that
-/// stop cleanly (run, soak, sweep, bench ipc). Called once, by those commands only: the others
-/// keep the default action (a signal ends them at once).
-fn stop_flag() -> Arc<AtomicBool> {
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        warn(&format!("cannot install the Ctrl-C handler: {e}"));
+/// Installs the one SIGINT/SIGTERM handler ([`plant::signal`]); the flag it sets is polled
+/// by the commands that stop cleanly (run, soak, analyze, sweep, bench ipc). Called by those
+/// commands only: the others keep the default action (a signal ends them at once).
+fn stop_flag() -> &'static AtomicBool {
+    let (stop, failed) = plant::signal::install();
+    if let Some(w) = failed {
+        warn(&w);
     }
     stop
 }
@@ -297,7 +299,7 @@ fn load_checked(scene: &Scene) -> anyhow::Result<()> {
 
 /// Progress on stderr about once a second, and the Ctrl-C flag.
 struct CliHooks {
-    stop: Arc<AtomicBool>,
+    stop: &'static AtomicBool,
     duration: f64,
     started: Instant,
     last: Instant,
@@ -403,7 +405,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
         plant::summary::snake_name(&prog.scene.controller.mode),
         dir.display()
     );
-    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress };
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop, progress };
     let done = match plant::soak::run(&prog, path, opts) {
         Ok(d) => d,
         Err(plant::soak::SoakError::Setup(e)) => return Err(e.into()),
@@ -426,7 +428,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 /// `plant analyze`.
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
     let _claim = plant::claim::claim(dir, false)?;
-    let a = plant::output::analyze_dir(dir)?;
+    let a = plant::output::analyze_dir(dir, stop_flag())?;
     eprintln!(
         "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",
         dir.display(),

@@ -297,37 +297,54 @@ pub enum AnalyzeError {
     /// `summary.json` or a chart could not be written.
     #[error("{0:#}")]
     Output(anyhow::Error),
+    /// SIGINT/SIGTERM; what was written by then is said.
+    #[error("interrupted by a signal; {0}")]
+    Interrupted(&'static str),
 }
 
 impl AnalyzeError {
-    /// Bad input (exit 2), as opposed to an output that could not be written (exit 1).
+    /// Bad input (exit 2), as opposed to an output that could not be written (exit 1) or an
+    /// interruption (exit 130).
     pub fn is_input(&self) -> bool {
-        !matches!(self, AnalyzeError::Output(_))
+        !matches!(self, AnalyzeError::Output(_) | AnalyzeError::Interrupted(_))
     }
 }
+
+/// The most a `summary.json` that `plant analyze` merges into may hold.
+const MAX_SUMMARY_BYTES: u64 = 16 << 20;
 
 /// `plant analyze DIR`: reads `scene.toml` (through the scene loader) and
 /// `trace.csv` (strictly, [`crate::trace::read_rows`]), merges the analysis
 /// into `summary.json` (created if missing; written atomically, only once the
-/// analysis succeeded), then writes the analysis charts.
-pub fn analyze_dir(dir: &Path) -> Result<Analysis, AnalyzeError> {
+/// analysis succeeded), then writes the analysis charts. Once `stop` is set
+/// (SIGINT/SIGTERM) it stops at the next row or step and says what it wrote.
+pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<Analysis, AnalyzeError> {
+    let stopped = || stop.load(std::sync::atomic::Ordering::Relaxed);
+    const NOTHING: &str = "nothing was written";
     let scene = crate::config::load_scene(&dir.join("scene.toml"), &[])?;
     let trace_path = dir.join("trace.csv");
     let mut recorder =
         crate::analysis::Analyzer::new(crate::summary::analysis_spec(&scene), Some(scene.output_interval));
     let mut rows = 0;
-    crate::trace::read_rows(&trace_path, |r| {
+    let whole = crate::trace::read_rows(&trace_path, |r| {
         recorder.push(r);
         rows += 1;
+        !stopped()
     })?;
+    if !whole {
+        return Err(AnalyzeError::Interrupted(NOTHING));
+    }
     if rows < 2 {
         return Err(TraceError::TooShort { path: trace_path, rows }.into());
     }
     let (analysis, data): (Analysis, AnalysisData) = recorder.finish();
+    if stopped() {
+        return Err(AnalyzeError::Interrupted(NOTHING));
+    }
 
     let summary_path = dir.join("summary.json");
     let bad_summary = |message: String| AnalyzeError::Summary { path: summary_path.display().to_string(), message };
-    let mut summary: serde_json::Value = match std::fs::read_to_string(&summary_path) {
+    let mut summary: serde_json::Value = match shock_table::input::read_text(&summary_path, MAX_SUMMARY_BYTES) {
         Ok(text) => serde_json::from_str(&text).map_err(|e| bad_summary(e.to_string()))?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => serde_json::json!({ "scene": scene.name }),
         // The summary is also this command's output: one that cannot be read cannot be replaced.
@@ -343,9 +360,15 @@ pub fn analyze_dir(dir: &Path) -> Result<Analysis, AnalyzeError> {
         map.extend(new);
     }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
+    if stopped() {
+        return Err(AnalyzeError::Interrupted("summary.json was updated, the charts were not drawn"));
+    }
     crate::analysis::write_plots(dir, &scene.name, &analysis, &data, scene.params.contact.gap)
         .context("writing analysis charts")
         .map_err(AnalyzeError::Output)?;
+    if stopped() {
+        return Err(AnalyzeError::Interrupted("summary.json and the charts were written"));
+    }
     Ok(analysis)
 }
 

@@ -296,8 +296,8 @@ fn peak_of(spec: &ShockSpec) -> f64 {
 /// Reads a programme file, applies the programme's and then `cli_set`
 /// overrides to its scene, and validates everything.
 pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+    let text = shock_table::input::read_text(path, shock_table::input::MAX_TOML_BYTES)
+        .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
     let mut raw: RawProgramme = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     if raw.name.is_empty() {
