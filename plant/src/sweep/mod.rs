@@ -172,8 +172,8 @@ impl Sweep {
     /// its members' scenes at the ends of the drawn ranges) so that bad input fails with exit 2
     /// before anything runs.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+        let text = shock_table::input::read_text(path, shock_table::input::MAX_TOML_BYTES)
+            .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
         let spec: SweepSpec = toml::from_str(&text)
             .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
         spec.axis.check("")?;

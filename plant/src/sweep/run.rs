@@ -16,7 +16,6 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 /// Options shared by `plant sweep` and `plant ensemble`.
 #[derive(clap::Args, Debug, Clone, Default)]
@@ -117,8 +116,16 @@ pub fn execute(sweep: &Sweep, dir: &Path, args: &RunArgs) -> anyhow::Result<()> 
         if !found.mismatch.is_empty() {
             return Err(SweepError::Mismatch { dir: dir.to_path_buf(), units: names(sweep, &found.mismatch) }.into());
         }
+        // A signal lets the merge finish its files (each written whole), then exits 130.
+        let (stop, failed) = crate::signal::install();
+        if let Some(w) = failed {
+            eprintln!("plant: warning: {w}");
+        }
         let written = merge_or_list(sweep, dir, &found, true)?;
         eprintln!("plant: merged {written} into {}", dir.display());
+        if stop.load(Ordering::Relaxed) {
+            return Err(SweepError::Interrupted.into());
+        }
         return Ok(());
     }
     let bad: Vec<(Unit, String)> = found.corrupt.iter().chain(&found.mismatch).cloned().collect();
@@ -136,16 +143,15 @@ pub fn execute(sweep: &Sweep, dir: &Path, args: &RunArgs) -> anyhow::Result<()> 
     }
     manifest.write(dir)?;
 
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        eprintln!("plant: warning: cannot install the Ctrl-C handler: {e}");
+    let (stop, failed) = crate::signal::install();
+    if let Some(w) = failed {
+        eprintln!("plant: warning: {w}");
     }
     let shard = args.shard.unwrap_or(Shard::ALL);
     let progress_bar = !args.quiet && std::io::stderr().is_terminal();
     let outcome = match &sweep.ensemble {
-        None => run_single(sweep, dir, shard, &stop, progress_bar, &mut found),
-        Some(_) => run_members(sweep, dir, shard, args.round, &stop, progress_bar, &mut found),
+        None => run_single(sweep, dir, shard, stop, progress_bar, &mut found),
+        Some(_) => run_members(sweep, dir, shard, args.round, stop, progress_bar, &mut found),
     }?;
     let complete = merge_or_list(sweep, dir, &found, false);
     if let Err(e) = &complete {
