@@ -329,6 +329,9 @@ pub fn run_into(
         );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
+            // The run reached the failure, not the end of its macro step (an integration
+            // error stops inside it).
+            t = e.time();
             outcome = Outcome::Diverged(e);
             break;
         }
