@@ -174,6 +174,14 @@ fn a_divergence_at_t0_exits_3_with_its_time_and_state() {
     assert_eq!(s["status"], "diverged");
     assert_eq!(num(&s, "failure_time_s"), 0.0);
     assert!(s["error"].as_str().unwrap_or_default().contains("at t = 0 s"), "{s:#}");
+    // Issue 21 item 7: the run reached t = 0, not the end of the failing macro step (the
+    // report said "results up to t = 0.00005 s", one sample off), and no row came before the
+    // failure, so there is no largest radius (it said 0.0).
+    assert_eq!(num(&s, "simulated_s"), 0.0, "{s:#}");
+    assert!(err.contains("results up to t = 0 s were written"), "{err}");
+    for key in ["max_radius_m", "max_contact_force_n", "max_race_speed_rpm"] {
+        assert!(s[key].is_null(), "{key}: {s:#}");
+    }
 }
 
 #[test]
