@@ -477,8 +477,7 @@ fn bench_ipc(
     };
     let started = Instant::now();
     let launch = controller.launch(run_id);
-    let (rt, latency, blocks) =
-        plant::cosim::bench_round_trips(samples.max(1), warmup, &launch, pins, spin_us, &mut hooks)?;
+    let (rt, latency, blocks) = plant::cosim::bench_round_trips(samples, warmup, &launch, pins, spin_us, &mut hooks)?;
     let wall = started.elapsed().as_secs_f64();
     println!(
         "ipc round trip (plant -> controller -> plant), {} samples: p50 {:.2} us, p99 {:.2} us, p99.9 {:.2} us, max {:.2} us",

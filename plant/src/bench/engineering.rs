@@ -175,7 +175,7 @@ pub fn command(
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
     let dir = super::out_dir(out, "bench-engineering");
-    engineering(config, &dir, repeats.max(1), log)?;
+    engineering(config, &dir, repeats, log)?;
     Ok(dir.join("engineering.csv"))
 }
 
