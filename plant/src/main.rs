@@ -22,7 +22,7 @@ use clap::Parser;
 use cli::{BenchCommand, Cli, Command, ControllerArg};
 use plant::config::{load_scene, ConfigError, Scene};
 use plant::cosim::{CosimError, Launch};
-use plant::run::{Hooks, Outcome, SetupError};
+use plant::run::{Hooks, Outcome};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -176,32 +176,22 @@ fn cosim_code(e: &CosimError) -> u8 {
     use controller::link::LinkError;
     use controller::lock::LockError;
     match e {
-        CosimError::Refused { .. }
-        | CosimError::RunId(_)
-        | CosimError::Pin(_)
-        | CosimError::Params(_)
-        | CosimError::Protocol(_)
-        | CosimError::Command { .. }
-        | CosimError::Lock(LockError::InUse { .. })
-        | CosimError::Link(LinkError::Incompatible { .. }) => exit::BAD_INPUT,
-        CosimError::ControllerExited { code: Some(2), .. } => exit::BAD_INPUT,
+        e if e.is_refusal() => exit::BAD_INPUT,
+        CosimError::Command { .. } => exit::BAD_INPUT,
         CosimError::NoController { .. } | CosimError::ControllerExited { .. } => exit::PEER_LOST,
         CosimError::Interrupted => exit::INTERRUPTED,
         CosimError::ControllerMissing { .. }
         | CosimError::Spawn { .. }
         | CosimError::Lock(LockError::Io { .. })
         | CosimError::Link(LinkError::Ipc { .. }) => exit::IO,
-    }
-}
-
-/// The `summary.json` status of a run that could not start.
-fn not_started_status(e: &SetupError) -> &'static str {
-    match e {
-        SetupError::Law(_) | SetupError::Overrides(_) => "refused",
-        SetupError::Cosim(CosimError::Interrupted) => "interrupted",
-        SetupError::Cosim(CosimError::Command { .. }) => "not_started",
-        SetupError::Cosim(c) if cosim_code(c) == exit::BAD_INPUT => "refused",
-        SetupError::Cosim(_) => "not_started",
+        // The refusals, matched above by `is_refusal`.
+        CosimError::Refused { .. }
+        | CosimError::RunId(_)
+        | CosimError::Pin(_)
+        | CosimError::Params(_)
+        | CosimError::Protocol(_)
+        | CosimError::Lock(LockError::InUse { .. })
+        | CosimError::Link(LinkError::Incompatible { .. }) => exit::BAD_INPUT,
     }
 }
 
@@ -357,7 +347,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
-            if let Err(w) = plant::output::write_not_started(&dir, &scene, not_started_status(&e), &e.to_string()) {
+            if let Err(w) = plant::output::write_not_started(&dir, &scene, e.status().name(), &e.to_string()) {
                 warn(&format!("{w:#}"));
             }
             return Err(e.into());
@@ -498,6 +488,7 @@ fn bench_ipc(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use plant::run::SetupError;
 
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
