@@ -197,7 +197,24 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         rss_csv,
         error: None,
     };
-    let result = run_into(scene, &opts.launch, &mut hooks, &mut sink)?;
+    let result = match run_into(scene, &opts.launch, &mut hooks, &mut sink) {
+        Ok(r) => r,
+        Err(e) => {
+            // The programme loaded: the folder records why the soak did not start.
+            let record = serde_json::json!({
+                "programme": prog.name,
+                "programme_file": programme_file.display().to_string(),
+                "status": e.status(),
+                "error": e.to_string(),
+                "simulated_s": 0.0,
+                "planned_s": scene.duration,
+                "shocks": prog.shocks.len(),
+                "passed": false,
+            });
+            crate::output::write_json(&dir.join("soak.json"), &record).context("writing soak.json").map_err(io)?;
+            return Err(e.into());
+        }
+    };
     if let Some(bar) = &hooks.bar {
         bar.finish_and_clear();
     }
