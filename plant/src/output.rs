@@ -16,7 +16,7 @@ use crate::hooks::Hooks;
 use crate::model::{Model, State};
 use crate::plot::{self, Scale, Series};
 use crate::record::{ChartData, Recorder};
-use crate::run::{run_into, RunResult, SetupError, Sink, SinkRun};
+use crate::run::{run_into, Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{TraceError, TraceWriter};
 use anyhow::Context;
@@ -130,15 +130,32 @@ impl RunFolder {
         self.recorder.push(r);
     }
 
-    /// Flushes `trace.csv`, writes `summary.json`, then the charts.
-    pub fn finish(mut self, dir: &Path, scene: &Scene, run: SinkRun) -> anyhow::Result<Written> {
+    /// Flushes `trace.csv`, writes `summary.json`, then the charts. A run that completed but
+    /// was asked to stop (`stopped`: SIGINT/SIGTERM) while its outputs were being written is
+    /// `interrupted` (exit 130): every output is still written, and the summary says so.
+    pub fn finish(
+        mut self,
+        dir: &Path,
+        scene: &Scene,
+        mut run: SinkRun,
+        stopped: &dyn Fn() -> bool,
+    ) -> anyhow::Result<Written> {
+        let interrupt = |run: &mut SinkRun| {
+            let late = stopped() && run.outcome == Outcome::Completed;
+            if late {
+                run.outcome = Outcome::Interrupted;
+            }
+            late
+        };
+        interrupt(&mut run);
         let trace_path = dir.join("trace.csv");
         let flushed = match self.error.take() {
             Some(e) => Err(e),
             None => self.trace.flush(),
         };
         let recorded = self.recorder.finish(run.outcome.failure_time());
-        let summary = Summary::from_parts(scene, &run, recorded.figures, recorded.analysis);
+        interrupt(&mut run);
+        let mut summary = Summary::from_parts(scene, &run, recorded.figures, recorded.analysis);
         write_json(&dir.join("summary.json"), &summary)?;
         flushed.with_context(|| format!("writing {}", trace_path.display()))?;
         let mut skipped = Vec::new();
@@ -157,6 +174,11 @@ impl RunFolder {
                     .into_iter()
                     .filter(|f| !written.contains(f)),
             );
+        }
+        if interrupt(&mut run) {
+            summary.status = run.outcome.status();
+            summary.error = run.outcome.error();
+            write_json(&dir.join("summary.json"), &summary)?;
         }
         Ok(Written { summary, run, skipped_charts: skipped })
     }
@@ -183,7 +205,7 @@ pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Ho
         }
         None => None,
     };
-    folder.finish(dir, recorded.as_ref().unwrap_or(scene), run).map_err(RunDirError::Output)
+    folder.finish(dir, recorded.as_ref().unwrap_or(scene), run, &|| hooks.cancelled()).map_err(RunDirError::Output)
 }
 
 /// Writes everything a run whose trace is in memory produced, as [`run_to_dir`] does.
@@ -191,7 +213,7 @@ pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Resul
     prepare(dir, scene)?;
     let mut folder = RunFolder::create(dir, scene)?;
     result.trace.rows().for_each(|r| folder.push(&r));
-    Ok(folder.finish(dir, scene, result.run.clone())?.summary)
+    Ok(folder.finish(dir, scene, result.run.clone(), &|| false)?.summary)
 }
 
 /// Writes a value as pretty JSON, atomically ([`crate::atomic::write`]).
@@ -376,7 +398,7 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationError, Stats};
-    use crate::run::{Outcome, RunError};
+    use crate::run::RunError;
 
     /// Issue 11 item 6: a run that diverged at t = 0 with a non-finite state has nothing to
     /// draw; its results are still written, the charts skipped (not "nothing to plot", exit 1).
@@ -401,7 +423,8 @@ mod tests {
             cosim: None,
             parked_steps: 0,
         };
-        let written = folder.finish(&dir, &scene, run).expect("a run with nothing to draw is not an output error");
+        let written =
+            folder.finish(&dir, &scene, run, &|| false).expect("a run with nothing to draw is not an output error");
         assert_eq!(written.summary.status, crate::status::Status::Diverged);
         assert!(written.summary.error.as_deref().unwrap_or_default().contains("non-finite state at t = 0 s"));
         assert!(written.skipped_charts.contains(&"orbit.png"), "{:?}", written.skipped_charts);

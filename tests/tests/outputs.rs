@@ -283,3 +283,30 @@ fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
         assert_exit(&analyzed, 0);
     }
 }
+
+/// Issue 21 item 7: a SIGINT or SIGTERM that came while a run wrote its outputs was
+/// swallowed (exit 0, `completed`, 9 of 9). Signalled once `summary.json` is written (the
+/// charts come after it), the run still writes every output, says `interrupted` and exits 130.
+#[cfg(unix)]
+#[test]
+fn a_signal_while_the_outputs_are_written_gives_130() {
+    let dir = TempDir::new("outputs-late-signal");
+    let out = dir.join("run");
+    let sets = ["scene.duration_s=0.05", "shock[0].start_s=0.01", "output.plots=true"];
+    let run = Proc::spawn(&mut plant_run(&scene("paper-3g.toml"), &out, &sets));
+    let summary = out.join("summary.json");
+    let deadline = std::time::Instant::now() + LIMIT;
+    while !summary.exists() {
+        assert!(std::time::Instant::now() < deadline, "no summary.json");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    run.signal(libc::SIGTERM);
+    let (code, log) = run.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    let s = read_json(&summary);
+    assert_eq!(s["status"], "interrupted", "{s:#}");
+    assert_eq!(num(&s, "simulated_s"), 0.05, "the run itself reached its end");
+    for chart in ["orbit.png", "radius.png", "currents.png", "spectrum.png"] {
+        assert!(out.join(chart).is_file(), "{chart}: nothing already written is lost");
+    }
+}
