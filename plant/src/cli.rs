@@ -116,7 +116,7 @@ impl ControllerArg {
             ControllerArg::Spawn => ControllerProcess::Spawn(None),
             ControllerArg::External => ControllerProcess::External,
         };
-        Launch { controller, run_id }
+        Launch { controller, run_id, log: None }
     }
 }
 

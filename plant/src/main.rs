@@ -490,6 +490,10 @@ mod tests {
     use super::*;
     use plant::run::SetupError;
 
+    fn exited(code: Option<i32>) -> CosimError {
+        CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
+    }
+
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
         let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
@@ -507,8 +511,8 @@ mod tests {
             (SetupError::Cosim(CosimError::Interrupted).into(), 130),
             (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
             (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
+            (exited(Some(2)).into(), 2),
+            (exited(Some(1)).into(), 4),
             (stopped(StopKind::MissBudget), 6),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),

@@ -36,6 +36,7 @@ pub const RUN_FILES: &[&str] = &[
     "whirl_spectrum.png",
     "spectrogram.png",
     "poincare.png",
+    "controller.log",
 ];
 
 /// Why `plant run` stopped before it wrote its results.
@@ -80,7 +81,10 @@ fn prepare_scene_toml(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
 /// choices, so that every exit after the scene loaded leaves both files. An earlier run's
 /// files are removed ([`prepare`]).
 pub fn write_not_started(dir: &Path, scene: &Scene, status: &str, error: &str) -> anyhow::Result<()> {
-    prepare(dir, scene)?;
+    // The controller's output of this attempt stays: the error quotes it.
+    std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display()))?;
+    remove_stale_except(dir, &["controller.log"])?;
+    prepare_scene_toml(dir, scene)?;
     let summary = serde_json::json!({
         "scene": scene.name,
         "status": status,
@@ -93,7 +97,12 @@ pub fn write_not_started(dir: &Path, scene: &Scene, status: &str, error: &str) -
 
 /// Removes the files of [`RUN_FILES`] from `dir` (those that are there).
 pub fn remove_stale(dir: &Path) -> anyhow::Result<()> {
-    for name in RUN_FILES {
+    remove_stale_except(dir, &[])
+}
+
+/// [`remove_stale`], keeping the files named in `keep`.
+fn remove_stale_except(dir: &Path, keep: &[&str]) -> anyhow::Result<()> {
+    for name in RUN_FILES.iter().filter(|n| !keep.contains(n)) {
         let path = dir.join(name);
         match std::fs::remove_file(&path) {
             Ok(()) => {}
@@ -194,7 +203,8 @@ impl Sink for RunFolder {
 pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<Written, RunDirError> {
     prepare(dir, scene).map_err(RunDirError::Output)?;
     let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
-    let run = run_into(scene, launch, hooks, &mut folder)?;
+    let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
+    let run = run_into(scene, &launch, hooks, &mut folder)?;
     // What an external controller ran differently from the scene goes into the record, so that
     // the folder reproduces the run.
     let recorded = match run.cosim.as_ref().and_then(|c| c.controller_overrides.as_ref()) {

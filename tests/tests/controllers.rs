@@ -273,3 +273,79 @@ fn the_c_header_matches_the_rust_layout() {
         ["SensorFrame - 0 112", "CommandFrame - 0 112", "WakeRequest - 0 8", "Hello - 0 4312", "Ack - 0 4416"]
     );
 }
+
+/// Issue 21 item 5: the controller inherited the plant's stdout; when that was a pipe nobody
+/// drained, a chatty controller blocked before its hello and the plant exited 4 after the
+/// connect timeout with no hint why. Its output now goes to `controller.log` in the run
+/// folder (bounded), drained as it comes: the run completes with the plant's stdout a pipe
+/// nobody reads, and a controller that fails is quoted, naming the file.
+#[cfg(unix)]
+#[test]
+fn the_controllers_output_goes_to_controller_log_and_never_blocks_it() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("controller-log");
+    let chatty = dir.join("chatty.sh");
+    // 3 MiB on stdout (a pipe holds 64 KiB), a line on stderr, then the real controller.
+    std::fs::write(
+        &chatty,
+        format!(
+            "#!/bin/sh\nhead -c 3145728 /dev/zero | tr '\\0' x\necho 'chatty: starting' >&2\nexec {:?} \"$@\"\n",
+            controller_bin().display().to_string()
+        ),
+    )
+    .unwrap();
+    let failing = dir.join("failing.sh");
+    std::fs::write(&failing, "#!/bin/sh\necho 'failing: cannot open my gains file' >&2\nexit 3\n").unwrap();
+    for script in [&chatty, &failing] {
+        std::fs::set_permissions(script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+
+    let out = dir.join("run");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&chatty.display().to_string()])]);
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra));
+    let stderr_file = dir.join("plant.stderr");
+    // The plant's stdout: a pipe that nobody reads (kept open, never drained).
+    let mut plant = cmd
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_file).unwrap())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = plant.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed() > LIMIT {
+            let _ = plant.kill();
+            panic!("the run did not end within {LIMIT:?}: {}", std::fs::read_to_string(&stderr_file).unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(0), "{}", std::fs::read_to_string(&stderr_file).unwrap());
+    let log = std::fs::read(out.join("controller.log")).unwrap();
+    let text = String::from_utf8_lossy(&log);
+    assert!(text.starts_with("--- plant: started `"), "{}", &text[..200]);
+    assert!(text.contains("chatty: starting"), "the last output is kept");
+    assert!(text.contains("bytes of the controller's output left out here"));
+    assert!(log.len() < 2 << 20, "controller.log is bounded: {} bytes", log.len());
+
+    let out = dir.join("failed");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&failing.display().to_string()])]);
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra)));
+    assert_exit(&run, 4);
+    let err = stderr(&run);
+    assert!(
+        err.contains("controller.log")
+            && err.contains("failing: cannot open my gains file")
+            && err.contains("exit status: 3"),
+        "{err}"
+    );
+    assert!(read_json(&out.join("summary.json"))["error"]
+        .as_str()
+        .unwrap_or_default()
+        .contains("cannot open my gains file"));
+    assert!(std::fs::read_to_string(out.join("controller.log"))
+        .unwrap()
+        .contains("failing: cannot open my gains file"));
+}

@@ -7,6 +7,7 @@ mod handshake;
 
 use handshake::Pending;
 
+use super::log::OutputLog;
 use super::process::{Child, Program};
 use super::stats::{CosimReport, Figures, Scheduling};
 use super::{CosimError, PeerEvent};
@@ -94,6 +95,8 @@ pub struct Session {
     _node: Node<Ipc>,
     child: Option<Child>,
     program: Option<Program>,
+    /// The output of the controllers started (after `child`: dropped once it is reaped).
+    log: OutputLog,
     _lock: RunLock,
     hello: Hello,
     limit: f64,
@@ -241,12 +244,12 @@ impl Session {
         let mut verdict = Verdict::Wait;
         let mut seen = Seen::default();
         loop {
-            let (run_id, child) = (&self.run_id, &mut self.child);
+            let (run_id, child, log) = (&self.run_id, &mut self.child, &mut self.log);
             let waited = self.frames.wait(SLICE, || {
                 if hooks.cancelled() {
                     return false;
                 }
-                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child);
+                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child, log);
                 matches!(verdict, Verdict::Wait)
             });
             let reply = match waited {
@@ -289,7 +292,7 @@ impl Session {
                 if t0.elapsed() < deadline {
                     continue;
                 }
-                return match controller_gone(&self.run_id, &mut self.child) {
+                return match controller_gone(&self.run_id, &mut self.child, &mut self.log) {
                     Some(why) => self.on_lost(sample, why, hooks),
                     None => self.on_silent(sample, &seen, hooks),
                 };
@@ -460,7 +463,7 @@ impl Session {
                     }
                     if self.last_heard.elapsed() >= self.next_check {
                         self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
-                        if let Some(why) = controller_gone(&self.run_id, &mut self.child) {
+                        if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
                             return self.on_lost(sample, why, hooks);
                         }
                     }
@@ -544,13 +547,14 @@ fn check_silence(
     deadline: Duration,
     run_id: &str,
     child: &mut Option<Child>,
+    log: &mut OutputLog,
 ) -> Verdict {
     let waited = t0.elapsed();
     if waited < *next_check {
         return Verdict::Wait;
     }
     *next_check = waited + timeout;
-    if let Some(why) = controller_gone(run_id, child) {
+    if let Some(why) = controller_gone(run_id, child, log) {
         return Verdict::Gone(why);
     }
     if waited >= deadline {
@@ -560,12 +564,13 @@ fn check_silence(
     }
 }
 
-/// `Some(why)` if the controller's process is gone: our child exited, or
-/// its node is dead or absent.
-fn controller_gone(run_id: &str, child: &mut Option<Child>) -> Option<String> {
+/// `Some(why)` if the controller's process is gone: our child exited (with its last output),
+/// or its node is dead or absent.
+fn controller_gone(run_id: &str, child: &mut Option<Child>, log: &mut OutputLog) -> Option<String> {
     if let Some(c) = child.as_mut() {
         if let Some(status) = c.exited() {
-            return Some(format!("the controller process exited ({status})"));
+            log.settle();
+            return Some(format!("the controller process exited ({status}){}", log.quote(3)));
         }
     }
     match link::peer(run_id, "controller") {

@@ -197,7 +197,8 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         rss_csv,
         error: None,
     };
-    let mut result = match run_into(scene, &opts.launch, &mut hooks, &mut sink) {
+    let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
+    let mut result = match run_into(scene, &launch, &mut hooks, &mut sink) {
         Ok(r) => r,
         Err(e) => {
             // The programme loaded: the folder records why the soak did not start.
