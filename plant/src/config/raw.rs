@@ -442,6 +442,14 @@ pub struct RawController {
     /// Co-simulation, realtime: the largest deadline-miss fraction a run may have; past it
     /// the run ends with status `miss_budget` (exit code 6). Default 1 (no limit).
     pub max_miss_fraction: f64,
+    /// Sampled and co-simulation: the most non-finite commands (NaN or infinite currents) in
+    /// a row a run holds the last valid command through; past it the run ends with status
+    /// `invalid_commands` (exit code 8). Default 10.
+    pub max_invalid_burst: u64,
+    /// Sampled and co-simulation: the largest share of non-finite commands a run may have
+    /// (judged from 1000 ticks on and over the whole run); past it the run ends with status
+    /// `invalid_commands` (exit code 8). Default 0.01; 1 = no limit.
+    pub max_invalid_fraction: f64,
 }
 defaults!(RawController {
     mode: ControlMode = ControlMode::Continuous,
@@ -468,6 +476,8 @@ defaults!(RawController {
     lockstep_timeout_ms: f64 = 5000.0,
     realtime_priority: u32 = 0,
     max_miss_fraction: f64 = 1.0,
+    max_invalid_burst: u64 = 10,
+    max_invalid_fraction: f64 = 0.01,
 });
 
 /// `[integrator]`.
