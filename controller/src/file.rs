@@ -35,6 +35,8 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "lockstep_timeout_ms",
     "realtime_priority",
     "max_miss_fraction",
+    "max_invalid_burst",
+    "max_invalid_fraction",
 ];
 
 /// `[controller]` keys the controller process uses (the `relev_*` ones are deprecated aliases

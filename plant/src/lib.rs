@@ -26,6 +26,7 @@ pub mod cosim;
 pub mod ensemble;
 pub mod hooks;
 pub mod initial;
+pub mod invalid;
 pub mod output;
 pub mod plot;
 pub mod record;

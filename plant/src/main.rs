@@ -14,6 +14,7 @@
 //! | 5 | `plant soak`: completed, but a criterion failed |
 //! | 6 | realtime: the deadline-miss budget `controller.max_miss_fraction` was exceeded |
 //! | 7 | `--merge` (sweep or ensemble): points or members missing or corrupt (they are listed) |
+//! | 8 | the controller's commands were non-finite past `controller.max_invalid_burst` or `controller.max_invalid_fraction` |
 //! | 130 | interrupted (SIGINT or SIGTERM to the plant) |
 
 mod cli;
@@ -43,6 +44,8 @@ mod exit {
     pub const CRITERION_FAILED: u8 = 5;
     /// Realtime: the deadline-miss budget was exceeded.
     pub const MISS_BUDGET: u8 = 6;
+    /// The controller's commands were non-finite past the budget (status `invalid_commands`).
+    pub const INVALID_COMMANDS: u8 = 8;
     // 7 (`--merge` with points or members missing or corrupt) and the other codes of
     // `plant sweep` / `plant ensemble` come from `plant::sweep::SweepError::exit_code`.
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
@@ -81,6 +84,7 @@ enum StopKind {
     Interrupted,
     PeerLost,
     MissBudget,
+    InvalidCommands,
 }
 
 fn main() -> ExitCode {
@@ -136,6 +140,7 @@ fn exit_code(err: &anyhow::Error) -> u8 {
                 Ending::Stopped { kind: StopKind::Diverged, .. } => exit::DIVERGED,
                 Ending::Stopped { kind: StopKind::PeerLost, .. } => exit::PEER_LOST,
                 Ending::Stopped { kind: StopKind::MissBudget, .. } => exit::MISS_BUDGET,
+                Ending::Stopped { kind: StopKind::InvalidCommands, .. } => exit::INVALID_COMMANDS,
                 Ending::Stopped { kind: StopKind::Interrupted, .. } => exit::INTERRUPTED,
                 Ending::CriteriaFailed(_) => exit::CRITERION_FAILED,
             };
@@ -372,6 +377,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
         Outcome::Interrupted => (StopKind::Interrupted, "interrupted".to_string()),
         Outcome::PeerLost(why) => (StopKind::PeerLost, why.clone()),
         Outcome::MissBudget(why) => (StopKind::MissBudget, why.clone()),
+        Outcome::InvalidCommands(why) => (StopKind::InvalidCommands, why.clone()),
     };
     Err(Ending::Stopped { kind, why, simulated_s }.into())
 }
@@ -514,6 +520,7 @@ mod tests {
             (exited(Some(2)).into(), 2),
             (exited(Some(1)).into(), 4),
             (stopped(StopKind::MissBudget), 6),
+            (stopped(StopKind::InvalidCommands), 8),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),
             (

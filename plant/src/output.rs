@@ -432,6 +432,7 @@ mod tests {
             final_state: [0.0; crate::model::N],
             cosim: None,
             parked_steps: 0,
+            invalid_commands: 0,
         };
         let written =
             folder.finish(&dir, &scene, run, &|| false).expect("a run with nothing to draw is not an output error");

@@ -81,6 +81,9 @@ pub enum Outcome {
     PeerLost(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// The law's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` ([`crate::invalid`]).
+    InvalidCommands(String),
 }
 
 /// Why a run could not start.
@@ -181,6 +184,8 @@ pub struct SinkRun {
     pub cosim: Option<CosimReport>,
     /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
     pub parked_steps: u64,
+    /// Ticks whose command was non-finite (the last valid one was held).
+    pub invalid_commands: u64,
 }
 
 /// Runs a scene from its initial state, sending every output sample (from
@@ -252,6 +257,8 @@ pub fn run_into(
     let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
+    let c = &scene.controller;
+    let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
     let guards = Guards::new(scene);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
@@ -293,6 +300,23 @@ pub fn run_into(
             },
         };
         if let Some(cmd) = command {
+            let cmd = match invalid.check(cmd, &sample) {
+                Ok(checked) => {
+                    if checked.first {
+                        hooks.note(&format!(
+                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {cmd:?} A: \
+                             the last valid command is held for it and for every later non-finite one, up to \
+                             controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
+                            sample.seq, sample.t_s, c.max_invalid_burst
+                        ));
+                    }
+                    checked.command
+                }
+                Err(why) => {
+                    outcome = Outcome::InvalidCommands(why);
+                    break;
+                }
+            };
             queue.push_back(cmd);
             if let Some(applied) = queue.pop_front() {
                 model.control = Control::Held(applied);
@@ -342,19 +366,36 @@ pub fn run_into(
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
+    // A run that completed is judged over all its ticks.
+    if outcome == Outcome::Completed {
+        if let Some(why) = invalid.at_end() {
+            outcome = Outcome::InvalidCommands(why);
+        }
+    }
     let cosim = match source {
         Source::Cosim(session) => {
-            // A realtime run that completed is judged over all its ticks.
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
                 }
             }
-            Some(session.finish(t, (t / period).round() as u64))
+            let mut report = session.finish(t, (t / period).round() as u64);
+            report.invalid_replies = invalid.count();
+            Some(report)
         }
         _ => None,
     };
-    Ok(SinkRun { stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim, parked_steps })
+    let invalid_commands = invalid.count();
+    Ok(SinkRun {
+        stats: integrator.stats(),
+        simulated: t,
+        wall_time,
+        outcome,
+        final_state: y,
+        cosim,
+        parked_steps,
+        invalid_commands,
+    })
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

@@ -23,6 +23,8 @@ pub enum Status {
     NotStarted,
     /// Realtime: the deadline-miss budget was exceeded (exit 6).
     MissBudget,
+    /// The controller's commands were non-finite past the budget (exit 8).
+    InvalidCommands,
 }
 
 impl Status {
@@ -36,6 +38,7 @@ impl Status {
             Status::Refused => "refused",
             Status::NotStarted => "not_started",
             Status::MissBudget => "miss_budget",
+            Status::InvalidCommands => "invalid_commands",
         }
     }
 }
@@ -55,6 +58,7 @@ impl Outcome {
             Outcome::Interrupted => Status::Interrupted,
             Outcome::PeerLost(_) => Status::PeerLost,
             Outcome::MissBudget(_) => Status::MissBudget,
+            Outcome::InvalidCommands(_) => Status::InvalidCommands,
         }
     }
 
@@ -64,7 +68,7 @@ impl Outcome {
             Outcome::Completed => None,
             Outcome::Diverged(e) => Some(e.to_string()),
             Outcome::Interrupted => Some("interrupted by a signal".to_string()),
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) => Some(why.clone()),
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::InvalidCommands(why) => Some(why.clone()),
         }
     }
 
@@ -126,6 +130,7 @@ mod tests {
             Status::Refused,
             Status::NotStarted,
             Status::MissBudget,
+            Status::InvalidCommands,
         ] {
             assert_eq!(serde_json::to_value(s).unwrap(), s.name());
         }

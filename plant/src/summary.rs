@@ -125,6 +125,9 @@ pub struct Summary {
     pub contact_time_s: f64,
     /// Fraction of macro steps run with the race parked (0 unless `race_when_clear = "parked"`).
     pub parked_fraction: f64,
+    /// Controller ticks whose command was non-finite (the last valid one was held; see
+    /// `controller.max_invalid_burst`, `controller.max_invalid_fraction`).
+    pub invalid_commands: u64,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -206,6 +209,7 @@ impl Summary {
                     0.0
                 }
             },
+            invalid_commands: run.invalid_commands,
             steps: run.stats.steps,
             rejected_steps: run.stats.rejected,
             rhs_evals: run.stats.rhs_evals,

@@ -106,6 +106,10 @@ pub struct ControllerSettings {
     pub params: controller::Params,
     /// Co-simulation settings (used in `lockstep` and `realtime`).
     pub cosim: CosimSettings,
+    /// The most non-finite commands in a row before the run ends ([`crate::invalid`]).
+    pub max_invalid_burst: u64,
+    /// The largest share of non-finite commands ([`crate::invalid`]).
+    pub max_invalid_fraction: f64,
 }
 
 /// Co-simulation settings, validated (SI).

@@ -201,23 +201,15 @@ impl Session {
         }
     }
 
-    /// Checks a reply's currents; non-finite ones are counted and the last current held, and
-    /// the first one is said (a run that holds currents is not the law's run).
-    fn accept(&mut self, reply: &CommandFrame, sample: &Sample, hooks: &mut dyn Hooks) -> [f64; 2] {
-        let current = reply.current_xy();
+    /// A reply's currents, saturated. A non-finite one is passed on as it is (the run loop
+    /// holds, counts and judges them, [`crate::invalid`]) and is not kept as the last current
+    /// (held on a miss or a loss).
+    fn accept(&mut self, reply: &CommandFrame) -> [f64; 2] {
+        let current = saturate(reply.current_xy(), self.limit);
         if current.iter().all(|i| i.is_finite()) {
-            self.last_cmd = saturate(current, self.limit);
-        } else {
-            if self.figures.invalid == 0 {
-                hooks.note(&format!(
-                    "warning: the controller sent a non-finite current {current:?} A for sample {} (t = {} s); \
-                     the last valid current is held for it and for every later non-finite reply (counted in summary.json, cosim.invalid_replies)",
-                    sample.seq, sample.t_s
-                ));
-            }
-            self.figures.invalid += 1;
+            self.last_cmd = current;
         }
-        self.last_cmd
+        current
     }
 
     /// The command for sample `k` to push into the delay line: the reply to
@@ -300,7 +292,7 @@ impl Session {
             self.figures.round_trip.record(t0.elapsed().as_nanos() as u64);
             self.figures.latency.record(reply.sent_ns.saturating_sub(frame.sent_ns));
             self.warn_if_never_woken(hooks);
-            return Ok(self.accept(&reply, sample, hooks));
+            return Ok(self.accept(&reply));
         }
     }
 
@@ -454,7 +446,7 @@ impl Session {
             match fresh {
                 Some(reply) => {
                     self.figures.misses.record(false);
-                    self.accept(&reply, sample, hooks)
+                    self.accept(&reply)
                 }
                 None => {
                     self.figures.misses.record(true);
@@ -517,7 +509,7 @@ impl Session {
             messages_received: f.received,
             sequence_gaps: f.gaps,
             stale_replies: f.stale,
-            invalid_replies: f.invalid,
+            invalid_replies: 0, // counted by the run loop, which fills it in
             foreign_frames: f.foreign,
             deadline_misses: f.misses.total,
             deadline_miss_fraction: f.miss_fraction(),
