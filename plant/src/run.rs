@@ -200,7 +200,7 @@ pub fn run_into(
     let limit = scene.params.current_limit;
     let bias = saturate(gains.bias_a, limit);
     let (design, params) = (scene.design(), &scene.controller.params);
-    let mut source = match scene.controller.mode {
+    let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
         ControlMode::Sampled => Source::InProcess(build_law(&scene.controller.law, &design, params)?),
         ControlMode::Lockstep | ControlMode::Realtime => {
@@ -212,6 +212,29 @@ pub fn run_into(
             Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
         }
     };
+    run_from(scene, source, hooks, sink)
+}
+
+/// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
+/// the registry (whatever the scene's mode): the sensor read at each tick, the command
+/// saturated, delayed `delay_samples` ticks and held. A lockstep run of the same law in a
+/// controller process writes the same trace, bit for bit. See [`crate::check`].
+pub fn run_law_into(
+    scene: &Scene,
+    law: Box<dyn ControlLaw>,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
+    run_from(scene, Source::InProcess(law), hooks, sink)
+}
+
+/// The loop, from a command source.
+fn run_from(
+    scene: &Scene,
+    mut source: Source,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
     // An external controller may run a design of its own (its `--config` or `--law`): the run
     // is then the scene with those overrides, initial state and bias included, so that the
     // scene it records reproduces it.
