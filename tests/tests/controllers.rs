@@ -52,9 +52,10 @@ fn target_dir() -> PathBuf {
 /// Issue 10 item 3: a controller crate outside the workspace, depending on `controller` by
 /// path, is built (offline, locked, into the workspace's target folder so the shared
 /// dependencies are reused) and run by the plant through `controller.command` in lockstep.
-/// Its trace is what its law gives: the example's own code, run here on the trace's sensor
-/// samples, reproduces every applied current bit for bit (delay 1: the current computed from
-/// sample k is in row k + 2), and differs from the plain PD's.
+/// Its trace is what its law gives: the run folder replayed through the example's own code
+/// (`plant::check::replay`) reproduces every applied current bit for bit, differs from the
+/// plain PD's, and the law run in the plant's process (`plant::check::run_law`) gives the
+/// same trace.
 #[test]
 fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace() {
     let crate_dir = workspace_root().join("examples").join("rust-controller");
@@ -92,34 +93,21 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     assert!(s["cosim"]["controller"].as_str().unwrap().starts_with("pd_notch:"), "{s:#}");
     assert_eq!(s["cosim"]["controller_command"][0].as_str(), Some(exe.display().to_string().as_str()));
 
-    let scene = plant::config::load_scene(&scene_file, &extra).expect("the scene");
-    let design = scene.design();
-    let mut law = pd_notch::build(&design, &scene.controller.params).expect("the law");
-    let mut pd = controller::build_law("pd", &design, &controller::Params::default()).unwrap();
+    // The run folder replayed through the crate's law (plant::check, issue 21 item 3): every
+    // applied current is the law's, bit for bit; through the plain PD it is not.
+    let replayed = plant::check::replay(&out, &pd_notch::LAW).expect("the replay");
+    eprintln!("replay of the out-of-tree crate's lockstep run through its law: {replayed}");
+    assert!(replayed.identical(), "{replayed}");
+    assert_eq!(replayed.compared, 1000);
+    let scene = plant::config::load_scene(&out.join("scene.toml"), &[]).expect("the run's scene");
+    let mut pd = controller::build_law("pd", &scene.design(), &controller::Params::default()).unwrap();
+    let pd = plant::check::replay_trace(&scene, &out.join("trace.csv"), pd.as_mut()).expect("the replay");
+    assert!(!pd.identical() && pd.largest_a > 1e-3, "the notch changed nothing: {pd}");
+    // And the same law run in the plant's process gives the same trace.
+    let in_process = plant::check::run_law(&scene, &pd_notch::LAW, &mut plant::run::Quiet).expect("the run");
     let trace = Csv::read(&out.join("trace.csv"));
-    let (t, dx, dy) = (trace.column("t_s"), trace.column("dx_m"), trace.column("dy_m"));
-    let (ix, iy) = (trace.column("ix_a"), trace.column("iy_a"));
-    let (gain, limit, period) = (design.constants.sensor_gain_v_per_m, design.current_limit_a, design.period_s);
-    let ticks = t.len() - 1;
-    assert_eq!(ticks, 1000);
-    let mut largest_difference_from_pd: f64 = 0.0;
-    for k in 0..ticks - 1 {
-        assert!((t[k] - k as f64 * period).abs() < 1e-12, "row {k} at t = {}", t[k]);
-        let sample =
-            controller::Sample { seq: k as u64, t_s: k as f64 * period, sensor_v: [gain * dx[k], gain * dy[k]] };
-        let i = controller::saturate(law.update(&sample), limit);
-        assert!(
-            ix[k + 2].to_bits() == i[0].to_bits() && iy[k + 2].to_bits() == i[1].to_bits(),
-            "sample {k}: the process applied ({}, {}) A, the law gives ({}, {}) A",
-            ix[k + 2],
-            iy[k + 2],
-            i[0],
-            i[1]
-        );
-        let p = controller::saturate(pd.update(&sample), limit);
-        largest_difference_from_pd = largest_difference_from_pd.max((p[0] - i[0]).abs()).max((p[1] - i[1]).abs());
-    }
-    assert!(largest_difference_from_pd > 1e-3, "the notch changed nothing: {largest_difference_from_pd} A");
+    assert_eq!(in_process.trace.ix_a, trace.column("ix_a"));
+    assert_eq!(in_process.trace.dy_m, trace.column("dy_m"));
 }
 
 /// Issue 10 item 4: the contract a command gets. The plant runs it exactly, with `--run-id
