@@ -283,6 +283,11 @@ pub fn serve(laws: &[LawEntry]) -> ExitCode {
 
 /// [`serve`] with the command line given (the program name first).
 pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
+    ExitCode::from(serve_code(argv, laws))
+}
+
+/// [`serve_from`], the exit code as a number (for the C API, which returns it).
+pub fn serve_code(argv: Vec<OsString>, laws: &[LawEntry]) -> u8 {
     let program = argv
         .first()
         .map(|p| std::path::Path::new(p).file_name().unwrap_or(p.as_os_str()).to_string_lossy().into_owned())
@@ -300,7 +305,7 @@ pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
     let ended = ServeOptions::from_args(&args, |k| std::env::var(k).ok())
         .and_then(|opts| run(&opts, laws, &STOP, &mut |w| eprintln!("{program}: {w}")));
     match ended {
-        Ok(_) => ExitCode::SUCCESS,
+        Ok(_) => exit::OK,
         Err(e) => {
             let code = e.exit_code();
             if matches!(code, exit::PLANT_LOST | exit::INTERRUPTED) {
@@ -308,7 +313,7 @@ pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
             } else {
                 eprintln!("{program}: error: {e}");
             }
-            ExitCode::from(code)
+            code
         }
     }
 }
