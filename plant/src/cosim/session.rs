@@ -565,11 +565,24 @@ fn controller_gone(run_id: &str, child: &mut Option<Child>, log: &mut OutputLog)
             return Some(format!("the controller process exited ({status}){}", log.quote(3)));
         }
     }
-    match link::peer(run_id, "controller") {
-        Peer::Alive => None,
-        Peer::Dead => Some("the controller's node is dead (its process died)".into()),
-        Peer::Absent => Some("the controller's node is gone".into()),
+    let why = match link::peer(run_id, "controller") {
+        Peer::Alive => return None,
+        Peer::Dead => "the controller's node is dead (its process died)",
+        Peer::Absent => "the controller's node is gone",
+    };
+    // A child of ours whose node went is on its way out: its exit status and last words say why.
+    if let Some(c) = child.as_mut() {
+        let until = Instant::now() + Duration::from_millis(500);
+        while Instant::now() < until {
+            if let Some(status) = c.exited() {
+                log.settle();
+                return Some(format!("{why}: the controller process exited ({status}){}", log.quote(3)));
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        return Some(format!("{why}{}", log.quote(3)));
     }
+    Some(why.into())
 }
 
 /// Waits for a wall-clock instant: sleeps while it is far, then spins.
