@@ -11,7 +11,7 @@
  * codes, exactly as controller::serve for a Rust law. No iceoryx2 of your
  * own: libamb_testbed_controller (.so or .a) holds it.
  *
- *   cargo build --release -p controller-c
+ *   cargo build --release
  *   cc -std=c11 -O2 -ffp-contract=off -Icontroller/include my_law.c \
  *      target/release/libamb_testbed_controller.a -lgcc_s -lutil -lrt -lpthread -lm -ldl -lc -o my-law
  *   target/release/plant run config/cosim-10g.toml --set 'controller.command=["./my-law"]'

@@ -5,7 +5,7 @@
  * (docs/wire-protocol.md, "The shipped laws, exactly"); compile with
  * -ffp-contract=off so that no multiply-add is fused.
  *
- *   cargo build --release -p controller-c
+ *   cargo build --release
  *   cc -std=c11 -O2 -ffp-contract=off -Icontroller/include examples/c/pd.c \
  *      target/release/libamb_testbed_controller.a -lgcc_s -lutil -lrt -lpthread -lm -ldl -lc -o pd-c
  *   target/release/plant run config/cosim-10g.toml --set 'controller.command=["./pd-c"]'

@@ -3,7 +3,7 @@
 // (tests/tests/c_api.rs). The functions handed to amb_serve are noexcept: an exception that
 // escaped one would abort the process.
 //
-//   cargo build --release -p controller-c
+//   cargo build --release
 //   c++ -std=c++17 -O2 -ffp-contract=off -Icontroller/include examples/cpp/pd.cpp
 //       -Ltarget/release -lamb_testbed_controller -Wl,-rpath,$PWD/target/release -o pd-cpp
 //   (one command line)
