@@ -7,11 +7,13 @@
 //! with the first one's (two runs at once used to leave one run's
 //! `summary.json` beside the other's `trace.csv`, both exiting 0). The kernel
 //! releases the claim when the process ends, however it ends (SIGKILL
-//! included); nothing is left in the folder. A folder the claim created and
-//! the command left empty (it failed before writing anything, e.g. `plant
+//! included); nothing is left in the folder. A claim also removes the
+//! temporaries of atomic writes that a killed process left in the folder
+//! ([`crate::atomic::remove_stale`]). A folder the claim created and the
+//! command left empty (it failed before writing anything, e.g. `plant
 //! compare --laws foo`) is removed again when the claim goes, with the
 //! parents it created. Sweeps and ensembles do not take it: their shards
-//! share one folder by design and check their own files.
+//! share one folder by design and check their own files (and temporaries).
 
 use std::fs::{File, TryLockError};
 use std::path::{Path, PathBuf};
@@ -70,7 +72,11 @@ pub fn claim(dir: &Path, create: bool) -> Result<Option<Claim>, ClaimError> {
     }
     let file = File::open(dir).map_err(io)?;
     match file.try_lock() {
-        Ok(()) => Ok(Some(Claim { _dir: file, created })),
+        Ok(()) => {
+            // A write of an earlier command killed half-way left its temporary here.
+            crate::atomic::remove_stale(dir);
+            Ok(Some(Claim { _dir: file, created }))
+        }
         Err(TryLockError::WouldBlock) => Err(ClaimError::InUse { path: dir.to_path_buf(), holder: holder(dir) }),
         Err(TryLockError::Error(e)) => Err(io(e)),
     }

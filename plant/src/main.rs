@@ -1,91 +1,28 @@
 //! `plant`: runs scenes of the AMB/touchdown-bearing testbed.
 //!
-//! `main` → [`run`] → [`exit_code`], on ripgrep's model: every command
+//! `main` → [`run`] → [`plant::exit::code`], on ripgrep's model: every command
 //! returns its errors to `main`, which prints them once ([`report`]) and maps
-//! them to the exit code by their type, never by their text:
-//!
-//! | code | meaning |
-//! |---|---|
-//! | 0 | success |
-//! | 1 | an output could not be written, or the system refused a resource |
-//! | 2 | bad input (scene, programme, sweep or ensemble file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol, a controller `command` that does not exist or is not executable, a run id or an output folder in use) |
-//! | 3 | numerical divergence |
-//! | 4 | the controller process was lost (died, stopped by a signal, silent past `controller.lockstep_timeout_ms`, exited before the handshake, never answered) |
-//! | 5 | `plant soak`: completed, but a criterion failed |
-//! | 6 | realtime: the deadline-miss budget `controller.max_miss_fraction` was exceeded |
-//! | 7 | `--merge` (sweep or ensemble): points or members missing or corrupt (they are listed) |
-//! | 8 | the controller's commands were non-finite past `controller.max_invalid_burst` or `controller.max_invalid_fraction` |
-//! | 130 | interrupted (SIGINT or SIGTERM to the plant) |
+//! them to the exit code by their type, never by their text ([`plant::exit`]
+//! holds the codes and the one map; `docs/guide/running.md` the table).
 
 mod cli;
 
 use clap::Parser;
 use cli::{BenchCommand, Cli, Command, ControllerArg};
-use plant::config::{load_scene, ConfigError, Scene};
-use plant::cosim::{CosimError, Launch};
+use plant::config::{load_scene, Scene};
+use plant::cosim::Launch;
+use plant::exit::{self, Code, Ending, StopKind};
 use plant::run::{Hooks, Outcome};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// Exit codes, one per kind of ending (the table in the module doc).
-mod exit {
-    /// An output could not be written, or the system refused a resource.
-    pub const IO: u8 = 1;
-    /// Bad input.
-    pub const BAD_INPUT: u8 = 2;
-    /// The simulation diverged (non-finite state, step-size underflow, radius guard).
-    pub const DIVERGED: u8 = 3;
-    /// Co-simulation: the controller process was lost and none took its place.
-    pub const PEER_LOST: u8 = 4;
-    /// `plant soak`: the run completed but a criterion of the programme failed.
-    pub const CRITERION_FAILED: u8 = 5;
-    /// Realtime: the deadline-miss budget was exceeded.
-    pub const MISS_BUDGET: u8 = 6;
-    /// The controller's commands were non-finite past the budget (status `invalid_commands`).
-    pub const INVALID_COMMANDS: u8 = 8;
-    // 7 (`--merge` with points or members missing or corrupt) and the other codes of
-    // `plant sweep` / `plant ensemble` come from `plant::sweep::SweepError::exit_code`.
-    /// Stopped by SIGINT/SIGTERM; results up to that point were written.
-    pub const INTERRUPTED: u8 = 130;
-}
 
 /// Most round trips `plant bench ipc` records or warms up with (each recorded one keeps 8
 /// bytes of figures).
 const MAX_BENCH_SAMPLES: u64 = 10_000_000;
-
-/// Endings of a command that are not successes and carry no error of a library type.
-#[derive(Debug, thiserror::Error)]
-enum Ending {
-    /// A command-line argument (or a scene the stability check refuses) is bad input.
-    #[error("{0}")]
-    BadArgument(String),
-    /// A run stopped before its end; its results up to then were written.
-    #[error("{why}; results up to t = {simulated_s} s were written")]
-    Stopped {
-        /// How it stopped.
-        kind: StopKind,
-        /// What happened.
-        why: String,
-        /// Simulated time reached (s).
-        simulated_s: f64,
-    },
-    /// `plant soak` completed, but criteria failed (each was named above).
-    #[error("{0} soak criterion (criteria) failed")]
-    CriteriaFailed(usize),
-}
-
-/// How a run stopped early.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum StopKind {
-    Diverged,
-    Interrupted,
-    PeerLost,
-    MissBudget,
-    InvalidCommands,
-}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -94,7 +31,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             report(&err);
-            ExitCode::from(exit_code(&err))
+            ExitCode::from(u8::from(exit::code(&err)))
         }
     }
 }
@@ -102,7 +39,7 @@ fn main() -> ExitCode {
 /// Prints an error once: `plant: error: …` (an interruption is not an error: `plant: …`).
 fn report(err: &anyhow::Error) {
     let text = chain_text(err);
-    if exit_code(err) == exit::INTERRUPTED {
+    if exit::code(err) == Code::Interrupted {
         eprintln!("plant: {text}");
     } else {
         eprintln!("plant: error: {text}");
@@ -128,87 +65,6 @@ fn chain_text(err: &anyhow::Error) -> String {
 /// A warning for the user.
 fn warn(message: &str) {
     eprintln!("plant: warning: {message}");
-}
-
-/// The exit code of an error: the code of the first cause in its chain whose type has one;
-/// 1 (an output or a resource) for the rest.
-fn exit_code(err: &anyhow::Error) -> u8 {
-    for cause in err.chain() {
-        if let Some(e) = cause.downcast_ref::<Ending>() {
-            return match e {
-                Ending::BadArgument(_) => exit::BAD_INPUT,
-                Ending::Stopped { kind: StopKind::Diverged, .. } => exit::DIVERGED,
-                Ending::Stopped { kind: StopKind::PeerLost, .. } => exit::PEER_LOST,
-                Ending::Stopped { kind: StopKind::MissBudget, .. } => exit::MISS_BUDGET,
-                Ending::Stopped { kind: StopKind::InvalidCommands, .. } => exit::INVALID_COMMANDS,
-                Ending::Stopped { kind: StopKind::Interrupted, .. } => exit::INTERRUPTED,
-                Ending::CriteriaFailed(_) => exit::CRITERION_FAILED,
-            };
-        }
-        if let Some(e) = cause.downcast_ref::<CosimError>() {
-            return cosim_code(e);
-        }
-        if let Some(e) = cause.downcast_ref::<plant::sweep::SweepError>() {
-            return e.exit_code();
-        }
-        if let Some(e) = cause.downcast_ref::<plant::claim::ClaimError>() {
-            return match e {
-                plant::claim::ClaimError::InUse { .. } => exit::BAD_INPUT,
-                plant::claim::ClaimError::Io { .. } => exit::IO,
-            };
-        }
-        if cause.is::<ConfigError>()
-            || cause.is::<controller::LawError>()
-            || cause.is::<controller::ParamsError>()
-            || cause.is::<shock_table::ShockError>()
-            || cause.is::<plant::bench::BadArgument>()
-        {
-            return exit::BAD_INPUT;
-        }
-        if let Some(e) = cause.downcast_ref::<plant::output::AnalyzeError>() {
-            return match e {
-                plant::output::AnalyzeError::Interrupted(_) => exit::INTERRUPTED,
-                e if e.is_input() => exit::BAD_INPUT,
-                _ => exit::IO,
-            };
-        }
-    }
-    exit::IO
-}
-
-/// The exit code of a co-simulation that could not start.
-fn cosim_code(e: &CosimError) -> u8 {
-    use controller::link::LinkError;
-    use controller::lock::LockError;
-    match e {
-        e if e.is_refusal() => exit::BAD_INPUT,
-        CosimError::Command { .. } => exit::BAD_INPUT,
-        CosimError::NoController { .. } | CosimError::ControllerExited { .. } => exit::PEER_LOST,
-        CosimError::Interrupted => exit::INTERRUPTED,
-        CosimError::ControllerMissing { .. }
-        | CosimError::Spawn { .. }
-        | CosimError::Lock(LockError::Io { .. })
-        | CosimError::Link(LinkError::Ipc { .. }) => exit::IO,
-        // The refusals, matched above by `is_refusal`.
-        CosimError::Refused { .. }
-        | CosimError::RunId(_)
-        | CosimError::Pin(_)
-        | CosimError::Params(_)
-        | CosimError::Protocol(_)
-        | CosimError::Lock(LockError::InUse { .. })
-        | CosimError::Link(LinkError::Incompatible { .. }) => exit::BAD_INPUT,
-    }
-}
-
-/// Installs the one SIGINT/SIGTERM handler ([`plant::signal`]); the flag it sets is polled
-/// by the commands that stop cleanly (run, soak, analyze, sweep, bench ipc). Called by those
-/// commands only: the others keep the default action (a signal ends them at once).
-fn stop_flag() -> &'static AtomicBool {
-    let (stop, failed) = plant::signal::install();
-    if let Some(w) = failed {
-        warn(&w);
-    }
-    stop
 }
 
 /// Runs one command.
@@ -294,7 +150,7 @@ fn load_checked(scene: &Scene) -> anyhow::Result<()> {
 
 /// Progress on stderr about once a second, and the Ctrl-C flag.
 struct CliHooks {
-    stop: &'static AtomicBool,
+    stop: Arc<AtomicBool>,
     duration: f64,
     started: Instant,
     last: Instant,
@@ -341,7 +197,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
     let mut hooks = CliHooks {
-        stop: stop_flag(),
+        stop: plant::interrupt::stop_flag(),
         duration: scene.duration,
         started: Instant::now(),
         last: Instant::now(),
@@ -388,7 +244,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
     let _claim = plant::claim::claim(&dir, true)?;
-    let stop = stop_flag();
+    let stop = plant::interrupt::stop_flag();
     let progress = match (quiet, std::io::stderr().is_terminal()) {
         (true, _) => plant::soak::Progress::Quiet,
         (false, true) => plant::soak::Progress::Bar,
@@ -401,7 +257,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
         plant::summary::snake_name(&prog.scene.controller.mode),
         dir.display()
     );
-    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop, progress };
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress };
     let done = match plant::soak::run(&prog, path, opts) {
         Ok(d) => d,
         Err(plant::soak::SoakError::Setup(e)) => return Err(e.into()),
@@ -424,7 +280,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 /// `plant analyze`.
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
     let _claim = plant::claim::claim(dir, false)?;
-    let a = plant::output::analyze_dir(dir, stop_flag())?;
+    let a = plant::output::analyze_dir(dir, &plant::interrupt::stop_flag())?;
     eprintln!(
         "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",
         dir.display(),
@@ -464,7 +320,7 @@ fn bench_ipc(
         return Err(Ending::BadArgument(format!("--spin-us {spin_us} µs: must be between 0 and 1e6")).into());
     }
     let mut hooks = CliHooks {
-        stop: stop_flag(),
+        stop: plant::interrupt::stop_flag(),
         duration: 0.0,
         started: Instant::now(),
         last: Instant::now(),
@@ -494,65 +350,10 @@ fn bench_ipc(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plant::run::SetupError;
-
-    fn exited(code: Option<i32>) -> CosimError {
-        CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
-    }
-
-    #[test]
-    fn exit_codes_follow_the_error_types_not_their_text() {
-        let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
-        let law = controller::LawError::Unknown { name: "nope".into() };
-        let cases: Vec<(anyhow::Error, u8)> = vec![
-            (stopped(StopKind::Diverged), 3),
-            (stopped(StopKind::PeerLost), 4),
-            (stopped(StopKind::Interrupted), 130),
-            (Ending::CriteriaFailed(1).into(), 5),
-            (Ending::BadArgument("diverged".into()).into(), 2),
-            (anyhow::Error::from(plant::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
-            (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),
-            (anyhow::Error::from(SetupError::Law(law)).context("the run"), 2),
-            (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),
-            (SetupError::Cosim(CosimError::Interrupted).into(), 130),
-            (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
-            (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
-            (exited(Some(2)).into(), 2),
-            (exited(Some(1)).into(), 4),
-            (stopped(StopKind::MissBudget), 6),
-            (stopped(StopKind::InvalidCommands), 8),
-            (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
-            (CosimError::Protocol("version 4".into()).into(), 2),
-            (
-                CosimError::Lock(controller::lock::LockError::InUse {
-                    run_id: "r".into(),
-                    role: "plant".into(),
-                    holder: "pid 1".into(),
-                    path: "p".into(),
-                })
-                .into(),
-                2,
-            ),
-            (
-                plant::output::AnalyzeError::Trace(plant::trace::TraceError::TooShort {
-                    path: "trace.csv".into(),
-                    rows: 1,
-                })
-                .into(),
-                2,
-            ),
-            (plant::output::AnalyzeError::Output(anyhow::anyhow!("read-only")).into(), 1),
-            // An output that could not be written, whatever its message says.
-            (anyhow::Error::from(std::io::Error::other("bad input")).context("writing summary.json"), 1),
-        ];
-        for (err, code) in cases {
-            assert_eq!(exit_code(&err), code, "{err:#}");
-        }
-    }
 
     #[test]
     fn each_cause_is_said_once() {
-        let setup = plant::run::SetupError::Cosim(CosimError::RunId("run id \"a b\": a space".into()));
+        let setup = plant::run::SetupError::Cosim(plant::cosim::CosimError::RunId("run id \"a b\": a space".into()));
         let err = anyhow::Error::from(setup).context("starting the run");
         assert_eq!(format!("{err:#}"), "starting the run: run id \"a b\": a space: run id \"a b\": a space");
         assert_eq!(chain_text(&err), "starting the run: run id \"a b\": a space");

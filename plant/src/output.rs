@@ -334,14 +334,6 @@ pub enum AnalyzeError {
     Interrupted(&'static str),
 }
 
-impl AnalyzeError {
-    /// Bad input (exit 2), as opposed to an output that could not be written (exit 1) or an
-    /// interruption (exit 130).
-    pub fn is_input(&self) -> bool {
-        !matches!(self, AnalyzeError::Output(_) | AnalyzeError::Interrupted(_))
-    }
-}
-
 /// The most a `summary.json` that `plant analyze` merges into may hold.
 const MAX_SUMMARY_BYTES: u64 = 16 << 20;
 

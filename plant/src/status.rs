@@ -3,10 +3,10 @@
 
 use crate::cosim::CosimError;
 use crate::run::{Outcome, SetupError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The `status` of `summary.json` and `soak.json`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Ran to the scene's duration.

@@ -252,6 +252,14 @@ impl Scene {
             .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
     }
 
+    /// The scene as resolved, read back from [`Scene::to_toml`] (every key, overrides applied,
+    /// recorded files absolute): what sweeps and ensembles key their units on and draw
+    /// relative to.
+    pub fn resolved(&self) -> Result<RawScene, ConfigError> {
+        toml::from_str(&self.to_toml()?)
+            .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
+    }
+
     /// The same scene with more `--set` overrides, validated again.
     pub fn reload(&self, overrides: &[String]) -> Result<Scene, ConfigError> {
         let mut table = self.table()?;
