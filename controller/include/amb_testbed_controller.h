@@ -80,25 +80,38 @@ typedef struct amb_plane_design {
     amb_loop_constants constants;
 } amb_plane_design;
 
-/* The design a law is built from. */
+/* The rigid rotor of the two-plane model; 0 on the planar model. */
+typedef struct amb_geometry {
+    double mass_kg;                  /* rotor mass M (kg) */
+    double transverse_inertia_kg_m2; /* I_t about the centre of mass (kg m^2) */
+    double polar_inertia_kg_m2;      /* I_p (kg m^2) */
+    double rated_speed_rad_s;        /* rated spin speed (rad/s) */
+    double bearing_z_m[2];           /* axial stations of bearings A, B from the centre of mass (m) */
+    double sensor_z_m[2];            /* axial stations of sensors A, B (m) */
+} amb_geometry;
+
+/* The design a law is built from. A law gets every axis at once: it drives the planar model
+ * (2 axes, one plane) and the two-plane rotor (4 axes: x, y at bearing A, then at B) alike,
+ * or refuses the one it cannot (build returns NULL with a message). */
 typedef struct amb_design {
-    uint32_t axes;          /* axes the law drives: 2 (x, y); 4 on a two-plane rotor */
-    uint32_t planes;        /* entries of plane[] in use: 1 (2 on a two-plane rotor) */
+    uint32_t axes;          /* axes the law drives: 2 (x, y) or 4 (x_A, y_A, x_B, y_B) */
+    uint32_t planes;        /* entries of plane[] in use: 1 or 2 */
     uint32_t delay_samples; /* the command of sample k is applied from tick k + delay_samples */
     uint32_t reserved;      /* 0 */
     double period_s;        /* sampling period T (s), as the plant computed it */
     amb_plane_design plane[AMB_MAX_PLANES];
+    amb_geometry geometry;  /* the two-plane rotor's; 0 on the planar model */
 } amb_design;
 
 /* One controller input. */
 typedef struct amb_sample {
     uint64_t seq;                    /* sample index k */
     double t_s;                      /* simulated time of the sample (s) */
-    uint32_t axes;                   /* entries of sensor_v in use: 2 (x, y) */
+    uint32_t axes;                   /* entries of sensor_v in use: 2 (x, y) or 4 (x_A, y_A, x_B, y_B) */
     uint32_t reserved;               /* 0 */
     double sensor_v[AMB_MAX_AXES];   /* sensor voltages A_s * displacement (V); the rest 0 */
-    double speed_rad_s;              /* the rotor's speed (rad/s): the keyphasor; 0 until the protocol carries it */
-    double angle_rad;                /* the rotor's angle (rad) in [0, 2 pi): the keyphasor; 0 until then */
+    double speed_rad_s;              /* the rotor's spin speed (rad/s): the keyphasor */
+    double angle_rad;                /* the rotor's angle (rad) in [0, 2 pi): the keyphasor (0: unbalance along +x) */
 } amb_sample;
 
 /* The parameter reader handed to build (opaque). */
@@ -116,7 +129,7 @@ typedef struct amb_law {
      * with the NUL). A refusal ends the run before it starts (the plant exits 2 with it). */
     void *(*build)(void *context, const amb_design *design, amb_params *params, char *error, size_t error_len);
     /* The coil currents (A) for a sample: sample->axes entries into current_a (room for
-     * AMB_MAX_AXES, zeroed), before the amplifier limit. A non-finite current is sent as NaN:
+     * AMB_MAX_AXES, zeroed), before the amplifier limits (each plane's). A non-finite current is sent as NaN:
      * the plant holds the last valid one and ends the run past its budget (exit 8). */
     void (*update)(void *law, const amb_sample *sample, double *current_a);
     /* Forget all memory (back to the state before the first sample). */
@@ -149,7 +162,9 @@ const char *amb_params_text(amb_params *params);
 AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_loop_constants) == 56, "amb_loop_constants");
 AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_plane_design) == 88, "amb_plane_design");
 AMB_CONTROLLER_STATIC_ASSERT(offsetof(amb_plane_design, constants) == 32, "amb_plane_design.constants");
-AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_design) == 24 + 4 * 88, "amb_design");
+AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_geometry) == 64, "amb_geometry");
+AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_design) == 24 + 4 * 88 + 64, "amb_design");
+AMB_CONTROLLER_STATIC_ASSERT(offsetof(amb_design, geometry) == 24 + 4 * 88, "amb_design.geometry");
 AMB_CONTROLLER_STATIC_ASSERT(offsetof(amb_design, plane) == 24, "amb_design.plane");
 AMB_CONTROLLER_STATIC_ASSERT(sizeof(amb_sample) == 104, "amb_sample");
 AMB_CONTROLLER_STATIC_ASSERT(offsetof(amb_sample, sensor_v) == 24, "amb_sample.sensor_v");

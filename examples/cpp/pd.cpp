@@ -11,33 +11,30 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <new>
+#include <vector>
 
 #include "amb_testbed_controller.h"
 
 namespace {
 
-class Pd {
+// One bearing plane's PD, as PdGains::from_design (left to right) and SampledPd.
+class PlanePd {
   public:
-    explicit Pd(const amb_design &design) {
-        const amb_plane_design &d = design.plane[0];
+    PlanePd(const amb_plane_design &d, double period) : period_(period) {
         const amb_loop_constants &c = d.constants;
-        // As PdGains::from_design, left to right.
         const double loop_gain = c.ki_n_per_a * c.amp_gain_a_per_v * c.sensor_gain_v_per_m;
         const double c_e = 2.0 * d.damping_ratio * std::sqrt(d.stiffness_n_per_m * c.rotor_mass_kg);
         kp_ = (d.stiffness_n_per_m + c.ks_n_per_m) / loop_gain;
         kd_ = c_e / loop_gain;
         amp_ = c.amp_gain_a_per_v;
         bias_ = {0.0, d.gravity_bias ? c.rotor_mass_kg * c.gravity_m_s2 / c.ki_n_per_a : 0.0};
-        period_ = design.period_s;
     }
 
-    void update(const amb_sample &s, double *current_a) {
+    void update(const double *u, double *current_a) {
         for (int j = 0; j < 2; j++) {
-            const double u = s.sensor_v[j];
-            const double rate = has_previous_ ? (u - previous_[j]) / period_ : 0.0;
-            current_a[j] = bias_[j] - amp_ * (kp_ * u + kd_ * rate);
-            previous_[j] = u;
+            const double rate = has_previous_ ? (u[j] - previous_[j]) / period_ : 0.0;
+            current_a[j] = bias_[j] - amp_ * (kp_ * u[j] + kd_ * rate);
+            previous_[j] = u[j];
         }
         has_previous_ = true;
     }
@@ -50,12 +47,42 @@ class Pd {
     bool has_previous_ = false;
 };
 
+// The law: one PD per plane (decentralised, as the registry's pd on a two-plane rotor).
+class Pd {
+  public:
+    explicit Pd(const amb_design &design) {
+        for (uint32_t p = 0; p < design.planes; p++) {
+            planes_.emplace_back(design.plane[p], design.period_s);
+        }
+    }
+
+    void update(const amb_sample &s, double *current_a) {
+        for (std::size_t p = 0; p < planes_.size(); p++) {
+            planes_[p].update(&s.sensor_v[2 * p], &current_a[2 * p]);
+        }
+    }
+
+    void reset() {
+        for (PlanePd &p : planes_) {
+            p.reset();
+        }
+    }
+
+  private:
+    std::vector<PlanePd> planes_;
+};
+
 void *build(void *, const amb_design *design, amb_params *, char *error, size_t error_len) noexcept {
-    if (design->planes != 1) {
-        std::snprintf(error, error_len, "drives one plane, not %u", design->planes);
+    if (design->planes < 1 || design->planes > AMB_MAX_PLANES || design->axes != 2 * design->planes) {
+        std::snprintf(error, error_len, "drives 2 axes per plane, not %u axes", design->axes);
         return nullptr;
     }
-    return new (std::nothrow) Pd(*design);
+    try {
+        return new Pd(*design);
+    } catch (...) { // std::bad_alloc: nothing may escape into the library
+        std::snprintf(error, error_len, "out of memory");
+        return nullptr;
+    }
 }
 
 void update(void *law, const amb_sample *sample, double *current_a) noexcept {

@@ -9,7 +9,8 @@
 //! * [`replay`] reads a run folder (`scene.toml`, `trace.csv`), builds the
 //!   law from the folder's design and `[controller.params]`, feeds it the
 //!   sensor samples the run's controller read (rebuilt from the trace's `dx_m`,
-//!   `dy_m` at each tick through the scene's sensor: gain, seeded noise, ADC),
+//!   `dy_m` at each tick through the scene's sensor: gain, seeded noise, ADC;
+//!   the keyphasor from `rotor_speed_rad_s` and `rotor_angle_rad`),
 //!   and compares what it answers, saturated, held over non-finite answers and
 //!   delayed `delay_samples` ticks, with the currents the trace applied
 //!   (`ix_a`, `iy_a`), bit for bit. The alignment: the current of row `r` at
@@ -187,7 +188,13 @@ pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Re
                 bad_time = Some((row, r[col::T_S], t_s));
                 return false;
             }
-            let sample = Sample { seq: k, t_s, sensor_v: sensor.read([r[col::DX_M], r[col::DY_M]]) };
+            let sample = Sample {
+                seq: k,
+                t_s,
+                sensor_v: sensor.read([r[col::DX_M], r[col::DY_M]]),
+                speed_rad_s: r[col::ROTOR_SPEED_RAD_S],
+                angle_rad: controller::wrap_angle(r[col::ROTOR_ANGLE_RAD]),
+            };
             let command = saturate(law.update(&sample), limit);
             let command = held.check(command, &sample).map(|h| h.command).unwrap_or(command);
             line.push_back(command);

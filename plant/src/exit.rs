@@ -243,7 +243,7 @@ mod tests {
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
         let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
-        let law = controller::LawError::Unknown { name: "nope".into() };
+        let law = controller::LawError::Unknown { name: "nope".into(), known: vec!["pd"] };
         let cases: Vec<(anyhow::Error, u8)> = vec![
             (stopped(StopKind::Diverged), 3),
             (stopped(StopKind::PeerLost), 4),
@@ -256,7 +256,11 @@ mod tests {
             (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),
             (SetupError::Cosim(CosimError::Interrupted).into(), 130),
             (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
-            (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
+            (
+                CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into(), peer_type: None })
+                    .into(),
+                2,
+            ),
             (exited(Some(2)).into(), 2),
             (exited(Some(1)).into(), 4),
             (stopped(StopKind::MissBudget), 6),

@@ -12,7 +12,7 @@
 //! ```
 //! use plant::invalid::InvalidCommands;
 //! let mut check = InvalidCommands::new([0.0, 0.5], 2, 1.0);
-//! let s = |k: u64| controller::Sample { seq: k, t_s: k as f64 * 5e-5, sensor_v: [0.0; 2] };
+//! let s = |k: u64| controller::Sample { seq: k, t_s: k as f64 * 5e-5, ..Default::default() };
 //! assert_eq!(check.check([0.1, 0.6], &s(0)).unwrap().command, [0.1, 0.6]);
 //! let held = check.check([f64::NAN, 0.7], &s(1)).unwrap();
 //! assert_eq!((held.command, held.first), ([0.1, 0.6], true)); // the last valid command, held
@@ -115,7 +115,7 @@ mod tests {
     use super::*;
 
     fn s(k: u64) -> Sample {
-        Sample { seq: k, t_s: k as f64 * 1e-3, sensor_v: [0.0; 2] }
+        Sample { seq: k, t_s: k as f64 * 1e-3, ..Default::default() }
     }
 
     #[test]

@@ -17,7 +17,7 @@ use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
 use crate::model::{ix, Control, Model, RaceWhenClear, State};
 use crate::sensor::Sensor;
 use crate::trace::Trace;
-use controller::{build_law, saturate, ControlLaw, PdGains, Sample};
+use controller::{build_law, saturate, wrap_angle, ControlLaw, PdGains, Sample};
 use std::collections::VecDeque;
 
 /// Why a run stopped before its end.
@@ -297,7 +297,14 @@ fn run_from(
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
+        // The keyphasor: the rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let sample = Sample {
+            seq: k,
+            t_s: t0,
+            sensor_v: sensor.read([y[ix::XR], y[ix::YR]]),
+            speed_rad_s: y[ix::WR],
+            angle_rad: wrap_angle(y[ix::TR]),
+        };
         let command = match &mut source {
             Source::Continuous => None,
             Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),

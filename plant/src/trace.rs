@@ -83,6 +83,8 @@ pub mod col {
     pub const VY_M_S: usize = 4;
     /// `rotor_angle_rad`.
     pub const ROTOR_ANGLE_RAD: usize = 9;
+    /// `rotor_speed_rad_s`.
+    pub const ROTOR_SPEED_RAD_S: usize = 10;
     /// `race_speed_rad_s`.
     pub const RACE_SPEED_RAD_S: usize = 11;
     /// `contact_force_n`.

@@ -119,7 +119,9 @@ fn the_header_matches_the_rust_definitions() {
         rotor_mass_kg, gravity_m_s2, air_gap_m);
     layout!("amb_plane_design", c::PlaneDesign; stiffness_n_per_m, damping_ratio, current_limit_a, gravity_bias,
         reserved, constants);
-    layout!("amb_design", c::Design; axes, planes, delay_samples, reserved, period_s, plane);
+    layout!("amb_geometry", c::Geometry; mass_kg, transverse_inertia_kg_m2, polar_inertia_kg_m2, rated_speed_rad_s,
+        bearing_z_m, sensor_z_m);
+    layout!("amb_design", c::Design; axes, planes, delay_samples, reserved, period_s, plane, geometry);
     layout!("amb_sample", c::Sample; seq, t_s, axes, reserved, sensor_v, speed_rad_s, angle_rad);
     layout!("amb_law", c::Law; abi_version, reserved, name, summary, context, build, update, reset, drop);
     let exit = |code: u8| i64::from(code);

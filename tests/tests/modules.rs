@@ -247,29 +247,9 @@ fn plant_has_no_module_cycle() {
     assert!(found.is_empty(), "module cycles:\n  {}", found.join("\n  "));
 }
 
-/// The controller crate's law modules and `registry` import each other on main (every law
-/// imports `LawEntry` from the list of laws that names it); the `wire-v4` branch moves
-/// `LawEntry` beside `ControlLaw` in `law.rs` and breaks that cycle. Until it lands, this is the
-/// one cycle allowed: any other, or a larger one, fails.
-const CONTROLLER_CYCLE_ON_MAIN: [&str; 9] =
-    ["discrete_pd", "law", "params", "pd", "pd_delay", "pid", "registry", "relev", "test_plant"];
-
 #[test]
-fn controller_has_no_module_cycle_but_the_known_one() {
-    let lib = Library::read(&common::workspace_root().join("controller/src"));
-    let mut found = Vec::new();
-    for (parent, edges) in lib.edges() {
-        for c in cycles(&edges) {
-            let known = parent.is_empty() && c.iter().all(|m| CONTROLLER_CYCLE_ON_MAIN.contains(&m.as_str()));
-            if !known {
-                found.push(format!(
-                    "under {}: {}",
-                    if parent.is_empty() { "crate".into() } else { parent.join("::") },
-                    c.join(" ↔ ")
-                ));
-            }
-        }
-    }
+fn controller_has_no_module_cycle() {
+    let found = cycles_of("controller");
     assert!(found.is_empty(), "controller module cycles:\n  {}", found.join("\n  "));
 }
 

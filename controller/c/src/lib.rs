@@ -13,11 +13,14 @@
 //! protocol, liveness, SIGINT/SIGTERM and the exit codes. The user needs no
 //! iceoryx2 of their own: the library holds it.
 //!
-//! The shapes extend to the two-plane rotor without a break: a sample holds
-//! `axes` entries of room for [`MAX_AXES`] plus the rotor's speed and angle
-//! (the keyphasor: 0 until the protocol carries it), a design `planes`
-//! per-plane designs of room for [`MAX_PLANES`]; [`ABI_VERSION`] says which
-//! layout a law was built against and [`amb_serve`] refuses another.
+//! A C law is a law of the whole rotor (`controller::RotorLaw`): it gets every
+//! axis at once, so it drives the planar model (2 axes, one plane) and the
+//! two-plane rotor (4 axes: x, y at bearing A, then at B) alike, or refuses
+//! the one it cannot. A sample holds `axes` entries (room for [`MAX_AXES`])
+//! and the keyphasor (the rotor's speed and angle); a design `planes`
+//! per-plane designs (room for [`MAX_PLANES`]) and, on the two-plane rotor,
+//! its geometry. [`ABI_VERSION`] says which layout a law was built against and
+//! [`amb_serve`] refuses another.
 //!
 //! **Bad input and faults.** A law's table with a NULL function, a NULL or
 //! over-long name, another ABI version, or more than [`MAX_LAWS`] laws: a
@@ -35,7 +38,7 @@
 //! boundary out of this library: [`amb_serve`] catches a panic of its own and
 //! returns an exit code.
 
-use controller::{Check, ControlLaw, LawEntry, LawError, ParamReader};
+use controller::{Check, LawError, ParamReader, RotorLaw, RotorLawEntry, ROTOR_AXES};
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr, OsString};
 use std::sync::{Mutex, OnceLock};
@@ -101,13 +104,31 @@ pub struct PlaneDesign {
     pub constants: LoopConstants,
 }
 
+/// The rigid rotor of the two-plane model (`controller::Geometry`); 0 on the planar model.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Geometry {
+    /// Rotor mass M (kg).
+    pub mass_kg: f64,
+    /// Transverse moment of inertia about the centre of mass I_t (kg m²).
+    pub transverse_inertia_kg_m2: f64,
+    /// Polar moment of inertia I_p (kg m²).
+    pub polar_inertia_kg_m2: f64,
+    /// Rated spin speed (rad/s).
+    pub rated_speed_rad_s: f64,
+    /// Axial stations of bearings A and B from the centre of mass (m).
+    pub bearing_z_m: [f64; 2],
+    /// Axial stations of sensors A and B (m).
+    pub sensor_z_m: [f64; 2],
+}
+
 /// The design a law is built from.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Design {
-    /// Axes the law drives: 2 (x, y of one plane; 4 on the two-plane rotor).
+    /// Axes the law drives: 2 (x, y of one plane) or 4 (x_A, y_A, x_B, y_B).
     pub axes: u32,
-    /// Bearing planes in `plane`: 1 (2 on the two-plane rotor).
+    /// Bearing planes in `plane`: 1 or 2.
     pub planes: u32,
     /// The command computed from sample k is applied from tick k + `delay_samples` (the plant
     /// applies it; for a law that compensates).
@@ -118,6 +139,8 @@ pub struct Design {
     pub period_s: f64,
     /// Per-plane designs; entries past `planes` are 0.
     pub plane: [PlaneDesign; MAX_PLANES],
+    /// The rotor's geometry (two planes); 0 on the planar model.
+    pub geometry: Geometry,
 }
 
 /// One controller input.
@@ -134,9 +157,9 @@ pub struct Sample {
     pub reserved: u32,
     /// Sensor voltages A_s·Δ (V) per axis; entries past `axes` are 0.
     pub sensor_v: [f64; MAX_AXES],
-    /// The rotor's speed (rad/s): the keyphasor; 0 until the protocol carries it.
+    /// The rotor's spin speed Ω (rad/s): the keyphasor.
     pub speed_rad_s: f64,
-    /// The rotor's angle (rad) in [0, 2π): the keyphasor; 0 until the protocol carries it.
+    /// The rotor's angle (rad) in [0, 2π): the keyphasor (at 0 the unbalance points along +x).
     pub angle_rad: f64,
 }
 
@@ -151,7 +174,7 @@ pub struct Params {
 pub type BuildFn =
     unsafe extern "C-unwind" fn(*mut c_void, *const Design, *mut Params, *mut c_char, usize) -> *mut c_void;
 /// `update`: the currents (A) for a sample, `axes` entries into `current_a` (room for
-/// [`MAX_AXES`], zeroed), before the amplifier limit.
+/// [`MAX_AXES`], zeroed), before the amplifier limits.
 pub type UpdateFn = unsafe extern "C-unwind" fn(*mut c_void, *const Sample, *mut f64);
 /// `reset` and `drop`: the law's state.
 pub type StateFn = unsafe extern "C-unwind" fn(*mut c_void);
@@ -193,15 +216,15 @@ struct Registered {
 /// The laws of the one [`amb_serve`] call of this process.
 static LAWS: OnceLock<Vec<Registered>> = OnceLock::new();
 
-/// A `LawEntry` needs a plain function per law: one trampoline per table index.
+/// A `RotorLawEntry` needs a plain function per law: one trampoline per table index.
 fn build_at<const I: usize>(
-    design: &controller::Design,
+    design: &controller::RotorDesign,
     params: &controller::Params,
-) -> Result<Box<dyn ControlLaw>, LawError> {
+) -> Result<Box<dyn RotorLaw>, LawError> {
     build(&LAWS.get().expect("amb_serve registered the laws")[I], design, params)
 }
 
-const BUILDERS: [controller::registry::BuildLaw; MAX_LAWS] = [
+const BUILDERS: [controller::BuildRotorLaw; MAX_LAWS] = [
     build_at::<0>,
     build_at::<1>,
     build_at::<2>,
@@ -220,39 +243,61 @@ const BUILDERS: [controller::registry::BuildLaw; MAX_LAWS] = [
     build_at::<15>,
 ];
 
-/// The C design of a (one-plane) Rust design.
-pub fn design_of(d: &controller::Design) -> Design {
-    let c = &d.constants;
+/// The C design of a rotor's design.
+pub fn design_of(d: &controller::RotorDesign) -> Design {
     let mut plane = [PlaneDesign::default(); MAX_PLANES];
-    plane[0] = PlaneDesign {
-        stiffness_n_per_m: d.stiffness_n_per_m,
-        damping_ratio: d.damping_ratio,
-        current_limit_a: d.current_limit_a,
-        gravity_bias: u32::from(d.gravity_bias),
+    for (slot, p) in plane.iter_mut().zip(d.planes()) {
+        let c = &p.constants;
+        *slot = PlaneDesign {
+            stiffness_n_per_m: p.stiffness_n_per_m,
+            damping_ratio: p.damping_ratio,
+            current_limit_a: p.current_limit_a,
+            gravity_bias: u32::from(p.gravity_bias),
+            reserved: 0,
+            constants: LoopConstants {
+                ki_n_per_a: c.ki_n_per_a,
+                ks_n_per_m: c.ks_n_per_m,
+                amp_gain_a_per_v: c.amp_gain_a_per_v,
+                sensor_gain_v_per_m: c.sensor_gain_v_per_m,
+                rotor_mass_kg: c.rotor_mass_kg,
+                gravity_m_s2: c.gravity_m_s2,
+                air_gap_m: c.air_gap_m,
+            },
+        };
+    }
+    let geometry = d.geometry().map_or(Geometry::default(), |g| Geometry {
+        mass_kg: g.mass_kg,
+        transverse_inertia_kg_m2: g.transverse_inertia_kg_m2,
+        polar_inertia_kg_m2: g.polar_inertia_kg_m2,
+        rated_speed_rad_s: g.rated_speed_rad_s,
+        bearing_z_m: g.bearing_z_m,
+        sensor_z_m: g.sensor_z_m,
+    });
+    let a = d.plane_a();
+    Design {
+        axes: d.axes(),
+        planes: d.planes().len() as u32,
+        delay_samples: a.delay_samples,
         reserved: 0,
-        constants: LoopConstants {
-            ki_n_per_a: c.ki_n_per_a,
-            ks_n_per_m: c.ks_n_per_m,
-            amp_gain_a_per_v: c.amp_gain_a_per_v,
-            sensor_gain_v_per_m: c.sensor_gain_v_per_m,
-            rotor_mass_kg: c.rotor_mass_kg,
-            gravity_m_s2: c.gravity_m_s2,
-            air_gap_m: c.air_gap_m,
-        },
-    };
-    Design { axes: 2, planes: 1, delay_samples: d.delay_samples, reserved: 0, period_s: d.period_s, plane }
+        period_s: a.period_s,
+        plane,
+        geometry,
+    }
 }
 
-/// The C sample of a (one-plane) Rust sample.
-pub fn sample_of(s: &controller::Sample) -> Sample {
+/// The C sample of a rotor's sample.
+pub fn sample_of(s: &controller::RotorSample) -> Sample {
+    let mut sensor_v = [0.0; MAX_AXES];
+    let n = (s.axes as usize).min(ROTOR_AXES);
+    sensor_v[..n].copy_from_slice(&s.sensor_v[..n]);
     Sample {
         seq: s.seq,
         t_s: s.t_s,
-        axes: 2,
+        axes: n as u32,
         reserved: 0,
-        sensor_v: controller::wire::axes_of(s.sensor_v),
-        speed_rad_s: 0.0,
-        angle_rad: 0.0,
+        sensor_v,
+        speed_rad_s: s.speed_rad_s,
+        angle_rad: s.angle_rad,
     }
 }
 
@@ -267,9 +312,9 @@ struct ParamsHandle<'a> {
 /// Builds law `law` through its C `build`.
 fn build(
     law: &'static Registered,
-    design: &controller::Design,
+    design: &controller::RotorDesign,
     params: &controller::Params,
-) -> Result<Box<dyn ControlLaw>, LawError> {
+) -> Result<Box<dyn RotorLaw>, LawError> {
     let cdesign = design_of(design);
     let text = params.to_document().unwrap_or_default();
     let mut handle = ParamsHandle {
@@ -308,7 +353,7 @@ fn build(
     Ok(Box::new(adapter))
 }
 
-/// A C law as a `ControlLaw`.
+/// A C law as a `RotorLaw`.
 struct Adapter {
     law: &'static Registered,
     state: *mut c_void,
@@ -319,24 +364,26 @@ struct Adapter {
 // law promises no more than that.
 unsafe impl Send for Adapter {}
 
-impl ControlLaw for Adapter {
+impl RotorLaw for Adapter {
     fn name(&self) -> &'static str {
         self.law.name
     }
 
-    fn update(&mut self, s: &controller::Sample) -> [f64; 2] {
+    fn update(&mut self, s: &controller::RotorSample) -> [f64; ROTOR_AXES] {
         let sample = sample_of(s);
         let mut current = [0.0; MAX_AXES];
         // SAFETY: the state is the one `build` returned; `current` has room for MAX_AXES.
         unsafe { (self.law.update)(self.state, &sample, current.as_mut_ptr()) };
-        let i = [current[0], current[1]];
-        if !self.warned && !i.iter().all(|v| v.is_finite()) {
+        let mut i = [0.0; ROTOR_AXES];
+        i.copy_from_slice(&current[..ROTOR_AXES]);
+        let used = &i[..sample.axes as usize];
+        if !self.warned && !used.iter().all(|v| v.is_finite()) {
             self.warned = true;
             eprintln!(
-                "amb_serve: warning: law `{}` returned a non-finite current {i:?} A for sample {} (t = {} s); \
+                "amb_serve: warning: law `{}` returned a non-finite current {:?} A for sample {} (t = {} s); \
                  it is sent as it is (a NaN after the limit): the plant holds the last valid current and ends the run \
                  past controller.max_invalid_burst or controller.max_invalid_fraction (said once)",
-                self.law.name, s.seq, s.t_s
+                self.law.name, used, s.seq, s.t_s
             );
         }
         i
@@ -472,12 +519,12 @@ pub unsafe extern "C" fn amb_serve(laws: *const Law, count: usize, argc: c_int, 
             eprintln!("{program}: error: amb_serve: called a second time in this process (once per process)");
             return i32::from(controller::serve::exit::BAD_INPUT);
         }
-        let entries: Vec<LawEntry> = LAWS
+        let entries: Vec<RotorLawEntry> = LAWS
             .get()
             .expect("set above")
             .iter()
             .zip(BUILDERS)
-            .map(|(law, build)| LawEntry { name: law.name, summary: "a law of the C API", build })
+            .map(|(law, build)| RotorLawEntry { name: law.name, summary: "a law of the C API", build })
             .collect();
         i32::from(controller::serve::serve_code(args, &entries))
     });
@@ -614,5 +661,131 @@ pub unsafe extern "C" fn amb_params_text(params: *mut Params) -> *const c_char {
     match unsafe { handle(params) } {
         Some(h) => h.text.as_ptr(),
         None => c"".as_ptr(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A law of the C API written in Rust: it keeps the design it was built from and answers
+    /// each axis with its sensor voltage plus the keyphasor, so the test sees what crossed.
+    unsafe extern "C-unwind" fn echo_build(
+        _context: *mut c_void,
+        design: *const Design,
+        params: *mut Params,
+        _error: *mut c_char,
+        _len: usize,
+    ) -> *mut c_void {
+        let mut scale = 0.0;
+        // SAFETY: the handle build received; a key and unit with their NULs.
+        let read = unsafe {
+            amb_params_number(params, c"scale".as_ptr(), c"".as_ptr(), 1.0, check::POSITIVE, 0.0, 0.0, &mut scale)
+        };
+        if read != 0 {
+            return std::ptr::null_mut();
+        }
+        // SAFETY: the design passed in is valid for the call.
+        Box::into_raw(Box::new((unsafe { *design }, scale))).cast()
+    }
+
+    unsafe extern "C-unwind" fn echo_update(law: *mut c_void, s: *const Sample, current: *mut f64) {
+        // SAFETY: the state echo_build made; the sample and MAX_AXES currents valid.
+        let ((_, scale), s) = unsafe { (&*law.cast::<(Design, f64)>(), &*s) };
+        for j in 0..s.axes as usize {
+            // SAFETY: j < axes <= MAX_AXES.
+            unsafe { *current.add(j) = scale * s.sensor_v[j] + s.speed_rad_s + s.angle_rad }
+        }
+    }
+
+    unsafe extern "C-unwind" fn nothing(_law: *mut c_void) {}
+
+    unsafe extern "C-unwind" fn free(law: *mut c_void) {
+        // SAFETY: the box echo_build made, freed once.
+        drop(unsafe { Box::from_raw(law.cast::<(Design, f64)>()) });
+    }
+
+    /// The two-plane rotor crosses the boundary whole: four axes, both planes' designs, the
+    /// geometry and the keyphasor in; four currents out; parameters through the reader.
+    #[test]
+    fn a_two_plane_design_and_sample_cross_the_boundary() {
+        let table = [Law {
+            abi_version: ABI_VERSION,
+            reserved: 0,
+            name: c"echo".as_ptr(),
+            summary: std::ptr::null(),
+            context: std::ptr::null_mut(),
+            build: Some(echo_build),
+            update: Some(echo_update),
+            reset: Some(nothing),
+            drop: Some(free),
+        }];
+        // SAFETY: a table of one law with static strings.
+        let registered = unsafe { register(table.as_ptr(), 1) }.unwrap();
+        assert!(LAWS.set(registered).is_ok());
+        let mut rotor = controller::RotorDesign::symmetric_study();
+        if let controller::RotorDesign::TwoPlane { planes, .. } = &mut rotor {
+            planes[1].stiffness_n_per_m = 2e6;
+        }
+        let params = controller::Params::parse("scale = 2.0").unwrap();
+        let mut law = BUILDERS[0](&rotor, &params).unwrap();
+        assert_eq!(law.name(), "echo");
+        let adapter_design = {
+            let c = design_of(&rotor);
+            assert_eq!((c.axes, c.planes, c.delay_samples), (4, 2, 1));
+            assert_eq!((c.plane[0].stiffness_n_per_m, c.plane[1].stiffness_n_per_m), (1e6, 2e6));
+            assert_eq!(c.plane[2], PlaneDesign::default());
+            assert_eq!((c.geometry.mass_kg, c.geometry.bearing_z_m), (23.0, [-0.18, 0.18]));
+            c
+        };
+        let s = controller::RotorSample {
+            seq: 7,
+            t_s: 3.5e-4,
+            axes: 4,
+            sensor_v: [0.1, 0.2, 0.3, 0.4],
+            speed_rad_s: 100.0,
+            angle_rad: 1.5,
+        };
+        let i = law.update(&s);
+        assert_eq!(i, [0.2 + 101.5, 0.4 + 101.5, 0.6 + 101.5, 0.8 + 101.5]);
+        // The design the law kept is the one converted.
+        drop(law);
+        let planar = controller::RotorDesign::Planar(controller::Design::study());
+        let c = design_of(&planar);
+        assert_eq!((c.axes, c.planes, c.geometry), (2, 1, Geometry::default()));
+        assert_ne!(adapter_design, c);
+        // A parameter the law refuses, and one it does not read.
+        let e = BUILDERS[0](&rotor, &controller::Params::parse("scale = -1.0").unwrap()).err().unwrap().to_string();
+        assert_eq!(e, "law echo: controller.params.scale = -1.0: must be a finite number > 0");
+        let e = BUILDERS[0](&rotor, &controller::Params::parse("sclae = 1.0").unwrap()).err().unwrap().to_string();
+        assert!(e.contains("unknown parameter controller.params.sclae"), "{e}");
+    }
+
+    #[test]
+    fn a_bad_table_is_refused_naming_the_law_and_the_field() {
+        let good = Law {
+            abi_version: ABI_VERSION,
+            reserved: 0,
+            name: c"ok".as_ptr(),
+            summary: std::ptr::null(),
+            context: std::ptr::null_mut(),
+            build: Some(echo_build),
+            update: Some(echo_update),
+            reset: Some(nothing),
+            drop: Some(free),
+        };
+        let refused = |table: &[Law]| unsafe { register(table.as_ptr(), table.len()) }.err().unwrap_or_default();
+        assert_eq!(
+            refused(&[Law { reset: None, ..good }]),
+            "law 0 (`ok`): `reset` is NULL; every function of an amb_law must be set"
+        );
+        assert!(
+            refused(&[good, Law { abi_version: 2, ..good }]).starts_with("law 1 (`ok`): built against ABI version 2")
+        );
+        assert_eq!(refused(&[Law { name: std::ptr::null(), ..good }]), "law 0: its name is NULL or empty");
+        assert_eq!(refused(&[good, good]), "law 1 (`ok`): a second law of that name");
+        assert_eq!(refused(&[]), "no law to serve (the table is NULL or empty)");
+        let long = c"a_name_that_is_longer_than_31_bytes";
+        assert!(refused(&[Law { name: long.as_ptr(), ..good }]).contains("at most 31"));
     }
 }

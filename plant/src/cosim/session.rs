@@ -198,6 +198,8 @@ impl Session {
             axes: wire::AXES,
             reserved: 0,
             sensor_v: wire::axes_of(sample.sensor_v),
+            speed_rad_s: sample.speed_rad_s,
+            angle_rad: sample.angle_rad,
         }
     }
 
