@@ -464,7 +464,7 @@ pub fn compare_laws(
             status: s.status,
             recovery_s: s.recovery_s.unwrap_or(f64::NAN),
             post_shock_mode: s.analysis.post_shock_mode,
-            max_contact_force_n: s.max_contact_force_n,
+            max_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
             contact_time_s: s.contact_time_s,
             steady_contact_fraction: s.analysis.steady_contact_fraction,
             whirl_hz: s.analysis.whirl_hz,
@@ -643,8 +643,8 @@ pub fn compare_realtime(
             latency_p999_us: c.as_ref().map_or(f64::NAN, |c| c.latency_us.p999),
             post_shock_mode: s.analysis.post_shock_mode,
             recovery_s: recovery_time(&r.trace, start).unwrap_or(f64::NAN),
-            max_contact_force_n: s.max_contact_force_n,
-            max_radius_m: s.max_radius_m,
+            max_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
+            max_radius_m: s.max_radius_m.unwrap_or(f64::NAN),
             steady_contact_fraction: s.analysis.steady_contact_fraction,
             rms_dev_m: rms,
             max_dev_m: max,
@@ -655,7 +655,7 @@ pub fn compare_realtime(
     let say = |r: &RealtimeRow| {
         format!(
             "{} {}: {}, {} deadline misses ({:.3} %, longest burst {}), {} plant overruns, tick p99.9 {:.1} µs max {:.1} µs; \
-             {}, recovered after {:.4} s, peak force {:.0} N; {}; load {:.2}",
+             {}, {}, peak force {:.0} N; {}; load {:.2}",
             snake_name(&r.mode),
             r.run,
             r.status,
@@ -666,7 +666,11 @@ pub fn compare_realtime(
             r.tick_p999_us,
             r.tick_max_us,
             r.post_shock_mode,
-            r.recovery_s,
+            if r.recovery_s.is_finite() {
+                format!("recovered after {:.4} s", r.recovery_s)
+            } else {
+                "still touching at the end".to_string()
+            },
             r.max_contact_force_n,
             if r.same_as_lockstep { "the lockstep trace bit for bit".to_string() } else { format!("max {:.2e} m from lockstep", r.max_dev_m) },
             r.load_1min

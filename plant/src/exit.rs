@@ -31,6 +31,9 @@ pub enum Code {
     MissBudget = 6,
     /// `plant sweep` / `plant ensemble` `--merge` (or `--round R`): units missing or corrupt.
     Incomplete = 7,
+    /// The controller's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` (status `invalid_commands`).
+    InvalidCommands = 8,
     /// Realtime: the plant-overrun budget was exceeded (status `overrun_budget`).
     OverrunBudget = 10,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
@@ -39,7 +42,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 9] = [
+    pub const ALL: [Code; 10] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -47,6 +50,7 @@ impl Code {
         Code::CriterionFailed,
         Code::MissBudget,
         Code::Incomplete,
+        Code::InvalidCommands,
         Code::OverrunBudget,
         Code::Interrupted,
     ];
@@ -62,6 +66,7 @@ const _: fn(Code) = |c| match c {
     | Code::CriterionFailed
     | Code::MissBudget
     | Code::Incomplete
+    | Code::InvalidCommands
     | Code::OverrunBudget
     | Code::Interrupted => {}
 };
@@ -140,6 +145,8 @@ pub enum StopKind {
     PeerLost,
     /// Realtime: past the deadline-miss budget.
     MissBudget,
+    /// Past the budget of non-finite commands.
+    InvalidCommands,
     /// Realtime: past the plant-overrun budget.
     OverrunBudget,
 }
@@ -151,6 +158,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::Diverged, .. } => Code::Diverged,
             Ending::Stopped { kind: StopKind::PeerLost, .. } => Code::PeerLost,
             Ending::Stopped { kind: StopKind::MissBudget, .. } => Code::MissBudget,
+            Ending::Stopped { kind: StopKind::InvalidCommands, .. } => Code::InvalidCommands,
             Ending::Stopped { kind: StopKind::OverrunBudget, .. } => Code::OverrunBudget,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
@@ -207,6 +215,7 @@ impl HasExitCode for AnalyzeError {
         match self {
             AnalyzeError::Scene(_) | AnalyzeError::Trace(_) | AnalyzeError::Summary { .. } => Code::BadInput,
             AnalyzeError::Output(_) => Code::Io,
+            AnalyzeError::Interrupted(_) => Code::Interrupted,
         }
     }
 }
@@ -234,6 +243,10 @@ mod tests {
     use super::*;
     use crate::run::SetupError;
 
+    fn exited(code: Option<i32>) -> CosimError {
+        CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
+    }
+
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
         let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
@@ -255,9 +268,11 @@ mod tests {
                     .into(),
                 2,
             ),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
+            (exited(Some(2)).into(), 2),
+            (exited(Some(1)).into(), 4),
             (stopped(StopKind::MissBudget), 6),
+            (stopped(StopKind::InvalidCommands), 8),
+            (AnalyzeError::Interrupted("nothing was written").into(), 130),
             (stopped(StopKind::OverrunBudget), 10),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),

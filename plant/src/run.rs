@@ -85,6 +85,9 @@ pub enum Outcome {
     MissBudget(String),
     /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
     OverrunBudget(String),
+    /// The law's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` ([`crate::invalid`]).
+    InvalidCommands(String),
 }
 
 /// Why a run could not start.
@@ -185,6 +188,8 @@ pub struct SinkRun {
     pub cosim: Option<CosimReport>,
     /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
     pub parked_steps: u64,
+    /// Ticks whose command was non-finite (the last valid one was held).
+    pub invalid_commands: u64,
     /// The cost of the ticks: the most model evaluations in one, and the execution times.
     pub ticks: TickCost,
 }
@@ -210,7 +215,7 @@ pub fn run_into(
     let limit = scene.params.current_limit;
     let bias = saturate(gains.bias_a, limit);
     let (design, params) = (scene.design(), &scene.controller.params);
-    let mut source = match scene.controller.mode {
+    let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
         ControlMode::Sampled => Source::InProcess(build_law(&scene.controller.law, &design, params)?),
         ControlMode::Lockstep | ControlMode::Realtime => {
@@ -222,6 +227,29 @@ pub fn run_into(
             Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
         }
     };
+    run_from(scene, source, hooks, sink)
+}
+
+/// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
+/// the registry (whatever the scene's mode): the sensor read at each tick, the command
+/// saturated, delayed `delay_samples` ticks and held. A lockstep run of the same law in a
+/// controller process writes the same trace, bit for bit. See [`crate::check`].
+pub fn run_law_into(
+    scene: &Scene,
+    law: Box<dyn ControlLaw>,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
+    run_from(scene, Source::InProcess(law), hooks, sink)
+}
+
+/// The loop, from a command source.
+fn run_from(
+    scene: &Scene,
+    mut source: Source,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
     // An external controller may run a design of its own (its `--config` or `--law`): the run
     // is then the scene with those overrides, initial state and bias included, so that the
     // scene it records reproduces it.
@@ -267,6 +295,8 @@ pub fn run_into(
     let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
+    let c = &scene.controller;
+    let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
     let guards = Guards::new(scene);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
@@ -321,6 +351,23 @@ pub fn run_into(
             },
         };
         if let Some(cmd) = command {
+            let cmd = match invalid.check(cmd, &sample) {
+                Ok(checked) => {
+                    if checked.first {
+                        hooks.note(&format!(
+                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {cmd:?} A: \
+                             the last valid command is held for it and for every later non-finite one, up to \
+                             controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
+                            sample.seq, sample.t_s, c.max_invalid_burst
+                        ));
+                    }
+                    checked.command
+                }
+                Err(why) => {
+                    outcome = Outcome::InvalidCommands(why);
+                    break;
+                }
+            };
             queue.push_back(cmd);
             if let Some(applied) = queue.pop_front() {
                 model.control = Control::Held(applied);
@@ -388,6 +435,9 @@ pub fn run_into(
         }
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
+            // The run reached the failure, not the end of its macro step (an integration
+            // error stops inside it).
+            t = e.time();
             outcome = Outcome::Diverged(e);
             break;
         }
@@ -398,9 +448,14 @@ pub fn run_into(
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
+    // A run that completed is judged over all its ticks.
+    if outcome == Outcome::Completed {
+        if let Some(why) = invalid.at_end() {
+            outcome = Outcome::InvalidCommands(why);
+        }
+    }
     let cosim = match source {
         Source::Cosim(session) => {
-            // A realtime run that completed is judged over all its ticks.
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
@@ -410,10 +465,12 @@ pub fn run_into(
             }
             let mut report = session.finish(t, (t / period).round() as u64);
             report.tet_us = cost.tet.as_ref().map(|tet| tet.report());
+            report.invalid_replies = invalid.count();
             Some(report)
         }
         _ => None,
     };
+    let invalid_commands = invalid.count();
     Ok(SinkRun {
         stats: integrator.stats(),
         simulated: t,
@@ -423,6 +480,7 @@ pub fn run_into(
         cosim,
         parked_steps,
         ticks: cost,
+        invalid_commands,
     })
 }
 
