@@ -26,6 +26,7 @@ pub mod cosim;
 pub mod ensemble;
 pub mod hooks;
 pub mod initial;
+pub mod machine;
 pub mod output;
 pub mod plot;
 pub mod record;

@@ -6,8 +6,10 @@
 //! failure (the row at the failure holds the state that failed, which is
 //! reported on its own as `failure_state`).
 
-use crate::analysis::{Analysis, AnalysisSpec, Analyzer};
+use crate::analysis::tilt::TiltAnalysis;
+use crate::analysis::{Analysis, AnalysisSpec};
 use crate::config::{DragChoice, ForceLaw, RaceWhenClearChoice, ReleaseChoice, Scene, SpinChoice, SupportChoice};
+use crate::record::{PlaneRecorded, Recorded, Recorder};
 use crate::run::{RunError, RunResult, SinkRun};
 use crate::status::Status;
 use crate::trace::{col, Row, Trace};
@@ -24,6 +26,9 @@ pub use crate::analysis::STEADY_REVOLUTIONS;
 /// file writes them.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelInfo {
+    /// `two_plane` for the two-plane rotor (`rotor.model`; not written for the planar model).
+    #[serde(skip_serializing_if = "is_planar")]
+    pub rotor: crate::config::RotorModel,
     /// `held` or `free` (`rotor.spin`).
     pub spin: SpinChoice,
     /// `rotating` or `fixed`.
@@ -57,6 +62,11 @@ impl ModelInfo {
         let (p, c) = (&scene.params, &scene.controller);
         let (race_when_clear, race_release) = RaceWhenClearChoice::of(&p.race_when_clear);
         ModelInfo {
+            rotor: if scene.two_plane.is_some() {
+                crate::config::RotorModel::TwoPlane
+            } else {
+                crate::config::RotorModel::Planar
+            },
             spin: SpinChoice::of(&p.spin),
             cage: p.cage,
             race_drag: DragChoice::of(&p.drag),
@@ -71,6 +81,10 @@ impl ModelInfo {
             delay_samples: c.delay_samples,
         }
     }
+}
+
+fn is_planar(m: &crate::config::RotorModel) -> bool {
+    *m == crate::config::RotorModel::Planar
 }
 
 /// Integrator of a run, for the record.
@@ -144,6 +158,59 @@ pub struct Summary {
     /// Co-simulation figures (`lockstep`, `realtime` modes only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cosim: Option<crate::cosim::CosimReport>,
+    /// A two-plane run's figures per bearing plane and its tilt (the figures above are those of
+    /// the governing plane, `planes.governing`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planes: Option<PlanesSummary>,
+}
+
+/// One bearing plane's figures in a two-plane run's `summary.json` (the planar summary's, for
+/// this plane).
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneSummary {
+    /// Largest rotor radius at the bearing relative to the housing (m).
+    pub max_radius_m: f64,
+    /// Fraction of samples with contact over the steady window.
+    pub contact_fraction: f64,
+    /// Largest rotor – race normal force (N).
+    pub max_contact_force_n: f64,
+    /// Largest race speed (rpm).
+    pub max_race_speed_rpm: f64,
+    /// From the first shock's start to the last sample in contact (s); `null` if still touching.
+    pub recovery_s: Option<f64>,
+    /// Time in contact over the run (s).
+    pub contact_time_s: f64,
+    /// The plane's analysis (spectra, Poincaré section, classification).
+    #[serde(flatten)]
+    pub analysis: Analysis,
+}
+
+/// A two-plane run's per-plane figures and tilt.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanesSummary {
+    /// The plane whose figures the summary's top level holds: `a` or `b`, the one with the
+    /// larger steady contact fraction, then the larger peak contact force, then `a`.
+    pub governing: &'static str,
+    /// Bearing plane A.
+    pub a: PlaneSummary,
+    /// Bearing plane B.
+    pub b: PlaneSummary,
+    /// The rotor's tilt.
+    pub tilt: TiltAnalysis,
+}
+
+impl PlaneSummary {
+    fn new(p: &PlaneRecorded, simulated: f64) -> Self {
+        Self {
+            max_radius_m: p.figures.max_radius_m,
+            contact_fraction: p.analysis.steady_contact_fraction,
+            max_contact_force_n: p.figures.max_contact_force_n,
+            max_race_speed_rpm: p.figures.max_race_speed_rpm,
+            recovery_s: p.figures.recovery_s,
+            contact_time_s: p.figures.contact_share() * simulated,
+            analysis: p.analysis.clone(),
+        }
+    }
 }
 
 impl Summary {
@@ -162,18 +229,25 @@ impl Summary {
 
     /// Figures of a run whose trace is in memory.
     pub fn new(scene: &Scene, result: &RunResult) -> Self {
-        let mut figures = FiguresBuilder::new(scene.first_shock_start());
-        let mut analyzer = Analyzer::new(analysis_spec(scene), None);
-        for r in result.trace.rows() {
-            figures.push(&r);
-            analyzer.push(&r);
-        }
-        let (analysis, _) = analyzer.finish();
-        Self::from_parts(scene, &result.run, figures.finish(result.run.outcome.failure_time()), analysis)
+        let mut recorder = Recorder::new(scene, false);
+        result.trace.records().for_each(|r| recorder.push(&r));
+        Self::from_parts(scene, &result.run, recorder.finish(result.run.outcome.failure_time()))
     }
 
-    /// The summary of a run from its figures and analysis, taken as its rows came.
-    pub fn from_parts(scene: &Scene, run: &SinkRun, figures: Figures, analysis: Analysis) -> Self {
+    /// The summary of a run from what its [`Recorder`] made of it as its rows came.
+    pub fn from_parts(scene: &Scene, run: &SinkRun, recorded: Recorded) -> Self {
+        let governing = recorded.governing();
+        let planes = match (&recorded.tilt, recorded.planes.as_slice()) {
+            (Some(tilt), [a, b]) => Some(PlanesSummary {
+                governing: ["a", "b"][governing],
+                a: PlaneSummary::new(a, run.simulated),
+                b: PlaneSummary::new(b, run.simulated),
+                tilt: tilt.clone(),
+            }),
+            _ => None,
+        };
+        let lead = recorded.planes.into_iter().nth(governing).expect("a recorded run has a plane");
+        let (figures, analysis) = (lead.figures, lead.analysis);
         let c = &scene.controller;
         let failure = match &run.outcome {
             crate::run::Outcome::Diverged(e) => Some(e),
@@ -194,7 +268,7 @@ impl Summary {
             recovery_s: figures.recovery_s,
             contact_time_s: figures.contact_share() * run.simulated,
             parked_fraction: {
-                let ticks = (run.simulated / c.period).round();
+                let ticks = (run.simulated / c.period).round() * run.planes as f64;
                 if ticks > 0.0 {
                     run.parked_steps as f64 / ticks
                 } else {
@@ -210,13 +284,17 @@ impl Summary {
             integrator: IntegratorInfo {
                 method: scene.integrator.method,
                 rtol: scene.integrator.rtol,
-                atol: scene.integrator.atol.to_vec(),
+                atol: match scene.two_plane {
+                    None => scene.integrator.atol.to_vec(),
+                    Some(_) => scene.integrator.two_plane_atol().to_vec(),
+                },
                 substeps: scene.integrator.substeps,
                 contact_substeps: scene.integrator.contact_substeps,
                 macro_step_s: c.period,
             },
             analysis,
             cosim: run.cosim.clone(),
+            planes,
         }
     }
 }
@@ -224,7 +302,17 @@ impl Summary {
 /// The state a diverged run failed in (`failure_state` in `summary.json`); non-finite
 /// values are written as `null`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FailureState {
+#[serde(untagged)]
+pub enum FailureState {
+    /// The planar model's.
+    Planar(PlanarFailure),
+    /// The two-plane rotor's.
+    TwoPlane(TwoPlaneFailure),
+}
+
+/// The planar model's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlanarFailure {
     /// Time of the failure (s).
     pub t_s: f64,
     /// Rotor radius relative to the housing (m).
@@ -245,31 +333,91 @@ pub struct FailureState {
     pub race_spin: [f64; 2],
 }
 
+/// One race of the two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RaceFailure {
+    /// Race radius relative to the housing (m).
+    pub race_radius_m: f64,
+    /// Race x, y relative to the housing (m).
+    pub race_m: [f64; 2],
+    /// Race velocity relative to the housing (m/s).
+    pub race_velocity_m_s: [f64; 2],
+    /// Race angle (rad) and speed (rad/s).
+    pub race_spin: [f64; 2],
+}
+
+/// The two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TwoPlaneFailure {
+    /// Time of the failure (s).
+    pub t_s: f64,
+    /// The rotor axis at the centre of mass's station, x, y relative to the housing (m).
+    pub rotor_m: [f64; 2],
+    /// Its velocity (m/s).
+    pub rotor_velocity_m_s: [f64; 2],
+    /// The slopes a, b of the axis (rad).
+    pub slopes_rad: [f64; 2],
+    /// Their rates (rad/s).
+    pub slope_rates_rad_s: [f64; 2],
+    /// Rotor spin angle (rad) and speed (rad/s).
+    pub rotor_spin: [f64; 2],
+    /// Race A.
+    pub race_a: RaceFailure,
+    /// Race B.
+    pub race_b: RaceFailure,
+}
+
 impl FailureState {
     /// The failing state of a divergence, if the error holds a whole state.
     pub fn of(e: &RunError) -> Option<Self> {
-        use crate::model::ix;
         let y = e.state();
-        if y.len() != crate::model::N {
-            return None;
+        if y.len() == crate::model::N {
+            use crate::model::ix;
+            return Some(Self::Planar(PlanarFailure {
+                t_s: e.time(),
+                rotor_radius_m: y[ix::XR].hypot(y[ix::YR]),
+                race_radius_m: y[ix::XB].hypot(y[ix::YB]),
+                rotor_m: [y[ix::XR], y[ix::YR]],
+                rotor_velocity_m_s: [y[ix::VXR], y[ix::VYR]],
+                race_m: [y[ix::XB], y[ix::YB]],
+                race_velocity_m_s: [y[ix::VXB], y[ix::VYB]],
+                rotor_spin: [y[ix::TR], y[ix::WR]],
+                race_spin: [y[ix::TB], y[ix::WB]],
+            }));
         }
-        Some(Self {
-            t_s: e.time(),
-            rotor_radius_m: y[ix::XR].hypot(y[ix::YR]),
-            race_radius_m: y[ix::XB].hypot(y[ix::YB]),
-            rotor_m: [y[ix::XR], y[ix::YR]],
-            rotor_velocity_m_s: [y[ix::VXR], y[ix::VYR]],
-            race_m: [y[ix::XB], y[ix::YB]],
-            race_velocity_m_s: [y[ix::VXB], y[ix::VYB]],
-            rotor_spin: [y[ix::TR], y[ix::WR]],
-            race_spin: [y[ix::TB], y[ix::WB]],
-        })
+        if y.len() == plant_physics::two_plane::N {
+            use plant_physics::two_plane::ix;
+            let race = |x: usize| RaceFailure {
+                race_radius_m: y[x].hypot(y[x + 1]),
+                race_m: [y[x], y[x + 1]],
+                race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
+                race_spin: [y[x + 2], y[x + 2 + ix::V]],
+            };
+            return Some(Self::TwoPlane(TwoPlaneFailure {
+                t_s: e.time(),
+                rotor_m: [y[ix::X], y[ix::Y]],
+                rotor_velocity_m_s: [y[ix::VX], y[ix::VY]],
+                slopes_rad: [y[ix::SX], y[ix::SY]],
+                slope_rates_rad_s: [y[ix::VSX], y[ix::VSY]],
+                rotor_spin: [y[ix::TR], y[ix::WR]],
+                race_a: race(ix::RACE_A),
+                race_b: race(ix::RACE_B),
+            }));
+        }
+        None
     }
 }
 
-/// The analysis setting of a scene: Poincaré section at spin phase 0, periodicity tolerance 1e-3 r_0.
+/// The analysis setting of a scene: Poincaré section at spin phase 0, periodicity tolerance 1e-3 r_0
+/// (r_0 of plane A, for a two-plane rotor).
 pub fn analysis_spec(scene: &Scene) -> AnalysisSpec {
-    AnalysisSpec { gap: scene.params.contact.gap, speed: scene.params.speed, phase: 0.0, tolerance: 1e-3 }
+    plane_analysis_spec(scene, 0)
+}
+
+/// [`analysis_spec`] of bearing plane `i` (its own air gap).
+pub fn plane_analysis_spec(scene: &Scene, i: usize) -> AnalysisSpec {
+    let p = scene.plane(i);
+    AnalysisSpec { gap: p.contact.gap, speed: p.speed, phase: 0.0, tolerance: 1e-3 }
 }
 
 /// The summary's figures of a whole run, taken row by row.

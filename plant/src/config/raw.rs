@@ -38,15 +38,27 @@ defaults!(RawMeta {
 });
 
 /// `[rotor]`.
+///
+/// `model` chooses the planar model (one bearing plane: the study's, `mass_kg` the share one
+/// bearing carries) or the two-plane rotor (the whole rotor on two bearings with its tilt). The
+/// keys without a fixed default take the model's: a two-plane scene's defaults are the
+/// symmetric machine equivalent to the study (docs/MODEL.md §10.1). The keys after `model`'s
+/// own are the two-plane rotor's and refused in a planar scene.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RawRotor {
-    /// m_r (kg). Default 11.5.
-    pub mass_kg: f64,
-    /// e (µm). Default 2.
+    /// `planar` (default) or `two_plane`.
+    pub model: RotorModel,
+    /// Mass (kg): planar, the share of one bearing, default 11.5; two-plane, the whole rotor,
+    /// default 23.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// e (µm): the centre of mass's offset from the geometric axis (static unbalance). Default 2.
     pub eccentricity_um: f64,
-    /// J_r (kg·m²). Default 5.81e-3.
-    pub polar_inertia_kg_m2: f64,
+    /// Polar moment of inertia (kg·m²): planar, the share of one bearing, default 5.81e-3;
+    /// two-plane, the whole rotor's I_p, default 11.62e-3.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polar_inertia_kg_m2: Option<f64>,
     /// r_r (mm). Default 19.85.
     pub radius_mm: f64,
     /// Rated speed (Hz). Default 500.
@@ -55,22 +67,75 @@ pub struct RawRotor {
     pub unbalance_phase_deg: f64,
     /// `held` (default) or `free`.
     pub spin: SpinChoice,
-    /// Speed-loop gain for `free` spin (N·m·s/rad). Default 0.05.
-    pub drive_gain_n_m_s: f64,
-    /// Drive torque limit for `free` spin (N·m). Default 2.
-    pub drive_torque_limit_n_m: f64,
+    /// Speed-loop gain for `free` spin (N·m·s/rad). Default 0.05 (two-plane: 0.1, the whole rotor's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drive_gain_n_m_s: Option<f64>,
+    /// Drive torque limit for `free` spin (N·m). Default 2 (two-plane: 4).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drive_torque_limit_n_m: Option<f64>,
+    /// Two-plane: transverse moment of inertia I_t about the centre of mass (kg·m²). Default 0.414.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transverse_inertia_kg_m2: Option<f64>,
+    /// Two-plane: couple unbalance, the tilt χ of the principal axis of inertia from the
+    /// geometric axis (µrad). Default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub couple_unbalance_urad: Option<f64>,
+    /// Two-plane: the rotor-fixed direction of that tilt, from the static unbalance's (deg). Default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub couple_unbalance_phase_deg: Option<f64>,
+    /// Two-plane: axial position of bearing A (AMB and touchdown bearing) from the centre of
+    /// mass (mm), < 0. Default −180.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_a_mm: Option<f64>,
+    /// Two-plane: axial position of bearing B (mm), > 0. Default 180.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_b_mm: Option<f64>,
+    /// Two-plane: axial position of plane A's displacement sensor (mm). Default: `bearing_a_mm`
+    /// (collocated).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_a_mm: Option<f64>,
+    /// Two-plane: axial position of plane B's displacement sensor (mm). Default: `bearing_b_mm`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_b_mm: Option<f64>,
+    /// Two-plane: axial position of the rotor's end on plane A's side (mm). Default −230.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_a_mm: Option<f64>,
+    /// Two-plane: axial position of the rotor's end on plane B's side (mm). Default 230.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_b_mm: Option<f64>,
 }
 defaults!(RawRotor {
-    mass_kg: f64 = 11.5,
+    model: RotorModel = RotorModel::Planar,
+    mass_kg: Option<f64> = None,
     eccentricity_um: f64 = 2.0,
-    polar_inertia_kg_m2: f64 = 5.81e-3,
+    polar_inertia_kg_m2: Option<f64> = None,
     radius_mm: f64 = 19.85,
     speed_hz: f64 = 500.0,
     unbalance_phase_deg: f64 = 0.0,
     spin: SpinChoice = SpinChoice::Held,
-    drive_gain_n_m_s: f64 = 0.05,
-    drive_torque_limit_n_m: f64 = 2.0,
+    drive_gain_n_m_s: Option<f64> = None,
+    drive_torque_limit_n_m: Option<f64> = None,
+    transverse_inertia_kg_m2: Option<f64> = None,
+    couple_unbalance_urad: Option<f64> = None,
+    couple_unbalance_phase_deg: Option<f64> = None,
+    bearing_a_mm: Option<f64> = None,
+    bearing_b_mm: Option<f64> = None,
+    sensor_a_mm: Option<f64> = None,
+    sensor_b_mm: Option<f64> = None,
+    end_a_mm: Option<f64> = None,
+    end_b_mm: Option<f64> = None,
 });
+
+/// `rotor.model`: the rotor model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RotorModel {
+    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
+    #[default]
+    Planar,
+    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
+    TwoPlane,
+}
 
 /// `[touchdown]`: the touchdown bearing.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -122,6 +187,12 @@ pub struct RawTouchdown {
     /// close: `equilibrium` (default: at rest on its supports under gravity and the current
     /// housing acceleration) or `held` (where it was parked, at rest).
     pub race_release: ReleaseChoice,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table>,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table>,
 }
 defaults!(RawTouchdown {
     air_gap_mm: f64 = 0.15,
@@ -145,6 +216,8 @@ defaults!(RawTouchdown {
     palmgren_f1: f64 = 5e-4,
     race_when_clear: RaceWhenClearChoice = RaceWhenClearChoice::Free,
     race_release: ReleaseChoice = ReleaseChoice::Equilibrium,
+    a: Option<toml::Table> = None,
+    b: Option<toml::Table> = None,
 });
 
 /// `[housing]`.
@@ -178,6 +251,12 @@ pub struct RawContact {
     pub stribeck_static_m_s: f64,
     /// v_d (m/s). Default 0.1.
     pub stribeck_dynamic_m_s: f64,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table>,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table>,
 }
 defaults!(RawContact {
     rotor_race_stiffness_n_per_m10_9: f64 = 1.988e9,
@@ -189,6 +268,8 @@ defaults!(RawContact {
     friction_dynamic: f64 = 0.1,
     stribeck_static_m_s: f64 = 0.1,
     stribeck_dynamic_m_s: f64 = 0.1,
+    a: Option<toml::Table> = None,
+    b: Option<toml::Table> = None,
 });
 
 /// `[amb]`: the magnetic bearing.
@@ -209,6 +290,12 @@ pub struct RawAmb {
     pub nominal_gap_mm: f64,
     /// Largest pull of one magnet, from flux saturation (N). Default 1000.
     pub magnet_force_limit_n: f64,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table>,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table>,
 }
 defaults!(RawAmb {
     force_law: ForceLaw = ForceLaw::Linear,
@@ -218,6 +305,8 @@ defaults!(RawAmb {
     sensor_gain_v_per_m: f64 = 25000.0,
     nominal_gap_mm: f64 = 1.0,
     magnet_force_limit_n: f64 = 1000.0,
+    a: Option<toml::Table> = None,
+    b: Option<toml::Table> = None,
 });
 
 /// `rotor.spin`: how the rotor's speed is driven.
@@ -512,8 +601,20 @@ pub struct RawInitial {
     pub rotor_x_um: f64,
     /// Offset added to the rotor's initial y (µm). Default 0.
     pub rotor_y_um: f64,
+    /// Two-plane: offset added to the initial slope a = dx/dz of the rotor axis (µrad). Default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slope_x_urad: Option<f64>,
+    /// Two-plane: offset added to the initial slope b = dy/dz (µrad). Default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slope_y_urad: Option<f64>,
 }
-defaults!(RawInitial { unbalance_orbit: bool = true, rotor_x_um: f64 = 0.0, rotor_y_um: f64 = 0.0 });
+defaults!(RawInitial {
+    unbalance_orbit: bool = true,
+    rotor_x_um: f64 = 0.0,
+    rotor_y_um: f64 = 0.0,
+    slope_x_urad: Option<f64> = None,
+    slope_y_urad: Option<f64> = None,
+});
 
 /// `[sensor]`: what the digital controller reads (sampled and co-simulation modes; the
 /// continuous PD sees the exact state). The gain is `amb.sensor_gain_v_per_m`.
