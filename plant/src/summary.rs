@@ -180,6 +180,8 @@ pub struct PlaneSummary {
     pub recovery_s: Option<f64>,
     /// Time in contact over the run (s).
     pub contact_time_s: f64,
+    /// Time of the first sample with rotor – race contact (s); `null` if the plane never touched.
+    pub first_contact_s: Option<f64>,
     /// The plane's analysis (spectra, Poincaré section, classification).
     #[serde(flatten)]
     pub analysis: Analysis,
@@ -208,6 +210,7 @@ impl PlaneSummary {
             max_race_speed_rpm: p.figures.max_race_speed_rpm,
             recovery_s: p.figures.recovery_s,
             contact_time_s: p.figures.contact_share() * simulated,
+            first_contact_s: p.figures.first_contact_s,
             analysis: p.analysis.clone(),
         }
     }
@@ -431,6 +434,8 @@ pub struct Figures {
     pub max_race_speed_rpm: f64,
     /// See [`Summary::recovery_s`].
     pub recovery_s: Option<f64>,
+    /// Time of the first row with rotor – race contact (s), if any.
+    pub first_contact_s: Option<f64>,
     /// Rows.
     pub rows: u64,
     /// Rows with a positive contact force.
@@ -459,6 +464,7 @@ pub struct FiguresBuilder {
     /// The last row's time and its radius, force and race speed (rpm), not yet in the maxima.
     pending: Option<[f64; 4]>,
     last_contact: Option<f64>,
+    first_contact: Option<f64>,
     last_row_in_contact: bool,
     rows: u64,
     contact_rows: u64,
@@ -474,6 +480,7 @@ impl FiguresBuilder {
             max_rpm: 0.0,
             pending: None,
             last_contact: None,
+            first_contact: None,
             last_row_in_contact: false,
             rows: 0,
             contact_rows: 0,
@@ -488,6 +495,9 @@ impl FiguresBuilder {
         self.pending = Some([t, r[col::DX_M].hypot(r[col::DY_M]), force, rpm]);
         self.rows += 1;
         self.contact_rows += u64::from(force > 0.0);
+        if force > 0.0 && self.first_contact.is_none() {
+            self.first_contact = Some(t);
+        }
         self.last_row_in_contact = t >= self.shock_start && force > 0.0;
         if self.last_row_in_contact {
             self.last_contact = Some(t);
@@ -523,6 +533,7 @@ impl FiguresBuilder {
                 Some(_) if self.last_row_in_contact => None,
                 Some(t) => Some(t - self.shock_start),
             },
+            first_contact_s: self.first_contact,
             rows: self.rows,
             contact_rows: self.contact_rows,
         }
