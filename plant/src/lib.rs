@@ -19,6 +19,7 @@ pub mod analysis;
 pub mod atomic;
 pub mod bench;
 pub mod bounded;
+pub mod campbell;
 pub mod claim;
 pub mod compare;
 pub mod config;

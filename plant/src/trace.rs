@@ -330,6 +330,14 @@ impl Trace {
         1 + usize::from(self.b.is_some())
     }
 
+    /// Plane `i`'s trace in the planar columns ([`Record::plane`]): the planar columns for 0, a
+    /// copy of plane B's with the shared ones for 1.
+    pub fn plane(&self, i: usize) -> Trace {
+        let mut t = Trace::with_capacity(self.len());
+        self.records().for_each(|r| t.push_row(&r.plane(i)));
+        t
+    }
+
     /// The planar columns' rows (plane A's, for a two-plane trace), in order.
     pub fn rows(&self) -> impl Iterator<Item = Row> + '_ {
         (0..self.len()).map(|i| self.row(i))

@@ -80,6 +80,12 @@ fn bad_two_plane_input_is_refused_at_load_naming_the_key() {
     // A plane's own bad value is named as the plane's key; an unknown key in it too.
     refused("plane-gap", &two, &["touchdown.b.air_gap_mm=-1"], &["touchdown.b.air_gap_mm = -1 mm"]);
     refused("plane-unknown", &two, &["contact.a.frition_static=0.2"], &["contact.a", "frition_static"]);
+    // The Campbell diagram of a planar scene.
+    let dir = TempDir::new("campbell-planar");
+    let out =
+        output_within(Command::new(plant_bin()).arg("campbell").arg(&planar).arg("--out").arg(dir.join("c")), QUICK);
+    assert_exit(&out, 2);
+    assert!(stderr(&out).contains("needs a two-plane scene"), "{}", stderr(&out));
     // A four-axis scene with a two-axis controller link (co-simulation).
     refused(
         "lockstep",
