@@ -14,6 +14,8 @@ pub struct SoakSink<'a> {
     pub(crate) tracker: ShockTracker,
     pub(crate) envelope: Envelope,
     pub(crate) planned: &'a [PlannedShock],
+    /// Two-plane: plane A's gap over plane B's (plane B's radius is scaled by it).
+    pub(crate) gap_ratio: f64,
     pub(crate) figures: Vec<ShockFigures>,
     pub(crate) soak_csv: RowFile,
     pub(crate) envelope_csv: RowFile,
@@ -70,12 +72,14 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn sample(&mut self, record: &Record) {
-        // Of a two-plane rotor, the larger radius and contact force of the two planes.
+        // Of a two-plane rotor, the plane nearer its gap: the larger of r_A and r_B·r0_A/r0_B
+        // (plane B's radius on plane A's gap, so that the clear test holds each plane to its
+        // own gap), and the larger contact force.
         let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
         let (mut radius, mut force) = of(&record.a);
         if record.planes() == 2 {
             let (rb, fb) = of(&record.plane(1));
-            (radius, force) = (radius.max(rb), force.max(fb));
+            (radius, force) = (radius.max(rb * self.gap_ratio), force.max(fb));
         }
         let t = record.a[col::T_S];
         if let Some(r) = self.envelope.sample(t, radius, force) {
