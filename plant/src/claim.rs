@@ -7,8 +7,11 @@
 //! with the first one's (two runs at once used to leave one run's
 //! `summary.json` beside the other's `trace.csv`, both exiting 0). The kernel
 //! releases the claim when the process ends, however it ends (SIGKILL
-//! included); nothing is left in the folder. Sweeps and ensembles do not take
-//! it: their shards share one folder by design and check their own files.
+//! included); nothing is left in the folder. A claim also removes the
+//! temporaries of atomic writes that a killed process left in the folder
+//! ([`crate::atomic::remove_stale`]). Sweeps and ensembles do not take it:
+//! their shards share one folder by design and check their own files (and
+//! temporaries).
 
 use std::fs::{File, TryLockError};
 use std::path::{Path, PathBuf};
@@ -51,7 +54,11 @@ pub fn claim(dir: &Path, create: bool) -> Result<Option<Claim>, ClaimError> {
     }
     let file = File::open(dir).map_err(io)?;
     match file.try_lock() {
-        Ok(()) => Ok(Some(Claim { _dir: file })),
+        Ok(()) => {
+            // A write of an earlier command killed half-way left its temporary here.
+            crate::atomic::remove_stale(dir);
+            Ok(Some(Claim { _dir: file }))
+        }
         Err(TryLockError::WouldBlock) => Err(ClaimError::InUse { path: dir.to_path_buf(), holder: holder(dir) }),
         Err(TryLockError::Error(e)) => Err(io(e)),
     }

@@ -43,6 +43,9 @@ pub trait Machine<const N: usize>: System<N> {
     /// Plane `i`'s radii relative to the housing (m): the rotor at the bearing, and the race.
     fn radii(&self, y: &[f64; N], i: usize) -> (f64, f64);
 
+    /// The rotor's spin angle (rad, unwrapped) and speed (rad/s) in state `y`: the keyphasor.
+    fn spin(&self, y: &[f64; N]) -> (f64, f64);
+
     /// The output sample of state `y` at time `t`.
     fn record(&self, t: f64, y: &[f64; N]) -> Record;
 }
@@ -85,6 +88,10 @@ impl Machine<{ crate::model::N }> for Model {
     fn radii(&self, y: &crate::model::State, _i: usize) -> (f64, f64) {
         use crate::model::ix::*;
         (y[XR].hypot(y[YR]), y[XB].hypot(y[YB]))
+    }
+
+    fn spin(&self, y: &crate::model::State) -> (f64, f64) {
+        (y[crate::model::ix::TR], y[crate::model::ix::WR])
     }
 
     fn record(&self, t: f64, y: &crate::model::State) -> Record {
@@ -142,6 +149,10 @@ impl Machine<{ two_plane::N }> for two_plane::Model {
         let (pos, _) = two_plane::at_station(y, self.params.planes[i].station);
         let race = two_plane::ix::RACE[i];
         (pos.x.hypot(pos.y), y[race].hypot(y[race + 1]))
+    }
+
+    fn spin(&self, y: &two_plane::State) -> (f64, f64) {
+        (y[two_plane::ix::TR], y[two_plane::ix::WR])
     }
 
     fn record(&self, t: f64, y: &two_plane::State) -> Record {

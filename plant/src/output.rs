@@ -402,13 +402,6 @@ pub enum AnalyzeError {
     Output(anyhow::Error),
 }
 
-impl AnalyzeError {
-    /// Bad input (exit 2), as opposed to an output that could not be written (exit 1).
-    pub fn is_input(&self) -> bool {
-        !matches!(self, AnalyzeError::Output(_))
-    }
-}
-
 /// `plant analyze DIR`: reads `scene.toml` (through the scene loader) and
 /// `trace.csv` (strictly, [`crate::trace::read_rows`]), merges the analysis
 /// into `summary.json` (created if missing; written atomically, only once the

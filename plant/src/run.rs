@@ -18,7 +18,7 @@ use crate::machine::Machine;
 use crate::model::{Control, Model, RaceWhenClear};
 use crate::sensor::Sensor;
 use crate::trace::{Record, Trace};
-use controller::{build_law, saturate, ControlLaw, PdGains, Sample};
+use controller::{build_rotor_law, saturate, saturate_axes, wrap_angle, PdGains, RotorLaw, RotorSample, ROTOR_AXES};
 use plant_physics::two_plane;
 use std::collections::VecDeque;
 
@@ -157,8 +157,8 @@ pub fn settings_with<const N: usize>(scene: &Scene, atol: [f64; N]) -> Settings<
 enum Source {
     /// The PD inside the derivative.
     Continuous,
-    /// The law of each plane in this process.
-    InProcess(Vec<Box<dyn ControlLaw>>),
+    /// The law in this process: one per plane (decentralised) or one of the whole rotor.
+    InProcess(Box<dyn RotorLaw>),
     /// The law in the controller process.
     Cosim(Box<Session>),
 }
@@ -207,23 +207,28 @@ pub fn run_into(
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
-    let gains = design_gains(scene)?;
-    let limit = scene.params.current_limit;
-    let bias = saturate(gains.bias_a, limit);
     let params = &scene.controller.params;
-    let designs = scene.plane_designs();
+    let bias_of = |scene: &Scene| -> Result<[f64; ROTOR_AXES], SetupError> {
+        let gains = plane_gains(scene)?;
+        let mut bias = [0.0; ROTOR_AXES];
+        for (i, g) in gains.iter().enumerate() {
+            let b = saturate(g.bias_a, scene.plane(i).current_limit);
+            bias[2 * i..2 * i + 2].copy_from_slice(&b);
+        }
+        Ok(bias)
+    };
     let mut source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
-        ControlMode::Sampled => Source::InProcess(
-            designs.iter().map(|d| build_law(&scene.controller.law, d, params)).collect::<Result<_, _>>()?,
-        ),
+        ControlMode::Sampled => {
+            Source::InProcess(build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?)
+        }
         ControlMode::Lockstep | ControlMode::Realtime => {
             // A design the controller would refuse is bad input here, before any process starts
             // (a controller command checks the laws it serves itself, in the handshake).
             if scene.controller.cosim.command.is_none() {
-                build_law(&scene.controller.law, &scene.design(), params)?;
+                build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?;
             }
-            Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
+            Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene)?, hooks)?))
         }
     };
     // An external controller may run a design of its own (its `--config` or `--law`): the run
@@ -235,14 +240,14 @@ pub fn run_into(
     };
     let scene = effective.as_ref().unwrap_or(scene);
     let gains = plane_gains(scene)?;
-    let limit = scene.params.current_limit;
-    let bias: Vec<[f64; 2]> = gains.iter().map(|g| saturate(g.bias_a, limit)).collect();
+    let bias = bias_of(scene)?;
+    let limits = scene.rotor_design().current_limits();
     if let (Source::Cosim(session), Some(_)) = (&mut source, &effective) {
-        session.adopt(bias[0], limit);
+        session.adopt(bias, limits);
     }
     let control = |i: usize| match source {
         Source::Continuous => Control::Continuous(gains[i]),
-        _ => Control::Held(bias[i]),
+        _ => Control::Held([bias[2 * i], bias[2 * i + 1]]),
     };
     match &scene.two_plane {
         None => {
@@ -253,7 +258,7 @@ pub fn run_into(
                 race_parked: false,
             };
             let y = initial_state(scene);
-            drive(scene, model, y, integrator_settings(scene), source, &bias, hooks, sink)
+            drive(scene, model, y, integrator_settings(scene), source, (bias, limits), hooks, sink)
         }
         Some(params) => {
             let model = two_plane::Model {
@@ -264,7 +269,7 @@ pub fn run_into(
             };
             let y = crate::initial::two_plane_initial_state(scene, params);
             let settings = settings_with(scene, scene.integrator.two_plane_atol());
-            drive(scene, model, y, settings, source, &bias, hooks, sink)
+            drive(scene, model, y, settings, source, (bias, limits), hooks, sink)
         }
     }
 }
@@ -277,7 +282,7 @@ fn drive<const N: usize, M: Machine<N>>(
     mut y: [f64; N],
     settings: Settings<N>,
     mut source: Source,
-    bias: &[[f64; 2]],
+    (bias, limits): ([f64; ROTOR_AXES], [f64; ROTOR_AXES]),
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
@@ -300,9 +305,8 @@ fn drive<const N: usize, M: Machine<N>>(
         _ => 0,
     };
     let delay = scene.controller.delay_samples.saturating_sub(inherent) as usize;
-    let bias_all = [bias[0], bias.get(1).copied().unwrap_or([0.0; 2])];
-    let mut queue: VecDeque<[[f64; 2]; 2]> = VecDeque::with_capacity(delay + 1);
-    queue.extend(std::iter::repeat_n(bias_all, delay));
+    let mut queue: VecDeque<[f64; ROTOR_AXES]> = VecDeque::with_capacity(delay + 1);
+    queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
     let guards = Guards::new(scene, &model);
     let breakpoints = scene.base.breakpoints();
@@ -319,19 +323,31 @@ fn drive<const N: usize, M: Machine<N>>(
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let mut command = [[0.0; 2]; 2];
-        let commanded = match &mut source {
-            Source::Continuous => false,
-            Source::InProcess(laws) => {
-                for (i, law) in laws.iter_mut().enumerate() {
-                    let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
-                    let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read_with_gain(model.sensed(&y, i), gain) };
-                    command[i] = saturate(law.update(&sample), model.bearing(i).current_limit);
-                }
-                true
+        // Every axis's sensor (the planes in order, one noise sequence) and the keyphasor: the
+        // rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let mut sample = RotorSample {
+            seq: k,
+            t_s: t0,
+            axes: 2 * planes as u32,
+            speed_rad_s: model.spin(&y).1,
+            ..Default::default()
+        };
+        sample.angle_rad = wrap_angle(model.spin(&y).0);
+        let read = |sensor: &mut Sensor, sample: &mut RotorSample| {
+            for i in 0..planes {
+                let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
+                let v = sensor.read_with_gain(model.sensed(&y, i), gain);
+                sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
+            }
+        };
+        let command = match &mut source {
+            Source::Continuous => None,
+            Source::InProcess(law) => {
+                read(&mut sensor, &mut sample);
+                Some(saturate_axes(law.update(&sample), limits))
             }
             Source::Cosim(session) => {
-                let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read(model.sensed(&y, 0)) };
+                read(&mut sensor, &mut sample);
                 match session.command(&sample, hooks) {
                     Ok(cmd) => {
                         let pid = session.controller_pid();
@@ -341,8 +357,7 @@ fn drive<const N: usize, M: Machine<N>>(
                                 hooks.controller_connected(pid);
                             }
                         }
-                        command[0] = cmd;
-                        true
+                        Some(cmd)
                     }
                     Err(halt) => {
                         outcome = match halt {
@@ -355,11 +370,11 @@ fn drive<const N: usize, M: Machine<N>>(
                 }
             }
         };
-        if commanded {
+        if let Some(command) = command {
             queue.push_back(command);
             if let Some(applied) = queue.pop_front() {
-                for (i, current) in applied.iter().enumerate().take(planes) {
-                    model.set_control(i, Control::Held(*current));
+                for i in 0..planes {
+                    model.set_control(i, Control::Held([applied[2 * i], applied[2 * i + 1]]));
                 }
             }
         }

@@ -2,10 +2,10 @@
 //! mapping from how a run ended ([`Outcome`]) to its status and error text.
 
 use crate::run::Outcome;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The `status` of `summary.json` and `soak.json`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Ran to the scene's duration.

@@ -217,7 +217,7 @@ fn free_spin_loses_speed_to_rubbing_and_the_drive_restores_it() {
             r.scene.duration_s = 0.06;
             r.rotor.spin = SpinChoice::Free;
             r.rotor.eccentricity_um = 0.0;
-            r.rotor.drive_gain_n_m_s = Some(gain);
+            r.rotor.drive_gain_n_m_s = gain;
             r.shock = ten_g(0.005);
         });
         completed(&s).trace

@@ -86,13 +86,50 @@ fn bad_two_plane_input_is_refused_at_load_naming_the_key() {
         output_within(Command::new(plant_bin()).arg("campbell").arg(&planar).arg("--out").arg(dir.join("c")), QUICK);
     assert_exit(&out, 2);
     assert!(stderr(&out).contains("needs a two-plane scene"), "{}", stderr(&out));
-    // A four-axis scene with a two-axis controller link (co-simulation).
-    refused(
-        "lockstep",
-        &two,
-        &["controller.mode=lockstep"],
-        &["controller.mode = \"lockstep\"", "four controlled axes"],
-    );
+    // A law of the whole rotor on a planar scene.
+    refused("modal-planar", &planar, &["controller.mode=sampled", "controller.law=modal"], &["modal"]);
+}
+
+/// A four-axis scene with a controller that runs two axes only: it refuses the hello with
+/// status 3, and the plant exits 2 naming the refusal (the run's record says `refused`).
+#[test]
+fn a_two_axis_controller_refuses_the_two_plane_rotor() {
+    let dir = TempDir::new("two-plane-two-axes");
+    let out = dir.join("run");
+    let command = format!("controller.command=[{:?}, \"--mode\", \"two-axes\"]", common::rogue_bin().display());
+    let sets = ["scene.duration_s=0.005", "controller.mode=lockstep", "output.plots=false", &command];
+    let run = output_within(&mut plant_run(&scene("two-plane-asymmetric-10g.toml"), &out, &sets), RUN);
+    assert_exit(&run, 2);
+    let err = stderr(&run);
+    assert!(err.contains("runs 2 axes, the plant asks for 4"), "{err}");
+    assert_eq!(read_json(&out.join("summary.json"))["status"], "refused");
+}
+
+/// The two-plane rotor co-simulated in lockstep (4 axes on the wire, the built-in controller)
+/// gives the trace of the same law run in-process (sampled), bit for bit: per-plane `pd`
+/// decentralised and the centralised `modal`.
+#[test]
+fn lockstep_two_plane_run_is_the_sampled_run() {
+    for law in ["pd", "modal"] {
+        let dir = TempDir::new(&format!("two-plane-lockstep-{law}"));
+        let law_set = format!("controller.law={law}");
+        let base =
+            ["scene.duration_s=0.03", "shock[0].start_s=0.01", "controller.damping_ratio=0.026", "output.plots=false"];
+        let runs: Vec<Csv> = ["sampled", "lockstep"]
+            .iter()
+            .map(|mode| {
+                let out = dir.join(mode);
+                let mode_set = format!("controller.mode={mode}");
+                let sets: Vec<&str> = base.iter().copied().chain([mode_set.as_str(), law_set.as_str()]).collect();
+                let run = output_within(&mut plant_run(&scene("two-plane-asymmetric-10g.toml"), &out, &sets), RUN);
+                assert_exit(&run, 0);
+                two_plane_trace(&out)
+            })
+            .collect();
+        assert_eq!(runs[0].rows, runs[1].rows, "law {law}: lockstep differs from sampled");
+        let contact = runs[0].column("contact_force_n").iter().filter(|f| **f > 0.0).count();
+        assert!(contact > 0, "law {law}: the window holds contact");
+    }
 }
 
 /// Reads `dir/trace.csv` and checks a two-plane header: the planar columns first, under their

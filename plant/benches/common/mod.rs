@@ -55,6 +55,8 @@ pub fn two_plane_model() -> (plant_physics::two_plane::Model, plant::config::Sce
         ..Default::default()
     };
     raw.rotor.model = plant::config::RotorModel::TwoPlane;
+    raw.rotor.mass_kg = 23.0;
+    raw.rotor.polar_inertia_kg_m2 = 11.62e-3;
     let scene = validate(raw, Path::new(".")).expect("scene");
     let gains = plant::run::plane_gains(&scene).expect("gains");
     let model = plant_physics::two_plane::Model {

@@ -250,6 +250,28 @@ impl Scene {
         }
     }
 
+    /// The whole rotor's design a law is built from (`controller::build_rotor_law`) and the
+    /// hello carries: the planar design, or each plane's with the rotor's geometry.
+    pub fn rotor_design(&self) -> controller::RotorDesign {
+        match &self.two_plane {
+            None => controller::RotorDesign::Planar(self.design()),
+            Some(m) => {
+                let [a, b] = &m.planes;
+                controller::RotorDesign::TwoPlane {
+                    planes: [self.design_of(&a.params), self.design_of(&b.params)],
+                    geometry: controller::Geometry {
+                        mass_kg: m.rotor.mass,
+                        transverse_inertia_kg_m2: m.rotor.transverse_inertia,
+                        polar_inertia_kg_m2: m.rotor.polar_inertia,
+                        rated_speed_rad_s: m.rotor.speed,
+                        bearing_z_m: [a.station, b.station],
+                        sensor_z_m: [a.sensor, b.sensor],
+                    },
+                }
+            }
+        }
+    }
+
     /// Bearing planes: 1 (planar) or 2.
     pub fn planes(&self) -> usize {
         if self.two_plane.is_some() {
@@ -294,6 +316,14 @@ impl Scene {
             }
         }
         toml::to_string(&raw)
+            .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
+    }
+
+    /// The scene as resolved, read back from [`Scene::to_toml`] (every key, overrides applied,
+    /// recorded files absolute): what sweeps and ensembles key their units on and draw
+    /// relative to.
+    pub fn resolved(&self) -> Result<RawScene, ConfigError> {
+        toml::from_str(&self.to_toml()?)
             .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
     }
 

@@ -436,19 +436,13 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
     if !two {
         refuse_two_plane_keys(&raw)?;
     }
-    // Defaults that depend on the model: the two-plane rotor's are the symmetric machine
-    // equivalent to the study (twice the planar share).
-    let default = |planar: f64, two_plane: f64| if two { two_plane } else { planar };
-    let rotor_mass = positive("rotor.mass_kg", r.mass_kg.unwrap_or(default(11.5, 23.0)), "kg")?;
+    let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
     let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
-    let rotor_inertia =
-        positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2.unwrap_or(default(5.81e-3, 11.62e-3)), "kg·m²")?;
+    let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
     let rotor_radius = positive("rotor.radius_mm", r.radius_mm, "mm")? * 1e-3;
     let speed = non_negative("rotor.speed_hz", r.speed_hz, "Hz")? * std::f64::consts::TAU;
-    let drive_gain =
-        non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s.unwrap_or(default(0.05, 0.1)), "N·m·s/rad")?;
-    let torque_limit =
-        non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m.unwrap_or(default(2.0, 4.0)), "N·m")?;
+    let drive_gain = non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?;
+    let torque_limit = non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?;
     let spin = match r.spin {
         SpinChoice::Held => Spin::Held,
         SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
@@ -462,15 +456,6 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         (bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?, None)
     };
     let loop_constants = physics.loop_constants;
-    if two && matches!(ctl.mode, ControlMode::Lockstep | ControlMode::Realtime) {
-        return Err(range(
-            "controller.mode",
-            format!("\"{}\"", crate::summary::snake_name(&ctl.mode)),
-            "",
-            "the two-plane rotor has four controlled axes and this plant's controller link carries two (wire \
-             protocol v3): use \"continuous\" or \"sampled\" (per-plane laws in the plant)",
-        ));
-    }
 
     let rate = positive("controller.rate_hz", ctl.rate_hz, "Hz")?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
@@ -599,11 +584,7 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
     };
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
-    // The resolved scene records the defaults its model chose.
-    raw.rotor.mass_kg = Some(rotor_mass);
-    raw.rotor.polar_inertia_kg_m2 = Some(rotor_inertia);
-    raw.rotor.drive_gain_n_m_s = Some(drive_gain);
-    raw.rotor.drive_torque_limit_n_m = Some(torque_limit);
+    // The resolved scene states the two-plane rotor's defaults.
     if two_plane.is_some() {
         record_two_plane(&mut raw);
     }
@@ -626,9 +607,7 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
     // The law validates its own parameters: a scene it refuses is bad input, before any run.
     // A controller command serves laws of its own: it checks them, in the handshake.
     if scene.controller.cosim.command.is_none() {
-        for design in scene.plane_designs() {
-            controller::build_law(&scene.controller.law, &design, &scene.controller.params)?;
-        }
+        controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
     }
     Ok(scene)
 }
