@@ -53,6 +53,15 @@ pub enum LawError {
         /// What is wrong.
         why: String,
     },
+    /// The law refuses the design it was given, for a reason of its own (a law of the C API
+    /// whose `build` returned NULL, with its message).
+    #[error("law {law}: {why}")]
+    Refused {
+        /// The law.
+        law: &'static str,
+        /// Its reason.
+        why: String,
+    },
     /// `[controller.params]` holds a key the law does not read.
     #[error("law {law}: unknown parameter controller.params.{key} = {value} (law {law} reads {known})", known = known_list(known))]
     UnknownParam {

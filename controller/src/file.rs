@@ -38,6 +38,8 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "lockstep_timeout_ms",
     "realtime_priority",
     "max_miss_fraction",
+    "max_invalid_burst",
+    "max_invalid_fraction",
 ];
 
 /// `[controller]` keys the controller process uses (the `relev_*` ones are deprecated aliases
@@ -201,8 +203,27 @@ pub fn load(path: &Path) -> Result<LawOverrides, FileError> {
 /// Reads the `[controller]` table of a file for a controller that serves the laws `served`.
 pub fn load_for(path: &Path, served: &[&str]) -> Result<LawOverrides, FileError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| FileError::Read { path: shown.clone(), source })?;
+    let text = read_input(path).map_err(|source| FileError::Read { path: shown.clone(), source })?;
     parse_for(&text, served).map_err(|message| FileError::Invalid { path: shown, message })
+}
+
+/// The most a `--config` file may hold (a scene file is a few kilobytes).
+const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// Reads a `--config` file without trusting it: a regular file of at most [`MAX_FILE_BYTES`]
+/// (a device such as `/dev/zero` or a FIFO is refused before it is read; the plant's files go
+/// through `shock_table::input`, which this crate does not depend on).
+fn read_input(path: &Path) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(Error::new(ErrorKind::InvalidInput, "not a regular file (a device, a FIFO or a folder)"));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)?.take(MAX_FILE_BYTES + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(Error::new(ErrorKind::InvalidInput, format!("more than {MAX_FILE_BYTES} bytes")));
+    }
+    Ok(text)
 }
 
 /// Parses the `[controller]` table of a TOML text.

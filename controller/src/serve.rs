@@ -290,6 +290,11 @@ pub fn serve<L: Copy + Into<AnyLaw>>(laws: &[L]) -> ExitCode {
 
 /// [`serve`] with the command line given (the program name first).
 pub fn serve_from<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> ExitCode {
+    ExitCode::from(serve_code(argv, laws))
+}
+
+/// [`serve_from`], the exit code as a number (for the C API, which returns it).
+pub fn serve_code<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> u8 {
     let program = argv
         .first()
         .map(|p| std::path::Path::new(p).file_name().unwrap_or(p.as_os_str()).to_string_lossy().into_owned())
@@ -307,7 +312,7 @@ pub fn serve_from<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> Ex
     let ended = ServeOptions::from_args(&args, |k| std::env::var(k).ok())
         .and_then(|opts| run(&opts, laws, &STOP, &mut |w| eprintln!("{program}: {w}")));
     match ended {
-        Ok(_) => ExitCode::SUCCESS,
+        Ok(_) => exit::OK,
         Err(e) => {
             let code = e.exit_code();
             if matches!(code, exit::PLANT_LOST | exit::INTERRUPTED) {
@@ -315,7 +320,7 @@ pub fn serve_from<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> Ex
             } else {
                 eprintln!("{program}: error: {e}");
             }
-            ExitCode::from(code)
+            code
         }
     }
 }
@@ -510,7 +515,7 @@ fn accept(
     let law = build_among(laws, &name, &rotor, &params).map_err(|e| match e {
         LawError::Param { .. } | LawError::UnknownParam { .. } => (Refusal::Params, e.to_string()),
         LawError::Axes { .. } => (Refusal::Axes, e.to_string()),
-        LawError::Unknown { .. } | LawError::Design { .. } => (Refusal::Law, e.to_string()),
+        LawError::Unknown { .. } | LawError::Design { .. } | LawError::Refused { .. } => (Refusal::Law, e.to_string()),
     })?;
     let a = rotor.plane_a();
     let description = match rotor.planes() {

@@ -472,7 +472,7 @@ pub fn compare_laws(
             status: s.status,
             recovery_s: s.recovery_s.unwrap_or(f64::NAN),
             post_shock_mode: s.analysis.post_shock_mode,
-            max_contact_force_n: s.max_contact_force_n,
+            max_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
             contact_time_s: s.contact_time_s,
             steady_contact_fraction: s.analysis.steady_contact_fraction,
             whirl_hz: s.analysis.whirl_hz,

@@ -31,13 +31,16 @@ pub enum Code {
     MissBudget = 6,
     /// `plant sweep` / `plant ensemble` `--merge` (or `--round R`): units missing or corrupt.
     Incomplete = 7,
+    /// The controller's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` (status `invalid_commands`).
+    InvalidCommands = 8,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     Interrupted = 130,
 }
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 8] = [
+    pub const ALL: [Code; 9] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -45,6 +48,7 @@ impl Code {
         Code::CriterionFailed,
         Code::MissBudget,
         Code::Incomplete,
+        Code::InvalidCommands,
         Code::Interrupted,
     ];
 }
@@ -59,6 +63,7 @@ const _: fn(Code) = |c| match c {
     | Code::CriterionFailed
     | Code::MissBudget
     | Code::Incomplete
+    | Code::InvalidCommands
     | Code::Interrupted => {}
 };
 
@@ -136,6 +141,8 @@ pub enum StopKind {
     PeerLost,
     /// Realtime: past the deadline-miss budget.
     MissBudget,
+    /// Past the budget of non-finite commands.
+    InvalidCommands,
 }
 
 impl HasExitCode for Ending {
@@ -145,6 +152,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::Diverged, .. } => Code::Diverged,
             Ending::Stopped { kind: StopKind::PeerLost, .. } => Code::PeerLost,
             Ending::Stopped { kind: StopKind::MissBudget, .. } => Code::MissBudget,
+            Ending::Stopped { kind: StopKind::InvalidCommands, .. } => Code::InvalidCommands,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
         }
@@ -200,6 +208,7 @@ impl HasExitCode for AnalyzeError {
         match self {
             AnalyzeError::Scene(_) | AnalyzeError::Trace(_) | AnalyzeError::Summary { .. } => Code::BadInput,
             AnalyzeError::Output(_) => Code::Io,
+            AnalyzeError::Interrupted(_) => Code::Interrupted,
         }
     }
 }
@@ -227,6 +236,10 @@ mod tests {
     use super::*;
     use crate::run::SetupError;
 
+    fn exited(code: Option<i32>) -> CosimError {
+        CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
+    }
+
     #[test]
     fn exit_codes_follow_the_error_types_not_their_text() {
         let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
@@ -248,9 +261,11 @@ mod tests {
                     .into(),
                 2,
             ),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
+            (exited(Some(2)).into(), 2),
+            (exited(Some(1)).into(), 4),
             (stopped(StopKind::MissBudget), 6),
+            (stopped(StopKind::InvalidCommands), 8),
+            (AnalyzeError::Interrupted("nothing was written").into(), 130),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),
             (

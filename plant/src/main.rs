@@ -10,9 +10,9 @@ mod cli;
 use clap::Parser;
 use cli::{BenchCommand, Cli, Command, ControllerArg};
 use plant::config::{load_scene, Scene};
-use plant::cosim::{CosimError, Launch};
-use plant::exit::{self, Code, Ending, HasExitCode, StopKind};
-use plant::run::{Hooks, Outcome, SetupError};
+use plant::cosim::Launch;
+use plant::exit::{self, Code, Ending, StopKind};
+use plant::run::{Hooks, Outcome};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -65,17 +65,6 @@ fn chain_text(err: &anyhow::Error) -> String {
 /// A warning for the user.
 fn warn(message: &str) {
     eprintln!("plant: warning: {message}");
-}
-
-/// The `summary.json` status of a run that could not start.
-fn not_started_status(e: &SetupError) -> &'static str {
-    match e {
-        SetupError::Law(_) | SetupError::Overrides(_) => "refused",
-        SetupError::Cosim(CosimError::Interrupted) => "interrupted",
-        SetupError::Cosim(CosimError::Command { .. }) => "not_started",
-        SetupError::Cosim(c) if c.exit_code() == Code::BadInput => "refused",
-        SetupError::Cosim(_) => "not_started",
-    }
 }
 
 /// Runs one command.
@@ -234,7 +223,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
-            if let Err(w) = plant::output::write_not_started(&dir, &scene, not_started_status(&e), &e.to_string()) {
+            if let Err(w) = plant::output::write_not_started(&dir, &scene, e.status().name(), &e.to_string()) {
                 warn(&format!("{w:#}"));
             }
             return Err(e.into());
@@ -259,6 +248,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
         Outcome::Interrupted => (StopKind::Interrupted, "interrupted".to_string()),
         Outcome::PeerLost(why) => (StopKind::PeerLost, why.clone()),
         Outcome::MissBudget(why) => (StopKind::MissBudget, why.clone()),
+        Outcome::InvalidCommands(why) => (StopKind::InvalidCommands, why.clone()),
     };
     Err(Ending::Stopped { kind, why, simulated_s }.into())
 }
@@ -305,7 +295,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 /// `plant analyze`.
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
     let _claim = plant::claim::claim(dir, false)?;
-    let a = plant::output::analyze_dir(dir)?;
+    let a = plant::output::analyze_dir(dir, &plant::interrupt::stop_flag())?;
     eprintln!(
         "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",
         dir.display(),
@@ -354,8 +344,7 @@ fn bench_ipc(
     };
     let started = Instant::now();
     let launch = controller.launch(run_id);
-    let (rt, latency, blocks) =
-        plant::cosim::bench_round_trips(samples.max(1), warmup, &launch, pins, spin_us, &mut hooks)?;
+    let (rt, latency, blocks) = plant::cosim::bench_round_trips(samples, warmup, &launch, pins, spin_us, &mut hooks)?;
     let wall = started.elapsed().as_secs_f64();
     println!(
         "ipc round trip (plant -> controller -> plant), {} samples: p50 {:.2} us, p99 {:.2} us, p99.9 {:.2} us, max {:.2} us",
@@ -379,7 +368,7 @@ mod tests {
 
     #[test]
     fn each_cause_is_said_once() {
-        let setup = plant::run::SetupError::Cosim(CosimError::RunId("run id \"a b\": a space".into()));
+        let setup = plant::run::SetupError::Cosim(plant::cosim::CosimError::RunId("run id \"a b\": a space".into()));
         let err = anyhow::Error::from(setup).context("starting the run");
         assert_eq!(format!("{err:#}"), "starting the run: run id \"a b\": a space: run id \"a b\": a space");
         assert_eq!(chain_text(&err), "starting the run: run id \"a b\": a space");

@@ -83,6 +83,9 @@ pub enum Outcome {
     PeerLost(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// The law's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` ([`crate::invalid`]).
+    InvalidCommands(String),
 }
 
 /// Why a run could not start.
@@ -197,6 +200,8 @@ pub struct SinkRun {
     pub parked_steps: u64,
     /// Bearing planes of the model (1 or 2).
     pub planes: usize,
+    /// Ticks whose command was non-finite (the last valid one was held).
+    pub invalid_commands: u64,
 }
 
 /// Runs a scene from its initial state, sending every output sample (from
@@ -208,16 +213,7 @@ pub fn run_into(
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
     let params = &scene.controller.params;
-    let bias_of = |scene: &Scene| -> Result<[f64; ROTOR_AXES], SetupError> {
-        let gains = plane_gains(scene)?;
-        let mut bias = [0.0; ROTOR_AXES];
-        for (i, g) in gains.iter().enumerate() {
-            let b = saturate(g.bias_a, scene.plane(i).current_limit);
-            bias[2 * i..2 * i + 2].copy_from_slice(&b);
-        }
-        Ok(bias)
-    };
-    let mut source = match scene.controller.mode {
+    let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
         ControlMode::Sampled => {
             Source::InProcess(build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?)
@@ -231,6 +227,40 @@ pub fn run_into(
             Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene)?, hooks)?))
         }
     };
+    run_from(scene, source, hooks, sink)
+}
+
+/// The bias currents per axis (A), each plane's within its limit (unused axes 0).
+fn bias_of(scene: &Scene) -> Result<[f64; ROTOR_AXES], SetupError> {
+    let gains = plane_gains(scene)?;
+    let mut bias = [0.0; ROTOR_AXES];
+    for (i, g) in gains.iter().enumerate() {
+        let b = saturate(g.bias_a, scene.plane(i).current_limit);
+        bias[2 * i..2 * i + 2].copy_from_slice(&b);
+    }
+    Ok(bias)
+}
+
+/// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
+/// the registry (whatever the scene's mode): the sensor read at each tick, the command
+/// saturated, delayed `delay_samples` ticks and held. A lockstep run of the same law in a
+/// controller process writes the same trace, bit for bit. See [`crate::check`].
+pub fn run_law_into(
+    scene: &Scene,
+    law: Box<dyn RotorLaw>,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
+    run_from(scene, Source::InProcess(law), hooks, sink)
+}
+
+/// The loop, from a command source.
+fn run_from(
+    scene: &Scene,
+    mut source: Source,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
     // An external controller may run a design of its own (its `--config` or `--law`): the run
     // is then the scene with those overrides, initial state and bias included, so that the
     // scene it records reproduces it.
@@ -308,6 +338,8 @@ fn drive<const N: usize, M: Machine<N>>(
     let mut queue: VecDeque<[f64; ROTOR_AXES]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
+    let c = &scene.controller;
+    let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
     let guards = Guards::new(scene, &model);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
@@ -370,8 +402,28 @@ fn drive<const N: usize, M: Machine<N>>(
                 }
             }
         };
-        if let Some(command) = command {
-            queue.push_back(command);
+        if let Some(cmd) = command {
+            let cmd = match invalid.check(cmd, &sample) {
+                Ok(checked) => {
+                    if checked.first {
+                        hooks.note(&format!(
+                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {:?} A: \
+                             the last valid command is held for it and for every later non-finite one, up to \
+                             controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
+                            sample.seq,
+                            sample.t_s,
+                            &cmd[..2 * planes],
+                            c.max_invalid_burst
+                        ));
+                    }
+                    checked.command
+                }
+                Err(why) => {
+                    outcome = Outcome::InvalidCommands(why);
+                    break;
+                }
+            };
+            queue.push_back(cmd);
             if let Some(applied) = queue.pop_front() {
                 for i in 0..planes {
                     model.set_control(i, Control::Held([applied[2 * i], applied[2 * i + 1]]));
@@ -421,6 +473,9 @@ fn drive<const N: usize, M: Machine<N>>(
         );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(&model, t1, &y)) {
+            // The run reached the failure, not the end of its macro step (an integration
+            // error stops inside it).
+            t = e.time();
             outcome = Outcome::Diverged(e);
             break;
         }
@@ -431,18 +486,26 @@ fn drive<const N: usize, M: Machine<N>>(
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
+    // A run that completed is judged over all its ticks.
+    if outcome == Outcome::Completed {
+        if let Some(why) = invalid.at_end() {
+            outcome = Outcome::InvalidCommands(why);
+        }
+    }
     let cosim = match source {
         Source::Cosim(session) => {
-            // A realtime run that completed is judged over all its ticks.
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
                 }
             }
-            Some(session.finish(t, (t / period).round() as u64))
+            let mut report = session.finish(t, (t / period).round() as u64);
+            report.invalid_replies = invalid.count();
+            Some(report)
         }
         _ => None,
     };
+    let invalid_commands = invalid.count();
     Ok(SinkRun {
         stats: integrator.stats(),
         simulated: t,
@@ -452,6 +515,7 @@ fn drive<const N: usize, M: Machine<N>>(
         cosim,
         parked_steps,
         planes,
+        invalid_commands,
     })
 }
 

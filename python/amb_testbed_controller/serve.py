@@ -275,11 +275,12 @@ def _ack(hello: wire.Hello, status: int, law: str, message: str) -> wire.Ack:
     )
 
 
-def lock_run_id(run_id: str, role: str = "controller") -> TextIO:
+def lock_run_id(run_id: str, role: str = "controller") -> "_RunLock":
     """Takes ``<lock dir>/<run_id>.<role>.lock`` with an exclusive ``flock``, as the Rust side does
     (``controller/src/lock.rs``): one live controller per run id. The lock dir is
     ``$AMB_TESTBED_LOCK_DIR``, else ``$TMPDIR/amb-testbed`` (``/tmp/amb-testbed``). The kernel
-    releases the lock when the process ends, however it ends. Returns the open file (keep it).
+    releases the lock when the process ends, however it ends. Returns the held lock (keep it:
+    it deletes its file and releases the lock when it goes).
     """
     folder = os.environ.get("AMB_TESTBED_LOCK_DIR") or os.path.join(os.environ.get("TMPDIR") or "/tmp", "amb-testbed")
     path = os.path.join(folder, f"{run_id}.{role}.lock")
@@ -288,24 +289,55 @@ def lock_run_id(run_id: str, role: str = "controller") -> TextIO:
             os.makedirs(folder, exist_ok=True)
             with contextlib.suppress(OSError):
                 os.chmod(folder, 0o1777)  # machine-wide like /tmp: any user may add a lock
-        file = open(path, "a+")
     except OSError as e:
         raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
-    try:
-        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        file.seek(0)
-        holder = file.read().strip() or "a process that has not written its name yet"
+    # A holder deletes its file when it releases it (controller/src/lock.rs): a lock taken on a
+    # file that was deleted between our open and our lock is not the run id's; start again.
+    for _ in range(100):
+        try:
+            file = open(path, "a+")
+        except OSError as e:
+            raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+        try:
+            fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            file.seek(0)
+            holder = file.read().strip() or "a process that has not written its name yet"
+            file.close()
+            raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
+                           "pick another --run-id or stop that process") from None
+        except OSError as e:
+            file.close()
+            raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+        named: os.stat_result | None
+        try:
+            named = os.stat(path)
+        except OSError:
+            named = None
+        mine = os.fstat(file.fileno())
+        if named is not None and (named.st_dev, named.st_ino) == (mine.st_dev, mine.st_ino):
+            break
         file.close()
-        raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
-                       "pick another --run-id or stop that process") from None
-    except OSError as e:
-        file.close()
-        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    else:
+        raise Ending(f"cannot lock run id {run_id} ({path}): the file was deleted under this process 100 times")
     file.truncate(0)
     file.write(f"pid {os.getpid()} ({' '.join(sys.argv)})\n")
     file.flush()
-    return file
+    return _RunLock(file)
+
+
+class _RunLock:
+    """A held run-id lock: when it goes, it deletes its file while still holding it, then
+    releases it, so that nothing is left behind (a process killed outright leaves its file to
+    the next Rust plant or controller, which deletes the files of dead holders)."""
+
+    def __init__(self, file: TextIO) -> None:
+        self.file = file
+
+    def __del__(self) -> None:
+        with contextlib.suppress(OSError):
+            os.unlink(self.file.name)
+        self.file.close()
 
 
 def _serve(laws: Sequence[LawClass], o: argparse.Namespace, signals: _Signals) -> None:

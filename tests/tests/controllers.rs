@@ -52,9 +52,10 @@ fn target_dir() -> PathBuf {
 /// Issue 10 item 3: a controller crate outside the workspace, depending on `controller` by
 /// path, is built (offline, locked, into the workspace's target folder so the shared
 /// dependencies are reused) and run by the plant through `controller.command` in lockstep.
-/// Its trace is what its law gives: the example's own code, run here on the trace's sensor
-/// samples, reproduces every applied current bit for bit (delay 1: the current computed from
-/// sample k is in row k + 2), and differs from the plain PD's.
+/// Its trace is what its law gives: the run folder replayed through the example's own code
+/// (`plant::check::replay`) reproduces every applied current bit for bit, differs from the
+/// plain PD's, and the law run in the plant's process (`plant::check::run_law`) gives the
+/// same trace.
 #[test]
 fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace() {
     let crate_dir = workspace_root().join("examples").join("rust-controller");
@@ -92,38 +93,21 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     assert!(s["cosim"]["controller"].as_str().unwrap().starts_with("pd_notch:"), "{s:#}");
     assert_eq!(s["cosim"]["controller_command"][0].as_str(), Some(exe.display().to_string().as_str()));
 
-    let scene = plant::config::load_scene(&scene_file, &extra).expect("the scene");
-    let design = scene.design();
-    let mut law = pd_notch::build(&design, &scene.controller.params).expect("the law");
-    let mut pd = controller::build_law("pd", &design, &controller::Params::default()).unwrap();
+    // The run folder replayed through the crate's law (plant::check, issue 21 item 3): every
+    // applied current is the law's, bit for bit; through the plain PD it is not.
+    let replayed = plant::check::replay(&out, &pd_notch::LAW).expect("the replay");
+    eprintln!("replay of the out-of-tree crate's lockstep run through its law: {replayed}");
+    assert!(replayed.identical(), "{replayed}");
+    assert_eq!(replayed.compared, 1000);
+    let scene = plant::config::load_scene(&out.join("scene.toml"), &[]).expect("the run's scene");
+    let mut pd = controller::build_law("pd", &scene.design(), &controller::Params::default()).unwrap();
+    let pd = plant::check::replay_trace(&scene, &out.join("trace.csv"), pd.as_mut()).expect("the replay");
+    assert!(!pd.identical() && pd.largest_a > 1e-3, "the notch changed nothing: {pd}");
+    // And the same law run in the plant's process gives the same trace.
+    let in_process = plant::check::run_law(&scene, &pd_notch::LAW, &mut plant::run::Quiet).expect("the run");
     let trace = Csv::read(&out.join("trace.csv"));
-    let (t, dx, dy) = (trace.column("t_s"), trace.column("dx_m"), trace.column("dy_m"));
-    let (ix, iy) = (trace.column("ix_a"), trace.column("iy_a"));
-    let (gain, limit, period) = (design.constants.sensor_gain_v_per_m, design.current_limit_a, design.period_s);
-    let ticks = t.len() - 1;
-    assert_eq!(ticks, 1000);
-    let mut largest_difference_from_pd: f64 = 0.0;
-    for k in 0..ticks - 1 {
-        assert!((t[k] - k as f64 * period).abs() < 1e-12, "row {k} at t = {}", t[k]);
-        let sample = controller::Sample {
-            seq: k as u64,
-            t_s: k as f64 * period,
-            sensor_v: [gain * dx[k], gain * dy[k]],
-            ..Default::default()
-        };
-        let i = controller::saturate(law.update(&sample), limit);
-        assert!(
-            ix[k + 2].to_bits() == i[0].to_bits() && iy[k + 2].to_bits() == i[1].to_bits(),
-            "sample {k}: the process applied ({}, {}) A, the law gives ({}, {}) A",
-            ix[k + 2],
-            iy[k + 2],
-            i[0],
-            i[1]
-        );
-        let p = controller::saturate(pd.update(&sample), limit);
-        largest_difference_from_pd = largest_difference_from_pd.max((p[0] - i[0]).abs()).max((p[1] - i[1]).abs());
-    }
-    assert!(largest_difference_from_pd > 1e-3, "the notch changed nothing: {largest_difference_from_pd} A");
+    assert_eq!(in_process.trace.ix_a, trace.column("ix_a"));
+    assert_eq!(in_process.trace.dy_m, trace.column("dy_m"));
 }
 
 /// Issue 10 item 4: the contract a command gets. The plant runs it exactly, with `--run-id
@@ -378,4 +362,80 @@ fn the_c_header_has_every_constant_and_layout_of_wire_rs() {
         rust.len(),
         c.len()
     );
+}
+
+/// Issue 21 item 5: the controller inherited the plant's stdout; when that was a pipe nobody
+/// drained, a chatty controller blocked before its hello and the plant exited 4 after the
+/// connect timeout with no hint why. Its output now goes to `controller.log` in the run
+/// folder (bounded), drained as it comes: the run completes with the plant's stdout a pipe
+/// nobody reads, and a controller that fails is quoted, naming the file.
+#[cfg(unix)]
+#[test]
+fn the_controllers_output_goes_to_controller_log_and_never_blocks_it() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("controller-log");
+    let chatty = dir.join("chatty.sh");
+    // 3 MiB on stdout (a pipe holds 64 KiB), a line on stderr, then the real controller.
+    std::fs::write(
+        &chatty,
+        format!(
+            "#!/bin/sh\nhead -c 3145728 /dev/zero | tr '\\0' x\necho 'chatty: starting' >&2\nexec {:?} \"$@\"\n",
+            controller_bin().display().to_string()
+        ),
+    )
+    .unwrap();
+    let failing = dir.join("failing.sh");
+    std::fs::write(&failing, "#!/bin/sh\necho 'failing: cannot open my gains file' >&2\nexit 3\n").unwrap();
+    for script in [&chatty, &failing] {
+        std::fs::set_permissions(script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+
+    let out = dir.join("run");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&chatty.display().to_string()])]);
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra));
+    let stderr_file = dir.join("plant.stderr");
+    // The plant's stdout: a pipe that nobody reads (kept open, never drained).
+    let mut plant = cmd
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_file).unwrap())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = plant.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed() > LIMIT {
+            let _ = plant.kill();
+            panic!("the run did not end within {LIMIT:?}: {}", std::fs::read_to_string(&stderr_file).unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(0), "{}", std::fs::read_to_string(&stderr_file).unwrap());
+    let log = std::fs::read(out.join("controller.log")).unwrap();
+    let text = String::from_utf8_lossy(&log);
+    assert!(text.starts_with("--- plant: started `"), "{}", &text[..200]);
+    assert!(text.contains("chatty: starting"), "the last output is kept");
+    assert!(text.contains("bytes of the controller's output left out here"));
+    assert!(log.len() < 2 << 20, "controller.log is bounded: {} bytes", log.len());
+
+    let out = dir.join("failed");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&failing.display().to_string()])]);
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra)));
+    assert_exit(&run, 4);
+    let err = stderr(&run);
+    assert!(
+        err.contains("controller.log")
+            && err.contains("failing: cannot open my gains file")
+            && err.contains("exit status: 3"),
+        "{err}"
+    );
+    assert!(read_json(&out.join("summary.json"))["error"]
+        .as_str()
+        .unwrap_or_default()
+        .contains("cannot open my gains file"));
+    assert!(std::fs::read_to_string(out.join("controller.log"))
+        .unwrap()
+        .contains("failing: cannot open my gains file"));
 }

@@ -944,22 +944,31 @@ fn a_controller_that_never_wakes_the_plant_is_warned_about() {
     assert!(num(c, "blocking_waits") >= 50.0, "{c:#}");
 }
 
-/// A controller that answers with a non-finite current: the plant holds the last valid
-/// current (docs/wire-protocol.md), counts every such reply, and says so once, naming the
-/// sample and its time, instead of completing silently.
+/// A controller that answers NaN from sample 100 on (the rogue `nan` mode). Within a budget
+/// that allows it, the last valid current is held for every such reply, counted, and the
+/// first one said. With the default budget (issue 21 item 4: such a run "completed" with exit
+/// 0) the run ends once more than `controller.max_invalid_burst` = 10 replies in a row were
+/// non-finite, status `invalid_commands`, exit 8, naming the samples; its outputs are written.
 #[test]
 fn non_finite_currents_are_held_counted_and_said_once() {
     let dir = TempDir::new("cosim-nan");
     let out = dir.join("run");
-    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("nan")];
+    let extra = [
+        "controller.mode=lockstep".to_string(),
+        "scene.duration_s=0.01".into(),
+        rogue("nan"),
+        "controller.max_invalid_burst=1000000".into(),
+        "controller.max_invalid_fraction=1".into(),
+    ];
     let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
     let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
     assert_exit(&run, 0);
     let err = stderr(&run);
-    assert_eq!(err.matches("non-finite current").count(), 1, "{err}");
+    assert_eq!(err.matches("is non-finite").count(), 1, "{err}");
     assert!(err.contains("sample 100 ") && err.contains("t = 0.005 s"), "{err}");
-    let c = &read_json(&out.join("summary.json"))["cosim"];
-    assert_eq!(num(c, "invalid_replies"), 100.0, "{c:#}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(num(&s["cosim"], "invalid_replies"), 100.0, "{s:#}");
+    assert_eq!(num(&s, "invalid_commands"), 100.0, "{s:#}");
     // The held x current: finite throughout, and one value once the held command is applied
     // (sample 100's command is due a tick later, through the one-sample delay line).
     let trace = std::fs::read_to_string(out.join("trace.csv")).unwrap();
@@ -976,4 +985,22 @@ fn non_finite_currents_are_held_counted_and_said_once() {
     assert!(rows.iter().all(|(_, i)| i.is_finite()), "a NaN current reached the trace");
     let held: Vec<f64> = rows.iter().filter(|(t, _)| *t >= 0.0052).map(|(_, i)| *i).collect();
     assert!(held.len() > 50 && held.iter().all(|i| *i == held[0]), "x current not held: {held:?}");
+
+    // The default budget.
+    let out = dir.join("default");
+    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("nan")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 8);
+    let err = stderr(&run);
+    assert!(
+        err.contains("non-finite for 11 samples in a row, from sample 100 (t = 0.005 s) to sample 110")
+            && err.contains("controller.max_invalid_burst = 10"),
+        "{err}"
+    );
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "invalid_commands", "{s:#}");
+    assert!(s["error"].as_str().unwrap_or_default().contains("max_invalid_burst"), "{s:#}");
+    assert_eq!(num(&s, "invalid_commands"), 11.0, "{s:#}");
+    assert!(out.join("trace.csv").is_file() && out.join("scene.toml").is_file());
 }

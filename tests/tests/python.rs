@@ -651,6 +651,7 @@ fn a_second_python_controller_under_a_live_run_id_is_refused() {
     first.signal(libc::SIGTERM);
     let (code, log) = first.finish_within(Duration::from_secs(30));
     assert_eq!(code, Some(130), "{log}");
+    assert!(!lock.exists(), "the released lock's file is left behind (issue 21 item 7)");
     let third = output_within(
         python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "0.3"])
             .env("AMB_TESTBED_LOCK_DIR", dir.join("locks")),

@@ -76,6 +76,17 @@ fn shards_merged_equal_an_unsharded_sweep() {
     assert_exit(&output(&mut plant_sweep(&file, &a, &["--merge"])), 0);
     assert_eq!(read_text(&a.join("points.csv")), read_text(&whole.join("points.csv")));
     assert_eq!(read_text(&a.join("poincare.csv")), read_text(&whole.join("poincare.csv")));
+    // Issue 21 item 7: a signal during `--merge` killed it outright; it finishes its files
+    // (each whole) and exits 130.
+    #[cfg(target_os = "linux")]
+    {
+        let merge = Proc::spawn(&mut plant_sweep(&file, &a, &["--merge"]));
+        wait_for_handler(merge.id(), libc::SIGTERM);
+        merge.signal(libc::SIGTERM);
+        let (code, log) = merge.finish_within(std::time::Duration::from_secs(300));
+        assert_eq!(code, Some(130), "{log}");
+        assert_eq!(read_text(&a.join("points.csv")), read_text(&whole.join("points.csv")));
+    }
 }
 
 #[test]

@@ -387,7 +387,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
         .map(|p| rows::read_accuracy(p).map_err(|e| super::BadArgument(format!("--peer-rows: {e:#}"))))
         .transpose()?
         .unwrap_or_default();
-    let mut report = accuracy(req.config, &dir, req.quick, req.repeats.max(1), peer.as_ref(), log)?;
+    let mut report = accuracy(req.config, &dir, req.quick, req.repeats, peer.as_ref(), log)?;
     let mut written = vec![dir.join("accuracy.csv"), dir.join("stability.csv")];
     if !earlier.is_empty() {
         report.rows.extend(earlier.into_iter().filter(|r| !r.implementation.starts_with("rust")));

@@ -482,6 +482,14 @@ pub struct RawController {
     /// Co-simulation, realtime: the largest deadline-miss fraction a run may have; past it
     /// the run ends with status `miss_budget` (exit code 6); 1 is no limit.
     pub max_miss_fraction: f64 = 1.0,
+    /// Sampled and co-simulation: the most non-finite commands (NaN currents) in a row a run
+    /// holds the last valid command through; past it the run ends with status
+    /// `invalid_commands` (exit code 8).
+    pub max_invalid_burst: u64 = 10,
+    /// Sampled and co-simulation: the largest share of non-finite commands a run may have
+    /// (judged from 1000 ticks on and over the whole run); past it the run ends with status
+    /// `invalid_commands` (exit code 8); 1 is no limit.
+    pub max_invalid_fraction: f64 = 0.01,
 }
 }
 

@@ -108,8 +108,8 @@ fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>)
         recovery_s: s.recovery_s,
         contact_fraction: s.contact_fraction,
         whirl_hz: a.whirl_hz,
-        max_radius_m: s.max_radius_m,
-        max_contact_force_n: s.max_contact_force_n,
+        max_radius_m: s.max_radius_m.unwrap_or(0.0), // stored as a number (null would not read back)
+        max_contact_force_n: s.max_contact_force_n.unwrap_or(0.0),
         steady_window_start_s: s.steady_window_start_s,
         wall_time_s: s.wall_time_s,
     };

@@ -109,8 +109,13 @@ pub fn execute<W: Work>(grid: &Grid, work: &W, dir: &Path, args: &RunArgs) -> an
         if !found.mismatch.is_empty() {
             return Err(GridError::Mismatch { dir: dir.to_path_buf(), units: names(grid, &found.mismatch) }.into());
         }
+        // A signal lets the merge finish its files (each written whole), then exits 130.
+        let stop = crate::interrupt::stop_flag();
         let written = merge_or_list(grid, work, dir, &found, true)?;
         eprintln!("plant: merged {written} into {}", dir.display());
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(GridError::Interrupted.into());
+        }
         return Ok(());
     }
     let bad: Vec<(Unit, String)> = found.corrupt.iter().chain(&found.mismatch).cloned().collect();

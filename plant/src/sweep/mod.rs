@@ -93,8 +93,8 @@ impl From<SweepFile> for SweepSpec {
 /// Reads and checks a sweep file: its grid, and its `[ensemble]` if it has one. The points are
 /// checked by [`Grid::validate`] with the work that runs them.
 pub fn load(path: &Path) -> Result<(Grid, Option<EnsembleSpec>), ConfigError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+    let text = shock_table::input::read_text(path, shock_table::input::MAX_TOML_BYTES)
+        .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
     let spec: SweepSpec = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     spec.axis.check("")?;

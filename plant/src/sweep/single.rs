@@ -68,8 +68,8 @@ pub fn run_point(point: &Point, stop: &AtomicBool) -> anyhow::Result<Option<Poin
         period_k: a.period_k,
         contact_fraction: s.contact_fraction,
         whirl_hz: a.whirl_hz,
-        max_radius_m: s.max_radius_m,
-        max_contact_force_n: s.max_contact_force_n,
+        max_radius_m: s.max_radius_m.unwrap_or(0.0), // stored as a number (null would not read back)
+        max_contact_force_n: s.max_contact_force_n.unwrap_or(0.0),
         poincare: a.section.iter().filter(|p| p.t_s >= a.steady_window_s[0]).map(|p| (p.n, p.x_m, p.y_m)).collect(),
     }))
 }

@@ -5,6 +5,7 @@
 
 use super::{Session, RING};
 use crate::config::{ControlMode, CosimSettings, Scene};
+use crate::cosim::log::OutputLog;
 use crate::cosim::process::{self, Child, Program};
 use crate::cosim::stats::{Figures, Scheduling};
 use crate::cosim::{ControllerProcess, CosimError, Launch};
@@ -114,6 +115,10 @@ impl Session {
             }
         }
         scheduling.plant = link::policy(0).to_string();
+        let log = OutputLog::create(launch.log.as_deref()).map_err(|e| CosimError::Spawn {
+            path: launch.log.clone().unwrap_or_default(),
+            why: format!("cannot create the file for the controller's output: {e}"),
+        })?;
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
@@ -125,6 +130,7 @@ impl Session {
             _node: node,
             child: None,
             program,
+            log,
             _lock: lock,
             hello,
             limits: hello.rotor_design().map_or([hello.current_limit_a; ROTOR_AXES], |d| d.current_limits()),
@@ -169,7 +175,7 @@ impl Session {
                 connect_timeout_s: self.settings.connect_timeout.max(1.0),
                 realtime_priority: self.settings.realtime_priority,
             };
-            self.child = Some(Child::spawn(program, &args)?);
+            self.child = Some(Child::spawn(program, &args, &mut self.log)?);
         }
         Ok(())
     }
@@ -256,10 +262,12 @@ impl Session {
             }
             if let Some(child) = self.child.as_mut() {
                 if let Some(status) = child.exited() {
+                    self.log.settle();
                     return Err(CosimError::ControllerExited {
                         program: child.program().describe(),
                         status: status.to_string(),
                         code: status.code(),
+                        output: self.log.quote(3),
                     });
                 }
             }
@@ -267,7 +275,11 @@ impl Session {
             if waited > timeout {
                 self.pending = None;
                 let hint = match &self.child {
-                    Some(c) => format!(" (the controller {} was started but did not answer)", c.program().describe()),
+                    Some(c) => format!(
+                        " (the controller {} was started but did not answer{})",
+                        c.program().describe(),
+                        self.log.quote(3)
+                    ),
                     None => format!("; start one with `controller --run-id {}`", self.run_id),
                 };
                 return Err(CosimError::NoController { waited_s: timeout, run_id: self.run_id.clone(), hint });
