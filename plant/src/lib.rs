@@ -27,6 +27,7 @@ pub mod config;
 pub mod cosim;
 pub mod ensemble;
 pub mod exit;
+pub mod figures;
 pub mod grid;
 pub mod hooks;
 pub mod initial;

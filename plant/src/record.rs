@@ -13,7 +13,7 @@ use crate::analysis::tilt::{TiltAnalysis, TiltAnalyzer};
 use crate::analysis::{Analysis, AnalysisData, Analyzer};
 use crate::bounded::{MinMaxBins, Strided};
 use crate::config::Scene;
-use crate::summary::{analysis_spec, plane_analysis_spec, Figures, FiguresBuilder};
+use crate::figures::{analysis_spec, plane_analysis_spec, Figures, FiguresBuilder};
 use crate::trace::{col, Record, Row};
 
 /// Bins of the time axis of a run's time charts.
