@@ -292,7 +292,8 @@ fn python_pd_writes_the_rust_pd_trace(scene_file: &str, name: &str) {
 
     let id = run_id(name);
     let out = dir.join("python");
-    let mut plant_cmd = plant_run(&scene(scene_file), &out, &sets);
+    let lockstep_sets: Vec<&str> = sets.iter().copied().chain(["controller.mode=lockstep"]).collect();
+    let mut plant_cmd = plant_run(&scene(scene_file), &out, &lockstep_sets);
     plant_cmd.args(["--controller", "external", "--run-id", &id]);
     let plant = Proc::spawn(&mut plant_cmd);
     let ctl = Proc::spawn(&mut python_controller("pd.py", &["--run-id", &id]));
