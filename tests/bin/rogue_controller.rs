@@ -7,6 +7,8 @@
 //! - `types`: opens the run's `ack` service with other message types, as a
 //!   controller of another protocol version would, and exits 2;
 //! - `version`: answers the hello with an ack of the next protocol version (5);
+//! - `two-axes`: a controller that can run two axes only (a planar one written against the
+//!   wire): refuses a four-axis hello with status 3 (`Refusal::Axes`), as the protocol says;
 //! - `other-session`: accepts the hello, then answers every sensor frame
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
@@ -58,6 +60,13 @@ fn main() -> ExitCode {
         std::thread::sleep(Duration::from_millis(1));
     };
     let mut ack = Ack::new(hello.session, hello.token, 0, "pd", &format!("rogue controller, mode {mode}"));
+    if mode == "two-axes" && hello.axes != wire::AXES {
+        let why = format!("this controller runs {} axes, the plant asks for {}", wire::AXES, hello.axes);
+        let refusal = Ack::new(hello.session, hello.token, wire::Refusal::Axes.code(), "pd", &why);
+        handshake.send(refusal).expect("ack");
+        std::thread::sleep(Duration::from_secs(1));
+        return ExitCode::from(2);
+    }
     if mode == "version" {
         ack.protocol_version = wire::PROTOCOL_VERSION + 1;
         handshake.send(ack).expect("ack");
