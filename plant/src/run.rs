@@ -267,7 +267,14 @@ pub fn run_into(
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
+        let mut sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
+        let excitation = hooks.excitation(k, t0, &sample.sensor_v);
+        if let Some(sine) = excitation {
+            sample.sensor_v.iter_mut().zip(sine.at(t0).0).for_each(|(v, e)| *v += e);
+        }
+        if let Source::Continuous = source {
+            model.control = excitation.map_or(Control::Continuous(gains), |e| Control::ContinuousExcited(gains, e));
+        }
         let command = match &mut source {
             Source::Continuous => None,
             Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),
