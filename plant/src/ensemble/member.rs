@@ -95,7 +95,7 @@ impl MemberResult {
 }
 
 /// The figures of a run: the one place that reads [`Summary`] for ensembles.
-fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
+pub fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
     let s = Summary::new(scene, result);
     let a = &s.analysis;
     let completed = s.status == crate::status::Status::Completed;
