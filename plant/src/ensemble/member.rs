@@ -174,7 +174,7 @@ pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
 }
 
 /// The field of a shock that sets its size, and its value.
-fn shock_size(s: &ShockSpec) -> Option<(&'static str, f64)> {
+pub fn shock_size(s: &ShockSpec) -> Option<(&'static str, f64)> {
     match s {
         ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => Some(("peak_g", *p)),
         ShockSpec::DoubleHalfSine { design_accel_g: Some(a), .. } => Some(("design_accel_g", *a)),
