@@ -14,6 +14,7 @@
 //! | 5 | `plant soak`: completed, but a criterion failed |
 //! | 6 | realtime: the deadline-miss budget `controller.max_miss_fraction` was exceeded |
 //! | 7 | `--merge` (sweep or ensemble): points or members missing or corrupt (they are listed) |
+//! | 9 | `plant assess`: a controller could not be graded (the rotor not levitated before the shock, or the excitation drove it into the touchdown bearing); the report was written |
 //! | 130 | interrupted (SIGINT or SIGTERM to the plant) |
 
 mod cli;
@@ -147,6 +148,9 @@ fn exit_code(err: &anyhow::Error) -> u8 {
         if let Some(e) = cause.downcast_ref::<plant::sweep::SweepError>() {
             return e.exit_code();
         }
+        if let Some(e) = cause.downcast_ref::<plant::assess::AssessError>() {
+            return e.kind.exit_code();
+        }
         if let Some(e) = cause.downcast_ref::<plant::claim::ClaimError>() {
             return match e {
                 plant::claim::ClaimError::InUse { .. } => exit::BAD_INPUT,
@@ -238,6 +242,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Analyze { dir } => analyze_cmd(&dir),
         Command::Sweep(args) => plant::sweep::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),
+        Command::Assess(args) => {
+            let dir = plant::assess::command(&args, &stop_flag())?;
+            eprintln!("plant assess: report in {}", dir.join("report.html").display());
+            Ok(())
+        }
         Command::Bench { what } => match what {
             BenchCommand::Ensemble(args) => {
                 plant::ensemble::bench::bench(&args, &mut |l| eprintln!("plant bench: {l}")).map(|_| ())
