@@ -37,7 +37,7 @@
 use crate::hooks::Hooks;
 use crate::model::{ix, Model, SensorSine, State};
 use crate::run::Sink;
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
 use serde::Serialize;
 use std::cell::Cell;
 use std::collections::VecDeque;
@@ -185,7 +185,7 @@ pub enum MeasureError {
         t_s: f64,
     },
     /// The level could not keep the response below the limit.
-    #[error("axis {axis}: at {f_hz:.2} Hz the response passed {limit_um:.1} µm even at an excitation of {amplitude_um:.2e} µm")]
+    #[error("axis {axis}: at {f_hz:.2} Hz the response to an excitation of {amplitude_um:.3} µm passed the limit of {limit_um:.1} µm (sensitivity.limit of the air gap) on its way to the touchdown bearing; lower sensitivity.excitation_um or keep sensitivity.auto_level = true")]
     Level {
         /// Axis.
         axis: String,
@@ -225,8 +225,10 @@ struct Step {
     settle_left: u64,
     window_ticks: u64,
     in_window: u64,
-    normal: DMatrix<f64>,
-    rhs: DVector<f64>,
+    /// The normal equations of the fit on `[1, cos θ, sin θ, cos Ωt, sin Ωt]` (the last two
+    /// zero at standstill), fixed-size: no allocation per tick.
+    normal: SMatrix<f64, 5, 5>,
+    rhs: SVector<f64, 5>,
     estimates: Vec<Complex<f64>>,
 }
 
@@ -394,7 +396,6 @@ impl<'a> Measure<'a> {
         }
         // A whole number of excitation periods, and whole ticks.
         let window = (window * f_hz).ceil() / f_hz;
-        let n = if self.speed_hz > 0.0 { 5 } else { 3 };
         self.phase = Phase::Step(Step {
             f_hz,
             omega,
@@ -404,9 +405,9 @@ impl<'a> Measure<'a> {
             settle_left: (settle / self.period).ceil() as u64,
             window_ticks: ((window / self.period).round() as u64).max(4),
             in_window: 0,
-            normal: DMatrix::zeros(n, n),
-            rhs: DVector::zeros(n),
-            estimates: Vec::new(),
+            normal: SMatrix::zeros(),
+            rhs: SVector::zeros(),
+            estimates: Vec::with_capacity(6),
         });
     }
 
@@ -467,17 +468,18 @@ impl<'a> Measure<'a> {
         if step.settle_left > 0 {
             step.settle_left -= 1;
         } else {
-            let mut phi = vec![1.0, theta.cos(), theta.sin()];
-            if speed > 0.0 {
-                let w = TAU * speed * t;
-                phi.extend([w.cos(), w.sin()]);
-            }
-            let phi = DVector::from_vec(phi);
-            step.normal += &phi * phi.transpose();
-            step.rhs += &phi * (u + e);
+            let (w_sin, w_cos) = if speed > 0.0 { (TAU * speed * t).sin_cos() } else { (0.0, 0.0) };
+            let phi = SVector::<f64, 5>::new(1.0, theta.cos(), theta.sin(), w_cos, w_sin);
+            step.normal += phi * phi.transpose();
+            step.rhs += phi * (u + e);
             step.in_window += 1;
             if step.in_window >= step.window_ticks {
-                let fit = step.normal.clone().lu().solve(&step.rhs);
+                let mut normal = step.normal;
+                if speed <= 0.0 {
+                    normal[(3, 3)] = 1.0;
+                    normal[(4, 4)] = 1.0;
+                }
+                let fit = normal.lu().solve(&step.rhs);
                 let v = fit.map_or(Complex::new(f64::NAN, f64::NAN), |c| Complex::new(c[1], -c[2]));
                 let s_est = v / Complex::new(0.0, -step.amplitude);
                 step.estimates.push(s_est);

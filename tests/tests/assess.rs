@@ -1,0 +1,119 @@
+//! End-to-end tests of `plant assess`: a small report card of two controllers (one stable, one
+//! the study's PD sampled at 20 kHz, unstable), bad input refused before anything runs, and an
+//! excitation that drives the rotor into the touchdown bearing (exit 9, the report kept).
+
+mod common;
+
+use common::*;
+use std::path::Path;
+use std::process::Command;
+
+/// A few short runs and a small ladder in a debug build on a loaded machine: a hang fails.
+const LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// An assessment file around the 10 G scene, shortened, with `extra` appended.
+fn file(dir: &Path, controllers: &str, extra: &str) -> std::path::PathBuf {
+    let scene = scene("paper-10g.toml");
+    let text = format!(
+        "scene = {scene:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\n{controllers}\n\
+         [sensitivity]\nf_min_hz = 20.0\nf_max_hz = 200.0\npoints = 4\nprobe_s = 0.3\nresolution = 0.05\nspeeds = [\"standstill\"]\n\
+         [ladder]\npeaks_g = [3.0, 20.0]\nmembers = 2\nbatch = 2\nverify = false\n{extra}",
+        scene = scene.display().to_string()
+    );
+    let path = dir.join("assess.toml");
+    std::fs::write(&path, text).expect("write");
+    path
+}
+
+fn assess(path: &Path, out: &Path) -> std::process::Output {
+    output_within(Command::new(plant_bin()).arg("assess").arg(path).arg("--out").arg(out).arg("--quiet"), LIMIT)
+}
+
+#[test]
+fn a_report_card_of_a_stable_and_an_unstable_controller() {
+    let dir = TempDir::new("assess-card");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
+                       [[controller]]\nlabel = \"study pd\"\nset = [\"controller.law=\\\"pd\\\"\"]\n";
+    let out = dir.join("out");
+    let o = assess(&file(&dir, controllers, ""), &out);
+    assert_exit(&o, 0);
+    let r = read_json(&out.join("report.json"));
+    let c = r["controllers"].as_array().expect("controllers");
+    assert_eq!(c.len(), 2);
+    // The damped loop: stable on both axes, a peak, a zone, the closed form's peak near it.
+    let s = &c[0]["sensitivity"]["result"];
+    for axis in s["axes"].as_array().expect("axes") {
+        assert_eq!(axis["stable"], true, "{axis}");
+        let measured = num(&axis["peak"], "s_db");
+        let closed = num(&s["closed_form"], "s_db");
+        assert!((measured - closed).abs() < 0.5, "measured {measured} dB, closed form {closed} dB");
+        assert!(["A", "B", "C", "D"].contains(&axis["zone"].as_str().expect("zone")));
+    }
+    // The study's PD at 20 kHz: unstable, no peak, and its closed form agrees.
+    let s = &c[1]["sensitivity"]["result"];
+    for axis in s["axes"].as_array().expect("axes") {
+        assert_eq!(axis["zone"], "unstable", "{axis}");
+        assert!(axis["peak"].is_null());
+    }
+    assert_eq!(s["closed_form"]["stable"], false);
+    assert!(c[1]["verdict"].as_str().expect("verdict").contains("UNSTABLE"));
+    // Vibration and ladder with the duty, for both.
+    for k in c {
+        assert_eq!(k["vibration"]["status"], "measured", "{}", k["vibration"]);
+        let v = &k["vibration"]["result"];
+        assert!(num(v, "peak_um") > 0.0 && num(v, "peak_um") < 150.0);
+        let rungs = k["ladder"]["result"]["rungs"].as_array().expect("rungs");
+        assert_eq!(rungs.len(), 2);
+        let top = &rungs[1];
+        assert_eq!(top["members"], 2);
+        // 20 G: the rotor hits the race; the duty has a force, a pressure and friction.
+        let d = &top["duty"];
+        assert!(num(&d["peak_contact_force_n"], "max") > 100.0, "{d}");
+        assert!(num(&d["peak_race_pressure_mpa"], "max") > 0.0);
+        assert!(num(&d["peak_ball_pressure_mpa"], "max") > 0.0);
+        assert!(num(&d["friction_energy_j"], "max") > 0.0);
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(html.contains("data:image/png;base64,") && html.contains("damped") && html.contains("study pd"));
+    assert!(!html.contains("http://") && !html.contains("https://") && !html.contains("<script"), "self-contained");
+    for png in ["sensitivity_1.png", "ladder_probability.png", "duty_friction.png"] {
+        Png::read(&out.join(png));
+    }
+}
+
+#[test]
+fn bad_input_is_refused_before_anything_runs() {
+    let dir = TempDir::new("assess-bad");
+    let cases = [
+        ("[[controller]]\nlabel = \"x\"\nset = [\"controller.law=\\\"nope\\\"\"]\n", "", "nope"),
+        ("", "[duty]\npoisson = 0.7\n", "duty.poisson = 0.7"),
+        ("", "[sensitivity2]\n", "sensitivity2"),
+    ];
+    for (i, (controllers, extra, says)) in cases.iter().enumerate() {
+        let sub = dir.join(&format!("case{i}"));
+        std::fs::create_dir_all(&sub).expect("dir");
+        let out = sub.join("out");
+        let o = assess(&file(&sub, controllers, extra), &out);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(says), "{}", stderr(&o));
+        assert!(!out.join("report.json").exists());
+    }
+}
+
+#[test]
+fn an_excitation_into_the_touchdown_bearing_is_not_graded() {
+    let dir = TempDir::new("assess-touch");
+    let controllers = "[[controller]]\nlabel = \"light\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.05\"]\n";
+    let out = dir.join("out");
+    let extra = "parts = [\"sensitivity\"]\n";
+    let path = file(&dir, controllers, extra);
+    let text = std::fs::read_to_string(&path)
+        .expect("read")
+        .replace("speeds =", "auto_level = false\nexcitation_um = 10.0\nspeeds =");
+    std::fs::write(&path, text).expect("write");
+    let o = assess(&path, &out);
+    assert_exit(&o, 9);
+    assert!(stderr(&o).contains("excitation"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    assert_eq!(r["controllers"][0]["sensitivity"]["failure"], "not_gradable");
+}
