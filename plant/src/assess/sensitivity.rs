@@ -256,6 +256,8 @@ pub struct Measure<'a> {
     note: Option<String>,
     theta_now: f64,
     t_now: f64,
+    /// After a level cut, the response is let come down until this time before it is judged again.
+    grace_until: f64,
 }
 
 impl<'a> Measure<'a> {
@@ -303,6 +305,7 @@ impl<'a> Measure<'a> {
             note: None,
             theta_now: 0.0,
             t_now: 0.0,
+            grace_until: 0.0,
         }
     }
 
@@ -310,6 +313,16 @@ impl<'a> Measure<'a> {
     pub fn result(mut self, simulated_s: f64) -> Result<AxisResult, MeasureError> {
         if let Some(e) = self.error.take() {
             return Err(e);
+        }
+        if self.stable.is_none() {
+            if let Some(t) = self.touched.get() {
+                self.stable = Some(false);
+                self.sigma = decay(&self.probe, self.speed_hz).0;
+                self.note = Some(format!(
+                    "the rotor reached the touchdown bearing {t:.3} s into the free decay from {:.1} µm",
+                    self.settings.probe_um
+                ));
+            }
         }
         let Some(stable) = self.stable else {
             let why = "the measurement did not get past its probe".into();
@@ -386,10 +399,16 @@ impl<'a> Measure<'a> {
         }
     }
 
+    /// The settling time at frequency `f_hz` (s).
+    fn settle_time(&self, f_hz: f64) -> f64 {
+        let s = &self.settings;
+        (s.settle.recip().ln() / self.sigma).clamp(2.0 / f_hz, s.max_settle_s.max(2.0 / f_hz))
+    }
+
     fn start(&mut self, f_hz: f64, amplitude: f64, t: f64) {
         let omega = TAU * f_hz;
         let s = &self.settings;
-        let settle = (s.settle.recip().ln() / self.sigma).clamp(2.0 / f_hz, s.max_settle_s.max(2.0 / f_hz));
+        let settle = self.settle_time(f_hz);
         let mut window = s.min_cycles / f_hz;
         if self.speed_hz > 0.0 {
             window = window.max(4.0 / (f_hz - self.speed_hz).abs());
@@ -447,7 +466,7 @@ impl<'a> Measure<'a> {
         self.theta_now = theta;
         self.t_now = t;
         let e = step.amplitude * theta.sin();
-        if u.abs() > limit_v {
+        if u.abs() > limit_v && t >= self.grace_until {
             // Too strong a response: a quarter of the level, and this frequency again.
             let (f, a, was) = (step.f_hz, step.amplitude / 4.0, step.amplitude);
             let floor = 1e-6 * self.settings.excitation_um * 1e-6 * self.sensor_gain;
@@ -462,6 +481,8 @@ impl<'a> Measure<'a> {
                 return None;
             }
             self.start(f, a, t);
+            // The response decays at σ: judge it again once it has had time to come down.
+            self.grace_until = t + (self.settle_time(f) * 0.5).min(2.0);
             return self.sine();
         }
         let mut done = None;
