@@ -11,8 +11,8 @@ use std::process::Command;
 /// A few short runs and a small ladder in a debug build on a loaded machine: a hang fails.
 const LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
 
-/// An assessment file around the 10 G scene, shortened, with `extra` appended.
-fn file(dir: &Path, controllers: &str, extra: &str) -> std::path::PathBuf {
+/// Writes the assessment file `path` around the 10 G scene, shortened, with `extra` appended.
+fn file(path: &Path, controllers: &str, extra: &str) -> std::path::PathBuf {
     let scene = scene("paper-10g.toml");
     let text = format!(
         "scene = {scene:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\n{controllers}\n\
@@ -20,9 +20,8 @@ fn file(dir: &Path, controllers: &str, extra: &str) -> std::path::PathBuf {
          [ladder]\npeaks_g = [3.0, 20.0]\nmembers = 2\nbatch = 2\nverify = false\n{extra}",
         scene = scene.display().to_string()
     );
-    let path = dir.join("assess.toml");
-    std::fs::write(&path, text).expect("write");
-    path
+    std::fs::write(path, text).expect("write");
+    path.to_path_buf()
 }
 
 fn assess(path: &Path, out: &Path) -> std::process::Output {
@@ -35,7 +34,7 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
     let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
                        [[controller]]\nlabel = \"study pd\"\nset = [\"controller.law=\\\"pd\\\"\"]\n";
     let out = dir.join("out");
-    let o = assess(&file(&dir, controllers, ""), &out);
+    let o = assess(&file(&dir.join("assess.toml"), controllers, ""), &out);
     assert_exit(&o, 0);
     let r = read_json(&out.join("report.json"));
     let c = r["controllers"].as_array().expect("controllers");
@@ -93,7 +92,7 @@ fn bad_input_is_refused_before_anything_runs() {
         let sub = dir.join(&format!("case{i}"));
         std::fs::create_dir_all(&sub).expect("dir");
         let out = sub.join("out");
-        let o = assess(&file(&sub, controllers, extra), &out);
+        let o = assess(&file(&sub.join("assess.toml"), controllers, extra), &out);
         assert_exit(&o, 2);
         assert!(stderr(&o).contains(says), "{}", stderr(&o));
         assert!(!out.join("report.json").exists());
@@ -106,7 +105,7 @@ fn an_excitation_into_the_touchdown_bearing_is_not_graded() {
     let controllers = "[[controller]]\nlabel = \"light\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.05\"]\n";
     let out = dir.join("out");
     let extra = "parts = [\"sensitivity\"]\n";
-    let path = file(&dir, controllers, extra);
+    let path = file(&dir.join("assess.toml"), controllers, extra);
     let text = std::fs::read_to_string(&path)
         .expect("read")
         .replace("speeds =", "auto_level = false\nexcitation_um = 10.0\nspeeds =");

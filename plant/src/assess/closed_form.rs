@@ -197,8 +197,8 @@ mod tests {
     fn continuous_pd_is_the_spring_damper_formula() {
         // S(s) = (m s² − k_s) / (m s² + c_e s + k_e), the note's form.
         let g = pd(0.05);
-        let (m, ks, ke) = (11.5, 4.32e5, 1e6);
-        let ce = 2.0 * 0.05 * (ke * m as f64).sqrt();
+        let (m, ks, ke): (f64, f64, f64) = (11.5, 4.32e5, 1e6);
+        let ce = 2.0 * 0.05 * (ke * m).sqrt();
         for f in [3.0, 47.0, 300.0] {
             let s = Complex::new(0.0, std::f64::consts::TAU * f);
             let expected = (s * s * m - ks) / (s * s * m + s * ce + ke);

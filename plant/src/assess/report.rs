@@ -83,6 +83,9 @@ struct Line {
     width: u32,
 }
 
+/// Error bars of one series: its colour and `(x, low, high)` per bar.
+type ErrorBars = (RGBColor, Vec<(f64, f64, f64)>);
+
 /// An x–y chart with a log or linear x axis, horizontal reference lines, optional error bars.
 fn chart(
     path: &Path,
@@ -91,7 +94,7 @@ fn chart(
     x_log: bool,
     lines: &[Line],
     hlines: &[(f64, &str)],
-    bars: &[(RGBColor, Vec<(f64, f64, f64)>)],
+    bars: &[ErrorBars],
 ) -> Result<(), PlotError> {
     let pts = lines.iter().flat_map(|l| l.points.iter().copied()).filter(|p| p.0.is_finite() && p.1.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
@@ -250,7 +253,7 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
             })
             .collect()
     };
-    let bars: Vec<(RGBColor, Vec<(f64, f64, f64)>)> = with
+    let bars: Vec<ErrorBars> = with
         .iter()
         .map(|(i, _, l)| {
             (colour(*i), l.rungs.iter().filter(|x| x.members > 0).map(|x| (x.peak_g, x.p_lo, x.p_hi)).collect())

@@ -209,7 +209,7 @@ pub enum MeasureError {
 /// Where the measurement stands.
 enum Phase {
     Probe,
-    Step(Step),
+    Step(Box<Step>),
     Done,
 }
 
@@ -357,7 +357,7 @@ impl<'a> Measure<'a> {
         let (sigma, f_d) = decay(&self.probe, self.speed_hz);
         self.sigma = sigma;
         self.probe_hz = f_d;
-        if !(sigma > 0.0) {
+        if sigma.is_nan() || sigma <= 0.0 {
             self.stable = Some(false);
             self.note = Some(format!(
                 "the free decay from {:.1} µm does not decay: its envelope grows at {:.3} 1/s (about {:.1} Hz)",
@@ -415,7 +415,7 @@ impl<'a> Measure<'a> {
         }
         // A whole number of excitation periods, and whole ticks.
         let window = (window * f_hz).ceil() / f_hz;
-        self.phase = Phase::Step(Step {
+        self.phase = Phase::Step(Box::new(Step {
             f_hz,
             omega,
             amplitude,
@@ -427,7 +427,7 @@ impl<'a> Measure<'a> {
             normal: SMatrix::zeros(),
             rhs: SVector::zeros(),
             estimates: Vec::with_capacity(6),
-        });
+        }));
     }
 
     /// Adds the midpoints around the largest `|S|` until its neighbours are within the resolution.

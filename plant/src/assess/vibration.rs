@@ -112,11 +112,11 @@ impl Sink for VibrationSink {
         self.peak = self.peak.max(y[ix::XR].hypot(y[ix::YR]));
         let i = model.evaluate(t, y).current;
         self.n += 1.0;
-        for k in 0..2 {
-            self.sum[k] += i[k];
-            self.sum2[k] += i[k] * i[k];
-            self.min[k] = self.min[k].min(i[k]);
-            self.max[k] = self.max[k].max(i[k]);
+        for (k, &a) in i.iter().enumerate() {
+            self.sum[k] += a;
+            self.sum2[k] += a * a;
+            self.min[k] = self.min[k].min(a);
+            self.max[k] = self.max[k].max(a);
         }
     }
 }
