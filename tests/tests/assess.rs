@@ -102,10 +102,10 @@ fn bad_input_is_refused_before_anything_runs() {
 #[test]
 fn an_excitation_into_the_touchdown_bearing_is_not_graded() {
     let dir = TempDir::new("assess-touch");
-    let controllers = "[[controller]]\nlabel = \"light\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.05\"]\n";
+    // `parts` is a top-level key: before the first table.
+    let controllers = "parts = [\"sensitivity\"]\n[[controller]]\nlabel = \"light\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.05\"]\n";
     let out = dir.join("out");
-    let extra = "parts = [\"sensitivity\"]\n";
-    let path = file(&dir.join("assess.toml"), controllers, extra);
+    let path = file(&dir.join("assess.toml"), controllers, "");
     let text = std::fs::read_to_string(&path)
         .expect("read")
         .replace("speeds =", "auto_level = false\nexcitation_um = 10.0\nspeeds =");
