@@ -1,6 +1,8 @@
 //! End-to-end tests of `plant assess`: a small report card of two controllers (one stable, one
-//! the study's PD sampled at 20 kHz, unstable), bad input refused before anything runs, and an
-//! excitation that drives the rotor into the touchdown bearing (exit 9, the report kept).
+//! the study's PD sampled at 20 kHz, unstable), bad input refused before anything runs, an
+//! excitation that drives the rotor into the touchdown bearing and a rotor not levitated
+//! before the shock (exit 9, the report kept), an external controller killed during the
+//! measurement (exit 4), and Ctrl-C midway (exit 130, the parts measured so far kept).
 
 mod common;
 
@@ -115,4 +117,89 @@ fn an_excitation_into_the_touchdown_bearing_is_not_graded() {
     assert!(stderr(&o).contains("excitation"), "{}", stderr(&o));
     let r = read_json(&out.join("report.json"));
     assert_eq!(r["controllers"][0]["sensitivity"]["failure"], "not_gradable");
+}
+
+#[test]
+fn a_rotor_not_levitated_before_the_shock_is_not_graded() {
+    // A coil current limit of 0.1 A cannot carry the rotor's weight: it sinks onto the race.
+    let dir = TempDir::new("assess-drop");
+    let controllers = "parts = [\"vibration\", \"ladder\"]\n[[controller]]\nlabel = \"weak\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.current_limit_a=0.1\"]\n";
+    let out = dir.join("out");
+    let o = assess(&file(&dir.join("assess.toml"), controllers, ""), &out);
+    assert_exit(&o, 9);
+    assert!(stderr(&o).contains("not levitated"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    assert_eq!(c["vibration"]["failure"], "not_gradable", "{}", c["vibration"]);
+    // No ladder for a rotor that is down before the shock (no member was run).
+    assert_eq!(c["ladder"]["failure"], "not_gradable", "{}", c["ladder"]);
+    assert!(c["ladder"]["result"].is_null());
+}
+
+/// A controller process killed (SIGKILL, by itself) 0.2 s into each run, co-simulated in
+/// lockstep: every part fails as "controller lost" (exit 4), none is graded, the report is
+/// written and says why.
+#[cfg(unix)]
+#[test]
+fn a_controller_killed_during_the_measurement_is_reported_lost() {
+    let dir = TempDir::new("assess-killed");
+    let command = format!(
+        "controller.command=[{:?}, \"--mode\", \"die\", \"--die-at\", \"4000\"]",
+        rogue_bin().display().to_string()
+    );
+    let controllers =
+        format!("[[controller]]\nlabel = \"dies\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\", {:?}]\n", command);
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), &controllers, "");
+    // The probe over by 0.1 s: the controller dies in the stepped sine.
+    let text = read_text(&path).replace("probe_s = 0.3", "probe_s = 0.1");
+    std::fs::write(&path, text).expect("write");
+    let o = assess(&path, &out);
+    assert_exit(&o, 4);
+    assert!(stderr(&o).contains("controller lost"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    for part in ["sensitivity", "vibration", "ladder"] {
+        assert_eq!(c[part]["status"], "failed", "{part}: {}", c[part]);
+        assert_eq!(c[part]["failure"], "peer_lost", "{part}: {}", c[part]);
+    }
+    // No member whose controller died is counted (as diverged or otherwise).
+    for rung in c["ladder"]["result"]["rungs"].as_array().expect("rungs") {
+        assert_eq!(rung["members"], 0, "{rung}");
+    }
+    assert!(c["sensitivity"]["result"].is_null());
+}
+
+/// SIGINT once the ladder has started: the sensitivity and the vibration measured before it
+/// are in the report, the ladder is marked interrupted, exit 130.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_midway_keeps_the_parts_measured_and_says_so() {
+    let dir = TempDir::new("assess-sigint");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
+                       [[controller]]\nlabel = \"second\"\nset = [\"controller.law=\\\"pd_delay\\\"\"]\n";
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), controllers, "");
+    // A ladder long enough to be interrupted in: up to 64 members per rung, two per round.
+    let text = read_text(&path).replace("members = 2", "members = 64");
+    std::fs::write(&path, text).expect("write");
+    let mut p = Proc::spawn(Command::new(plant_bin()).arg("assess").arg(&path).arg("--out").arg(&out));
+    p.wait_line("damped: shock ladder");
+    p.signal(libc::SIGINT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    assert!(log.contains("interrupted"), "{log}");
+    let r = read_json(&out.join("report.json"));
+    assert_eq!(r["interrupted"], true);
+    let c = &r["controllers"][0];
+    assert_eq!(c["sensitivity"]["status"], "measured", "{}", c["sensitivity"]);
+    assert_eq!(c["vibration"]["status"], "measured", "{}", c["vibration"]);
+    assert_eq!(c["ladder"]["status"], "interrupted", "{}", c["ladder"]);
+    assert!(c["verdict"].as_str().expect("verdict").contains("ladder interrupted"), "{}", c["verdict"]);
+    // The second controller was never started.
+    let second = &r["controllers"][1];
+    for part in ["sensitivity", "vibration", "ladder"] {
+        assert_eq!(second[part]["status"], "interrupted", "{part}: {}", second[part]);
+    }
+    assert!(std::fs::read_to_string(out.join("report.html")).expect("report.html").contains("INTERRUPTED"));
 }

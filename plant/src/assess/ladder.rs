@@ -168,6 +168,12 @@ pub struct LadderResult {
     pub interrupted: bool,
 }
 
+/// A member's controller process was lost (or missed its realtime budget): the ladder stops
+/// there, keeping the rungs it has.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ControllerLost(pub String);
+
 /// A member's outcome with the duty of its counted run.
 struct Counted {
     result: MemberResult,
@@ -204,8 +210,14 @@ fn run_counted(
         let mut sink = DutySink::new(&mut trace, bearing, balls);
         let run = run_into(scene, &crate::cosim::Launch::default(), &mut Cancel(stop), &mut sink)?;
         let duty = sink.finish();
-        if run.outcome == Outcome::Interrupted {
-            return Ok(None);
+        match &run.outcome {
+            Outcome::Interrupted => return Ok(None),
+            // A member whose controller was lost says nothing of the controller's recovery: it
+            // must not be counted (as a run that did not complete, it would count as diverged).
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) => {
+                return Err(ControllerLost(why.clone()).into());
+            }
+            Outcome::Completed | Outcome::Diverged(_) => {}
         }
         Ok(Some((RunResult { trace, run }, duty)))
     };
@@ -238,7 +250,9 @@ fn run_counted(
     }))
 }
 
-/// Runs the ladder for the controller whose scene is `path` with `sets`.
+/// Runs the ladder for the controller whose scene is `path` with `sets`. A member that fails
+/// (its controller lost, a run that cannot start) stops the ladder after its round: the result
+/// then holds the rungs so far, the undecided ones marked incomplete, with the error beside it.
 pub fn ladder(
     path: &Path,
     sets: &[String],
@@ -246,7 +260,7 @@ pub fn ladder(
     bearing: Bearing,
     stop: &AtomicBool,
     log: &(dyn Fn(&str) + Sync),
-) -> anyhow::Result<LadderResult> {
+) -> anyhow::Result<(LadderResult, Option<anyhow::Error>)> {
     let base = load_scene(path, sets)?;
     let spec = EnsembleSpec {
         members: settings.members,
@@ -268,6 +282,7 @@ pub fn ladder(
     let mut decided = vec![false; points.len()];
     let mut members_run = 0;
     let mut interrupted = false;
+    let mut failed: Option<anyhow::Error> = None;
     for round in 0..spec.rounds() {
         let work: Vec<(usize, usize)> = (0..points.len())
             .filter(|&i| !decided[i])
@@ -291,13 +306,19 @@ pub fn ladder(
             })
             .collect();
         for r in done {
-            match r? {
-                Some(c) => {
+            match r {
+                Ok(Some(c)) => {
                     members_run += 1;
                     counted[c.result.point].push(c);
                 }
-                None => interrupted = true,
+                Ok(None) => interrupted = true,
+                Err(e) => {
+                    failed.get_or_insert(e);
+                }
             }
+        }
+        if failed.is_some() {
+            break;
         }
         if interrupted || stop.load(Ordering::Relaxed) {
             interrupted = true;
@@ -336,5 +357,5 @@ pub fn ladder(
     }
     let safe_up_to_g = rungs.iter().take_while(|r| r.complete && r.p_lo >= settings.min_p).last().map(|r| r.peak_g);
     let verified = rungs.iter().map(|r| r.verified).sum();
-    Ok(LadderResult { rungs, safe_up_to_g, member_setting, members_run, verified, interrupted })
+    Ok((LadderResult { rungs, safe_up_to_g, member_setting, members_run, verified, interrupted }, failed))
 }

@@ -108,7 +108,7 @@ pub struct AssessError {
 
 /// A part's outcome.
 #[derive(Clone, Debug, Serialize)]
-pub struct Outcome_<T> {
+pub struct PartOutcome<T> {
     /// `measured`, `skipped`, `failed`, or `interrupted`.
     pub status: &'static str,
     /// Why it was not measured.
@@ -121,7 +121,7 @@ pub struct Outcome_<T> {
     pub wall_s: f64,
 }
 
-impl<T> Outcome_<T> {
+impl<T> PartOutcome<T> {
     fn measured(result: T, wall_s: f64) -> Self {
         Self { status: "measured", why: None, failure: None, result: Some(result), wall_s }
     }
@@ -179,11 +179,11 @@ pub struct ControllerReport {
     /// Rate (Hz).
     pub rate_hz: f64,
     /// Stability margin.
-    pub sensitivity: Outcome_<SensitivityPart>,
+    pub sensitivity: PartOutcome<SensitivityPart>,
     /// Vibration.
-    pub vibration: Outcome_<vibration::Vibration>,
+    pub vibration: PartOutcome<vibration::Vibration>,
     /// Shock ladder with the duty.
-    pub ladder: Outcome_<ladder::LadderResult>,
+    pub ladder: PartOutcome<ladder::LadderResult>,
     /// The verdict line.
     pub verdict: String,
     /// Wall time of the whole (s).
@@ -218,7 +218,7 @@ fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)
         Outcome::Interrupted if stop.load(Ordering::Relaxed) => Some((Failure::Interrupted, "interrupted".into())),
         Outcome::Interrupted => None,
         Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
-        Outcome::PeerLost(why) => Some((Failure::PeerLost, format!("the controller was lost: {why}"))),
+        Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
         Outcome::MissBudget(why) => Some((Failure::PeerLost, why.clone())),
     }
 }
@@ -422,9 +422,9 @@ fn assess_controller(
         },
         mode: crate::summary::snake_name(&scene.controller.mode),
         rate_hz: scene.controller.rate_hz,
-        sensitivity: Outcome_::skipped("not asked for"),
-        vibration: Outcome_::skipped("not asked for"),
-        ladder: Outcome_::skipped("not asked for"),
+        sensitivity: PartOutcome::skipped("not asked for"),
+        vibration: PartOutcome::skipped("not asked for"),
+        ladder: PartOutcome::skipped("not asked for"),
         verdict: String::new(),
         wall_s: 0.0,
     };
@@ -441,9 +441,9 @@ fn assess_controller(
                     .filter(|x| x.speed_hz > 0.0 || p.axes.iter().all(|y| y.speed_hz == 0.0))
                     .map(|x| x.decay_per_s)
                     .reduce(f64::min);
-                Outcome_::measured(p, t.elapsed().as_secs_f64())
+                PartOutcome::measured(p, t.elapsed().as_secs_f64())
             }
-            Err((kind, why)) => Outcome_::failed(kind, why, t.elapsed().as_secs_f64()),
+            Err((kind, why)) => PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()),
         };
     }
     let mut levitated = true;
@@ -451,38 +451,45 @@ fn assess_controller(
         log(&format!("{}: vibration (ISO 14839-2)", c.label));
         let t = Instant::now();
         report.vibration = match vibration_part(&scene, decay_at_speed, stop) {
-            Ok(v) => Outcome_::measured(v, t.elapsed().as_secs_f64()),
+            Ok(v) => PartOutcome::measured(v, t.elapsed().as_secs_f64()),
             Err((kind, why)) => {
                 levitated = kind != Failure::NotGradable;
-                Outcome_::failed(kind, why, t.elapsed().as_secs_f64())
+                PartOutcome::failed(kind, why, t.elapsed().as_secs_f64())
             }
         };
     }
     if a.parts.contains(&Part::Ladder) && !interrupted() {
         if !levitated {
             let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
-            report.ladder = Outcome_::failed(Failure::NotGradable, why, 0.0);
+            report.ladder = PartOutcome::failed(Failure::NotGradable, why, 0.0);
         } else {
             log(&format!("{}: shock ladder", c.label));
             let t = Instant::now();
             let b = bearing(&scene, a)?;
+            let kind = |e: &anyhow::Error| {
+                if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
+                    Failure::PeerLost
+                } else {
+                    Failure::Other
+                }
+            };
             report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stop, log) {
-                Ok(l) if l.interrupted => Outcome_ {
+                Ok((l, Some(e))) => PartOutcome {
+                    status: "failed",
+                    why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
+                    failure: Some(kind(&e)),
+                    result: Some(l),
+                    wall_s: t.elapsed().as_secs_f64(),
+                },
+                Ok((l, None)) if l.interrupted => PartOutcome {
                     status: "interrupted",
                     why: Some("interrupted: the rungs marked incomplete were not decided".into()),
                     failure: Some(Failure::Interrupted),
                     result: Some(l),
                     wall_s: t.elapsed().as_secs_f64(),
                 },
-                Ok(l) => Outcome_::measured(l, t.elapsed().as_secs_f64()),
-                Err(e) => {
-                    let kind = if e.chain().any(|c| c.is::<crate::run::SetupError>()) {
-                        Failure::PeerLost
-                    } else {
-                        Failure::Other
-                    };
-                    Outcome_::failed(kind, format!("{e:#}"), t.elapsed().as_secs_f64())
-                }
+                Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
+                Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
             };
         }
     }
@@ -494,12 +501,14 @@ fn assess_controller(
         if status == "skipped" && interrupted() && a.parts.iter().any(|p| p.name() == part) {
             match part {
                 "sensitivity" => {
-                    report.sensitivity = Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
+                    report.sensitivity =
+                        PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
                 }
                 "vibration" => {
-                    report.vibration = Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
+                    report.vibration =
+                        PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
                 }
-                _ => report.ladder = Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+                _ => report.ladder = PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
             }
         }
     }
@@ -568,7 +577,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
     let mut report = Report {
         program: format!("plant {}", env!("CARGO_PKG_VERSION")),
         file: args.file.display().to_string(),
-        scene: a.scene.display().to_string(),
+        scene: shown(&a.scene),
         parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
         bearing,
         ladder_settings: a.ladder.clone(),
@@ -591,9 +600,9 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
             law: String::new(),
             mode: String::new(),
             rate_hz: 0.0,
-            sensitivity: Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            vibration: Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            ladder: Outcome_::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
             verdict: String::new(),
             wall_s: 0.0,
         };
@@ -633,4 +642,40 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
 /// Where a relative path of an assessment file points.
 pub fn relative_to(file: &Path, path: &str) -> PathBuf {
     file.parent().unwrap_or(Path::new(".")).join(path)
+}
+
+/// A path as the report shows it: `.` and each `dir/..` pair dropped, lexically
+/// (`config/assess/../paper-10g.toml` is shown `config/paper-10g.toml`); the scene is still
+/// loaded by the path as written, which a symbolic link could make differ.
+pub fn shown(path: &Path) -> String {
+    use std::path::Component;
+    let mut kept: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(kept.last(), Some(Component::Normal(_))) => {
+                kept.pop();
+            }
+            c => kept.push(c),
+        }
+    }
+    if kept.is_empty() {
+        return ".".into();
+    }
+    kept.iter().collect::<PathBuf>().display().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+    use std::path::Path;
+
+    #[test]
+    fn a_scene_path_is_shown_without_dot_dot() {
+        assert_eq!(shown(Path::new("config/assess/../paper-10g.toml")), "config/paper-10g.toml");
+        assert_eq!(shown(Path::new("./a/./b/../../c.toml")), "c.toml");
+        assert_eq!(shown(Path::new("../x/../../y.toml")), "../../y.toml");
+        assert_eq!(shown(Path::new("/etc/../a.toml")), "/a.toml");
+        assert_eq!(shown(Path::new("a/..")), ".");
+    }
 }

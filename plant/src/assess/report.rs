@@ -51,15 +51,21 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
     } else if r.vibration.status != "skipped" {
         parts.push(format!("vibration {}", r.vibration.status));
     }
-    if let Some(l) = &r.ladder.result {
+    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.members > 0)) {
+        // An interrupted or failed ladder: its figures are those of the rungs decided so far.
+        let so_far = match r.ladder.status {
+            "measured" => String::new(),
+            status => format!("ladder {status}, on the members run so far: "),
+        };
         parts.push(match l.safe_up_to_g {
-            Some(g) => format!("P(recovered) ≥ 0.9 up to {g} G"),
-            None => "P(recovered) ≥ 0.9 at no rung".to_string(),
+            Some(g) => format!("{so_far}P(recovered) ≥ 0.9 up to {g} G"),
+            None => format!("{so_far}P(recovered) ≥ 0.9 at no rung"),
         });
         if let Some(rung) = l.rungs.iter().find(|x| (x.peak_g - duty_g).abs() < 1e-9) {
             let d = &rung.duty;
             parts.push(format!(
-                "at {duty_g} G: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
+                "at {duty_g} G{}: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
+                if rung.complete { "" } else { " (incomplete)" },
                 rung.p_recovered,
                 rung.p_lo,
                 rung.p_hi,
@@ -259,17 +265,22 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
             (colour(*i), l.rungs.iter().filter(|x| x.members > 0).map(|x| (x.peak_g, x.p_lo, x.p_hi)).collect())
         })
         .collect();
-    let p = dir.join("ladder_probability.png");
-    chart(
-        &p,
-        "Probability of recovery against the shock's peak (Wilson 95 % intervals)",
-        ("peak of the shock (G)", "P(recovered)"),
-        false,
-        &series(&|x| Some(x.p_recovered), false, ""),
-        &[(r.ladder_settings.min_p, "0.9")],
-        &bars,
-    )?;
-    out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
+    // A ladder interrupted or stopped before any member was counted has nothing to draw.
+    let lines = series(&|x| Some(x.p_recovered), false, "");
+    if lines.iter().any(|l| !l.points.is_empty()) {
+        let p = dir.join("ladder_probability.png");
+        let min_p = format!("{}", r.ladder_settings.min_p);
+        chart(
+            &p,
+            "Probability of recovery against the shock's peak (Wilson 95 % intervals)",
+            ("peak of the shock (G)", "P(recovered)"),
+            false,
+            &lines,
+            &[(r.ladder_settings.min_p, min_p.as_str())],
+            &bars,
+        )?;
+        out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
+    }
     let mut lines = series(&|x| x.recovery_median_s.map(|v| v * 1e3), false, " median");
     lines.extend(series(&|x| x.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
     if lines.iter().any(|l| !l.points.is_empty()) {
@@ -445,6 +456,12 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
     }
     });
     row(&mut h, "highest safe shock", &|c| match &c.ladder.result {
+        Some(l) if c.ladder.status != "measured" => format!(
+            "<span class=\"bad\">{}</span>: {}; the complete rungs: {}",
+            c.ladder.status,
+            esc(c.ladder.why.as_deref().unwrap_or("")),
+            l.safe_up_to_g.map_or("none safe".into(), |g| format!("safe up to {g} G"))
+        ),
         Some(l) => match l.safe_up_to_g {
             Some(g) => {
                 format!("<b class=\"ok\">{g} G</b> (every rung up to it: lower bound ≥ {})", r.ladder_settings.min_p)
