@@ -212,6 +212,8 @@ fn run_counted(
         let duty = sink.finish();
         match &run.outcome {
             Outcome::Interrupted => return Ok(None),
+            // Ctrl-C in a terminal stops the controller process too: interrupted, not lost.
+            _ if stop.load(Ordering::Relaxed) && run.outcome != Outcome::Completed => return Ok(None),
             // A member whose controller was lost says nothing of the controller's recovery: it
             // must not be counted (as a run that did not complete, it would count as diverged).
             Outcome::PeerLost(why) | Outcome::MissBudget(why) => {

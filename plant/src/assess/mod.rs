@@ -215,7 +215,9 @@ fn quiet_run_overrides(scene: &Scene, duration: f64, output_hz: f64, substeps: u
 fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)> {
     match outcome {
         Outcome::Completed => None,
-        Outcome::Interrupted if stop.load(Ordering::Relaxed) => Some((Failure::Interrupted, "interrupted".into())),
+        // Ctrl-C in a terminal also reaches a controller process of the same process group,
+        // which then stops: the run was interrupted, not its controller lost.
+        _ if stop.load(Ordering::Relaxed) => Some((Failure::Interrupted, "interrupted".into())),
         Outcome::Interrupted => None,
         Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
         Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
@@ -257,14 +259,17 @@ pub fn measure_axis(
     );
     let mut watch = sensitivity::ContactWatch { touched };
     let run = run_into(&run_scene, &Launch::default(), &mut m, &mut watch)
-        .map_err(|e| MeasureError::Run { kind: setup_failure(&e), why: e.to_string() })?;
+        .map_err(|e| MeasureError::Run { kind: setup_failure(&e, stop), why: e.to_string() })?;
     if let Some((kind, why)) = run_failure(&run.outcome, stop) {
         return Err(MeasureError::Run { kind, why });
     }
     m.result(run.simulated)
 }
 
-fn setup_failure(e: &crate::run::SetupError) -> Failure {
+fn setup_failure(e: &crate::run::SetupError, stop: &AtomicBool) -> Failure {
+    if stop.load(Ordering::Relaxed) {
+        return Failure::Interrupted;
+    }
     match e {
         crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted) => Failure::Interrupted,
         crate::run::SetupError::Cosim(_) => Failure::PeerLost,
@@ -374,7 +379,7 @@ fn vibration_part(
     let run_scene = scene.reload(&sets).map_err(|e| (Failure::Other, e.to_string()))?;
     let mut sink = vibration::VibrationSink::new(settle);
     let run = run_into(&run_scene, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut sink)
-        .map_err(|e| (setup_failure(&e), e.to_string()))?;
+        .map_err(|e| (setup_failure(&e, stop), e.to_string()))?;
     if let Some(t) = sink.touched {
         return Err((
             Failure::NotGradable,
@@ -467,20 +472,25 @@ fn assess_controller(
             let t = Instant::now();
             let b = bearing(&scene, a)?;
             let kind = |e: &anyhow::Error| {
-                if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
+                if interrupted() {
+                    Failure::Interrupted
+                } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
                     Failure::PeerLost
                 } else {
                     Failure::Other
                 }
             };
             report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stop, log) {
-                Ok((l, Some(e))) => PartOutcome {
-                    status: "failed",
-                    why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
-                    failure: Some(kind(&e)),
-                    result: Some(l),
-                    wall_s: t.elapsed().as_secs_f64(),
-                },
+                Ok((l, Some(e))) => {
+                    let kind = kind(&e);
+                    PartOutcome {
+                        status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
+                        why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
+                        failure: Some(kind),
+                        result: Some(l),
+                        wall_s: t.elapsed().as_secs_f64(),
+                    }
+                }
                 Ok((l, None)) if l.interrupted => PartOutcome {
                     status: "interrupted",
                     why: Some("interrupted: the rungs marked incomplete were not decided".into()),
