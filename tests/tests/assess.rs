@@ -89,6 +89,12 @@ fn bad_input_is_refused_before_anything_runs() {
         ("[[controller]]\nlabel = \"x\"\nset = [\"controller.law=\\\"nope\\\"\"]\n", "", "nope"),
         ("", "[duty]\npoisson = 0.7\n", "duty.poisson = 0.7"),
         ("", "[sensitivity2]\n", "sensitivity2"),
+        // An external controller that cannot be started: found by starting it once, for one tick.
+        (
+            "[[controller]]\nlabel = \"x\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.command=[\\\"/nonexistent/ctl\\\"]\"]\n",
+            "",
+            "cannot run \"/nonexistent/ctl\"",
+        ),
     ];
     for (i, (controllers, extra, says)) in cases.iter().enumerate() {
         let sub = dir.join(&format!("case{i}"));

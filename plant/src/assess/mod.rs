@@ -25,6 +25,7 @@ use crate::cosim::Launch;
 use crate::ensemble::member::setting_overrides;
 use crate::ensemble::spec::MemberSetting;
 use crate::run::{run_into, Outcome};
+use anyhow::Context;
 use rayon::prelude::*;
 use serde::Serialize;
 use spec::{Assessment, ControllerSpec, Part};
@@ -395,6 +396,18 @@ fn vibration_part(
     Ok(sink.figures(scene.params.contact.gap, scene.params.current_limit, speed_hz, settle, window))
 }
 
+/// A co-simulated controller started once, for one tick, before anything is measured: a
+/// command that cannot run, a controller that refuses the run or speaks another protocol is
+/// found here, with the exit code `plant run` gives it (bad input: 2), instead of failing every
+/// part of the assessment. A controller lost in that tick is left to the parts to report.
+fn controller_starts(scene: &Scene, stop: &AtomicBool) -> anyhow::Result<()> {
+    let sets = [format!("scene.duration_s={:?}", scene.controller.period), "output.plots=false".to_string()];
+    let one_tick = scene.reload(&sets)?;
+    let mut trace = crate::trace::Trace::with_capacity(4);
+    run_into(&one_tick, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut trace)?;
+    Ok(())
+}
+
 /// The bearing of a scene with the assessment's materials.
 fn bearing(scene: &Scene, a: &Assessment) -> anyhow::Result<duty::Bearing> {
     let raw = crate::ensemble::resolved(scene)?;
@@ -571,6 +584,9 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
                 s.extend(ladder::rung_overrides(&scene, *g)?);
                 load_scene(&a.scene, &s)?;
             }
+        }
+        if matches!(scene.controller.mode, ControlMode::Lockstep | ControlMode::Realtime) {
+            controller_starts(&scene, stop).with_context(|| format!("{}: starting its controller", c.label))?;
         }
         first.get_or_insert(scene);
     }
