@@ -78,3 +78,14 @@ fn an_unstable_sampled_pd_is_measured_unstable() {
     let m = measure_axis(&s, 0, 0.0, &set, &stop).expect("measured");
     assert!(!m.stable && m.peak.is_none() && m.zone == "unstable", "{m:?}");
 }
+
+#[test]
+fn a_sampled_law_has_its_closed_form_whatever_the_command_and_a_command_has_none() {
+    // A scene naming a controller process but run sampled: the law runs in the plant.
+    let cmd = "controller.command=[\"some-controller\"]";
+    let sampled = scene(&["controller.mode=\"sampled\"", cmd]);
+    assert!(matches!(closed_form_of(&sampled), Some(closed_form::PdLoop::Sampled { .. })));
+    // Co-simulated: the built-in controller runs the registry's law; a command is a black box.
+    assert!(closed_form_of(&scene(&["controller.mode=\"lockstep\""])).is_some());
+    assert!(closed_form_of(&scene(&["controller.mode=\"lockstep\"", cmd])).is_none());
+}

@@ -294,16 +294,19 @@ pub fn closed_form_of(scene: &Scene) -> Option<closed_form::PdLoop> {
     }
     let design = scene.design();
     let c = &scene.controller;
+    // A sampled law runs in the plant whatever `controller.command` says; co-simulated, the
+    // built-in controller runs the registry's law, a command is a black box.
+    let registry = c.mode == ControlMode::Sampled || c.cosim.command.is_none();
     match (c.mode, c.law.as_str()) {
         (ControlMode::Continuous, _) => {
             let g = crate::run::design_gains(scene).ok()?;
             Some(closed_form::PdLoop::Continuous { kp: g.kp, kd: g.kd })
         }
-        (_, "pd") if c.cosim.command.is_none() => {
+        (_, "pd") if registry => {
             let g = crate::run::design_gains(scene).ok()?;
             Some(closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples })
         }
-        (_, "pd_delay" | "relev") if c.cosim.command.is_none() => {
+        (_, "pd_delay" | "relev") if registry => {
             let g = controller::discrete_pd::DelayPdGains::from_design(
                 &design.pd(),
                 &design.constants,
