@@ -234,6 +234,18 @@ pub fn measure_axis(
     settings: &sensitivity::Settings,
     stop: &AtomicBool,
 ) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
+    measure_axis_or_abandon(scene, axis, speed_hz, settings, stop, None)
+}
+
+/// [`measure_axis`], stopping early (`MeasureError::Abandoned`) once `abandon` is set.
+fn measure_axis_or_abandon(
+    scene: &Scene,
+    axis: usize,
+    speed_hz: f64,
+    settings: &sensitivity::Settings,
+    stop: &AtomicBool,
+    abandon: Option<&AtomicBool>,
+) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
     use sensitivity::MeasureError;
     let continuous = scene.controller.mode == ControlMode::Continuous;
     let period = scene.controller.period;
@@ -258,9 +270,23 @@ pub fn measure_axis(
         stop,
         touched.clone(),
     );
+    if let Some(flag) = abandon {
+        m = m.abandon_on(flag);
+    }
     let mut watch = sensitivity::ContactWatch { touched };
-    let run = run_into(&run_scene, &Launch::default(), &mut m, &mut watch)
-        .map_err(|e| MeasureError::Run { kind: setup_failure(&e, stop), why: e.to_string() })?;
+    let run = run_into(&run_scene, &Launch::default(), &mut m, &mut watch);
+    // Stopped by another axis' failure (while running or still connecting), not by Ctrl-C.
+    let abandoned = || abandon.is_some_and(|a| a.load(Ordering::Relaxed)) && !stop.load(Ordering::Relaxed);
+    let run = match run {
+        Ok(run) => run,
+        Err(crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted)) if abandoned() => {
+            return Err(MeasureError::Abandoned)
+        }
+        Err(e) => return Err(MeasureError::Run { kind: setup_failure(&e, stop), why: e.to_string() }),
+    };
+    if run.outcome == Outcome::Interrupted && abandoned() {
+        return Err(MeasureError::Abandoned);
+    }
     if let Some((kind, why)) = run_failure(&run.outcome, stop) {
         return Err(MeasureError::Run { kind, why });
     }
@@ -282,6 +308,7 @@ fn measure_kind(e: &sensitivity::MeasureError) -> Failure {
     match e {
         sensitivity::MeasureError::Touched { .. } | sensitivity::MeasureError::Level { .. } => Failure::NotGradable,
         sensitivity::MeasureError::Run { kind, .. } => *kind,
+        sensitivity::MeasureError::Abandoned => Failure::Other,
     }
 }
 
@@ -352,17 +379,36 @@ fn sensitivity_part(scene: &Scene, a: &Assessment, stop: &AtomicBool) -> Result<
     let speeds: Vec<f64> = a.speeds.iter().map(|s| if *s == spec::Speed::Rated { speed } else { 0.0 }).collect();
     let jobs: Vec<(usize, f64)> =
         speeds.iter().flat_map(|s| (0..axis_names(scene).len()).map(move |k| (k, *s))).collect();
-    let results: Vec<_> = jobs.par_iter().map(|&(k, s)| measure_axis(scene, k, s, &a.sensitivity, stop)).collect();
+    // One axis failing fails the part: the others stop there instead of running on for nothing.
+    let abandon = AtomicBool::new(false);
+    let results: Vec<_> = jobs
+        .par_iter()
+        .map(|&(k, s)| {
+            let r = measure_axis_or_abandon(scene, k, s, &a.sensitivity, stop, Some(&abandon));
+            if r.is_err() {
+                abandon.store(true, Ordering::Relaxed);
+            }
+            r
+        })
+        .collect();
     let mut axes = Vec::new();
     let mut errors = Vec::new();
     for r in results {
         match r {
             Ok(x) => axes.push(x),
+            Err(sensitivity::MeasureError::Abandoned) => {}
             Err(e) => errors.push((measure_kind(&e), e.to_string())),
         }
     }
     if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
-        let why = errors.iter().map(|e| e.1.as_str()).collect::<Vec<_>>().join("; ");
+        // The axes often fail alike (one controller command, one interruption): each reason once.
+        let mut reasons: Vec<&str> = Vec::new();
+        for (_, why) in &errors {
+            if !reasons.contains(&why.as_str()) {
+                reasons.push(why);
+            }
+        }
+        let why = reasons.join("; ");
         return Err((worst.0, why));
     }
     let simulated_s = axes.iter().map(|x| x.simulated_s).sum();

@@ -196,6 +196,9 @@ pub enum MeasureError {
         /// Last amplitude (µm).
         amplitude_um: f64,
     },
+    /// Stopped because another axis of the same part failed.
+    #[error("not finished: another axis failed")]
+    Abandoned,
     /// The run ended otherwise (controller lost, divergence, interruption, time cap).
     #[error("{why}")]
     Run {
@@ -243,6 +246,8 @@ pub struct Measure<'a> {
     speed_hz: f64,
     f_max: f64,
     stop: &'a AtomicBool,
+    /// Set when another axis of the same part has failed: this one stops too.
+    abandon: Option<&'a AtomicBool>,
     touched: Rc<Cell<Option<f64>>>,
     phase: Phase,
     probe: Vec<(f64, f64)>,
@@ -292,6 +297,7 @@ impl<'a> Measure<'a> {
             speed_hz,
             f_max,
             stop,
+            abandon: None,
             touched,
             phase: Phase::Probe,
             probe: Vec::new(),
@@ -307,6 +313,12 @@ impl<'a> Measure<'a> {
             t_now: 0.0,
             grace_until: 0.0,
         }
+    }
+
+    /// Stops the measurement, too, once `flag` is set (another axis of the part has failed).
+    pub fn abandon_on(mut self, flag: &'a AtomicBool) -> Self {
+        self.abandon = Some(flag);
+        self
     }
 
     /// The result, once the run has ended (`simulated_s`: how far it ran).
@@ -544,7 +556,10 @@ impl<'a> Measure<'a> {
 
 impl Hooks for Measure<'_> {
     fn cancelled(&self) -> bool {
-        matches!(self.phase, Phase::Done) || self.touched.get().is_some() || self.stop.load(Ordering::Relaxed)
+        matches!(self.phase, Phase::Done)
+            || self.touched.get().is_some()
+            || self.stop.load(Ordering::Relaxed)
+            || self.abandon.is_some_and(|a| a.load(Ordering::Relaxed))
     }
 
     fn excitation(&mut self, _k: u64, t: f64, sensor_v: &[f64]) -> Option<SensorSine> {
