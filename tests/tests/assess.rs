@@ -89,6 +89,8 @@ fn bad_input_is_refused_before_anything_runs() {
         ("[[controller]]\nlabel = \"x\"\nset = [\"controller.law=\\\"nope\\\"\"]\n", "", "nope"),
         ("", "[duty]\npoisson = 0.7\n", "duty.poisson = 0.7"),
         ("", "[sensitivity2]\n", "sensitivity2"),
+        // Appended inside [ladder]: the verdict's duty rung must be a rung.
+        ("", "duty_g = 4.0\n", "ladder.duty_g = 4 G"),
         // An external controller that cannot be started: found by starting it once, for one tick.
         (
             "[[controller]]\nlabel = \"x\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.command=[\\\"/nonexistent/ctl\\\"]\"]\n",
@@ -105,6 +107,17 @@ fn bad_input_is_refused_before_anything_runs() {
         assert!(stderr(&o).contains(says), "{}", stderr(&o));
         assert!(!out.join("report.json").exists());
     }
+    // A lowest frequency whose periods alone outlast the measurement's run (it ran 3000 s
+    // simulated, then failed with exit 1).
+    let sub = dir.join("slow");
+    std::fs::create_dir_all(&sub).expect("dir");
+    let path = file(&sub.join("assess.toml"), "", "");
+    std::fs::write(&path, read_text(&path).replace("f_min_hz = 20.0", "f_min_hz = 0.001")).expect("write");
+    let out = sub.join("out");
+    let o = assess(&path, &out);
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("sensitivity.f_min_hz = 0.001 Hz"), "{}", stderr(&o));
+    assert!(!out.exists());
 }
 
 #[test]
@@ -208,4 +221,39 @@ fn ctrl_c_midway_keeps_the_parts_measured_and_says_so() {
         assert_eq!(second[part]["status"], "interrupted", "{part}: {}", second[part]);
     }
     assert!(std::fs::read_to_string(out.join("report.html")).expect("report.html").contains("INTERRUPTED"));
+}
+
+/// SIGINT during the sensitivity measurement, once one axis is measured: that axis is kept in
+/// the report (the part marked interrupted, its reason naming what was measured), nothing after
+/// it runs, exit 130.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_during_the_sensitivity_keeps_the_axes_measured() {
+    let dir = TempDir::new("assess-sigint-sens");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n";
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), controllers, "");
+    // Four axis runs (x and y, at standstill and at speed) on a pool of at most two threads.
+    let text = read_text(&path).replace("speeds = [\"standstill\"]", "speeds = [\"standstill\", \"rated\"]");
+    std::fs::write(&path, text).expect("write");
+    let mut p = Proc::spawn(Command::new(plant_bin()).arg("assess").arg(&path).arg("--out").arg(&out));
+    p.wait_line("  axis ");
+    p.signal(libc::SIGINT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    let s = &c["sensitivity"];
+    assert_eq!(s["status"], "interrupted", "{s}");
+    let axes = s["result"]["axes"].as_array().expect("the axes measured are kept");
+    assert!(!axes.is_empty() && axes.len() < 4, "{s}");
+    for axis in axes {
+        assert_eq!(axis["stable"], true, "{axis}");
+        assert!(num(&axis["peak"], "s_db").is_finite(), "{axis}");
+    }
+    assert!(s["why"].as_str().expect("why").contains("measured before it"), "{s}");
+    for part in ["vibration", "ladder"] {
+        assert_eq!(c[part]["status"], "interrupted", "{part}: {}", c[part]);
+    }
+    assert!(c["verdict"].as_str().expect("verdict").starts_with("sensitivity interrupted, on the"), "{}", c["verdict"]);
 }

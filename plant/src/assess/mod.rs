@@ -251,7 +251,7 @@ fn measure_axis_or_abandon(
     let period = scene.controller.period;
     // The continuous PD reads the sine inside the derivative: steps of at most 1/20 of its period.
     let substeps = if continuous { ((20.0 * settings.f_max_hz * period).ceil() as u32).max(1) } else { 1 };
-    let cap = 3000.0;
+    let cap = sensitivity::RUN_CAP_S;
     let mut sets = quiet_run_overrides(scene, cap, 1000.0, substeps);
     sets.push(format!("rotor.speed_hz={speed_hz:?}"));
     sets.push(format!("{}={:?}", initial_offset_key(axis), settings.probe_um));
@@ -373,8 +373,17 @@ fn closed_form_peak(scene: &Scene, pd: &closed_form::PdLoop, settings: &sensitiv
     }
 }
 
+/// A sensitivity part that failed or was interrupted: how, why, and the part with the axes
+/// measured before it (none: `None`).
+type PartialSensitivity = (Failure, String, Option<SensitivityPart>);
+
 /// The sensitivity part of one controller: every axis at each speed, in parallel.
-fn sensitivity_part(scene: &Scene, a: &Assessment, stop: &AtomicBool) -> Result<SensitivityPart, (Failure, String)> {
+fn sensitivity_part(
+    scene: &Scene,
+    a: &Assessment,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> Result<SensitivityPart, PartialSensitivity> {
     let speed = scene.params.speed / std::f64::consts::TAU;
     let speeds: Vec<f64> = a.speeds.iter().map(|s| if *s == spec::Speed::Rated { speed } else { 0.0 }).collect();
     let jobs: Vec<(usize, f64)> =
@@ -385,8 +394,13 @@ fn sensitivity_part(scene: &Scene, a: &Assessment, stop: &AtomicBool) -> Result<
         .par_iter()
         .map(|&(k, s)| {
             let r = measure_axis_or_abandon(scene, k, s, &a.sensitivity, stop, Some(&abandon));
-            if r.is_err() {
-                abandon.store(true, Ordering::Relaxed);
+            match &r {
+                Ok(x) => {
+                    let peak =
+                        x.peak.as_ref().map_or(String::new(), |p| format!(", {:.2} dB at {:.2} Hz", p.s_db, p.f_hz));
+                    log(&format!("  axis {} at {:.0} Hz: zone {}{peak}", x.axis, x.speed_hz, x.zone));
+                }
+                Err(_) => abandon.store(true, Ordering::Relaxed),
             }
             r
         })
@@ -400,6 +414,9 @@ fn sensitivity_part(scene: &Scene, a: &Assessment, stop: &AtomicBool) -> Result<
             Err(e) => errors.push((measure_kind(&e), e.to_string())),
         }
     }
+    let simulated_s = axes.iter().map(|x| x.simulated_s).sum();
+    let closed_form = closed_form_of(scene).map(|pd| closed_form_peak(scene, &pd, &a.sensitivity));
+    let part = SensitivityPart { axes, closed_form, simulated_s, settings: a.sensitivity.clone() };
     if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
         // The axes often fail alike (one controller command, one interruption): each reason once.
         let mut reasons: Vec<&str> = Vec::new();
@@ -408,12 +425,21 @@ fn sensitivity_part(scene: &Scene, a: &Assessment, stop: &AtomicBool) -> Result<
                 reasons.push(why);
             }
         }
-        let why = reasons.join("; ");
-        return Err((worst.0, why));
+        let mut why = reasons.join("; ");
+        // The axes measured before the failure are kept, and said to be all there is.
+        let kept = (!part.axes.is_empty()).then_some(part);
+        if let Some(p) = &kept {
+            let names: Vec<String> = p.axes.iter().map(|x| format!("{} at {:.0} Hz", x.axis, x.speed_hz)).collect();
+            why.push_str(&format!(
+                "; measured before it: {} of {} axes ({})",
+                names.len(),
+                jobs.len(),
+                names.join(", ")
+            ));
+        }
+        return Err((worst.0, why, kept));
     }
-    let simulated_s = axes.iter().map(|x| x.simulated_s).sum();
-    let closed_form = closed_form_of(scene).map(|pd| closed_form_peak(scene, &pd, &a.sensitivity));
-    Ok(SensitivityPart { axes, closed_form, simulated_s, settings: a.sensitivity.clone() })
+    Ok(part)
 }
 
 /// The vibration part: the levitated rotor at its speed without shock.
@@ -500,7 +526,7 @@ fn assess_controller(
     if a.parts.contains(&Part::Sensitivity) && !interrupted() {
         log(&format!("{}: sensitivity (ISO 14839-3)", c.label));
         let t = Instant::now();
-        report.sensitivity = match sensitivity_part(&scene, a, stop) {
+        report.sensitivity = match sensitivity_part(&scene, a, stop, log) {
             Ok(p) => {
                 decay_at_speed = p
                     .axes
@@ -510,7 +536,9 @@ fn assess_controller(
                     .reduce(f64::min);
                 PartOutcome::measured(p, t.elapsed().as_secs_f64())
             }
-            Err((kind, why)) => PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()),
+            Err((kind, why, kept)) => {
+                PartOutcome { result: kept, ..PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()) }
+            }
         };
     }
     let mut levitated = true;

@@ -38,10 +38,15 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
                     })
                 })
                 .unwrap_or_default();
+            // A part that failed or was interrupted: the axes measured before it, said so.
+            let so_far = match r.sensitivity.status {
+                "measured" => String::new(),
+                status => format!("sensitivity {status}, on the {} axes measured: ", s.axes.len()),
+            };
             if s.axes.iter().any(|a| !a.stable) {
-                parts.push("UNSTABLE loop: no stability margin".to_string());
+                parts.push(format!("{so_far}UNSTABLE loop: no stability margin"));
             } else {
-                parts.push(worst);
+                parts.push(format!("{so_far}{worst}"));
             }
         }
         (None, status) => parts.push(format!("sensitivity {status}")),
@@ -404,23 +409,32 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
         c.set.iter().map(|s| format!("<code>{}</code>", esc(s))).collect::<Vec<_>>().join("<br>")
     });
     row(&mut h, "stability margin (ISO 14839-3)", &|c| match &c.sensitivity.result {
-        Some(s) => s
-            .axes
-            .iter()
-            .map(|a| match &a.peak {
-                Some(p) if a.stable => format!(
-                    "{} at {:.0} Hz: zone <b>{}</b>, |S| {:.2} ({:.2} dB) at {:.2} Hz",
-                    a.axis, a.speed_hz, a.zone, p.s_abs, p.s_db, p.f_hz
+        Some(s) => {
+            let not_all = match c.sensitivity.status {
+                "measured" => String::new(),
+                status => format!(
+                    "<span class=\"bad\">{status}</span>: {}<br>",
+                    esc(c.sensitivity.why.as_deref().unwrap_or(""))
                 ),
-                _ => format!(
-                    "{} at {:.0} Hz: <b class=\"bad\">unstable</b> ({})",
-                    a.axis,
-                    a.speed_hz,
-                    esc(a.note.as_deref().unwrap_or(""))
-                ),
-            })
-            .collect::<Vec<_>>()
-            .join("<br>"),
+            };
+            not_all
+                + &s.axes
+                    .iter()
+                    .map(|a| match &a.peak {
+                        Some(p) if a.stable => format!(
+                            "{} at {:.0} Hz: zone <b>{}</b>, |S| {:.2} ({:.2} dB) at {:.2} Hz",
+                            a.axis, a.speed_hz, a.zone, p.s_abs, p.s_db, p.f_hz
+                        ),
+                        _ => format!(
+                            "{} at {:.0} Hz: <b class=\"bad\">unstable</b> ({})",
+                            a.axis,
+                            a.speed_hz,
+                            esc(a.note.as_deref().unwrap_or(""))
+                        ),
+                    })
+                    .collect::<Vec<_>>()
+                    .join("<br>")
+        }
         None => format!(
             "<span class=\"bad\">{}</span>: {}",
             c.sensitivity.status,

@@ -609,6 +609,19 @@ impl Sink for ContactWatch {
     }
 }
 
+/// The longest a measurement run may simulate (s): one that has not reached its last frequency
+/// by then fails.
+pub const RUN_CAP_S: f64 = 3000.0;
+
+/// The least simulated time a measurement of `settings` takes (s): the probe, then at each
+/// frequency of the grid two periods of settling and two windows of `min_cycles` periods. Above
+/// [`RUN_CAP_S`] it cannot finish, and is refused before anything runs.
+pub fn least_simulated_s(settings: &Settings) -> f64 {
+    let per_frequency = 2.0 + 2.0 * settings.min_cycles;
+    settings.probe_s
+        + log_grid(settings.f_min_hz, settings.f_max_hz, settings.points).iter().map(|f| per_frequency / f).sum::<f64>()
+}
+
 /// `n` frequencies log-spaced from `lo` to `hi` (Hz).
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> VecDeque<f64> {
     let n = n.max(2);

@@ -291,6 +291,18 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
     if sens.f_min_hz >= sens.f_max_hz {
         return Err(bad(&k("f_min_hz"), sens.f_min_hz, "Hz", "must be below sensitivity.f_max_hz"));
     }
+    let least = sensitivity::least_simulated_s(&sens);
+    if least > sensitivity::RUN_CAP_S {
+        let why = format!(
+            "the grid's periods alone (two of settling and two windows of min_cycles = {} at each of its {} \
+             frequencies) take {least:.0} s of simulated time per axis, more than the {} s a measurement may run: \
+             raise f_min_hz or lower min_cycles or points",
+            sens.min_cycles,
+            sens.points,
+            sensitivity::RUN_CAP_S
+        );
+        return Err(bad(&k("f_min_hz"), sens.f_min_hz, "Hz", &why));
+    }
     let speeds = match &s.speeds {
         None => vec![Speed::Standstill, Speed::Rated],
         Some(list) if !list.is_empty() => list
@@ -318,6 +330,8 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             "must be 1 to 64 ascending peaks above 0 and at most 1000",
         ));
     }
+    // Not given: the rung nearest the study's 10 G.
+    let default_duty = peaks.iter().copied().min_by(|a, b| (a - dl.duty_g).abs().total_cmp(&(b - dl.duty_g).abs()));
     let members = count("ladder.members", l.members, dl.members, 1, 10_000)?;
     let ladder = ladder::Settings {
         peaks_g: peaks,
@@ -326,8 +340,13 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         seed: count("ladder.seed", l.seed, dl.seed as usize, 0, i64::MAX)? as u64,
         verify: l.verify.unwrap_or(dl.verify),
         min_p: number("ladder.min_p", l.min_p, dl.min_p, "", 0.0, 1.0)?,
-        duty_g: number("ladder.duty_g", l.duty_g, dl.duty_g, "G", 0.0, 1e3)?,
+        duty_g: number("ladder.duty_g", l.duty_g, default_duty.unwrap_or(dl.duty_g), "G", 0.0, 1e3)?,
     };
+    // The verdict's duty is that of a rung: a `duty_g` on none would leave it out silently.
+    if parts.contains(&Part::Ladder) && !ladder.peaks_g.iter().any(|g| (g - ladder.duty_g).abs() < 1e-9) {
+        let why = format!("must be one of ladder.peaks_g {:?} (the rung whose duty the verdict gives)", ladder.peaks_g);
+        return Err(bad("ladder.duty_g", ladder.duty_g, "G", &why));
+    }
     let du = &raw.duty;
     let dm = Materials::default();
     let materials = Materials {
