@@ -375,7 +375,7 @@ fn closed_form_peak(scene: &Scene, pd: &closed_form::PdLoop, settings: &sensitiv
 
 /// A sensitivity part that failed or was interrupted: how, why, and the part with the axes
 /// measured before it (none: `None`).
-type PartialSensitivity = (Failure, String, Option<SensitivityPart>);
+type PartialSensitivity = (Failure, String, Option<Box<SensitivityPart>>);
 
 /// The sensitivity part of one controller: every axis at each speed, in parallel.
 fn sensitivity_part(
@@ -427,7 +427,7 @@ fn sensitivity_part(
         }
         let mut why = reasons.join("; ");
         // The axes measured before the failure are kept, and said to be all there is.
-        let kept = (!part.axes.is_empty()).then_some(part);
+        let kept = (!part.axes.is_empty()).then(|| Box::new(part));
         if let Some(p) = &kept {
             let names: Vec<String> = p.axes.iter().map(|x| format!("{} at {:.0} Hz", x.axis, x.speed_hz)).collect();
             why.push_str(&format!(
@@ -537,7 +537,7 @@ fn assess_controller(
                 PartOutcome::measured(p, t.elapsed().as_secs_f64())
             }
             Err((kind, why, kept)) => {
-                PartOutcome { result: kept, ..PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()) }
+                PartOutcome { result: kept.map(|p| *p), ..PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()) }
             }
         };
     }
