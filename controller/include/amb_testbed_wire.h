@@ -1,12 +1,15 @@
 /*
  * amb_testbed_wire.h: the plant <-> controller wire protocol of the AMB
- * touchdown testbed, version 3, for controllers written in C or C++.
+ * touchdown testbed, version 4, for controllers written in C or C++.
  *
  * The source of truth is controller/src/wire.rs; docs/wire-protocol.md is
  * the long form (services, handshake, wake protocol, liveness, the exact
- * floating-point form of the shipped laws). Every size and offset below is
- * checked at compile time, and tests/tests/controllers.rs compiles a program
- * with this header and compares them with Rust's size_of/offset_of.
+ * floating-point form of the shipped laws, the history of the versions).
+ * Every size and offset below is checked at compile time, and
+ * tests/tests/controllers.rs reads this header (every #define and every
+ * struct field), compiles a program with it, and compares each constant,
+ * size and offset with the Rust definitions (controller::wire::constants and
+ * layouts), naming any difference.
  *
  * All structs: native endianness (both processes run on one machine),
  * double = IEEE 754 binary64, text UTF-8 padded with NUL bytes, no padding
@@ -30,11 +33,16 @@ extern "C" {
 #define AMB_TESTBED_ALIGNOF _Alignof
 #endif
 
-/* Protocol version; also in every iceoryx2 type name. */
-#define AMB_TESTBED_PROTOCOL_VERSION 3u
-/* Room for axes in a frame; `axes` says how many entries are used (2: x, y). */
+/* Protocol version; also in every iceoryx2 type name (a peer of another
+ * version cannot open this version's services). */
+#define AMB_TESTBED_PROTOCOL_VERSION 4u
+/* Room for axes in a frame; `axes` says how many entries are used. */
 #define AMB_TESTBED_MAX_AXES 8
+/* Axes of the planar model (x, y) and of the two-plane rotor (x_A, y_A, x_B,
+ * y_B): Hello.axes is one of them. A controller that drives only the planar
+ * model refuses a 4-axis hello with AMB_TESTBED_ACK_AXES. */
 #define AMB_TESTBED_AXES 2u
+#define AMB_TESTBED_TWO_PLANE_AXES 4u
 /* Units code: V, A, s, N, m, kg. */
 #define AMB_TESTBED_UNITS_SI 1u
 #define AMB_TESTBED_RUN_ID_LEN 32
@@ -48,11 +56,11 @@ extern "C" {
 #define AMB_TESTBED_SERVICE_PREFIX "amb-testbed"
 
 /* iceoryx2 payload type names. */
-#define AMB_TESTBED_SENSOR_FRAME_TYPE_NAME "amb_testbed.v3.SensorFrame"
-#define AMB_TESTBED_COMMAND_FRAME_TYPE_NAME "amb_testbed.v3.CommandFrame"
-#define AMB_TESTBED_WAKE_REQUEST_TYPE_NAME "amb_testbed.v3.WakeRequest"
-#define AMB_TESTBED_HELLO_TYPE_NAME "amb_testbed.v3.Hello"
-#define AMB_TESTBED_ACK_TYPE_NAME "amb_testbed.v3.Ack"
+#define AMB_TESTBED_SENSOR_FRAME_TYPE_NAME "amb_testbed.v4.SensorFrame"
+#define AMB_TESTBED_COMMAND_FRAME_TYPE_NAME "amb_testbed.v4.CommandFrame"
+#define AMB_TESTBED_WAKE_REQUEST_TYPE_NAME "amb_testbed.v4.WakeRequest"
+#define AMB_TESTBED_HELLO_TYPE_NAME "amb_testbed.v4.Hello"
+#define AMB_TESTBED_ACK_TYPE_NAME "amb_testbed.v4.Ack"
 
 /* SensorFrame.status: the run is over; exit 0 (seq and values carry no sample). */
 #define AMB_TESTBED_SENSOR_STOP 1u
@@ -74,7 +82,7 @@ extern "C" {
 #define AMB_TESTBED_ACK_RUN_ID 6u
 #define AMB_TESTBED_ACK_PARAMS 7u
 
-/* One sample of the sensors, plant -> controller (service <id>/sensor). 112 bytes. */
+/* One sample of the sensors with the keyphasor, plant -> controller (service <id>/sensor). 128 bytes. */
 typedef struct amb_testbed_SensorFrame {
     uint64_t seq; /* tick index k (0, 1, 2, ...) */
     double t_s; /* simulated time of the sample, k T (s) */
@@ -82,9 +90,11 @@ typedef struct amb_testbed_SensorFrame {
     uint64_t sent_ns; /* plant's CLOCK_MONOTONIC at publish (ns) */
     uint32_t status; /* bit 0: AMB_TESTBED_SENSOR_STOP */
     uint32_t session; /* handshake session (Hello.session) */
-    uint32_t axes; /* entries of sensor_v in use (2) */
+    uint32_t axes; /* entries of sensor_v in use (Hello.axes: 2 or 4) */
     uint32_t reserved; /* 0 */
-    double sensor_v[AMB_TESTBED_MAX_AXES]; /* sensor voltages A_s * delta (V), x then y; unused entries 0 */
+    double sensor_v[AMB_TESTBED_MAX_AXES]; /* sensor voltages A_s * delta (V): x, y or x_A, y_A, x_B, y_B; unused entries 0 */
+    double speed_rad_s; /* keyphasor: the rotor's spin speed (rad/s) */
+    double angle_rad; /* keyphasor: the rotor's angle (rad) in [0, 2 pi); 0 when the unbalance points along +x */
 } amb_testbed_SensorFrame;
 
 /* The answer to one sample, controller -> plant (service <id>/command). 112 bytes. */
@@ -95,9 +105,9 @@ typedef struct amb_testbed_CommandFrame {
     uint64_t sent_ns; /* controller's CLOCK_MONOTONIC at publish (ns) */
     uint32_t status; /* 0, or AMB_TESTBED_COMMAND_STOPPING */
     uint32_t session; /* handshake session (Hello.session) */
-    uint32_t axes; /* entries of current_a in use (2) */
+    uint32_t axes; /* entries of current_a in use (Hello.axes) */
     uint32_t reserved; /* 0 */
-    double current_a[AMB_TESTBED_MAX_AXES]; /* coil currents (A), x then y, saturated at Hello.current_limit_a; unused entries 0 */
+    double current_a[AMB_TESTBED_MAX_AXES]; /* coil currents (A) in axis order, each saturated at its plane's limit (current_limit_a, b_current_limit_a); unused entries 0 */
 } amb_testbed_CommandFrame;
 
 /* "Notify me before I block" (services <id>/sensor/wake and <id>/command/wake). 8 bytes. */
@@ -105,10 +115,12 @@ typedef struct amb_testbed_WakeRequest {
     uint64_t seq; /* informative */
 } amb_testbed_WakeRequest;
 
-/* The plant's side of the handshake (service <id>/hello). 4312 bytes. */
+/* The plant's side of the handshake (service <id>/hello). 4448 bytes. Plane A
+ * (the planar model's plane) in the fields of version 3, plane B and the
+ * rotor's geometry after params (0 on a planar hello). */
 typedef struct amb_testbed_Hello {
     uint32_t protocol_version; /* AMB_TESTBED_PROTOCOL_VERSION */
-    uint32_t axes; /* 2 */
+    uint32_t axes; /* AMB_TESTBED_AXES or AMB_TESTBED_TWO_PLANE_AXES */
     uint32_t units; /* AMB_TESTBED_UNITS_SI */
     uint32_t session; /* 1, +1 per reconnection */
     uint64_t token; /* the run's token: random, never 0 */
@@ -122,7 +134,7 @@ typedef struct amb_testbed_Hello {
     double ks_n_per_m; /* k_s (N/m) */
     double amp_gain_a_per_v; /* A_a (A/V) */
     double sensor_gain_v_per_m; /* A_s (V/m) */
-    double rotor_mass_kg; /* m_r (kg) */
+    double rotor_mass_kg; /* m_r (kg): the mass this bearing carries */
     double gravity_m_s2; /* g (m/s^2) */
     double current_limit_a; /* i_max (A): saturate the currents at it */
     double air_gap_m; /* touchdown air gap r_0 (m) */
@@ -134,6 +146,23 @@ typedef struct amb_testbed_Hello {
     uint32_t params_len; /* bytes of params in use */
     uint32_t reserved; /* 0 */
     char params[AMB_TESTBED_PARAMS_LEN]; /* the law's parameters: [controller.params] as TOML text, UTF-8, not NUL-terminated */
+    double b_stiffness_n_per_m; /* plane B: design k_e (N/m) */
+    double b_damping_ratio; /* plane B: design xi_e */
+    double b_ki_n_per_a; /* plane B: k_i (N/A) */
+    double b_ks_n_per_m; /* plane B: k_s (N/m) */
+    double b_amp_gain_a_per_v; /* plane B: A_a (A/V) */
+    double b_sensor_gain_v_per_m; /* plane B: A_s (V/m) */
+    double b_rotor_mass_kg; /* plane B: the mass it carries (kg) */
+    double b_current_limit_a; /* plane B: i_max (A) */
+    double b_air_gap_m; /* plane B: touchdown air gap (m) */
+    double total_mass_kg; /* the whole rotor's mass M (kg) */
+    double transverse_inertia_kg_m2; /* I_t about the centre of mass (kg m^2) */
+    double polar_inertia_kg_m2; /* I_p (kg m^2) */
+    double rated_speed_rad_s; /* rated spin speed (rad/s) */
+    double bearing_a_z_m; /* station of bearing A from the centre of mass along z (m), < bearing_b_z_m */
+    double bearing_b_z_m; /* station of bearing B (m) */
+    double sensor_a_z_m; /* station of sensor A (m) */
+    double sensor_b_z_m; /* station of sensor B (m) */
 } amb_testbed_Hello;
 
 /* The controller's answer to a hello (service <id>/ack). 4416 bytes. */
@@ -151,7 +180,7 @@ typedef struct amb_testbed_Ack {
 } amb_testbed_Ack;
 
 /* The layout, checked by the compiler. */
-AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_SensorFrame) == 112, "SensorFrame: 112 bytes");
+AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_SensorFrame) == 128, "SensorFrame: 128 bytes");
 AMB_TESTBED_STATIC_ASSERT(AMB_TESTBED_ALIGNOF(amb_testbed_SensorFrame) == 8, "SensorFrame: alignment 8");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, seq) == 0, "SensorFrame.seq at 0");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, t_s) == 8, "SensorFrame.t_s at 8");
@@ -162,6 +191,8 @@ AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, session) == 36, "Sen
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, axes) == 40, "SensorFrame.axes at 40");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, reserved) == 44, "SensorFrame.reserved at 44");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, sensor_v) == 48, "SensorFrame.sensor_v at 48");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, speed_rad_s) == 112, "SensorFrame.speed_rad_s at 112");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_SensorFrame, angle_rad) == 120, "SensorFrame.angle_rad at 120");
 AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_CommandFrame) == 112, "CommandFrame: 112 bytes");
 AMB_TESTBED_STATIC_ASSERT(AMB_TESTBED_ALIGNOF(amb_testbed_CommandFrame) == 8, "CommandFrame: alignment 8");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_CommandFrame, seq) == 0, "CommandFrame.seq at 0");
@@ -176,7 +207,7 @@ AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_CommandFrame, current_a) == 48, "
 AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_WakeRequest) == 8, "WakeRequest: 8 bytes");
 AMB_TESTBED_STATIC_ASSERT(AMB_TESTBED_ALIGNOF(amb_testbed_WakeRequest) == 8, "WakeRequest: alignment 8");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_WakeRequest, seq) == 0, "WakeRequest.seq at 0");
-AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_Hello) == 4312, "Hello: 4312 bytes");
+AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_Hello) == 4448, "Hello: 4448 bytes");
 AMB_TESTBED_STATIC_ASSERT(AMB_TESTBED_ALIGNOF(amb_testbed_Hello) == 8, "Hello: alignment 8");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, protocol_version) == 0, "Hello.protocol_version at 0");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, axes) == 4, "Hello.axes at 4");
@@ -205,6 +236,23 @@ AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, plant_pid) == 204, "Hello.
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, params_len) == 208, "Hello.params_len at 208");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, reserved) == 212, "Hello.reserved at 212");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, params) == 216, "Hello.params at 216");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_stiffness_n_per_m) == 4312, "Hello.b_stiffness_n_per_m at 4312");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_damping_ratio) == 4320, "Hello.b_damping_ratio at 4320");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_ki_n_per_a) == 4328, "Hello.b_ki_n_per_a at 4328");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_ks_n_per_m) == 4336, "Hello.b_ks_n_per_m at 4336");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_amp_gain_a_per_v) == 4344, "Hello.b_amp_gain_a_per_v at 4344");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_sensor_gain_v_per_m) == 4352, "Hello.b_sensor_gain_v_per_m at 4352");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_rotor_mass_kg) == 4360, "Hello.b_rotor_mass_kg at 4360");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_current_limit_a) == 4368, "Hello.b_current_limit_a at 4368");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, b_air_gap_m) == 4376, "Hello.b_air_gap_m at 4376");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, total_mass_kg) == 4384, "Hello.total_mass_kg at 4384");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, transverse_inertia_kg_m2) == 4392, "Hello.transverse_inertia_kg_m2 at 4392");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, polar_inertia_kg_m2) == 4400, "Hello.polar_inertia_kg_m2 at 4400");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, rated_speed_rad_s) == 4408, "Hello.rated_speed_rad_s at 4408");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, bearing_a_z_m) == 4416, "Hello.bearing_a_z_m at 4416");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, bearing_b_z_m) == 4424, "Hello.bearing_b_z_m at 4424");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, sensor_a_z_m) == 4432, "Hello.sensor_a_z_m at 4432");
+AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Hello, sensor_b_z_m) == 4440, "Hello.sensor_b_z_m at 4440");
 AMB_TESTBED_STATIC_ASSERT(sizeof(amb_testbed_Ack) == 4416, "Ack: 4416 bytes");
 AMB_TESTBED_STATIC_ASSERT(AMB_TESTBED_ALIGNOF(amb_testbed_Ack) == 8, "Ack: alignment 8");
 AMB_TESTBED_STATIC_ASSERT(offsetof(amb_testbed_Ack, protocol_version) == 0, "Ack.protocol_version at 0");

@@ -288,9 +288,9 @@ mod tests {
         let c = LoopConstants::study();
         let mut law = DelayPd::new(DelayPdGains::from_design(&design(), &c, 5e-5, 1).unwrap(), 5e-5);
         assert_eq!(law.name(), "pd_delay");
-        let s0 = Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, -0.2] };
+        let s0 = Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, -0.2], ..Default::default() };
         let first = law.update(&s0);
-        law.update(&Sample { seq: 1, t_s: 5e-5, sensor_v: [0.3, 0.0] });
+        law.update(&Sample { seq: 1, t_s: 5e-5, sensor_v: [0.3, 0.0], ..Default::default() });
         law.reset();
         assert_eq!(law.update(&s0), first);
     }

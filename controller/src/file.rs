@@ -8,6 +8,9 @@
 //! (`Ack.overrides`), which writes it into the run folder, so that the folder
 //! reproduces the run.
 //!
+//! The design keys (`stiffness_n_per_m`, `damping_ratio`, `current_limit_a`,
+//! `gravity_bias`) apply to every bearing plane of a two-plane hello alike.
+//!
 //! `[controller.params]` are the law's own parameters. With the plant's law,
 //! its keys replace the hello's one by one; with another law (`law` or
 //! `--law`), the hello's parameters (which belong to the plant's law) are
@@ -15,7 +18,7 @@
 //! aliases of `relev`'s parameters (a warning names the new key; giving both
 //! is an error); with another law they are ignored, with a warning.
 
-use crate::law::Design;
+use crate::law::{Design, RotorDesign};
 use crate::params::Params;
 use crate::wire::{self, Hello};
 use std::path::Path;
@@ -35,6 +38,8 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "lockstep_timeout_ms",
     "realtime_priority",
     "max_miss_fraction",
+    "max_invalid_burst",
+    "max_invalid_fraction",
 ];
 
 /// `[controller]` keys the controller process uses (the `relev_*` ones are deprecated aliases
@@ -82,8 +87,10 @@ pub struct LawOverrides {
 pub struct Applied {
     /// The law's name.
     pub law: String,
-    /// The design.
+    /// The design (plane A's on a two-plane rotor).
     pub design: Design,
+    /// The whole rotor's design (every plane with the overrides applied).
+    pub rotor: RotorDesign,
     /// The law's parameters.
     pub params: Params,
     /// What differs from the hello, as the `[controller]` table of a scene (`law`, the design
@@ -126,6 +133,7 @@ impl LawOverrides {
                 ));
             }
         }
+        let mut rotor = hello.rotor_design().ok_or_else(|| format!("a hello of {} axes", hello.axes))?;
         let mut design = hello.design();
         let mut overrides = toml::Table::new();
         if law != plant_law {
@@ -151,7 +159,18 @@ impl LawOverrides {
         if params != hello_params {
             overrides.insert("params".into(), toml::Value::Table(params.clone()));
         }
-        Ok(Applied { law, design, params: Params::new(params), overrides, warnings })
+        let planes: &mut [Design] = match &mut rotor {
+            RotorDesign::Planar(d) => std::slice::from_mut(d),
+            RotorDesign::TwoPlane { planes, .. } => planes,
+        };
+        for plane in planes {
+            let (stiffness, damping, limit) = (plane.stiffness_n_per_m, plane.damping_ratio, plane.current_limit_a);
+            plane.stiffness_n_per_m = self.stiffness_n_per_m.unwrap_or(stiffness);
+            plane.damping_ratio = self.damping_ratio.unwrap_or(damping);
+            plane.current_limit_a = self.current_limit_a.unwrap_or(limit);
+            plane.gravity_bias = self.gravity_bias.unwrap_or(plane.gravity_bias);
+        }
+        Ok(Applied { law, design, rotor, params: Params::new(params), overrides, warnings })
     }
 }
 
@@ -178,14 +197,33 @@ pub enum FileError {
 
 /// Reads the `[controller]` table of a file (a `law` must be of the registry).
 pub fn load(path: &Path) -> Result<LawOverrides, FileError> {
-    load_for(path, &crate::registry::law_names())
+    load_for(path, &crate::registry::all_law_names())
 }
 
 /// Reads the `[controller]` table of a file for a controller that serves the laws `served`.
 pub fn load_for(path: &Path, served: &[&str]) -> Result<LawOverrides, FileError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| FileError::Read { path: shown.clone(), source })?;
+    let text = read_input(path).map_err(|source| FileError::Read { path: shown.clone(), source })?;
     parse_for(&text, served).map_err(|message| FileError::Invalid { path: shown, message })
+}
+
+/// The most a `--config` file may hold (a scene file is a few kilobytes).
+const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// Reads a `--config` file without trusting it: a regular file of at most [`MAX_FILE_BYTES`]
+/// (a device such as `/dev/zero` or a FIFO is refused before it is read; the plant's files go
+/// through `shock_table::input`, which this crate does not depend on).
+fn read_input(path: &Path) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(Error::new(ErrorKind::InvalidInput, "not a regular file (a device, a FIFO or a folder)"));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)?.take(MAX_FILE_BYTES + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(Error::new(ErrorKind::InvalidInput, format!("more than {MAX_FILE_BYTES} bytes")));
+    }
+    Ok(text)
 }
 
 /// Parses the `[controller]` table of a TOML text.
@@ -196,7 +234,7 @@ pub fn load_for(path: &Path, served: &[&str]) -> Result<LawOverrides, FileError>
 /// assert!(controller::file::parse("[controller]\nbogus = 1\n").unwrap_err().contains("controller.bogus"));
 /// ```
 pub fn parse(text: &str) -> Result<LawOverrides, String> {
-    parse_for(text, &crate::registry::law_names())
+    parse_for(text, &crate::registry::all_law_names())
 }
 
 /// [`parse`] for a controller that serves the laws `served` (a `law` must be one of them).
@@ -348,6 +386,20 @@ mod tests {
         let a = o.apply(&Hello::example("r")).unwrap();
         assert_eq!(a.design.damping_ratio, 0.02);
         assert_eq!(a.overrides_document(), "[controller]\ndamping_ratio = 0.02\n");
+    }
+
+    #[test]
+    fn the_design_keys_apply_to_both_planes_of_a_two_plane_hello() {
+        let o = parse("[controller]\nstiffness_n_per_m = 2e6\ncurrent_limit_a = 3.0\n").unwrap();
+        let a = o.apply(&Hello::example_two_plane("r")).unwrap();
+        for plane in a.rotor.planes() {
+            assert_eq!((plane.stiffness_n_per_m, plane.current_limit_a, plane.damping_ratio), (2e6, 3.0, 0.01));
+        }
+        assert_eq!(a.rotor.planes().len(), 2);
+        assert_eq!(a.design, a.rotor.planes()[0]);
+        assert_eq!(a.overrides_document(), "[controller]\ncurrent_limit_a = 3.0\nstiffness_n_per_m = 2000000.0\n");
+        let planar = o.apply(&Hello::example("r")).unwrap();
+        assert_eq!(planar.rotor, RotorDesign::Planar(planar.design));
     }
 
     #[test]

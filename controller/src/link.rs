@@ -48,12 +48,49 @@ pub enum LinkError {
         detail: String,
     },
     /// A service exists with other message types: the peer was built with
-    /// another protocol version (the version is part of every type name).
-    #[error("{service}: the peer uses other message types (another protocol version: this side speaks version {version}, type names amb_testbed.v{version}.*)", version = wire::PROTOCOL_VERSION)]
+    /// another protocol version (the version is part of every type name). The
+    /// existing service's type name tells which, when it can be read.
+    #[error("{service}: the peer uses other message types ({peer}; this side speaks version {version}, type names amb_testbed.v{version}.*): run a plant and a controller of the same protocol version", peer = describe_peer(peer_type.as_deref()), version = wire::PROTOCOL_VERSION)]
     Incompatible {
         /// Service name.
         service: String,
+        /// The payload type name the existing service was created with, if it could be read.
+        peer_type: Option<String>,
     },
+}
+
+/// The protocol version in a type name `amb_testbed.v<N>.<Struct>`.
+pub fn version_of(type_name: &str) -> Option<u32> {
+    type_name.strip_prefix("amb_testbed.v")?.split('.').next()?.parse().ok()
+}
+
+fn describe_peer(peer_type: Option<&str>) -> String {
+    match peer_type {
+        Some(t) => match version_of(t) {
+            Some(v) if v == wire::PROTOCOL_VERSION => {
+                format!("its type is {t}: this protocol version, but another message on this service")
+            }
+            Some(v) => format!("the peer speaks protocol version {v}: its type is {t}"),
+            None => format!("its type is {t}, not of this testbed's protocol"),
+        },
+        None => "another protocol version".to_string(),
+    }
+}
+
+/// The payload type name of the publish-subscribe service `name` as its creator made it, if
+/// it exists and can be read (to name a peer's protocol version).
+fn existing_type_name(name: &ServiceName) -> Option<String> {
+    use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Static;
+    let details = <Ipc as iceoryx2::service::Service>::details(
+        name,
+        Config::global_config(),
+        iceoryx2::service::messaging_pattern::MessagingPattern::PublishSubscribe,
+    )
+    .ok()??;
+    match details.static_details.messaging_pattern() {
+        Static::PublishSubscribe(c) => Some(c.message_type_details().payload.type_name().to_string()),
+        _ => None,
+    }
 }
 
 fn ipc_err(what: impl Into<String>) -> impl FnOnce(&dyn Debug) -> LinkError {
@@ -145,7 +182,7 @@ fn pubsub<T: Debug + Copy + ZeroCopySend + 'static>(
         .map_err(|e| match e {
             PublishSubscribeOpenOrCreateError::PublishSubscribeOpenError(
                 PublishSubscribeOpenError::IncompatibleTypes,
-            ) => LinkError::Incompatible { service: name.to_string() },
+            ) => LinkError::Incompatible { service: name.to_string(), peer_type: existing_type_name(&name) },
             other => ipc_err(format!("opening service {name}"))(&other),
         })
 }

@@ -7,5 +7,5 @@
 //! so that a crate outside this repository is a controller by the same call.
 
 fn main() -> std::process::ExitCode {
-    controller::serve(controller::LAWS)
+    controller::serve(controller::ALL_LAWS)
 }

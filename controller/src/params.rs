@@ -19,7 +19,7 @@
 //! assert!(r.finish().unwrap_err().to_string().contains("unknown parameter controller.params.bogus"));
 //! ```
 
-use crate::law::LawError;
+use crate::error::LawError;
 
 /// Longest `[controller.params]` document, as TOML text (bytes): the size of
 /// the hello's `params` field ([`crate::wire::Hello::params`]).

@@ -12,9 +12,9 @@
 //! so `k_p = (k_e + k_s) / (k_i A_a A_s)` (V/V) and `k_d = c_e / (k_i A_a A_s)` (s).
 //! The gravity bias `i_g = m_r g / k_i` on the y axis centres the levitated rotor.
 
-use crate::law::{ControlLaw, Design, LawError, LoopConstants, Sample};
+pub use crate::law::PdDesign;
+use crate::law::{ControlLaw, Design, LawEntry, LawError, LoopConstants, Sample};
 use crate::params::Params;
-use crate::registry::LawEntry;
 
 /// `pd`: the naively sampled PD of the design (no parameters of its own).
 pub const LAW: LawEntry =
@@ -24,17 +24,6 @@ fn build(design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawErr
     params.reader(LAW.name).finish()?;
     let gains = PdGains::from_design(&design.pd(), &design.constants)?;
     Ok(Box::new(SampledPd::new(gains, design.period_s)))
-}
-
-/// A PD design: the closed-loop behaviour asked for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PdDesign {
-    /// Closed-loop stiffness k_e (N/m), > 0.
-    pub stiffness_n_per_m: f64,
-    /// Closed-loop damping ratio ξ_e, ≥ 0.
-    pub damping_ratio: f64,
-    /// Add the gravity bias current on the y axis.
-    pub gravity_bias: bool,
 }
 
 /// PD gains derived from a design.
@@ -178,12 +167,12 @@ mod tests {
         let d = PdDesign { stiffness_n_per_m: 1e6, damping_ratio: 0.01, gravity_bias: false };
         let g = PdGains::from_design(&d, &c).unwrap();
         let mut law = SampledPd::new(g, 1e-4);
-        let first = law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0] });
+        let first = law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0], ..Default::default() });
         assert_eq!(first, g.current([0.1, 0.0], [0.0; 2]));
-        let second = law.update(&Sample { seq: 1, t_s: 1e-4, sensor_v: [0.2, 0.0] });
+        let second = law.update(&Sample { seq: 1, t_s: 1e-4, sensor_v: [0.2, 0.0], ..Default::default() });
         assert_eq!(second, g.current([0.2, 0.0], [1000.0, 0.0]));
         law.reset();
-        assert_eq!(law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0] }), first);
+        assert_eq!(law.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.1, 0.0], ..Default::default() }), first);
     }
 
     #[test]

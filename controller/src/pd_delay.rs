@@ -3,9 +3,8 @@
 //! delay (no parameters of its own).
 
 use crate::discrete_pd::{DelayPd, DelayPdGains};
-use crate::law::{ControlLaw, Design, LawError};
+use crate::law::{ControlLaw, Design, LawEntry, LawError};
 use crate::params::Params;
-use crate::registry::LawEntry;
 
 /// `pd_delay`: the design's poles held exactly by a PD designed for the period and the delay.
 pub const LAW: LawEntry = LawEntry {

@@ -40,10 +40,9 @@
 //! stays where it was when the limit was reached, and the current leaves the
 //! limit as soon as the error reverses.
 
-use crate::law::{ControlLaw, Design, LawError, LoopConstants, Sample};
+use crate::law::{ControlLaw, Design, LawEntry, LawError, LoopConstants, Sample};
 use crate::params::{Check, Params};
 use crate::pd::{BackwardDifference, PdDesign, PdGains};
-use crate::registry::LawEntry;
 
 /// `pid`: parameter `integral_time_s` (s, > 0; default `10/ω_n`).
 pub const LAW: LawEntry = LawEntry {
@@ -260,14 +259,14 @@ mod tests {
 
     /// Ticks until the saturated current leaves the limit after the error reverses.
     fn ticks_to_leave(law: &mut SampledPid, limit: f64) -> usize {
-        let big = Sample { seq: 0, t_s: 0.0, sensor_v: [10.0, 0.0] }; // 400 µm: k_p u exceeds the limit
+        let big = Sample { seq: 0, t_s: 0.0, sensor_v: [10.0, 0.0], ..Default::default() }; // 400 µm: k_p u exceeds the limit
         for k in 0..20_000 {
             let i = saturate(law.update(&Sample { seq: k, ..big }), limit);
             assert_eq!(i[0], -limit);
         }
         // −40 µm. The first reversed tick carries the derivative kick, which
         // leaves the limit in any case: count from the tick after it.
-        let back = Sample { seq: 0, t_s: 0.0, sensor_v: [-1.0, 0.0] };
+        let back = Sample { seq: 0, t_s: 0.0, sensor_v: [-1.0, 0.0], ..Default::default() };
         law.update(&Sample { seq: 20_000, ..back });
         (0..1_000_000)
             .position(|k| saturate(law.update(&Sample { seq: 20_001 + k as u64, ..back }), limit)[0] > -limit)
@@ -292,8 +291,9 @@ mod tests {
         let gains = PidGains::from_design(&design(0.01, true), &c).unwrap();
         let mut law = SampledPid::new(gains, 5e-5, 2.0);
         assert_eq!(law.name(), "pid");
-        let samples: Vec<Sample> =
-            (0..50).map(|k| Sample { seq: k, t_s: k as f64 * 5e-5, sensor_v: [0.01 * k as f64, -0.02] }).collect();
+        let samples: Vec<Sample> = (0..50)
+            .map(|k| Sample { seq: k, t_s: k as f64 * 5e-5, sensor_v: [0.01 * k as f64, -0.02], ..Default::default() })
+            .collect();
         let first: Vec<[f64; 2]> = samples.iter().map(|s| law.update(s)).collect();
         assert_ne!(law.integral(), [0.0; 2]);
         law.reset();

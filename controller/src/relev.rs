@@ -29,10 +29,9 @@
 //! estimate.
 
 use crate::discrete_pd::DelayPdGains;
-use crate::law::{ControlLaw, Design, LawError, LoopConstants, Sample};
+use crate::law::{ControlLaw, Design, LawEntry, LawError, LoopConstants, Sample};
 use crate::params::{Check, Params};
 use crate::pd::{BackwardDifference, PdDesign};
-use crate::registry::LawEntry;
 
 /// `relev` and its parameters (`[controller.params]`):
 ///
@@ -260,7 +259,7 @@ mod tests {
 
     fn at(law: &mut Relev, k: u64, x_m: f64) -> [f64; 2] {
         let u = [x_m * LoopConstants::study().sensor_gain_v_per_m, 0.0];
-        law.update(&Sample { seq: k, t_s: k as f64 * PERIOD, sensor_v: u })
+        law.update(&Sample { seq: k, t_s: k as f64 * PERIOD, sensor_v: u, ..Default::default() })
     }
 
     #[test]

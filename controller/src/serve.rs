@@ -10,6 +10,12 @@
 //! }
 //! ```
 //!
+//! Laws of both kinds (per plane, [`crate::LawEntry`]; of the whole rotor, [`crate::RotorLawEntry`])
+//! are served together as [`AnyLaw`]s: `controller::serve(controller::ALL_LAWS)` is the
+//! `controller` binary. A per-plane law serves the planar model (2 axes) and, one instance per
+//! bearing plane, the two-plane rotor (4 axes); a law of the whole rotor the rotor it drives
+//! (a hello it cannot drive is refused with code 3, axes).
+//!
 //! What [`serve`] does, in order:
 //!
 //! 1. reads the command line ([`ServeArgs`]: `--run-id ID` or the
@@ -18,13 +24,14 @@
 //!    `--quiet`); installs one SIGINT/SIGTERM handler;
 //! 2. takes the run id's controller lock ([`crate::lock`]): a second
 //!    controller under a live run id is refused (exit 2, naming the first);
-//! 3. waits for the plant's hello, checks it ([`wire::check_hello`]), applies
-//!    the `--config`/`--law` overrides, and builds the law the hello names
-//!    from the laws given to it; refuses the run (an [`Ack`] with a
-//!    [`Refusal`] code and the reason) when the law is not among them or
-//!    refuses its parameters;
+//! 3. waits for the plant's hello, checks it ([`wire::check_hello`]: protocol
+//!    version 4, 2 or 4 axes), applies the `--config`/`--law` overrides, and
+//!    builds the law the hello names from the laws given to it, for the
+//!    rotor the hello describes ([`Hello::rotor_design`]); refuses the run (an
+//!    [`Ack`] with a [`Refusal`] code and the reason) when the law is not
+//!    among them, cannot drive that rotor, or refuses its parameters;
 //! 4. answers every sensor frame of the run's token and session with the
-//!    law's currents, saturated at the hello's limit, through
+//!    law's currents, each saturated at its plane's limit, through
 //!    [`link::Endpoint`] (spin, then block, with the wake protocol both ways:
 //!    it asks to be woken before blocking, and wakes the plant when asked);
 //! 5. watches the plant's node while it is silent, and ends: 0 on the plant's
@@ -38,11 +45,10 @@
 //! warning for each step the system refuses.
 
 use crate::file::{self, Applied, LawOverrides};
+use crate::law::{build_among, saturate_axes, AnyLaw, LawError, RotorLaw, ROTOR_AXES};
 use crate::link::{self, Endpoint, LinkError, Mailbox, Peer};
 use crate::lock::{self, LockError};
-use crate::registry::LawEntry;
 use crate::wire::{self, Ack, CommandFrame, Expect, Hello, Refusal, SensorFrame};
-use crate::{saturate, ControlLaw, LawError, Sample};
 use clap::{CommandFactory, FromArgMatches, Parser};
 use std::ffi::OsString;
 use std::path::PathBuf;
@@ -275,14 +281,20 @@ pub struct Served {
 static STOP: AtomicBool = AtomicBool::new(false);
 
 /// The whole controller process: reads the command line and the environment, serves one
-/// run with `laws`, prints the ending once (`<program>: …`) and returns its exit code.
-/// Call it from `main` (see the module doc).
-pub fn serve(laws: &[LawEntry]) -> ExitCode {
+/// run with `laws` (per-plane [`crate::LawEntry`]s, [`crate::RotorLawEntry`]s or [`AnyLaw`]s),
+/// prints the ending once (`<program>: …`) and returns its exit code. Call it from `main`
+/// (see the module doc).
+pub fn serve<L: Copy + Into<AnyLaw>>(laws: &[L]) -> ExitCode {
     serve_from(std::env::args_os().collect(), laws)
 }
 
 /// [`serve`] with the command line given (the program name first).
-pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
+pub fn serve_from<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> ExitCode {
+    ExitCode::from(serve_code(argv, laws))
+}
+
+/// [`serve_from`], the exit code as a number (for the C API, which returns it).
+pub fn serve_code<L: Copy + Into<AnyLaw>>(argv: Vec<OsString>, laws: &[L]) -> u8 {
     let program = argv
         .first()
         .map(|p| std::path::Path::new(p).file_name().unwrap_or(p.as_os_str()).to_string_lossy().into_owned())
@@ -300,7 +312,7 @@ pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
     let ended = ServeOptions::from_args(&args, |k| std::env::var(k).ok())
         .and_then(|opts| run(&opts, laws, &STOP, &mut |w| eprintln!("{program}: {w}")));
     match ended {
-        Ok(_) => ExitCode::SUCCESS,
+        Ok(_) => exit::OK,
         Err(e) => {
             let code = e.exit_code();
             if matches!(code, exit::PLANT_LOST | exit::INTERRUPTED) {
@@ -308,7 +320,7 @@ pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
             } else {
                 eprintln!("{program}: error: {e}");
             }
-            ExitCode::from(code)
+            code
         }
     }
 }
@@ -316,13 +328,14 @@ pub fn serve_from(argv: Vec<OsString>, laws: &[LawEntry]) -> ExitCode {
 /// Serves one run of the plant with `laws`: handshake, then one reply per sensor frame
 /// until the plant's STOP (`Ok`), or a [`ServeError`]. `stop` is the signal flag (set it
 /// to end the run: the plant is told); `say` gets the start-up and end lines and warnings.
-pub fn run(
+pub fn run<L: Copy + Into<AnyLaw>>(
     opts: &ServeOptions,
-    laws: &[LawEntry],
+    laws: &[L],
     stop: &AtomicBool,
     say: &mut dyn FnMut(&str),
 ) -> Result<Served, ServeError> {
-    let served: Vec<&'static str> = laws.iter().map(|l| l.name).collect();
+    let laws: Vec<AnyLaw> = laws.iter().map(|&l| l.into()).collect();
+    let served: Vec<&'static str> = laws.iter().map(AnyLaw::name).collect();
     let mut overrides = match &opts.config {
         Some(path) => file::load_for(path, &served)?,
         None => LawOverrides::default(),
@@ -369,9 +382,10 @@ pub fn run(
         // node.wait only sleeps here: signals are handled by the flag (see crate::link).
         let _ = node.wait(Duration::from_millis(1));
     };
-    let (mut law, limit, description) = match accept(&hello, run_id, &overrides, laws, &served, say) {
-        Ok((law, limit, description, document)) => {
-            let ack = Ack::new(hello.session, hello.token, 0, law.name(), &description).with_overrides(&document);
+    let Built { mut law, limits, description, .. } = match accept(&hello, run_id, &overrides, &laws, say) {
+        Ok(built) => {
+            let ack = Ack::new(hello.session, hello.token, 0, built.law.name(), &built.description)
+                .with_overrides(&built.document);
             match ack {
                 Ok(a) => handshake.send(a)?,
                 Err(len) => {
@@ -380,7 +394,7 @@ pub fn run(
                     return Err(refuse(&handshake, &hello, Refusal::Params, message));
                 }
             }
-            (law, limit, description)
+            built
         }
         Err((why, message)) => return Err(refuse(&handshake, &hello, why, message)),
     };
@@ -389,7 +403,7 @@ pub fn run(
         say(&format!("serving run {run_id} (session {}, pid {}): {description}", hello.session, std::process::id()));
     }
 
-    let (session, token) = (hello.session, hello.token);
+    let (session, token, axes) = (hello.session, hello.token, hello.axes);
     let mut last_heard = Instant::now();
     let mut last_check = Instant::now();
     let mut lost: Option<String> = None;
@@ -400,7 +414,7 @@ pub fn run(
                 status: CommandFrame::STOPPING,
                 session,
                 token,
-                axes: wire::AXES,
+                axes,
                 sent_ns: wire::monotonic_ns(),
                 ..Default::default()
             };
@@ -454,8 +468,9 @@ pub fn run(
             unsafe { libc::kill(libc::getpid(), libc::SIGKILL) };
         }
         let received_ns = wire::monotonic_ns();
-        let sample = Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy() };
-        let current = saturate(law.update(&sample), limit);
+        // The hello's axis count, whatever the frame says: the law was built for it.
+        let sample = wire::SensorFrame { axes, ..frame }.rotor_sample();
+        let current = saturate_axes(law.update(&sample), limits);
         answered += 1;
         frames.send(CommandFrame {
             seq: frame.seq,
@@ -464,47 +479,62 @@ pub fn run(
             sent_ns: wire::monotonic_ns(),
             status: 0,
             session,
-            axes: wire::AXES,
+            axes,
             reserved: 0,
-            current_a: wire::axes_of(current),
+            current_a: wire::rotor_axes_of(current, axes),
         })?;
     }
 }
 
-/// The law a hello asks for, built: `(law, current limit, description, overrides document)`,
-/// or the refusal.
-#[allow(clippy::type_complexity)]
+/// The law a hello asks for, built, with what the ack says.
+struct Built {
+    law: Box<dyn RotorLaw>,
+    /// Each axis's current limit (A).
+    limits: [f64; ROTOR_AXES],
+    /// The ack's message: the law and its design.
+    description: String,
+    /// The overrides document.
+    document: String,
+}
+
+/// Builds the law a hello asks for among `laws`, or the refusal.
 fn accept(
     hello: &Hello,
     run_id: &str,
     overrides: &LawOverrides,
-    laws: &[LawEntry],
-    served: &[&'static str],
+    laws: &[AnyLaw],
     say: &mut dyn FnMut(&str),
-) -> Result<(Box<dyn ControlLaw>, f64, String, String), (Refusal, String)> {
+) -> Result<Built, (Refusal, String)> {
     wire::check_hello(hello, &Expect { run_id, rate_hz: overrides.rate_hz })?;
     let applied = overrides.apply(hello).map_err(|message| (Refusal::Params, message))?;
     let document = applied.overrides_document();
-    let Applied { law: name, design, params, warnings, .. } = applied;
+    let Applied { law: name, rotor, params, warnings, .. } = applied;
     for w in &warnings {
         say(&format!("warning: {w}"));
     }
-    let Some(entry) = laws.iter().find(|l| l.name == name) else {
-        return Err((
-            Refusal::Law,
-            format!("law `{name}` is not served by this controller (it serves {})", served.join(", ")),
-        ));
-    };
-    let law = (entry.build)(&design, &params).map_err(|e| match e {
+    let law = build_among(laws, &name, &rotor, &params).map_err(|e| match e {
         LawError::Param { .. } | LawError::UnknownParam { .. } => (Refusal::Params, e.to_string()),
-        _ => (Refusal::Law, e.to_string()),
+        LawError::Axes { .. } => (Refusal::Axes, e.to_string()),
+        LawError::Unknown { .. } | LawError::Design { .. } | LawError::Refused { .. } => (Refusal::Law, e.to_string()),
     })?;
-    let limit = design.current_limit_a;
-    let description = format!(
-        "{name}: k_e = {} N/m, xi_e = {}, i_max = {limit} A at {} Hz",
-        design.stiffness_n_per_m, design.damping_ratio, hello.rate_hz
-    );
-    Ok((law, limit, description, document))
+    let a = rotor.plane_a();
+    let description = match rotor.planes() {
+        [_, b] => format!(
+            "{name}: 4 axes, k_e = {} / {} N/m, xi_e = {} / {}, i_max = {} / {} A (planes A / B) at {} Hz",
+            a.stiffness_n_per_m,
+            b.stiffness_n_per_m,
+            a.damping_ratio,
+            b.damping_ratio,
+            a.current_limit_a,
+            b.current_limit_a,
+            hello.rate_hz
+        ),
+        _ => format!(
+            "{name}: k_e = {} N/m, xi_e = {}, i_max = {} A at {} Hz",
+            a.stiffness_n_per_m, a.damping_ratio, a.current_limit_a, hello.rate_hz
+        ),
+    };
+    Ok(Built { law, limits: rotor.current_limits(), description, document })
 }
 
 /// Tells the plant why its hello is refused; the ending to return.
@@ -528,7 +558,7 @@ mod tests {
             (ServeError::UnknownLaw { name: "nope".into(), served: vec!["pd"] }, 2),
             (ServeError::PlantLost("gone".into()), 4),
             (ServeError::Interrupted { run_id: "r".into() }, 130),
-            (LinkError::Incompatible { service: "s".into() }.into(), 2),
+            (LinkError::Incompatible { service: "s".into(), peer_type: Some("amb_testbed.v3.Hello".into()) }.into(), 2),
             (ServeError::Link(LinkError::Ipc { what: "w".into(), detail: "d".into() }, Some("while x".into())), 1),
             (
                 ServeError::Lock(LockError::InUse {
@@ -578,6 +608,36 @@ mod tests {
         assert_eq!(parse(&["--run-id", "a"], &[(REALTIME_PRIORITY_ENV, "0")]).unwrap().realtime_priority, None);
         let e = parse(&["--run-id", "a"], &[(REALTIME_PRIORITY_ENV, "120")]).unwrap_err().to_string();
         assert!(e.contains(REALTIME_PRIORITY_ENV) && e.contains("120"), "{e}");
+    }
+
+    /// The hello's rotor decides what is built: a per-plane law runs on 2 or 4 axes, `modal`
+    /// on 4 only (a planar hello is refused with code 3, axes), an unknown law with code 5
+    /// naming the laws this controller serves.
+    #[test]
+    fn a_hello_is_built_for_its_rotor_or_refused_with_its_code() {
+        let laws = [AnyLaw::from(crate::pd::LAW), AnyLaw::from(crate::modal::LAW)];
+        let none = LawOverrides::default();
+        let with_law = |mut h: Hello, law: &str| {
+            h.law = wire::fixed_str(law);
+            h
+        };
+        let two = Hello::example_two_plane("r");
+        let built = accept(&with_law(two, "modal"), "r", &none, &laws, &mut |_| {}).expect("modal on 4 axes");
+        assert_eq!(built.law.name(), "modal");
+        assert!(built.description.starts_with("modal: 4 axes, k_e = 1000000 / 1000000 N/m"), "{}", built.description);
+        let built = accept(&two, "r", &none, &laws, &mut |_| {}).expect("pd on 4 axes");
+        assert_eq!((built.law.name(), built.limits), ("pd", [2.0; 4]));
+        let planar = Hello::example("r");
+        let built = accept(&planar, "r", &none, &laws, &mut |_| {}).expect("pd on 2 axes");
+        assert_eq!(built.description, "pd: k_e = 1000000 N/m, xi_e = 0.01, i_max = 2 A at 20000 Hz");
+        let (why, message) = accept(&with_law(planar, "modal"), "r", &none, &laws, &mut |_| {}).err().unwrap();
+        assert_eq!(why.code(), 3, "{message}");
+        assert!(
+            message.contains("law modal drives a two-plane rotor (4 axes) only; this rotor has 2 axes"),
+            "{message}"
+        );
+        let (why, message) = accept(&with_law(two, "pid"), "r", &none, &laws, &mut |_| {}).err().unwrap();
+        assert_eq!((why.code(), message.as_str()), (5, "unknown controller law `pid` (known laws: pd, modal)"));
     }
 
     #[test]

@@ -84,7 +84,10 @@ pub(crate) fn simulate(
     for k in 0..ticks {
         let sensor_v = [c.sensor_gain_v_per_m * y[0][0], c.sensor_gain_v_per_m * y[1][0]];
         xs.push([y[0][0], y[1][0]]);
-        let cmd = saturate(law.update(&Sample { seq: k as u64, t_s: k as f64 * period, sensor_v }), limit);
+        let cmd = saturate(
+            law.update(&Sample { seq: k as u64, t_s: k as f64 * period, sensor_v, ..Default::default() }),
+            limit,
+        );
         cmds.push(cmd);
         if k == 0 {
             // Before the first command arrives the coil holds it (the plant holds the bias).

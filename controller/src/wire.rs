@@ -71,20 +71,24 @@
 //! get no history. `docs/wire-protocol.md` says the rest (the order of the
 //! checks, liveness, the exact form of the shipped laws).
 
-use crate::law::{Design, LoopConstants};
+use crate::law::{Design, Geometry, LoopConstants, RotorDesign, RotorSample, ROTOR_AXES};
 use crate::params::{ParamsError, PARAMS_LEN};
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Protocol version. Incremented on any change of a layout or of the meaning
 /// of a field; it is also part of every iceoryx2 type name below, so peers of
-/// different versions cannot even open each other's services.
-pub const PROTOCOL_VERSION: u32 = 3;
+/// different versions cannot even open each other's services (`docs/wire-protocol.md`,
+/// "Versions", says what each side then sees).
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// Room for axes in a frame: entries `0..axes` are used, the rest are 0.
 pub const MAX_AXES: usize = 8;
 
-/// Number of controlled axes (x, y).
+/// Axes of the planar model (x, y): `Hello.axes` of a planar run.
 pub const AXES: u32 = 2;
+
+/// Axes of the two-plane rotor (x_A, y_A, x_B, y_B): `Hello.axes` of a two-plane run.
+pub const TWO_PLANE_AXES: u32 = 4;
 
 /// Units code: sensor in volts, currents in amperes, time in seconds, all
 /// other quantities SI.
@@ -115,21 +119,23 @@ pub mod mode {
     pub const BENCH: u32 = 3;
 }
 
-/// One sample of the sensors, plant → controller. 112 bytes.
+/// One sample of the sensors with the keyphasor, plant → controller. 128 bytes.
 ///
-/// | offset | size | field      | type      |
-/// |-------:|-----:|------------|-----------|
-/// | 0      | 8    | `seq`      | u64       |
-/// | 8      | 8    | `t_s`      | f64       |
-/// | 16     | 8    | `token`    | u64       |
-/// | 24     | 8    | `sent_ns`  | u64       |
-/// | 32     | 4    | `status`   | u32       |
-/// | 36     | 4    | `session`  | u32       |
-/// | 40     | 4    | `axes`     | u32       |
-/// | 44     | 4    | `reserved` | u32       |
-/// | 48     | 64   | `sensor_v` | [f64; 8]  |
+/// | offset | size | field         | type      |
+/// |-------:|-----:|---------------|-----------|
+/// | 0      | 8    | `seq`         | u64       |
+/// | 8      | 8    | `t_s`         | f64       |
+/// | 16     | 8    | `token`       | u64       |
+/// | 24     | 8    | `sent_ns`     | u64       |
+/// | 32     | 4    | `status`      | u32       |
+/// | 36     | 4    | `session`     | u32       |
+/// | 40     | 4    | `axes`        | u32       |
+/// | 44     | 4    | `reserved`    | u32       |
+/// | 48     | 64   | `sensor_v`    | [f64; 8]  |
+/// | 112    | 8    | `speed_rad_s` | f64       |
+/// | 120    | 8    | `angle_rad`   | f64       |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v3.SensorFrame")]
+#[type_name("amb_testbed.v4.SensorFrame")]
 #[repr(C)]
 pub struct SensorFrame {
     /// Tick index k (0, 1, 2, …).
@@ -144,12 +150,18 @@ pub struct SensorFrame {
     pub status: u32,
     /// Session of the handshake this frame belongs to ([`Hello::session`]).
     pub session: u32,
-    /// Entries of `sensor_v` in use ([`AXES`]).
+    /// Entries of `sensor_v` in use: [`AXES`] or [`TWO_PLANE_AXES`], as the hello.
     pub axes: u32,
     /// 0.
     pub reserved: u32,
-    /// Sensor voltages `A_s·Δ` (V), x then y; unused entries 0.
+    /// Sensor voltages `A_s·Δ` (V) in axis order: x, y (planar) or x_A, y_A, x_B, y_B;
+    /// unused entries 0.
     pub sensor_v: [f64; MAX_AXES],
+    /// The keyphasor's speed: the rotor's spin speed Ω (rad/s) at the sample.
+    pub speed_rad_s: f64,
+    /// The keyphasor's angle: the rotor's angle (rad) in [0, 2π) at the sample, in the sensor
+    /// frame; 0 when the unbalance points along +x ([`crate::Sample::angle_rad`]).
+    pub angle_rad: f64,
 }
 
 impl SensorFrame {
@@ -157,9 +169,25 @@ impl SensorFrame {
     /// values carry no sample.
     pub const STOP: u32 = 1;
 
-    /// The x and y sensor voltages (V).
+    /// The x and y sensor voltages (V) (plane A's on a two-plane rotor).
     pub fn sensor_xy(&self) -> [f64; 2] {
         [self.sensor_v[0], self.sensor_v[1]]
+    }
+
+    /// The sample this frame carries, for a law of the whole rotor (at most
+    /// [`ROTOR_AXES`] axes read; `axes` as the frame says, capped there).
+    pub fn rotor_sample(&self) -> RotorSample {
+        let axes = self.axes.min(ROTOR_AXES as u32);
+        let mut sensor_v = [0.0; ROTOR_AXES];
+        sensor_v[..axes as usize].copy_from_slice(&self.sensor_v[..axes as usize]);
+        RotorSample {
+            seq: self.seq,
+            t_s: self.t_s,
+            axes,
+            sensor_v,
+            speed_rad_s: self.speed_rad_s,
+            angle_rad: self.angle_rad,
+        }
     }
 }
 
@@ -167,6 +195,14 @@ impl SensorFrame {
 pub fn axes_of(xy: [f64; 2]) -> [f64; MAX_AXES] {
     let mut out = [0.0; MAX_AXES];
     out[..2].copy_from_slice(&xy);
+    out
+}
+
+/// Widens the first `axes` entries of a rotor's axis array to a frame's (the rest 0).
+pub fn rotor_axes_of(values: [f64; ROTOR_AXES], axes: u32) -> [f64; MAX_AXES] {
+    let n = (axes as usize).min(ROTOR_AXES);
+    let mut out = [0.0; MAX_AXES];
+    out[..n].copy_from_slice(&values[..n]);
     out
 }
 
@@ -184,7 +220,7 @@ pub fn axes_of(xy: [f64; 2]) -> [f64; MAX_AXES] {
 /// | 44     | 4    | `reserved`    | u32      |
 /// | 48     | 64   | `current_a`   | [f64; 8] |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v3.CommandFrame")]
+#[type_name("amb_testbed.v4.CommandFrame")]
 #[repr(C)]
 pub struct CommandFrame {
     /// The `seq` of the [`SensorFrame`] this answers.
@@ -199,11 +235,13 @@ pub struct CommandFrame {
     pub status: u32,
     /// Session of the handshake ([`Hello::session`]).
     pub session: u32,
-    /// Entries of `current_a` in use ([`AXES`]).
+    /// Entries of `current_a` in use: the hello's `axes`.
     pub axes: u32,
     /// 0.
     pub reserved: u32,
-    /// Coil currents (A), x then y, saturated at [`Hello::current_limit_a`]; unused entries 0.
+    /// Coil currents (A) in axis order (x, y, or x_A, y_A, x_B, y_B), each saturated at its
+    /// plane's limit ([`Hello::current_limit_a`], [`Hello::b_current_limit_a`]); unused
+    /// entries 0.
     pub current_a: [f64; MAX_AXES],
 }
 
@@ -212,9 +250,14 @@ impl CommandFrame {
     /// `seq` and `current_a` carry no answer.
     pub const STOPPING: u32 = 1;
 
-    /// The x and y currents (A).
+    /// The x and y currents (A) (plane A's on a two-plane rotor).
     pub fn current_xy(&self) -> [f64; 2] {
         [self.current_a[0], self.current_a[1]]
+    }
+
+    /// The currents of the first [`ROTOR_AXES`] axes (A), in axis order.
+    pub fn current_axes(&self) -> [f64; ROTOR_AXES] {
+        [self.current_a[0], self.current_a[1], self.current_a[2], self.current_a[3]]
     }
 }
 
@@ -225,15 +268,17 @@ impl CommandFrame {
 /// |-------:|-----:|--------|------|
 /// | 0      | 8    | `seq`  | u64  |
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("amb_testbed.v3.WakeRequest")]
+#[type_name("amb_testbed.v4.WakeRequest")]
 #[repr(C)]
 pub struct WakeRequest {
     /// The `seq` the sender waits for (informative).
     pub seq: u64,
 }
 
-/// The plant's side of the handshake: what it runs, the common loop design
-/// ([`Design`]) and the law's own parameters. 4312 bytes.
+/// The plant's side of the handshake: what it runs, each bearing plane's loop design
+/// ([`Design`]: plane A in the fields of protocol 3, plane B's in the `b_` fields), the
+/// rotor's geometry for 4 axes ([`Geometry`]), and the law's own parameters. 4448 bytes.
+/// The fields of a planar hello past `params` are 0.
 ///
 /// | offset | size | field                  | type       |
 /// |-------:|-----:|------------------------|------------|
@@ -264,13 +309,30 @@ pub struct WakeRequest {
 /// | 208    | 4    | `params_len`           | u32        |
 /// | 212    | 4    | `reserved`             | u32        |
 /// | 216    | 4096 | `params`               | [u8; 4096] |
+/// | 4312   | 8    | `b_stiffness_n_per_m`  | f64        |
+/// | 4320   | 8    | `b_damping_ratio`      | f64        |
+/// | 4328   | 8    | `b_ki_n_per_a`         | f64        |
+/// | 4336   | 8    | `b_ks_n_per_m`         | f64        |
+/// | 4344   | 8    | `b_amp_gain_a_per_v`   | f64        |
+/// | 4352   | 8    | `b_sensor_gain_v_per_m`| f64        |
+/// | 4360   | 8    | `b_rotor_mass_kg`      | f64        |
+/// | 4368   | 8    | `b_current_limit_a`    | f64        |
+/// | 4376   | 8    | `b_air_gap_m`          | f64        |
+/// | 4384   | 8    | `total_mass_kg`        | f64        |
+/// | 4392   | 8    | `transverse_inertia_kg_m2` | f64    |
+/// | 4400   | 8    | `polar_inertia_kg_m2`  | f64        |
+/// | 4408   | 8    | `rated_speed_rad_s`    | f64        |
+/// | 4416   | 8    | `bearing_a_z_m`        | f64        |
+/// | 4424   | 8    | `bearing_b_z_m`        | f64        |
+/// | 4432   | 8    | `sensor_a_z_m`         | f64        |
+/// | 4440   | 8    | `sensor_b_z_m`         | f64        |
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("amb_testbed.v3.Hello")]
+#[type_name("amb_testbed.v4.Hello")]
 #[repr(C)]
 pub struct Hello {
     /// [`PROTOCOL_VERSION`] of the plant.
     pub protocol_version: u32,
-    /// Number of axes, [`AXES`].
+    /// Number of axes: [`AXES`] (planar) or [`TWO_PLANE_AXES`].
     pub axes: u32,
     /// Units code, [`UNITS_SI`].
     pub units: u32,
@@ -287,25 +349,26 @@ pub struct Hello {
     pub run_id: [u8; RUN_ID_LEN],
     /// Law name (`controller.law`), UTF-8, NUL-padded.
     pub law: [u8; LAW_NAME_LEN],
-    /// Design stiffness k_e (N/m).
+    /// Design stiffness k_e (N/m) (plane A's).
     pub stiffness_n_per_m: f64,
-    /// Design damping ratio ξ_e.
+    /// Design damping ratio ξ_e (plane A's).
     pub damping_ratio: f64,
-    /// Force-current coefficient k_i (N/A).
+    /// Force-current coefficient k_i (N/A) (plane A's).
     pub ki_n_per_a: f64,
-    /// Force-displacement coefficient k_s (N/m).
+    /// Force-displacement coefficient k_s (N/m) (plane A's).
     pub ks_n_per_m: f64,
-    /// Amplifier gain A_a (A/V).
+    /// Amplifier gain A_a (A/V) (plane A's).
     pub amp_gain_a_per_v: f64,
-    /// Sensor gain A_s (V/m).
+    /// Sensor gain A_s (V/m) (plane A's).
     pub sensor_gain_v_per_m: f64,
-    /// Rotor mass m_r (kg).
+    /// Rotor mass m_r (kg) carried by the bearing: the planar model's mass, plane A's share on
+    /// a two-plane rotor.
     pub rotor_mass_kg: f64,
-    /// Gravity g (m/s²).
+    /// Gravity g (m/s²) (both planes).
     pub gravity_m_s2: f64,
-    /// Amplifier limit i_max (A): the controller saturates at it.
+    /// Amplifier limit i_max (A) (plane A's): the controller saturates at it.
     pub current_limit_a: f64,
-    /// Radial air gap r_0 of the touchdown bearing (m).
+    /// Radial air gap r_0 of the touchdown bearing (m) (plane A's).
     pub air_gap_m: f64,
     /// Samples between a sample and the tick its command is applied from.
     pub delay_samples: u32,
@@ -324,6 +387,40 @@ pub struct Hello {
     /// The scene's `[controller.params]` table as TOML text, UTF-8 (the first `params_len`
     /// bytes; the rest 0).
     pub params: [u8; PARAMS_LEN],
+    /// Plane B's design stiffness k_e (N/m); 0 on a planar hello (as every field below).
+    pub b_stiffness_n_per_m: f64,
+    /// Plane B's design damping ratio ξ_e.
+    pub b_damping_ratio: f64,
+    /// Plane B's k_i (N/A).
+    pub b_ki_n_per_a: f64,
+    /// Plane B's k_s (N/m).
+    pub b_ks_n_per_m: f64,
+    /// Plane B's amplifier gain A_a (A/V).
+    pub b_amp_gain_a_per_v: f64,
+    /// Plane B's sensor gain A_s (V/m).
+    pub b_sensor_gain_v_per_m: f64,
+    /// The rotor mass plane B carries (kg).
+    pub b_rotor_mass_kg: f64,
+    /// Plane B's amplifier limit (A).
+    pub b_current_limit_a: f64,
+    /// Plane B's touchdown air gap (m).
+    pub b_air_gap_m: f64,
+    /// The whole rotor's mass M (kg).
+    pub total_mass_kg: f64,
+    /// Transverse moment of inertia I_t about the centre of mass (kg m²).
+    pub transverse_inertia_kg_m2: f64,
+    /// Polar moment of inertia I_p (kg m²).
+    pub polar_inertia_kg_m2: f64,
+    /// Rated spin speed (rad/s).
+    pub rated_speed_rad_s: f64,
+    /// Bearing plane A's station z_A from the centre of mass (m, negative: A is on −z).
+    pub bearing_a_z_m: f64,
+    /// Bearing plane B's station z_B (m), > z_A.
+    pub bearing_b_z_m: f64,
+    /// Sensor plane A's station (m).
+    pub sensor_a_z_m: f64,
+    /// Sensor plane B's station (m).
+    pub sensor_b_z_m: f64,
 }
 
 /// The controller's side of the handshake. 4416 bytes.
@@ -341,7 +438,7 @@ pub struct Hello {
 /// | 316    | 4    | `reserved`         | u32        |
 /// | 320    | 4096 | `overrides`        | [u8; 4096] |
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("amb_testbed.v3.Ack")]
+#[type_name("amb_testbed.v4.Ack")]
 #[repr(C)]
 pub struct Ack {
     /// [`PROTOCOL_VERSION`] of the controller.
@@ -389,6 +486,23 @@ pub enum Refusal {
 }
 
 impl Refusal {
+    /// Every refusal, in code order.
+    pub const ALL: [Refusal; 7] =
+        [Refusal::Version, Refusal::Rate, Refusal::Axes, Refusal::Units, Refusal::Law, Refusal::RunId, Refusal::Params];
+
+    /// Its name in the C header (`AMB_TESTBED_ACK_<name>`) and [`constants`].
+    pub fn constant_name(self) -> &'static str {
+        match self {
+            Refusal::Version => "VERSION",
+            Refusal::Rate => "RATE",
+            Refusal::Axes => "AXES",
+            Refusal::Units => "UNITS",
+            Refusal::Law => "LAW",
+            Refusal::RunId => "RUN_ID",
+            Refusal::Params => "PARAMS",
+        }
+    }
+
     /// The code as sent.
     pub fn code(self) -> u32 {
         self as u32
@@ -412,12 +526,13 @@ impl Refusal {
 // The layouts above are the protocol: a change must fail to compile here.
 const _: () = {
     use core::mem::{align_of, offset_of, size_of};
-    assert!(size_of::<SensorFrame>() == 112 && align_of::<SensorFrame>() == 8);
+    assert!(size_of::<SensorFrame>() == 128 && align_of::<SensorFrame>() == 8);
     assert!(offset_of!(SensorFrame, seq) == 0 && offset_of!(SensorFrame, t_s) == 8);
     assert!(offset_of!(SensorFrame, token) == 16 && offset_of!(SensorFrame, sent_ns) == 24);
     assert!(offset_of!(SensorFrame, status) == 32 && offset_of!(SensorFrame, session) == 36);
     assert!(offset_of!(SensorFrame, axes) == 40 && offset_of!(SensorFrame, reserved) == 44);
     assert!(offset_of!(SensorFrame, sensor_v) == 48);
+    assert!(offset_of!(SensorFrame, speed_rad_s) == 112 && offset_of!(SensorFrame, angle_rad) == 120);
     assert!(size_of::<CommandFrame>() == 112 && align_of::<CommandFrame>() == 8);
     assert!(offset_of!(CommandFrame, seq) == 0 && offset_of!(CommandFrame, token) == 8);
     assert!(offset_of!(CommandFrame, received_ns) == 16 && offset_of!(CommandFrame, sent_ns) == 24);
@@ -425,7 +540,7 @@ const _: () = {
     assert!(offset_of!(CommandFrame, axes) == 40 && offset_of!(CommandFrame, reserved) == 44);
     assert!(offset_of!(CommandFrame, current_a) == 48);
     assert!(size_of::<WakeRequest>() == 8 && align_of::<WakeRequest>() == 8);
-    assert!(size_of::<Hello>() == 4312 && align_of::<Hello>() == 8);
+    assert!(size_of::<Hello>() == 4448 && align_of::<Hello>() == 8);
     assert!(offset_of!(Hello, protocol_version) == 0 && offset_of!(Hello, axes) == 4);
     assert!(offset_of!(Hello, units) == 8 && offset_of!(Hello, session) == 12);
     assert!(offset_of!(Hello, token) == 16 && offset_of!(Hello, rate_hz) == 24);
@@ -440,6 +555,15 @@ const _: () = {
     assert!(offset_of!(Hello, mode) == 200 && offset_of!(Hello, plant_pid) == 204);
     assert!(offset_of!(Hello, params_len) == 208 && offset_of!(Hello, reserved) == 212);
     assert!(offset_of!(Hello, params) == 216);
+    assert!(offset_of!(Hello, b_stiffness_n_per_m) == 4312 && offset_of!(Hello, b_damping_ratio) == 4320);
+    assert!(offset_of!(Hello, b_ki_n_per_a) == 4328 && offset_of!(Hello, b_ks_n_per_m) == 4336);
+    assert!(offset_of!(Hello, b_amp_gain_a_per_v) == 4344 && offset_of!(Hello, b_sensor_gain_v_per_m) == 4352);
+    assert!(offset_of!(Hello, b_rotor_mass_kg) == 4360 && offset_of!(Hello, b_current_limit_a) == 4368);
+    assert!(offset_of!(Hello, b_air_gap_m) == 4376 && offset_of!(Hello, total_mass_kg) == 4384);
+    assert!(offset_of!(Hello, transverse_inertia_kg_m2) == 4392 && offset_of!(Hello, polar_inertia_kg_m2) == 4400);
+    assert!(offset_of!(Hello, rated_speed_rad_s) == 4408 && offset_of!(Hello, bearing_a_z_m) == 4416);
+    assert!(offset_of!(Hello, bearing_b_z_m) == 4424 && offset_of!(Hello, sensor_a_z_m) == 4432);
+    assert!(offset_of!(Hello, sensor_b_z_m) == 4440);
     assert!(size_of::<Ack>() == 4416 && align_of::<Ack>() == 8);
     assert!(offset_of!(Ack, protocol_version) == 0 && offset_of!(Ack, session) == 4);
     assert!(offset_of!(Ack, status) == 8 && offset_of!(Ack, controller_pid) == 12);
@@ -506,7 +630,10 @@ pub struct Expect<'a> {
     pub rate_hz: Option<f64>,
 }
 
-/// Checks a [`Hello`] against this controller: protocol version, axes,
+/// The axis counts a hello may carry: planar and two-plane.
+pub const SUPPORTED_AXES: [u32; 2] = [AXES, TWO_PLANE_AXES];
+
+/// Checks a [`Hello`] against this controller: protocol version, axes (2 or 4),
 /// units, run id and rate. The message names both values.
 ///
 /// ```
@@ -519,6 +646,21 @@ pub struct Expect<'a> {
 /// assert!(msg.contains("10000") && msg.contains("20000"), "{msg}");
 /// ```
 pub fn check_hello(h: &Hello, expect: &Expect) -> Result<(), (Refusal, String)> {
+    check_hello_for(h, expect, &SUPPORTED_AXES)
+}
+
+/// [`check_hello`] for a controller that drives only the axis counts `axes` (a controller
+/// written for the planar model passes `&[AXES]` and so refuses a two-plane hello with
+/// [`Refusal::Axes`], code 3).
+///
+/// ```
+/// use controller::wire::{check_hello_for, Expect, Hello, Refusal, AXES};
+/// let h = Hello::example_two_plane("r");
+/// let (why, msg) = check_hello_for(&h, &Expect { run_id: "r", rate_hz: None }, &[AXES]).unwrap_err();
+/// assert_eq!((why, why.code()), (Refusal::Axes, 3));
+/// assert_eq!(msg, "the plant has 4 axes, this controller drives 2");
+/// ```
+pub fn check_hello_for(h: &Hello, expect: &Expect, axes: &[u32]) -> Result<(), (Refusal, String)> {
     if h.protocol_version != PROTOCOL_VERSION {
         return Err((
             Refusal::Version,
@@ -528,8 +670,12 @@ pub fn check_hello(h: &Hello, expect: &Expect) -> Result<(), (Refusal, String)> 
             ),
         ));
     }
-    if h.axes != AXES {
-        return Err((Refusal::Axes, format!("the plant has {} axes, this controller drives {AXES}", h.axes)));
+    if !axes.contains(&h.axes) {
+        let drives: Vec<String> = axes.iter().map(u32::to_string).collect();
+        return Err((
+            Refusal::Axes,
+            format!("the plant has {} axes, this controller drives {}", h.axes, drives.join(" or ")),
+        ));
     }
     if h.units != UNITS_SI {
         return Err((
@@ -556,66 +702,124 @@ pub fn check_hello(h: &Hello, expect: &Expect) -> Result<(), (Refusal, String)> 
 }
 
 impl Hello {
-    /// The hello of a run: law `law` built from `design` at `rate_hz`, with the law's parameter
-    /// document `params` (TOML text, at most [`PARAMS_LEN`] bytes). Session 0 (the plant counts
-    /// handshakes from 1), token 0 (the plant sets the run's), lockstep, no spin, this process
-    /// as the plant.
+    /// The hello of a planar run: law `law` built from `design` at `rate_hz`, with the law's
+    /// parameter document `params` (TOML text, at most [`PARAMS_LEN`] bytes). Session 0 (the
+    /// plant counts handshakes from 1), token 0 (the plant sets the run's), lockstep, no spin,
+    /// this process as the plant.
     pub fn new(run_id: &str, law: &str, design: &Design, rate_hz: f64, params: &str) -> Result<Self, ParamsError> {
+        Self::for_rotor(run_id, law, &RotorDesign::Planar(*design), rate_hz, params)
+    }
+
+    /// [`Hello::new`] for any rotor: a planar design gives `axes` = 2 and zeros past
+    /// `params`; a two-plane design `axes` = 4, plane B's design in the `b_` fields and the
+    /// geometry. The planes' shared fields (period, delay, gravity bias, gravity) are plane
+    /// A's ([`RotorDesign::check`]).
+    pub fn for_rotor(
+        run_id: &str,
+        law: &str,
+        design: &RotorDesign,
+        rate_hz: f64,
+        params: &str,
+    ) -> Result<Self, ParamsError> {
         if params.len() > PARAMS_LEN {
             return Err(ParamsError::TooLong { len: params.len() });
         }
-        let c = &design.constants;
+        let a = design.plane_a();
+        let c = &a.constants;
         let mut hello = Hello {
             protocol_version: PROTOCOL_VERSION,
-            axes: AXES,
+            axes: design.axes(),
             units: UNITS_SI,
             session: 0,
             token: 0,
             rate_hz,
-            period_s: design.period_s,
+            period_s: a.period_s,
             run_id: fixed_str(run_id),
             law: fixed_str(law),
-            stiffness_n_per_m: design.stiffness_n_per_m,
-            damping_ratio: design.damping_ratio,
+            stiffness_n_per_m: a.stiffness_n_per_m,
+            damping_ratio: a.damping_ratio,
             ki_n_per_a: c.ki_n_per_a,
             ks_n_per_m: c.ks_n_per_m,
             amp_gain_a_per_v: c.amp_gain_a_per_v,
             sensor_gain_v_per_m: c.sensor_gain_v_per_m,
             rotor_mass_kg: c.rotor_mass_kg,
             gravity_m_s2: c.gravity_m_s2,
-            current_limit_a: design.current_limit_a,
+            current_limit_a: a.current_limit_a,
             air_gap_m: c.air_gap_m,
-            delay_samples: design.delay_samples,
-            gravity_bias: u32::from(design.gravity_bias),
+            delay_samples: a.delay_samples,
+            gravity_bias: u32::from(a.gravity_bias),
             spin_ns: 0,
             mode: mode::LOCKSTEP,
             plant_pid: std::process::id(),
             params_len: params.len() as u32,
             reserved: 0,
             params: [0; PARAMS_LEN],
+            b_stiffness_n_per_m: 0.0,
+            b_damping_ratio: 0.0,
+            b_ki_n_per_a: 0.0,
+            b_ks_n_per_m: 0.0,
+            b_amp_gain_a_per_v: 0.0,
+            b_sensor_gain_v_per_m: 0.0,
+            b_rotor_mass_kg: 0.0,
+            b_current_limit_a: 0.0,
+            b_air_gap_m: 0.0,
+            total_mass_kg: 0.0,
+            transverse_inertia_kg_m2: 0.0,
+            polar_inertia_kg_m2: 0.0,
+            rated_speed_rad_s: 0.0,
+            bearing_a_z_m: 0.0,
+            bearing_b_z_m: 0.0,
+            sensor_a_z_m: 0.0,
+            sensor_b_z_m: 0.0,
         };
         hello.params[..params.len()].copy_from_slice(params.as_bytes());
+        if let RotorDesign::TwoPlane { planes: [_, b], geometry: g } = design {
+            let c = &b.constants;
+            hello.b_stiffness_n_per_m = b.stiffness_n_per_m;
+            hello.b_damping_ratio = b.damping_ratio;
+            hello.b_ki_n_per_a = c.ki_n_per_a;
+            hello.b_ks_n_per_m = c.ks_n_per_m;
+            hello.b_amp_gain_a_per_v = c.amp_gain_a_per_v;
+            hello.b_sensor_gain_v_per_m = c.sensor_gain_v_per_m;
+            hello.b_rotor_mass_kg = c.rotor_mass_kg;
+            hello.b_current_limit_a = b.current_limit_a;
+            hello.b_air_gap_m = c.air_gap_m;
+            hello.total_mass_kg = g.mass_kg;
+            hello.transverse_inertia_kg_m2 = g.transverse_inertia_kg_m2;
+            hello.polar_inertia_kg_m2 = g.polar_inertia_kg_m2;
+            hello.rated_speed_rad_s = g.rated_speed_rad_s;
+            [hello.bearing_a_z_m, hello.bearing_b_z_m] = g.bearing_z_m;
+            [hello.sensor_a_z_m, hello.sensor_b_z_m] = g.sensor_z_m;
+        }
         Ok(hello)
     }
 
-    /// A hello with the study's default constants (for examples and tests).
+    /// A planar hello with the study's design ([`Design::study`], law `pd`, 20 kHz; for
+    /// examples and tests).
     ///
     /// ```
     /// let h = controller::wire::Hello::example("run1");
-    /// assert_eq!(h.design().stiffness_n_per_m, 1e6);
+    /// assert_eq!((h.axes, h.design().stiffness_n_per_m), (2, 1e6));
     /// assert_eq!(h.params_text().unwrap(), "");
     /// ```
     pub fn example(run_id: &str) -> Self {
-        let design = Design {
-            stiffness_n_per_m: 1e6,
-            damping_ratio: 0.01,
-            period_s: 1.0 / 20_000.0,
-            gravity_bias: true,
-            current_limit_a: 2.0,
-            delay_samples: 1,
-            constants: LoopConstants::study(),
-        };
-        let mut h = Self::new(run_id, "pd", &design, 20_000.0, "").expect("an empty document fits");
+        Self::example_of(run_id, &RotorDesign::Planar(Design::study()))
+    }
+
+    /// A two-plane hello of the study's symmetric machine ([`RotorDesign::symmetric_study`],
+    /// law `pd`, 20 kHz; for examples and tests).
+    ///
+    /// ```
+    /// let h = controller::wire::Hello::example_two_plane("run1");
+    /// assert_eq!((h.axes, h.total_mass_kg, h.b_rotor_mass_kg), (4, 23.0, 11.5));
+    /// assert_eq!(h.rotor_design(), Some(controller::RotorDesign::symmetric_study()));
+    /// ```
+    pub fn example_two_plane(run_id: &str) -> Self {
+        Self::example_of(run_id, &RotorDesign::symmetric_study())
+    }
+
+    fn example_of(run_id: &str, design: &RotorDesign) -> Self {
+        let mut h = Self::for_rotor(run_id, "pd", design, 20_000.0, "").expect("an empty document fits");
         h.session = 1;
         h.token = 1;
         h.spin_ns = 200_000;
@@ -623,7 +827,8 @@ impl Hello {
         h
     }
 
-    /// The common loop design the hello carries (the inverse of [`Hello::new`]).
+    /// Plane A's loop design (the planar design of a planar hello; the inverse of
+    /// [`Hello::new`]).
     pub fn design(&self) -> Design {
         Design {
             stiffness_n_per_m: self.stiffness_n_per_m,
@@ -641,6 +846,42 @@ impl Hello {
                 gravity_m_s2: self.gravity_m_s2,
                 air_gap_m: self.air_gap_m,
             },
+        }
+    }
+
+    /// The whole rotor's design the hello carries (the inverse of [`Hello::for_rotor`]);
+    /// `None` for an axis count other than 2 and 4.
+    pub fn rotor_design(&self) -> Option<RotorDesign> {
+        let a = self.design();
+        match self.axes {
+            AXES => Some(RotorDesign::Planar(a)),
+            TWO_PLANE_AXES => {
+                let b = Design {
+                    stiffness_n_per_m: self.b_stiffness_n_per_m,
+                    damping_ratio: self.b_damping_ratio,
+                    current_limit_a: self.b_current_limit_a,
+                    constants: LoopConstants {
+                        ki_n_per_a: self.b_ki_n_per_a,
+                        ks_n_per_m: self.b_ks_n_per_m,
+                        amp_gain_a_per_v: self.b_amp_gain_a_per_v,
+                        sensor_gain_v_per_m: self.b_sensor_gain_v_per_m,
+                        rotor_mass_kg: self.b_rotor_mass_kg,
+                        air_gap_m: self.b_air_gap_m,
+                        ..a.constants
+                    },
+                    ..a
+                };
+                let geometry = Geometry {
+                    mass_kg: self.total_mass_kg,
+                    transverse_inertia_kg_m2: self.transverse_inertia_kg_m2,
+                    polar_inertia_kg_m2: self.polar_inertia_kg_m2,
+                    rated_speed_rad_s: self.rated_speed_rad_s,
+                    bearing_z_m: [self.bearing_a_z_m, self.bearing_b_z_m],
+                    sensor_z_m: [self.sensor_a_z_m, self.sensor_b_z_m],
+                };
+                Some(RotorDesign::TwoPlane { planes: [a, b], geometry })
+            }
+            _ => None,
         }
     }
 
@@ -694,6 +935,126 @@ impl Ack {
     }
 }
 
+/// One field of a message as it lies in memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FieldLayout {
+    /// The field's name (the same in Rust, C and Python).
+    pub name: &'static str,
+    /// Offset from the message's start (bytes).
+    pub offset: usize,
+    /// Size (bytes).
+    pub size: usize,
+}
+
+/// A message's layout: what a port must reproduce.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MessageLayout {
+    /// The struct's name (`SensorFrame`, …; `amb_testbed_<name>` in C).
+    pub name: &'static str,
+    /// Its iceoryx2 type name.
+    pub type_name: &'static str,
+    /// Size (bytes).
+    pub size: usize,
+    /// Alignment (bytes).
+    pub align: usize,
+    /// Every field, in order.
+    pub fields: Vec<FieldLayout>,
+}
+
+/// The size of a field, through an accessor (no value needed).
+fn field_size<T, F>(_: fn(&T) -> &F) -> usize {
+    core::mem::size_of::<F>()
+}
+
+macro_rules! message_layout {
+    ($t:ident; $($f:ident),+ $(,)?) => {
+        MessageLayout {
+            name: stringify!($t),
+            // SAFETY: type_name has no preconditions; it is unsafe only because implementors
+            // promise uniqueness.
+            type_name: unsafe { <$t as ZeroCopySend>::type_name() },
+            size: core::mem::size_of::<$t>(),
+            align: core::mem::align_of::<$t>(),
+            fields: vec![$(FieldLayout {
+                name: stringify!($f),
+                offset: core::mem::offset_of!($t, $f),
+                size: field_size::<$t, _>(|m| &m.$f),
+            }),+],
+        }
+    };
+}
+
+/// The layout of every message, from the Rust definitions: the one source the C header, the
+/// Python kit and `docs/wire-protocol.md` are checked against (the tests fail naming the
+/// difference). A unit test checks that the fields listed here tile each struct exactly, so a
+/// field added to a struct and not here fails too.
+pub fn layouts() -> Vec<MessageLayout> {
+    vec![
+        message_layout!(SensorFrame; seq, t_s, token, sent_ns, status, session, axes, reserved, sensor_v,
+            speed_rad_s, angle_rad),
+        message_layout!(CommandFrame; seq, token, received_ns, sent_ns, status, session, axes, reserved, current_a),
+        message_layout!(WakeRequest; seq),
+        message_layout!(Hello; protocol_version, axes, units, session, token, rate_hz, period_s, run_id, law,
+            stiffness_n_per_m, damping_ratio, ki_n_per_a, ks_n_per_m, amp_gain_a_per_v, sensor_gain_v_per_m,
+            rotor_mass_kg, gravity_m_s2, current_limit_a, air_gap_m, delay_samples, gravity_bias, spin_ns, mode,
+            plant_pid, params_len, reserved, params, b_stiffness_n_per_m, b_damping_ratio, b_ki_n_per_a,
+            b_ks_n_per_m, b_amp_gain_a_per_v, b_sensor_gain_v_per_m, b_rotor_mass_kg, b_current_limit_a,
+            b_air_gap_m, total_mass_kg, transverse_inertia_kg_m2, polar_inertia_kg_m2, rated_speed_rad_s,
+            bearing_a_z_m, bearing_b_z_m, sensor_a_z_m, sensor_b_z_m),
+        message_layout!(Ack; protocol_version, session, status, controller_pid, token, law, message,
+            overrides_len, reserved, overrides),
+    ]
+}
+
+/// A constant of the protocol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Constant {
+    /// An integer.
+    Number(u64),
+    /// A text (a name or prefix).
+    Text(&'static str),
+}
+
+/// Every constant of the protocol by its name in the C header (`AMB_TESTBED_<name>`) and in
+/// the Python kit's `wire.CONSTANTS`: the one source both are checked against.
+pub fn constants() -> Vec<(String, Constant)> {
+    use Constant::{Number, Text};
+    let mut out: Vec<(String, Constant)> = vec![
+        ("PROTOCOL_VERSION".into(), Number(PROTOCOL_VERSION.into())),
+        ("MAX_AXES".into(), Number(MAX_AXES as u64)),
+        ("AXES".into(), Number(AXES.into())),
+        ("TWO_PLANE_AXES".into(), Number(TWO_PLANE_AXES.into())),
+        ("UNITS_SI".into(), Number(UNITS_SI.into())),
+        ("RUN_ID_LEN".into(), Number(RUN_ID_LEN as u64)),
+        ("LAW_NAME_LEN".into(), Number(LAW_NAME_LEN as u64)),
+        ("MESSAGE_LEN".into(), Number(MESSAGE_LEN as u64)),
+        ("PARAMS_LEN".into(), Number(PARAMS_LEN as u64)),
+        ("OVERRIDES_LEN".into(), Number(OVERRIDES_LEN as u64)),
+        ("SERVICE_PREFIX".into(), Text(SERVICE_PREFIX)),
+        ("SENSOR_STOP".into(), Number(SensorFrame::STOP.into())),
+        ("COMMAND_STOPPING".into(), Number(CommandFrame::STOPPING.into())),
+        ("MODE_LOCKSTEP".into(), Number(mode::LOCKSTEP.into())),
+        ("MODE_REALTIME".into(), Number(mode::REALTIME.into())),
+        ("MODE_BENCH".into(), Number(mode::BENCH.into())),
+        ("ACK_ACCEPTED".into(), Number(0)),
+    ];
+    for r in Refusal::ALL {
+        out.push((format!("ACK_{}", r.constant_name()), Number(r.code().into())));
+    }
+    for m in layouts() {
+        // SensorFrame -> SENSOR_FRAME_TYPE_NAME
+        let mut upper = String::new();
+        for (i, c) in m.name.chars().enumerate() {
+            if c.is_uppercase() && i > 0 {
+                upper.push('_');
+            }
+            upper.push(c.to_ascii_uppercase());
+        }
+        out.push((format!("{upper}_TYPE_NAME"), Text(m.type_name)));
+    }
+    out
+}
+
 /// `CLOCK_MONOTONIC` now (ns): the clock both processes stamp frames with.
 #[inline]
 pub fn monotonic_ns() -> u64 {
@@ -726,15 +1087,81 @@ mod tests {
         }
     }
 
+    /// The fields [`layouts`] lists tile each struct from byte 0 to its size, in order, with no
+    /// gap: a field added to a struct and not to the list (or a padding byte) fails here.
+    #[test]
+    fn the_layout_list_covers_every_byte_of_every_message() {
+        for m in layouts() {
+            let mut at = 0;
+            for f in &m.fields {
+                assert_eq!(
+                    f.offset, at,
+                    "{}.{} at {} (expected {at}: a field is missing or padded)",
+                    m.name, f.name, f.offset
+                );
+                at += f.size;
+            }
+            assert_eq!(at, m.size, "{}: the listed fields end at {at}, the struct is {} bytes", m.name, m.size);
+            assert_eq!(m.align, 8, "{}", m.name);
+        }
+        let sizes: Vec<(&str, usize)> = layouts().iter().map(|m| (m.name, m.size)).collect();
+        assert_eq!(
+            sizes,
+            [("SensorFrame", 128), ("CommandFrame", 112), ("WakeRequest", 8), ("Hello", 4448), ("Ack", 4416)]
+        );
+        let names: Vec<String> = constants().into_iter().map(|(n, _)| n).collect();
+        assert!(names.contains(&"ACK_PARAMS".to_string()) && names.contains(&"HELLO_TYPE_NAME".to_string()));
+        assert!(
+            constants().contains(&("SENSOR_FRAME_TYPE_NAME".to_string(), Constant::Text("amb_testbed.v4.SensorFrame")))
+        );
+    }
+
+    /// A two-plane design goes through the hello and back whole; a planar hello's v4 fields
+    /// are 0.
+    #[test]
+    fn a_two_plane_design_travels_in_the_hello() {
+        let RotorDesign::TwoPlane { planes: [a, _], geometry } = RotorDesign::symmetric_study() else { unreachable!() };
+        let b = Design {
+            stiffness_n_per_m: 1.3e6,
+            damping_ratio: 0.02,
+            current_limit_a: 3.0,
+            constants: LoopConstants {
+                ki_n_per_a: 190.0,
+                ks_n_per_m: 3e5,
+                amp_gain_a_per_v: 0.5,
+                sensor_gain_v_per_m: 2e4,
+                rotor_mass_kg: 9.5,
+                air_gap_m: 1.2e-4,
+                ..a.constants
+            },
+            ..a
+        };
+        let g = Geometry { bearing_z_m: [-0.2, 0.16], sensor_z_m: [-0.22, 0.19], ..geometry };
+        let design = RotorDesign::TwoPlane { planes: [a, b], geometry: g };
+        let h = Hello::for_rotor("r", "modal", &design, 20_000.0, "").unwrap();
+        assert_eq!(h.axes, 4);
+        assert_eq!(h.rotor_design(), Some(design));
+        assert_eq!(h.design(), a);
+        let planar = Hello::example("r");
+        assert_eq!(planar.rotor_design(), Some(RotorDesign::Planar(planar.design())));
+        let bytes = unsafe { std::slice::from_raw_parts((&planar as *const Hello).cast::<u8>(), size_of::<Hello>()) };
+        assert!(bytes[4312..].iter().all(|b| *b == 0), "a planar hello's v4 fields are 0");
+        let mut odd = planar;
+        odd.axes = 3;
+        assert_eq!(odd.rotor_design(), None);
+    }
+
     #[test]
     fn each_mismatch_is_refused_with_its_code() {
         let ok = Expect { run_id: "r", rate_hz: None };
         let base = Hello::example("r");
         assert!(check_hello(&base, &ok).is_ok());
         type Spoil = fn(&mut Hello);
-        let cases: [(Spoil, Refusal); 4] = [
+        assert!(check_hello(&Hello::example_two_plane("r"), &ok).is_ok(), "this controller drives 4 axes too");
+        let cases: [(Spoil, Refusal); 5] = [
             (|h| h.protocol_version += 1, Refusal::Version),
             (|h| h.axes = 3, Refusal::Axes),
+            (|h| h.axes = 8, Refusal::Axes),
             (|h| h.units = 7, Refusal::Units),
             (|h| h.run_id = fixed_str("other"), Refusal::RunId),
         ];
@@ -771,12 +1198,15 @@ mod tests {
             axes: 2,
             reserved: 0,
             sensor_v: sensor,
+            speed_rad_s: 3141.5,
+            angle_rad: 6.25,
         };
         let b = bytes(&s);
-        assert_eq!(b.len(), 112);
+        assert_eq!(b.len(), 128);
         assert_eq!((u64_at(&b, 0), f64_at(&b, 8), u64_at(&b, 16), u64_at(&b, 24)), (7, 0.25, 0xA1, 9));
         assert_eq!((u32_at(&b, 32), u32_at(&b, 36), u32_at(&b, 40), u32_at(&b, 44)), (1, 3, 2, 0));
         assert_eq!((f64_at(&b, 48), f64_at(&b, 56), f64_at(&b, 104)), (1.5, -2.5, 0.0));
+        assert_eq!((f64_at(&b, 112), f64_at(&b, 120)), (3141.5, 6.25));
 
         let c = CommandFrame {
             seq: 7,
@@ -802,8 +1232,8 @@ mod tests {
         h.mode = mode::REALTIME;
         h.plant_pid = 42;
         let b = bytes(&h);
-        assert_eq!(b.len(), 4312);
-        assert_eq!((u32_at(&b, 0), u32_at(&b, 4), u32_at(&b, 8), u32_at(&b, 12)), (3, 2, 1, 2));
+        assert_eq!(b.len(), 4448);
+        assert_eq!((u32_at(&b, 0), u32_at(&b, 4), u32_at(&b, 8), u32_at(&b, 12)), (4, 2, 1, 2));
         assert_eq!((u64_at(&b, 16), f64_at(&b, 24), f64_at(&b, 32)), (0xC3, 20_000.0, 5e-5));
         assert_eq!((&b[40..45], b[45], &b[72..77]), (&b"run-7"[..], 0, &b"relev"[..]));
         let doubles = [1e6, 0.01, 216.0, 4.32e5, 1.0, 25_000.0, 11.5, 9.80665, 2.0, 150e-6];
@@ -813,11 +1243,43 @@ mod tests {
         assert_eq!((u32_at(&b, 184), u32_at(&b, 188), u64_at(&b, 192)), (1, 1, 11));
         assert_eq!((u32_at(&b, 200), u32_at(&b, 204), u32_at(&b, 208), u32_at(&b, 212)), (2, 42, 13, 0));
         assert_eq!(&b[216..229], b"arm_ms = 5.0\n");
+        let RotorDesign::TwoPlane { planes: [a, _], geometry } = RotorDesign::symmetric_study() else { unreachable!() };
+        let mut plane_b = a;
+        plane_b.stiffness_n_per_m = 2e6;
+        plane_b.damping_ratio = 0.03;
+        plane_b.current_limit_a = 2.5;
+        plane_b.constants = LoopConstants {
+            ki_n_per_a: 200.0,
+            ks_n_per_m: 4e5,
+            amp_gain_a_per_v: 0.75,
+            sensor_gain_v_per_m: 2e4,
+            rotor_mass_kg: 12.5,
+            air_gap_m: 1.4e-4,
+            ..a.constants
+        };
+        let g = Geometry {
+            mass_kg: 24.0,
+            transverse_inertia_kg_m2: 0.5,
+            polar_inertia_kg_m2: 0.012,
+            rated_speed_rad_s: 3000.0,
+            bearing_z_m: [-0.18, 0.2],
+            sensor_z_m: [-0.19, 0.21],
+        };
+        let _ = geometry;
+        let h = Hello::for_rotor("r", "pd", &RotorDesign::TwoPlane { planes: [a, plane_b], geometry: g }, 20_000.0, "")
+            .unwrap();
+        let b = bytes(&h);
+        assert_eq!(u32_at(&b, 4), 4);
+        let tail =
+            [2e6, 0.03, 200.0, 4e5, 0.75, 2e4, 12.5, 2.5, 1.4e-4, 24.0, 0.5, 0.012, 3000.0, -0.18, 0.2, -0.19, 0.21];
+        for (i, v) in tail.iter().enumerate() {
+            assert_eq!(f64_at(&b, 4312 + 8 * i), *v, "f64 #{i} at {}", 4312 + 8 * i);
+        }
 
         let a = Ack::new(2, 0xD4, 7, "relev", "why").with_overrides("[controller]\n").unwrap();
         let b = bytes(&a);
         assert_eq!(b.len(), 4416);
-        assert_eq!((u32_at(&b, 0), u32_at(&b, 4), u32_at(&b, 8)), (3, 2, 7));
+        assert_eq!((u32_at(&b, 0), u32_at(&b, 4), u32_at(&b, 8)), (4, 2, 7));
         assert_eq!((u64_at(&b, 16), &b[24..29], &b[56..59]), (0xD4, &b"relev"[..], &b"why"[..]));
         assert_eq!((u32_at(&b, 312), u32_at(&b, 316), &b[320..333]), (13, 0, &b"[controller]\n"[..]));
     }

@@ -7,8 +7,13 @@
 //! with the first one's (two runs at once used to leave one run's
 //! `summary.json` beside the other's `trace.csv`, both exiting 0). The kernel
 //! releases the claim when the process ends, however it ends (SIGKILL
-//! included); nothing is left in the folder. Sweeps and ensembles do not take
-//! it: their shards share one folder by design and check their own files.
+//! included); nothing is left in the folder. A claim also removes the
+//! temporaries of atomic writes that a killed process left in the folder
+//! ([`crate::atomic::remove_stale`]). A folder the claim created and the
+//! command left empty (it failed before writing anything, e.g. `plant
+//! compare --laws foo`) is removed again when the claim goes, with the
+//! parents it created. Sweeps and ensembles do not take it: their shards
+//! share one folder by design and check their own files (and temporaries).
 
 use std::fs::{File, TryLockError};
 use std::path::{Path, PathBuf};
@@ -38,20 +43,40 @@ pub enum ClaimError {
 #[derive(Debug)]
 pub struct Claim {
     _dir: File,
+    /// The folders the claim created, the deepest first.
+    created: Vec<PathBuf>,
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        // `remove_dir` removes only an empty folder: whatever the command wrote stays.
+        for dir in &self.created {
+            if std::fs::remove_dir(dir).is_err() {
+                break;
+            }
+        }
+    }
 }
 
 /// Claims `dir`, creating it first when `create` (a run's `--out`); without `create` a
 /// missing folder is not an error here (`Ok(None)`: the command says what is missing).
 pub fn claim(dir: &Path, create: bool) -> Result<Option<Claim>, ClaimError> {
     let io = |source| ClaimError::Io { path: dir.to_path_buf(), source };
+    let mut created = Vec::new();
     if create {
+        created =
+            dir.ancestors().take_while(|d| !d.as_os_str().is_empty() && !d.exists()).map(Path::to_path_buf).collect();
         std::fs::create_dir_all(dir).map_err(io)?;
     } else if !dir.is_dir() {
         return Ok(None);
     }
     let file = File::open(dir).map_err(io)?;
     match file.try_lock() {
-        Ok(()) => Ok(Some(Claim { _dir: file })),
+        Ok(()) => {
+            // A write of an earlier command killed half-way left its temporary here.
+            crate::atomic::remove_stale(dir);
+            Ok(Some(Claim { _dir: file, created }))
+        }
         Err(TryLockError::WouldBlock) => Err(ClaimError::InUse { path: dir.to_path_buf(), holder: holder(dir) }),
         Err(TryLockError::Error(e)) => Err(io(e)),
     }
@@ -92,6 +117,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         assert!(claim(&dir, false).unwrap().is_none(), "a missing folder is not created without `create`");
         assert!(!dir.exists());
+        std::fs::create_dir_all(&dir).unwrap();
         let first = claim(&dir, true).unwrap().expect("claimed");
         let second = claim(&dir, true).unwrap_err().to_string();
         assert!(second.contains("in use by a live process"), "{second}");
@@ -100,5 +126,26 @@ mod tests {
         assert!(claim(&dir, false).unwrap().is_some());
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing is left in the folder");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Issue 21 item 7: `plant compare --laws foo` failed after creating its folder and left
+    /// it empty. A folder the claim created goes with it while empty, parents included; one
+    /// that holds a file, or that existed before, stays.
+    #[test]
+    fn a_folder_the_claim_created_and_left_empty_is_removed() {
+        let root = std::env::temp_dir().join(format!("plant-claim-created-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let deep = root.join("a").join("b");
+        drop(claim(&deep, true).unwrap());
+        assert!(!root.exists(), "the folders the claim created are gone");
+        let kept = claim(&deep, true).unwrap();
+        std::fs::write(deep.join("summary.json"), "{}").unwrap();
+        drop(kept);
+        assert!(deep.join("summary.json").is_file(), "a folder with a file stays");
+        let empty = root.join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        drop(claim(&empty, true).unwrap());
+        assert!(empty.is_dir(), "a folder that existed before stays");
+        let _ = std::fs::remove_dir_all(&root);
     }
 }

@@ -4,6 +4,11 @@ use clap::{Parser, Subcommand};
 use plant::cosim::{ControllerProcess, Launch};
 use std::path::PathBuf;
 
+/// `--repeats` of the benches: 1 to 1000 (0 used to run once silently).
+fn repeats() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(1..=1000)
+}
+
 #[derive(Parser)]
 #[command(name = "plant", version, about = "Rotor on AMBs with touchdown bearings under base shock")]
 pub struct Cli {
@@ -115,7 +120,7 @@ impl ControllerArg {
             ControllerArg::Spawn => ControllerProcess::Spawn(None),
             ControllerArg::External => ControllerProcess::External,
         };
-        Launch { controller, run_id }
+        Launch { controller, run_id, log: None }
     }
 }
 
@@ -128,8 +133,8 @@ pub enum BenchCommand {
     /// IPC round trip plant → controller process → plant (lockstep frames, the real
     /// controller binary); prints p50/p99/p99.9/max. Build with `--release` for figures.
     Ipc {
-        /// Recorded round trips.
-        #[arg(long, default_value_t = 200_000)]
+        /// Recorded round trips (1 to 1e7).
+        #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
         samples: u64,
         /// Unrecorded round trips first.
         #[arg(long, default_value_t = 20_000)]
@@ -156,8 +161,8 @@ pub enum BenchCommand {
         /// Scene folder holding paper-3g.toml and paper-10g.toml.
         #[arg(long, default_value = "config")]
         config: PathBuf,
-        /// Timed runs per setting; the minimum counts.
-        #[arg(long, default_value_t = 5)]
+        /// Timed runs per setting (1 to 1000); the minimum counts.
+        #[arg(long, default_value_t = 5, value_parser = repeats())]
         repeats: usize,
         /// Two settings per method, one timed run: a smoke test of the bench.
         #[arg(long)]
@@ -183,8 +188,8 @@ pub enum BenchCommand {
         /// Scene folder holding paper-3g.toml and paper-10g.toml.
         #[arg(long, default_value = "config")]
         config: PathBuf,
-        /// Timed runs per variant; the minimum counts.
-        #[arg(long, default_value_t = 5)]
+        /// Timed runs per variant (1 to 1000); the minimum counts.
+        #[arg(long, default_value_t = 5, value_parser = repeats())]
         repeats: usize,
     },
     /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
@@ -197,8 +202,8 @@ pub enum BenchCommand {
         /// Scene folder holding paper-3g.toml and paper-10g.toml.
         #[arg(long, default_value = "config")]
         config: PathBuf,
-        /// Timed runs per setting; the minimum counts.
-        #[arg(long, default_value_t = 3)]
+        /// Timed runs per setting (1 to 1000); the minimum counts.
+        #[arg(long, default_value_t = 3, value_parser = repeats())]
         repeats: usize,
     },
 }

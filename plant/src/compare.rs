@@ -15,9 +15,11 @@
 //! ([`RateRow`]), `stability_map.csv` ([`MapPoint`]), `laws.csv`
 //! ([`LawRow`]).
 
-use crate::config::{load_scene, Scene};
+use crate::analysis::classify::MotionMode;
+use crate::config::{load_scene, ControlMode, Scene};
 use crate::plot::{self, PointGroup, Scale, Series};
 use crate::run::{run, Outcome, Quiet, RunResult};
+use crate::status::Status;
 use crate::summary::{recovery_time, snake_name, Summary};
 use crate::table::{plain, sci};
 use anyhow::Context;
@@ -34,9 +36,9 @@ pub struct RateRow {
     #[serde(with = "plain")]
     pub rate_hz: f64,
     /// `continuous`, `sampled` or `lockstep`.
-    pub mode: &'static str,
+    pub mode: ControlMode,
     /// How the run ended.
-    pub status: String,
+    pub status: Status,
     /// RMS deviation of the rotor displacement from the continuous run (m).
     #[serde(with = "sci")]
     pub rms_dev_m: f64,
@@ -50,7 +52,7 @@ pub struct RateRow {
     #[serde(with = "sci")]
     pub recover_s: f64,
     /// Post-shock mode.
-    pub post_shock_mode: String,
+    pub post_shock_mode: MotionMode,
 }
 
 fn with(path: &Path, base: &[String], extra: &[String]) -> anyhow::Result<Scene> {
@@ -122,38 +124,48 @@ pub fn compare(
     let reference = run(&continuous, &mut Quiet)?;
     let shocks = continuous.shock_count();
     let decay = |extra: &[String]| free_decay(scene_path, &base, extra, shocks).map(|(xi, _, _)| xi);
-    let row = |rate: f64, mode: &'static str, r: &RunResult, scene: &Scene, xi: f64| {
-        let (rms, max) = if mode == "continuous" { (0.0, 0.0) } else { deviation(r, &reference, start) };
+    let row = |rate: f64, mode: ControlMode, r: &RunResult, scene: &Scene, xi: f64| {
+        let (rms, max) = if mode == ControlMode::Continuous { (0.0, 0.0) } else { deviation(r, &reference, start) };
         let s = Summary::new(scene, r);
         RateRow {
             rate_hz: rate,
             mode,
-            status: s.status.to_string(),
+            status: s.status,
             rms_dev_m: rms,
             max_dev_m: max,
             damping_ratio: xi,
             recover_s: recovery_time(&r.trace, start).unwrap_or(f64::NAN),
-            post_shock_mode: snake_name(&s.analysis.post_shock_mode),
+            post_shock_mode: s.analysis.post_shock_mode,
         }
     };
-    let mut rows =
-        vec![row(0.0, "continuous", &reference, &continuous, decay(&["controller.mode=\"continuous\"".into()])?)];
+    let mut rows = vec![row(
+        0.0,
+        ControlMode::Continuous,
+        &reference,
+        &continuous,
+        decay(&["controller.mode=\"continuous\"".into()])?,
+    )];
     log(&format!("continuous: damping ratio {:.4}", rows[0].damping_ratio));
     let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone())];
-    let modes: Vec<&'static str> = if cosim { vec!["sampled", "lockstep"] } else { vec!["sampled"] };
+    let modes = if cosim { vec![ControlMode::Sampled, ControlMode::Lockstep] } else { vec![ControlMode::Sampled] };
     for &rate in rates {
         for &mode in &modes {
-            let extra = vec![format!("controller.mode=\"{mode}\""), format!("controller.rate_hz={rate:?}")];
+            let name = snake_name(&mode);
+            let extra = vec![format!("controller.mode=\"{name}\""), format!("controller.rate_hz={rate:?}")];
             let scene = with(scene_path, &base, &extra)?;
             let r = run(&scene, &mut Quiet)?;
-            let xi = if mode == "sampled" { decay(&extra)? } else { rows.last().map_or(f64::NAN, |r| r.damping_ratio) };
+            let xi = if mode == ControlMode::Sampled {
+                decay(&extra)?
+            } else {
+                rows.last().map_or(f64::NAN, |r| r.damping_ratio)
+            };
             let rw = row(rate, mode, &r, &scene, xi);
             log(&format!(
-                "{mode} at {rate} Hz: {}, deviation rms {:.2e} m max {:.2e} m, damping ratio {:.4}, recovered after {:.4} s, {}",
+                "{name} at {rate} Hz: {}, deviation rms {:.2e} m max {:.2e} m, damping ratio {:.4}, recovered after {:.4} s, {}",
                 rw.status, rw.rms_dev_m, rw.max_dev_m, rw.damping_ratio, rw.recover_s, rw.post_shock_mode
             ));
             rows.push(rw);
-            if mode == "sampled" {
+            if mode == ControlMode::Sampled {
                 traces.push((format!("sampled {} kHz", rate / 1e3), r));
             }
         }
@@ -388,14 +400,14 @@ pub struct LawRow {
     /// Law name.
     pub law: String,
     /// Controller mode the scene ran in.
-    pub mode: String,
+    pub mode: ControlMode,
     /// How the run ended.
-    pub status: String,
+    pub status: Status,
     /// Time from the shock start to the last rotor – race contact (s); NaN if still touching at the end.
     #[serde(with = "sci")]
     pub recovery_s: f64,
     /// Post-shock mode.
-    pub post_shock_mode: String,
+    pub post_shock_mode: MotionMode,
     /// Peak rotor – race force (N).
     #[serde(with = "sci")]
     pub max_contact_force_n: f64,
@@ -442,18 +454,18 @@ pub fn compare_laws(
         let s = Summary::new(&scene, &r);
         let row = LawRow {
             law: law.clone(),
-            mode: snake_name(&scene.controller.mode),
-            status: s.status.to_string(),
+            mode: scene.controller.mode,
+            status: s.status,
             recovery_s: s.recovery_s.unwrap_or(f64::NAN),
-            post_shock_mode: snake_name(&s.analysis.post_shock_mode),
-            max_contact_force_n: s.max_contact_force_n,
+            post_shock_mode: s.analysis.post_shock_mode,
+            max_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
             contact_time_s: s.contact_time_s,
             steady_contact_fraction: s.analysis.steady_contact_fraction,
             whirl_hz: s.analysis.whirl_hz,
         };
         log(&format!(
             "{law} ({}): {}, recovered after {:.4} s, {}, peak force {:.0} N, {:.4} s in contact, whirl {:.1} Hz",
-            row.mode,
+            snake_name(&row.mode),
             row.status,
             row.recovery_s,
             row.post_shock_mode,

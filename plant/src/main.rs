@@ -1,29 +1,18 @@
 //! `plant`: runs scenes of the AMB/touchdown-bearing testbed.
 //!
-//! `main` → [`run`] → [`exit_code`], on ripgrep's model: every command
+//! `main` → [`run`] → [`plant::exit::code`], on ripgrep's model: every command
 //! returns its errors to `main`, which prints them once ([`report`]) and maps
-//! them to the exit code by their type, never by their text:
-//!
-//! | code | meaning |
-//! |---|---|
-//! | 0 | success |
-//! | 1 | an output could not be written, or the system refused a resource |
-//! | 2 | bad input (scene, programme, sweep or ensemble file, `--set`, argument, unreadable trace, a controller that refuses the run or speaks another protocol, a controller `command` that does not exist or is not executable, a run id or an output folder in use) |
-//! | 3 | numerical divergence |
-//! | 4 | the controller process was lost (died, stopped by a signal, silent past `controller.lockstep_timeout_ms`, exited before the handshake, never answered) |
-//! | 5 | `plant soak`: completed, but a criterion failed |
-//! | 6 | realtime: the deadline-miss budget `controller.max_miss_fraction` was exceeded |
-//! | 7 | `--merge` (sweep or ensemble): points or members missing or corrupt (they are listed) |
-//! | 9 | `plant assess`: a controller could not be graded (the rotor not levitated before the shock, or the excitation drove it into the touchdown bearing); the report was written |
-//! | 130 | interrupted (SIGINT or SIGTERM to the plant) |
+//! them to the exit code by their type, never by their text ([`plant::exit`]
+//! holds the codes and the one map; `docs/guide/running.md` the table).
 
 mod cli;
 
 use clap::Parser;
 use cli::{BenchCommand, Cli, Command, ControllerArg};
-use plant::config::{load_scene, ConfigError, Scene};
-use plant::cosim::{CosimError, Launch};
-use plant::run::{Hooks, Outcome, SetupError};
+use plant::config::{load_scene, Scene};
+use plant::cosim::Launch;
+use plant::exit::{self, Code, Ending, StopKind};
+use plant::run::{Hooks, Outcome};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -31,59 +20,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Exit codes, one per kind of ending (the table in the module doc).
-mod exit {
-    /// An output could not be written, or the system refused a resource.
-    pub const IO: u8 = 1;
-    /// Bad input.
-    pub const BAD_INPUT: u8 = 2;
-    /// The simulation diverged (non-finite state, step-size underflow, radius guard).
-    pub const DIVERGED: u8 = 3;
-    /// Co-simulation: the controller process was lost and none took its place.
-    pub const PEER_LOST: u8 = 4;
-    /// `plant soak`: the run completed but a criterion of the programme failed.
-    pub const CRITERION_FAILED: u8 = 5;
-    /// Realtime: the deadline-miss budget was exceeded.
-    pub const MISS_BUDGET: u8 = 6;
-    // 7 (`--merge` with points or members missing or corrupt) and the other codes of
-    // `plant sweep` / `plant ensemble` come from `plant::sweep::SweepError::exit_code`.
-    /// Stopped by SIGINT/SIGTERM; results up to that point were written.
-    pub const INTERRUPTED: u8 = 130;
-}
-
 /// Most round trips `plant bench ipc` records or warms up with (each recorded one keeps 8
 /// bytes of figures).
 const MAX_BENCH_SAMPLES: u64 = 10_000_000;
-
-/// Endings of a command that are not successes and carry no error of a library type.
-#[derive(Debug, thiserror::Error)]
-enum Ending {
-    /// A command-line argument (or a scene the stability check refuses) is bad input.
-    #[error("{0}")]
-    BadArgument(String),
-    /// A run stopped before its end; its results up to then were written.
-    #[error("{why}; results up to t = {simulated_s} s were written")]
-    Stopped {
-        /// How it stopped.
-        kind: StopKind,
-        /// What happened.
-        why: String,
-        /// Simulated time reached (s).
-        simulated_s: f64,
-    },
-    /// `plant soak` completed, but criteria failed (each was named above).
-    #[error("{0} soak criterion (criteria) failed")]
-    CriteriaFailed(usize),
-}
-
-/// How a run stopped early.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum StopKind {
-    Diverged,
-    Interrupted,
-    PeerLost,
-    MissBudget,
-}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -92,7 +31,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             report(&err);
-            ExitCode::from(exit_code(&err))
+            ExitCode::from(u8::from(exit::code(&err)))
         }
     }
 }
@@ -100,7 +39,7 @@ fn main() -> ExitCode {
 /// Prints an error once: `plant: error: …` (an interruption is not an error: `plant: …`).
 fn report(err: &anyhow::Error) {
     let text = chain_text(err);
-    if exit_code(err) == exit::INTERRUPTED {
+    if exit::code(err) == Code::Interrupted {
         eprintln!("plant: {text}");
     } else {
         eprintln!("plant: error: {text}");
@@ -128,96 +67,6 @@ fn warn(message: &str) {
     eprintln!("plant: warning: {message}");
 }
 
-/// The exit code of an error: the code of the first cause in its chain whose type has one;
-/// 1 (an output or a resource) for the rest.
-fn exit_code(err: &anyhow::Error) -> u8 {
-    for cause in err.chain() {
-        if let Some(e) = cause.downcast_ref::<Ending>() {
-            return match e {
-                Ending::BadArgument(_) => exit::BAD_INPUT,
-                Ending::Stopped { kind: StopKind::Diverged, .. } => exit::DIVERGED,
-                Ending::Stopped { kind: StopKind::PeerLost, .. } => exit::PEER_LOST,
-                Ending::Stopped { kind: StopKind::MissBudget, .. } => exit::MISS_BUDGET,
-                Ending::Stopped { kind: StopKind::Interrupted, .. } => exit::INTERRUPTED,
-                Ending::CriteriaFailed(_) => exit::CRITERION_FAILED,
-            };
-        }
-        if let Some(e) = cause.downcast_ref::<CosimError>() {
-            return cosim_code(e);
-        }
-        if let Some(e) = cause.downcast_ref::<plant::sweep::SweepError>() {
-            return e.exit_code();
-        }
-        if let Some(e) = cause.downcast_ref::<plant::assess::AssessError>() {
-            return e.kind.exit_code();
-        }
-        if let Some(e) = cause.downcast_ref::<plant::claim::ClaimError>() {
-            return match e {
-                plant::claim::ClaimError::InUse { .. } => exit::BAD_INPUT,
-                plant::claim::ClaimError::Io { .. } => exit::IO,
-            };
-        }
-        if cause.is::<ConfigError>()
-            || cause.is::<controller::LawError>()
-            || cause.is::<controller::ParamsError>()
-            || cause.is::<shock_table::ShockError>()
-            || cause.is::<plant::bench::BadArgument>()
-        {
-            return exit::BAD_INPUT;
-        }
-        if let Some(e) = cause.downcast_ref::<plant::output::AnalyzeError>() {
-            return if e.is_input() { exit::BAD_INPUT } else { exit::IO };
-        }
-    }
-    exit::IO
-}
-
-/// The exit code of a co-simulation that could not start.
-fn cosim_code(e: &CosimError) -> u8 {
-    use controller::link::LinkError;
-    use controller::lock::LockError;
-    match e {
-        CosimError::Refused { .. }
-        | CosimError::RunId(_)
-        | CosimError::Pin(_)
-        | CosimError::Params(_)
-        | CosimError::Protocol(_)
-        | CosimError::Command { .. }
-        | CosimError::Lock(LockError::InUse { .. })
-        | CosimError::Link(LinkError::Incompatible { .. }) => exit::BAD_INPUT,
-        CosimError::ControllerExited { code: Some(2), .. } => exit::BAD_INPUT,
-        CosimError::NoController { .. } | CosimError::ControllerExited { .. } => exit::PEER_LOST,
-        CosimError::Interrupted => exit::INTERRUPTED,
-        CosimError::ControllerMissing { .. }
-        | CosimError::Spawn { .. }
-        | CosimError::Lock(LockError::Io { .. })
-        | CosimError::Link(LinkError::Ipc { .. }) => exit::IO,
-    }
-}
-
-/// The `summary.json` status of a run that could not start.
-fn not_started_status(e: &SetupError) -> &'static str {
-    match e {
-        SetupError::Law(_) | SetupError::Overrides(_) => "refused",
-        SetupError::Cosim(CosimError::Interrupted) => "interrupted",
-        SetupError::Cosim(CosimError::Command { .. }) => "not_started",
-        SetupError::Cosim(c) if cosim_code(c) == exit::BAD_INPUT => "refused",
-        SetupError::Cosim(_) => "not_started",
-    }
-}
-
-/// Installs the one SIGINT/SIGTERM handler; the flag it sets is polled by the commands that
-/// stop cleanly (run, soak, sweep, bench ipc). Called once, by those commands only: the others
-/// keep the default action (a signal ends them at once).
-fn stop_flag() -> Arc<AtomicBool> {
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        warn(&format!("cannot install the Ctrl-C handler: {e}"));
-    }
-    stop
-}
-
 /// Runs one command.
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
@@ -243,7 +92,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(args) => plant::sweep::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),
         Command::Assess(args) => {
-            let dir = plant::assess::command(&args, &stop_flag())?;
+            let dir = plant::assess::command(&args, &plant::interrupt::stop_flag())?;
             eprintln!("plant assess: report in {}", dir.join("report.html").display());
             Ok(())
         }
@@ -353,7 +202,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
     let mut hooks = CliHooks {
-        stop: stop_flag(),
+        stop: plant::interrupt::stop_flag(),
         duration: scene.duration,
         started: Instant::now(),
         last: Instant::now(),
@@ -364,7 +213,7 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
-            if let Err(w) = plant::output::write_not_started(&dir, &scene, not_started_status(&e), &e.to_string()) {
+            if let Err(w) = plant::output::write_not_started(&dir, &scene, e.status().name(), &e.to_string()) {
                 warn(&format!("{w:#}"));
             }
             return Err(e.into());
@@ -389,6 +238,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
         Outcome::Interrupted => (StopKind::Interrupted, "interrupted".to_string()),
         Outcome::PeerLost(why) => (StopKind::PeerLost, why.clone()),
         Outcome::MissBudget(why) => (StopKind::MissBudget, why.clone()),
+        Outcome::InvalidCommands(why) => (StopKind::InvalidCommands, why.clone()),
     };
     Err(Ending::Stopped { kind, why, simulated_s }.into())
 }
@@ -399,7 +249,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
     let _claim = plant::claim::claim(&dir, true)?;
-    let stop = stop_flag();
+    let stop = plant::interrupt::stop_flag();
     let progress = match (quiet, std::io::stderr().is_terminal()) {
         (true, _) => plant::soak::Progress::Quiet,
         (false, true) => plant::soak::Progress::Bar,
@@ -435,7 +285,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 /// `plant analyze`.
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
     let _claim = plant::claim::claim(dir, false)?;
-    let a = plant::output::analyze_dir(dir)?;
+    let a = plant::output::analyze_dir(dir, &plant::interrupt::stop_flag())?;
     eprintln!(
         "plant: {}: post-shock mode {:?}, steady class {:?} (k = {:?}), whirl {:.1} Hz; summary.json updated",
         dir.display(),
@@ -475,7 +325,7 @@ fn bench_ipc(
         return Err(Ending::BadArgument(format!("--spin-us {spin_us} µs: must be between 0 and 1e6")).into());
     }
     let mut hooks = CliHooks {
-        stop: stop_flag(),
+        stop: plant::interrupt::stop_flag(),
         duration: 0.0,
         started: Instant::now(),
         last: Instant::now(),
@@ -484,8 +334,7 @@ fn bench_ipc(
     };
     let started = Instant::now();
     let launch = controller.launch(run_id);
-    let (rt, latency, blocks) =
-        plant::cosim::bench_round_trips(samples.max(1), warmup, &launch, pins, spin_us, &mut hooks)?;
+    let (rt, latency, blocks) = plant::cosim::bench_round_trips(samples, warmup, &launch, pins, spin_us, &mut hooks)?;
     let wall = started.elapsed().as_secs_f64();
     println!(
         "ipc round trip (plant -> controller -> plant), {} samples: p50 {:.2} us, p99 {:.2} us, p99.9 {:.2} us, max {:.2} us",
@@ -508,57 +357,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn exit_codes_follow_the_error_types_not_their_text() {
-        let stopped = |kind| anyhow::Error::from(Ending::Stopped { kind, why: "x".into(), simulated_s: 0.1 });
-        let law = controller::LawError::Unknown { name: "nope".into() };
-        let cases: Vec<(anyhow::Error, u8)> = vec![
-            (stopped(StopKind::Diverged), 3),
-            (stopped(StopKind::PeerLost), 4),
-            (stopped(StopKind::Interrupted), 130),
-            (Ending::CriteriaFailed(1).into(), 5),
-            (Ending::BadArgument("diverged".into()).into(), 2),
-            (anyhow::Error::from(plant::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
-            (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),
-            (anyhow::Error::from(SetupError::Law(law)).context("the run"), 2),
-            (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),
-            (SetupError::Cosim(CosimError::Interrupted).into(), 130),
-            (CosimError::NoController { waited_s: 1.0, run_id: "r".into(), hint: String::new() }.into(), 4),
-            (CosimError::Link(controller::link::LinkError::Incompatible { service: "s".into() }).into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(2) }.into(), 2),
-            (CosimError::ControllerExited { program: "c".into(), status: "x".into(), code: Some(1) }.into(), 4),
-            (stopped(StopKind::MissBudget), 6),
-            (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
-            (CosimError::Protocol("version 4".into()).into(), 2),
-            (
-                CosimError::Lock(controller::lock::LockError::InUse {
-                    run_id: "r".into(),
-                    role: "plant".into(),
-                    holder: "pid 1".into(),
-                    path: "p".into(),
-                })
-                .into(),
-                2,
-            ),
-            (
-                plant::output::AnalyzeError::Trace(plant::trace::TraceError::TooShort {
-                    path: "trace.csv".into(),
-                    rows: 1,
-                })
-                .into(),
-                2,
-            ),
-            (plant::output::AnalyzeError::Output(anyhow::anyhow!("read-only")).into(), 1),
-            // An output that could not be written, whatever its message says.
-            (anyhow::Error::from(std::io::Error::other("bad input")).context("writing summary.json"), 1),
-        ];
-        for (err, code) in cases {
-            assert_eq!(exit_code(&err), code, "{err:#}");
-        }
-    }
-
-    #[test]
     fn each_cause_is_said_once() {
-        let setup = plant::run::SetupError::Cosim(CosimError::RunId("run id \"a b\": a space".into()));
+        let setup = plant::run::SetupError::Cosim(plant::cosim::CosimError::RunId("run id \"a b\": a space".into()));
         let err = anyhow::Error::from(setup).context("starting the run");
         assert_eq!(format!("{err:#}"), "starting the run: run id \"a b\": a space: run id \"a b\": a space");
         assert_eq!(chain_text(&err), "starting the run: run id \"a b\": a space");

@@ -16,7 +16,7 @@ use crate::hooks::Hooks;
 use crate::model::{Model, State};
 use crate::plot::{self, Scale, Series};
 use crate::record::{ChartData, Recorder};
-use crate::run::{run_into, RunResult, SetupError, Sink, SinkRun};
+use crate::run::{run_into, Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{TraceError, TraceWriter};
 use anyhow::Context;
@@ -36,6 +36,7 @@ pub const RUN_FILES: &[&str] = &[
     "whirl_spectrum.png",
     "spectrogram.png",
     "poincare.png",
+    "controller.log",
 ];
 
 /// Why `plant run` stopped before it wrote its results.
@@ -80,7 +81,10 @@ fn prepare_scene_toml(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
 /// choices, so that every exit after the scene loaded leaves both files. An earlier run's
 /// files are removed ([`prepare`]).
 pub fn write_not_started(dir: &Path, scene: &Scene, status: &str, error: &str) -> anyhow::Result<()> {
-    prepare(dir, scene)?;
+    // The controller's output of this attempt stays: the error quotes it.
+    std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display()))?;
+    remove_stale_except(dir, &["controller.log"])?;
+    prepare_scene_toml(dir, scene)?;
     let summary = serde_json::json!({
         "scene": scene.name,
         "status": status,
@@ -93,7 +97,12 @@ pub fn write_not_started(dir: &Path, scene: &Scene, status: &str, error: &str) -
 
 /// Removes the files of [`RUN_FILES`] from `dir` (those that are there).
 pub fn remove_stale(dir: &Path) -> anyhow::Result<()> {
-    for name in RUN_FILES {
+    remove_stale_except(dir, &[])
+}
+
+/// [`remove_stale`], keeping the files named in `keep`.
+fn remove_stale_except(dir: &Path, keep: &[&str]) -> anyhow::Result<()> {
+    for name in RUN_FILES.iter().filter(|n| !keep.contains(n)) {
         let path = dir.join(name);
         match std::fs::remove_file(&path) {
             Ok(()) => {}
@@ -130,15 +139,32 @@ impl RunFolder {
         self.recorder.push(r);
     }
 
-    /// Flushes `trace.csv`, writes `summary.json`, then the charts.
-    pub fn finish(mut self, dir: &Path, scene: &Scene, run: SinkRun) -> anyhow::Result<Written> {
+    /// Flushes `trace.csv`, writes `summary.json`, then the charts. A run that completed but
+    /// was asked to stop (`stopped`: SIGINT/SIGTERM) while its outputs were being written is
+    /// `interrupted` (exit 130): every output is still written, and the summary says so.
+    pub fn finish(
+        mut self,
+        dir: &Path,
+        scene: &Scene,
+        mut run: SinkRun,
+        stopped: &dyn Fn() -> bool,
+    ) -> anyhow::Result<Written> {
+        let interrupt = |run: &mut SinkRun| {
+            let late = stopped() && run.outcome == Outcome::Completed;
+            if late {
+                run.outcome = Outcome::Interrupted;
+            }
+            late
+        };
+        interrupt(&mut run);
         let trace_path = dir.join("trace.csv");
         let flushed = match self.error.take() {
             Some(e) => Err(e),
             None => self.trace.flush(),
         };
         let recorded = self.recorder.finish(run.outcome.failure_time());
-        let summary = Summary::from_parts(scene, &run, recorded.figures, recorded.analysis);
+        interrupt(&mut run);
+        let mut summary = Summary::from_parts(scene, &run, recorded.figures, recorded.analysis);
         write_json(&dir.join("summary.json"), &summary)?;
         flushed.with_context(|| format!("writing {}", trace_path.display()))?;
         let mut skipped = Vec::new();
@@ -158,6 +184,11 @@ impl RunFolder {
                     .filter(|f| !written.contains(f)),
             );
         }
+        if interrupt(&mut run) {
+            summary.status = run.outcome.status();
+            summary.error = run.outcome.error();
+            write_json(&dir.join("summary.json"), &summary)?;
+        }
         Ok(Written { summary, run, skipped_charts: skipped })
     }
 }
@@ -172,7 +203,8 @@ impl Sink for RunFolder {
 pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<Written, RunDirError> {
     prepare(dir, scene).map_err(RunDirError::Output)?;
     let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
-    let run = run_into(scene, launch, hooks, &mut folder)?;
+    let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
+    let run = run_into(scene, &launch, hooks, &mut folder)?;
     // What an external controller ran differently from the scene goes into the record, so that
     // the folder reproduces the run.
     let recorded = match run.cosim.as_ref().and_then(|c| c.controller_overrides.as_ref()) {
@@ -183,7 +215,7 @@ pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Ho
         }
         None => None,
     };
-    folder.finish(dir, recorded.as_ref().unwrap_or(scene), run).map_err(RunDirError::Output)
+    folder.finish(dir, recorded.as_ref().unwrap_or(scene), run, &|| hooks.cancelled()).map_err(RunDirError::Output)
 }
 
 /// Writes everything a run whose trace is in memory produced, as [`run_to_dir`] does.
@@ -191,7 +223,7 @@ pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Resul
     prepare(dir, scene)?;
     let mut folder = RunFolder::create(dir, scene)?;
     result.trace.rows().for_each(|r| folder.push(&r));
-    Ok(folder.finish(dir, scene, result.run.clone())?.summary)
+    Ok(folder.finish(dir, scene, result.run.clone(), &|| false)?.summary)
 }
 
 /// Writes a value as pretty JSON, atomically ([`crate::atomic::write`]).
@@ -297,37 +329,46 @@ pub enum AnalyzeError {
     /// `summary.json` or a chart could not be written.
     #[error("{0:#}")]
     Output(anyhow::Error),
+    /// SIGINT/SIGTERM; what was written by then is said.
+    #[error("interrupted by a signal; {0}")]
+    Interrupted(&'static str),
 }
 
-impl AnalyzeError {
-    /// Bad input (exit 2), as opposed to an output that could not be written (exit 1).
-    pub fn is_input(&self) -> bool {
-        !matches!(self, AnalyzeError::Output(_))
-    }
-}
+/// The most a `summary.json` that `plant analyze` merges into may hold.
+const MAX_SUMMARY_BYTES: u64 = 16 << 20;
 
 /// `plant analyze DIR`: reads `scene.toml` (through the scene loader) and
 /// `trace.csv` (strictly, [`crate::trace::read_rows`]), merges the analysis
 /// into `summary.json` (created if missing; written atomically, only once the
-/// analysis succeeded), then writes the analysis charts.
-pub fn analyze_dir(dir: &Path) -> Result<Analysis, AnalyzeError> {
+/// analysis succeeded), then writes the analysis charts. Once `stop` is set
+/// (SIGINT/SIGTERM) it stops at the next row or step and says what it wrote.
+pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<Analysis, AnalyzeError> {
+    let stopped = || stop.load(std::sync::atomic::Ordering::Relaxed);
+    const NOTHING: &str = "nothing was written";
     let scene = crate::config::load_scene(&dir.join("scene.toml"), &[])?;
     let trace_path = dir.join("trace.csv");
     let mut recorder =
         crate::analysis::Analyzer::new(crate::summary::analysis_spec(&scene), Some(scene.output_interval));
     let mut rows = 0;
-    crate::trace::read_rows(&trace_path, |r| {
+    let whole = crate::trace::read_rows(&trace_path, |r| {
         recorder.push(r);
         rows += 1;
+        !stopped()
     })?;
+    if !whole {
+        return Err(AnalyzeError::Interrupted(NOTHING));
+    }
     if rows < 2 {
         return Err(TraceError::TooShort { path: trace_path, rows }.into());
     }
     let (analysis, data): (Analysis, AnalysisData) = recorder.finish();
+    if stopped() {
+        return Err(AnalyzeError::Interrupted(NOTHING));
+    }
 
     let summary_path = dir.join("summary.json");
     let bad_summary = |message: String| AnalyzeError::Summary { path: summary_path.display().to_string(), message };
-    let mut summary: serde_json::Value = match std::fs::read_to_string(&summary_path) {
+    let mut summary: serde_json::Value = match shock_table::input::read_text(&summary_path, MAX_SUMMARY_BYTES) {
         Ok(text) => serde_json::from_str(&text).map_err(|e| bad_summary(e.to_string()))?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => serde_json::json!({ "scene": scene.name }),
         // The summary is also this command's output: one that cannot be read cannot be replaced.
@@ -343,9 +384,15 @@ pub fn analyze_dir(dir: &Path) -> Result<Analysis, AnalyzeError> {
         map.extend(new);
     }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
+    if stopped() {
+        return Err(AnalyzeError::Interrupted("summary.json was updated, the charts were not drawn"));
+    }
     crate::analysis::write_plots(dir, &scene.name, &analysis, &data, scene.params.contact.gap)
         .context("writing analysis charts")
         .map_err(AnalyzeError::Output)?;
+    if stopped() {
+        return Err(AnalyzeError::Interrupted("summary.json and the charts were written"));
+    }
     Ok(analysis)
 }
 
@@ -353,7 +400,7 @@ pub fn analyze_dir(dir: &Path) -> Result<Analysis, AnalyzeError> {
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationError, Stats};
-    use crate::run::{Outcome, RunError};
+    use crate::run::RunError;
 
     /// Issue 11 item 6: a run that diverged at t = 0 with a non-finite state has nothing to
     /// draw; its results are still written, the charts skipped (not "nothing to plot", exit 1).
@@ -377,8 +424,10 @@ mod tests {
             final_state: [0.0; crate::model::N],
             cosim: None,
             parked_steps: 0,
+            invalid_commands: 0,
         };
-        let written = folder.finish(&dir, &scene, run).expect("a run with nothing to draw is not an output error");
+        let written =
+            folder.finish(&dir, &scene, run, &|| false).expect("a run with nothing to draw is not an output error");
         assert_eq!(written.summary.status, crate::status::Status::Diverged);
         assert!(written.summary.error.as_deref().unwrap_or_default().contains("non-finite state at t = 0 s"));
         assert!(written.skipped_charts.contains(&"orbit.png"), "{:?}", written.skipped_charts);

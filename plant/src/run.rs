@@ -17,7 +17,7 @@ use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
 use crate::model::{ix, Control, Model, RaceWhenClear, State};
 use crate::sensor::Sensor;
 use crate::trace::Trace;
-use controller::{build_law, saturate, ControlLaw, PdGains, Sample};
+use controller::{build_law, saturate, wrap_angle, ControlLaw, PdGains, Sample};
 use std::collections::VecDeque;
 
 /// Why a run stopped before its end.
@@ -81,6 +81,9 @@ pub enum Outcome {
     PeerLost(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// The law's commands were non-finite past `controller.max_invalid_burst` or
+    /// `controller.max_invalid_fraction` ([`crate::invalid`]).
+    InvalidCommands(String),
 }
 
 /// Why a run could not start.
@@ -181,6 +184,8 @@ pub struct SinkRun {
     pub cosim: Option<CosimReport>,
     /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
     pub parked_steps: u64,
+    /// Ticks whose command was non-finite (the last valid one was held).
+    pub invalid_commands: u64,
 }
 
 /// Runs a scene from its initial state, sending every output sample (from
@@ -195,7 +200,7 @@ pub fn run_into(
     let limit = scene.params.current_limit;
     let bias = saturate(gains.bias_a, limit);
     let (design, params) = (scene.design(), &scene.controller.params);
-    let mut source = match scene.controller.mode {
+    let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
         ControlMode::Sampled => Source::InProcess(build_law(&scene.controller.law, &design, params)?),
         ControlMode::Lockstep | ControlMode::Realtime => {
@@ -207,6 +212,29 @@ pub fn run_into(
             Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
         }
     };
+    run_from(scene, source, hooks, sink)
+}
+
+/// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
+/// the registry (whatever the scene's mode): the sensor read at each tick, the command
+/// saturated, delayed `delay_samples` ticks and held. A lockstep run of the same law in a
+/// controller process writes the same trace, bit for bit. See [`crate::check`].
+pub fn run_law_into(
+    scene: &Scene,
+    law: Box<dyn ControlLaw>,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
+    run_from(scene, Source::InProcess(law), hooks, sink)
+}
+
+/// The loop, from a command source.
+fn run_from(
+    scene: &Scene,
+    mut source: Source,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
     // An external controller may run a design of its own (its `--config` or `--law`): the run
     // is then the scene with those overrides, initial state and bias included, so that the
     // scene it records reproduces it.
@@ -252,6 +280,8 @@ pub fn run_into(
     let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
+    let c = &scene.controller;
+    let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
     let guards = Guards::new(scene);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
@@ -267,7 +297,14 @@ pub fn run_into(
     for k in 0..ticks {
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        let mut sample = Sample { seq: k, t_s: t0, sensor_v: sensor.read([y[ix::XR], y[ix::YR]]) };
+        // The keyphasor: the rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let mut sample = Sample {
+            seq: k,
+            t_s: t0,
+            sensor_v: sensor.read([y[ix::XR], y[ix::YR]]),
+            speed_rad_s: y[ix::WR],
+            angle_rad: wrap_angle(y[ix::TR]),
+        };
         let excitation = hooks.excitation(k, t0, &sample.sensor_v);
         if let Some(sine) = excitation {
             sample.sensor_v.iter_mut().zip(sine.at(t0).0).for_each(|(v, e)| *v += e);
@@ -300,6 +337,23 @@ pub fn run_into(
             },
         };
         if let Some(cmd) = command {
+            let cmd = match invalid.check(cmd, &sample) {
+                Ok(checked) => {
+                    if checked.first {
+                        hooks.note(&format!(
+                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {cmd:?} A: \
+                             the last valid command is held for it and for every later non-finite one, up to \
+                             controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
+                            sample.seq, sample.t_s, c.max_invalid_burst
+                        ));
+                    }
+                    checked.command
+                }
+                Err(why) => {
+                    outcome = Outcome::InvalidCommands(why);
+                    break;
+                }
+            };
             queue.push_back(cmd);
             if let Some(applied) = queue.pop_front() {
                 model.control = Control::Held(applied);
@@ -336,6 +390,9 @@ pub fn run_into(
         );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
+            // The run reached the failure, not the end of its macro step (an integration
+            // error stops inside it).
+            t = e.time();
             outcome = Outcome::Diverged(e);
             break;
         }
@@ -346,19 +403,36 @@ pub fn run_into(
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
+    // A run that completed is judged over all its ticks.
+    if outcome == Outcome::Completed {
+        if let Some(why) = invalid.at_end() {
+            outcome = Outcome::InvalidCommands(why);
+        }
+    }
     let cosim = match source {
         Source::Cosim(session) => {
-            // A realtime run that completed is judged over all its ticks.
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
                 }
             }
-            Some(session.finish(t, (t / period).round() as u64))
+            let mut report = session.finish(t, (t / period).round() as u64);
+            report.invalid_replies = invalid.count();
+            Some(report)
         }
         _ => None,
     };
-    Ok(SinkRun { stats: integrator.stats(), simulated: t, wall_time, outcome, final_state: y, cosim, parked_steps })
+    let invalid_commands = invalid.count();
+    Ok(SinkRun {
+        stats: integrator.stats(),
+        simulated: t,
+        wall_time,
+        outcome,
+        final_state: y,
+        cosim,
+        parked_steps,
+        invalid_commands,
+    })
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

@@ -1,11 +1,12 @@
 //! A run's status, as `summary.json` and `soak.json` write it, and the one
 //! mapping from how a run ended ([`Outcome`]) to its status and error text.
 
-use crate::run::Outcome;
-use serde::Serialize;
+use crate::cosim::CosimError;
+use crate::run::{Outcome, SetupError};
+use serde::{Deserialize, Serialize};
 
 /// The `status` of `summary.json` and `soak.json`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Ran to the scene's duration.
@@ -22,6 +23,8 @@ pub enum Status {
     NotStarted,
     /// Realtime: the deadline-miss budget was exceeded (exit 6).
     MissBudget,
+    /// The controller's commands were non-finite past the budget (exit 8).
+    InvalidCommands,
 }
 
 impl Status {
@@ -35,6 +38,7 @@ impl Status {
             Status::Refused => "refused",
             Status::NotStarted => "not_started",
             Status::MissBudget => "miss_budget",
+            Status::InvalidCommands => "invalid_commands",
         }
     }
 }
@@ -54,6 +58,7 @@ impl Outcome {
             Outcome::Interrupted => Status::Interrupted,
             Outcome::PeerLost(_) => Status::PeerLost,
             Outcome::MissBudget(_) => Status::MissBudget,
+            Outcome::InvalidCommands(_) => Status::InvalidCommands,
         }
     }
 
@@ -63,7 +68,7 @@ impl Outcome {
             Outcome::Completed => None,
             Outcome::Diverged(e) => Some(e.to_string()),
             Outcome::Interrupted => Some("interrupted by a signal".to_string()),
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) => Some(why.clone()),
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::InvalidCommands(why) => Some(why.clone()),
         }
     }
 
@@ -73,6 +78,41 @@ impl Outcome {
             Outcome::Diverged(e) => Some(e.time()),
             _ => None,
         }
+    }
+}
+
+impl SetupError {
+    /// The status of a run that could not start: `refused` (the controller refused the run or
+    /// is incompatible, the design or its overrides are invalid, the run id is in use),
+    /// `interrupted` (a signal while waiting for it), else `not_started`.
+    pub fn status(&self) -> Status {
+        match self {
+            SetupError::Law(_) | SetupError::Overrides(_) => Status::Refused,
+            SetupError::Cosim(CosimError::Interrupted) => Status::Interrupted,
+            SetupError::Cosim(c) if c.is_refusal() => Status::Refused,
+            SetupError::Cosim(_) => Status::NotStarted,
+        }
+    }
+}
+
+impl CosimError {
+    /// The controller (or the run's setting) refused the run: bad input on the plant's side
+    /// (exit 2), status `refused`. A `controller.command` that cannot be run is bad input too,
+    /// but the run did not start (`not_started`).
+    pub fn is_refusal(&self) -> bool {
+        use controller::link::LinkError;
+        use controller::lock::LockError;
+        matches!(
+            self,
+            CosimError::Refused { .. }
+                | CosimError::RunId(_)
+                | CosimError::Pin(_)
+                | CosimError::Params(_)
+                | CosimError::Protocol(_)
+                | CosimError::Lock(LockError::InUse { .. })
+                | CosimError::Link(LinkError::Incompatible { .. })
+                | CosimError::ControllerExited { code: Some(2), .. }
+        )
     }
 }
 
@@ -90,6 +130,7 @@ mod tests {
             Status::Refused,
             Status::NotStarted,
             Status::MissBudget,
+            Status::InvalidCommands,
         ] {
             assert_eq!(serde_json::to_value(s).unwrap(), s.name());
         }

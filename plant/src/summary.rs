@@ -106,17 +106,18 @@ pub struct Summary {
     pub failure_state: Option<FailureState>,
     /// Simulated time reached (s).
     pub simulated_s: f64,
-    /// Largest rotor radius relative to the housing (m), over the rows before a failure.
-    pub max_radius_m: f64,
+    /// Largest rotor radius relative to the housing (m), over the rows before a failure;
+    /// `null` when there is no such row (a run that failed at its first row).
+    pub max_radius_m: Option<f64>,
     /// Fraction of trace samples with rotor – race contact over the last 200 revolutions
     /// (the analysis's `steady_contact_fraction`).
     pub contact_fraction: f64,
     /// Start of the window of `contact_fraction` (s).
     pub steady_window_start_s: f64,
-    /// Largest rotor – race normal force at the trace samples (N).
-    pub max_contact_force_n: f64,
-    /// Largest race speed (rpm).
-    pub max_race_speed_rpm: f64,
+    /// Largest rotor – race normal force at the trace samples (N); `null` without a row.
+    pub max_contact_force_n: Option<f64>,
+    /// Largest race speed (rpm); `null` without a row.
+    pub max_race_speed_rpm: Option<f64>,
     /// Time from the first shock's start to the last trace sample with rotor – race contact (s):
     /// 0 without contact after the shock, `null` if the rotor is still touching at the end.
     pub recovery_s: Option<f64>,
@@ -124,6 +125,9 @@ pub struct Summary {
     pub contact_time_s: f64,
     /// Fraction of macro steps run with the race parked (0 unless `race_when_clear = "parked"`).
     pub parked_fraction: f64,
+    /// Controller ticks whose command was non-finite (the last valid one was held; see
+    /// `controller.max_invalid_burst`, `controller.max_invalid_fraction`).
+    pub invalid_commands: u64,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -149,14 +153,18 @@ pub struct Summary {
 impl Summary {
     /// One line of what the run did: status, time, speed, largest radius and force.
     pub fn headline(&self) -> String {
+        let or_none = |v: Option<f64>, scale: f64, decimals: usize, unit: &str| match v {
+            Some(v) => format!("{:.*} {unit}", decimals, v * scale),
+            None => "none (no row before the failure)".to_string(),
+        };
         format!(
-            "{} {} s simulated in {:.2} s ({:.2}x real time); max radius {:.1} µm, max contact force {:.0} N",
+            "{} {} s simulated in {:.2} s ({:.2}x real time); max radius {}, max contact force {}",
             self.status,
             self.simulated_s,
             self.wall_time_s,
             self.realtime_factor,
-            self.max_radius_m * 1e6,
-            self.max_contact_force_n,
+            or_none(self.max_radius_m, 1e6, 1, "µm"),
+            or_none(self.max_contact_force_n, 1.0, 0, "N"),
         )
     }
 
@@ -201,6 +209,7 @@ impl Summary {
                     0.0
                 }
             },
+            invalid_commands: run.invalid_commands,
             steps: run.stats.steps,
             rejected_steps: run.stats.rejected,
             rhs_evals: run.stats.rhs_evals,
@@ -275,12 +284,12 @@ pub fn analysis_spec(scene: &Scene) -> AnalysisSpec {
 /// The summary's figures of a whole run, taken row by row.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Figures {
-    /// Largest rotor radius (m).
-    pub max_radius_m: f64,
-    /// Largest contact force (N).
-    pub max_contact_force_n: f64,
-    /// Largest race speed (rpm).
-    pub max_race_speed_rpm: f64,
+    /// Largest rotor radius (m); `None` when no row counts (a failure at the first row).
+    pub max_radius_m: Option<f64>,
+    /// Largest contact force (N); `None` when no row counts.
+    pub max_contact_force_n: Option<f64>,
+    /// Largest race speed (rpm); `None` when no row counts.
+    pub max_race_speed_rpm: Option<f64>,
     /// See [`Summary::recovery_s`].
     pub recovery_s: Option<f64>,
     /// Rows.
@@ -314,6 +323,8 @@ pub struct FiguresBuilder {
     last_row_in_contact: bool,
     rows: u64,
     contact_rows: u64,
+    /// Rows taken into the maxima.
+    counted: u64,
 }
 
 impl FiguresBuilder {
@@ -329,6 +340,7 @@ impl FiguresBuilder {
             last_row_in_contact: false,
             rows: 0,
             contact_rows: 0,
+            counted: 0,
         }
     }
 
@@ -356,6 +368,7 @@ impl FiguresBuilder {
             keep(&mut self.max_radius, radius);
             keep(&mut self.max_force, force);
             keep(&mut self.max_rpm, rpm);
+            self.counted += 1;
         }
     }
 
@@ -364,10 +377,11 @@ impl FiguresBuilder {
         if self.pending.is_some_and(|p| failure_time.is_none_or(|tf| p[0] < tf)) {
             self.commit();
         }
+        let counted = |m: f64| (self.counted > 0).then_some(m);
         Figures {
-            max_radius_m: self.max_radius,
-            max_contact_force_n: self.max_force,
-            max_race_speed_rpm: self.max_rpm,
+            max_radius_m: counted(self.max_radius),
+            max_contact_force_n: counted(self.max_force),
+            max_race_speed_rpm: counted(self.max_rpm),
             // From the shock's start to the last row in contact: 0 if none, `None` if the last
             // row is in contact (the rotor never left).
             recovery_s: match self.last_contact {
@@ -408,9 +422,20 @@ mod tests {
             f.push(&r);
         }
         let diverged = f.clone().finish(Some(2e-4));
-        assert_eq!((diverged.max_radius_m, diverged.max_contact_force_n), (628e-6, 10.0));
+        assert_eq!((diverged.max_radius_m, diverged.max_contact_force_n), (Some(628e-6), Some(10.0)));
         let completed = f.finish(None);
-        assert_eq!((completed.max_radius_m, completed.max_contact_force_n), (793e-6, 2e5));
+        assert_eq!((completed.max_radius_m, completed.max_contact_force_n), (Some(793e-6), Some(2e5)));
+    }
+
+    /// Issue 21 item 7: a run that failed at its first row reported `max_radius_m = 0.0`, a
+    /// radius it never had: without a row before the failure the maxima are `None` (null).
+    #[test]
+    fn maxima_over_no_row_are_none() {
+        let mut f = FiguresBuilder::new(0.0);
+        f.push(&row(0.0, f64::NAN, f64::NAN));
+        let failed = f.finish(Some(0.0));
+        assert_eq!((failed.max_radius_m, failed.max_contact_force_n, failed.max_race_speed_rpm), (None, None, None));
+        assert_eq!(FiguresBuilder::new(0.0).finish(None).max_radius_m, None);
     }
 
     #[test]

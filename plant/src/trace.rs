@@ -83,6 +83,8 @@ pub mod col {
     pub const VY_M_S: usize = 4;
     /// `rotor_angle_rad`.
     pub const ROTOR_ANGLE_RAD: usize = 9;
+    /// `rotor_speed_rad_s`.
+    pub const ROTOR_SPEED_RAD_S: usize = 10;
     /// `race_speed_rad_s`.
     pub const RACE_SPEED_RAD_S: usize = 11;
     /// `contact_force_n`.
@@ -160,7 +162,10 @@ impl Trace {
     /// Reads a `trace.csv` strictly (see [`read_rows`]).
     pub fn read_csv(path: &Path) -> Result<Self, TraceError> {
         let mut trace = Trace::default();
-        read_rows(path, |r| trace.push_row(r))?;
+        read_rows(path, |r| {
+            trace.push_row(r);
+            true
+        })?;
         Ok(trace)
     }
 }
@@ -231,7 +236,16 @@ pub enum TraceError {
     },
 }
 
-/// Reads `trace.csv` at `path` strictly, passing each row to `row` in order.
+/// The longest line a `trace.csv` may have (bytes): a row of 19 numbers takes about 450.
+pub const MAX_LINE_BYTES: usize = 64 << 10;
+
+/// Reads `trace.csv` at `path` strictly, passing each row to `row` in order, while `row`
+/// returns `true`; returns whether every row was read.
+///
+/// The file must be a regular file (a device such as `/dev/zero`, a FIFO or a folder is
+/// refused before it is read) and no line may be longer than [`MAX_LINE_BYTES`], so that a
+/// file that is not a trace (a link to `/dev/zero`, a sparse file of zeros) is refused at
+/// once in bounded memory.
 ///
 /// The header must hold every name of [`Trace::COLUMNS`] (other columns are
 /// ignored). Refused, naming the line and, where one is to blame, the
@@ -241,7 +255,7 @@ pub enum TraceError {
 /// that does not increase (running backwards or repeating), and a last line
 /// without its line end (a file cut in the middle of a row, whose last field
 /// may read as a number it never was).
-pub fn read_rows(path: &Path, mut row: impl FnMut(&Row)) -> Result<(), TraceError> {
+pub fn read_rows(path: &Path, mut row: impl FnMut(&Row) -> bool) -> Result<bool, TraceError> {
     let io = |source| TraceError::Io { path: path.to_path_buf(), source };
     let bad = |line: u64, column: Option<&str>, what: String| TraceError::Malformed {
         path: path.to_path_buf(),
@@ -249,10 +263,10 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row)) -> Result<(), TraceErro
         column: column.map(str::to_string),
         what,
     };
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = shock_table::input::open_regular(path).map_err(io)?;
     let len = file.metadata().map_err(io)?.len();
-    let mut reader =
-        csv::ReaderBuilder::new().has_headers(false).flexible(true).from_reader(std::io::BufReader::new(file));
+    let lines = LineBound { inner: std::io::BufReader::new(file), line: 1, run: 0 };
+    let mut reader = csv::ReaderBuilder::new().has_headers(false).flexible(true).from_reader(lines);
     let mut record = csv::ByteRecord::new();
     let csv_err = |e: csv::Error| match e.kind() {
         csv::ErrorKind::Io(_) => match e.into_kind() {
@@ -298,11 +312,13 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row)) -> Result<(), TraceErro
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        row(&values);
+        if !row(&values) {
+            return Ok(false);
+        }
     }
     if len > 0 {
         use std::io::{Read, Seek, SeekFrom};
-        let mut file = std::fs::File::open(path).map_err(io)?;
+        let mut file = reader.into_inner().inner.into_inner();
         file.seek(SeekFrom::End(-1)).map_err(io)?;
         let mut last = [0u8; 1];
         file.read_exact(&mut last).map_err(io)?;
@@ -310,7 +326,38 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row)) -> Result<(), TraceErro
             return Err(bad(last_line, None, "the last row has no line end: the file was cut".to_string()));
         }
     }
-    Ok(())
+    Ok(true)
+}
+
+/// A reader that fails (`InvalidData`, naming the line) as soon as a line grows past
+/// [`MAX_LINE_BYTES`]: the csv reader would otherwise gather a line of any length in memory.
+struct LineBound<R> {
+    inner: R,
+    /// The line being read, from 1.
+    line: u64,
+    /// Bytes of that line read so far.
+    run: usize,
+}
+
+impl<R: std::io::Read> std::io::Read for LineBound<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for segment in buf[..n].split_inclusive(|&b| b == b'\n') {
+            let ends = segment.last() == Some(&b'\n');
+            self.run += segment.len() - usize::from(ends);
+            if self.run > MAX_LINE_BYTES {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!("line {} is longer than {MAX_LINE_BYTES} bytes: this is not a trace", self.line),
+                ));
+            }
+            if ends {
+                self.line += 1;
+                self.run = 0;
+            }
+        }
+        Ok(n)
+    }
 }
 
 #[cfg(test)]
@@ -364,6 +411,38 @@ mod tests {
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{a:?} vs {b:?}");
         }
         let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    }
+
+    /// Issue 21 item 7: `plant analyze` read `trace.csv` without a bound: a link to
+    /// `/dev/zero` grew to 4 GiB and never ended, a 2 GB sparse file peaked at 8 GiB, a FIFO
+    /// blocked forever. Each is refused at once now, in bounded memory.
+    #[cfg(unix)]
+    #[test]
+    fn a_device_a_fifo_or_a_line_without_end_is_refused_at_once() {
+        let dir = std::env::temp_dir().join(format!("plant-trace-hostile-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let zero = dir.join("zero.csv");
+        std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+        let e = Trace::read_csv(&zero).unwrap_err().to_string();
+        assert!(e.contains("zero.csv") && e.contains("not a regular file"), "{e}");
+        let fifo = dir.join("fifo.csv");
+        let name = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+        // SAFETY: mkfifo(3) with a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0);
+        let e = Trace::read_csv(&fifo).unwrap_err().to_string();
+        assert!(e.contains("fifo.csv") && e.contains("not a regular file"), "{e}");
+        // A sparse file of 2 GB of zeros: one line that never ends.
+        let sparse = dir.join("sparse.csv");
+        std::fs::File::create(&sparse).unwrap().set_len(2 << 30).unwrap();
+        let e = Trace::read_csv(&sparse).unwrap_err().to_string();
+        assert!(e.contains("sparse.csv") && e.contains("line 1 is longer than 65536 bytes"), "{e}");
+        // The same after a good header and rows: the line is named.
+        let mut text = format!("{}\n{}\n", header(), line(0.0, "1e-6"));
+        text.push_str(&"7".repeat(MAX_LINE_BYTES + 1));
+        let e = error_of("long", &text);
+        assert!(e.contains("line 3 is longer"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

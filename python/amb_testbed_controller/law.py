@@ -1,18 +1,29 @@
 """What a law is built from and what it gets each tick; why it refuses to be built.
 
-A law is a class with a ``name`` (its ``controller.law``), built as
-``Law(design, params)`` from the hello's :class:`Design` and its own
-parameters (:class:`Params`, the scene's ``[controller.params]``), with a
-method ``update(sample) -> (i_x, i_y)``: coil currents (A) before the
-amplifier limit, which the kit applies. State lives in the object; time
-comes in the sample, never from a clock. Refuse a design with
+A law (:class:`Law`) is a class with a ``name`` (its ``controller.law``),
+built as ``Law(design, params)`` from one bearing plane's :class:`Design`
+and its own parameters (:class:`Params`, the scene's
+``[controller.params]``), with a method ``update(sample) -> (i_x, i_y)``:
+that plane's coil currents (A) before the amplifier limit, which the kit
+applies. On the planar model (2 axes) it is the whole controller; on a
+two-plane rotor (4 axes) the kit builds it once per plane, each from its
+plane's design, and feeds each its plane's pair (decentralised). A class
+may say ``axes = (2,)`` to drive the planar model only: the kit then
+refuses a 4-axis hello (code 3). A law of the whole rotor
+(:class:`RotorLaw`, ``whole_rotor = True``) is built as
+``Law(rotor_design, params)`` from the :class:`RotorDesign` and answers
+``update(rotor_sample)`` with every axis's current. Every sample carries
+the keyphasor (the rotor's speed and angle). State lives in the object;
+time comes in the sample, never from a clock. Refuse a design with
 :class:`DesignError` and a parameter with ``params.error(...)`` (a
 :class:`ParamError`); the kit answers the plant's hello with the refusal.
 """
 
 import math
 import tomllib
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol
 
 from . import wire
 
@@ -30,7 +41,8 @@ class LoopConstants:
     sensor_gain_v_per_m: float
     """Sensor gain A_s (V/m)."""
     rotor_mass_kg: float
-    """Rotor mass m_r (kg)."""
+    """The rotor mass this bearing carries m_r (kg): the planar model's mass, a plane's share on
+    a two-plane rotor."""
     gravity_m_s2: float
     """Gravity g (m/s²)."""
     air_gap_m: float
@@ -39,7 +51,7 @@ class LoopConstants:
 
 @dataclass(frozen=True)
 class Design:
-    """The common loop design a law is built from (``controller::Design`` in Rust)."""
+    """One bearing plane's loop design a law is built from (``controller::Design`` in Rust)."""
 
     stiffness_n_per_m: float
     """Closed-loop stiffness k_e (N/m)."""
@@ -57,6 +69,7 @@ class Design:
 
     @classmethod
     def from_hello(cls, h: "wire.Hello") -> "Design":
+        """Plane A's design (the planar design of a planar hello)."""
         return cls(
             stiffness_n_per_m=h.stiffness_n_per_m,
             damping_ratio=h.damping_ratio,
@@ -76,24 +89,154 @@ class Design:
         )
 
 
+    def plane_b(self, h: "wire.Hello") -> "Design":
+        """Plane B's design from a two-plane hello, sharing this (plane A's) period, delay,
+        gravity bias switch and gravity."""
+        return Design(
+            stiffness_n_per_m=h.b_stiffness_n_per_m,
+            damping_ratio=h.b_damping_ratio,
+            period_s=self.period_s,
+            gravity_bias=self.gravity_bias,
+            current_limit_a=h.b_current_limit_a,
+            delay_samples=self.delay_samples,
+            constants=LoopConstants(
+                ki_n_per_a=h.b_ki_n_per_a,
+                ks_n_per_m=h.b_ks_n_per_m,
+                amp_gain_a_per_v=h.b_amp_gain_a_per_v,
+                sensor_gain_v_per_m=h.b_sensor_gain_v_per_m,
+                rotor_mass_kg=h.b_rotor_mass_kg,
+                gravity_m_s2=self.constants.gravity_m_s2,
+                air_gap_m=h.b_air_gap_m,
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A two-plane rotor's geometry and inertia (SI; ``controller::Geometry`` in Rust).
+    Stations are along z from the centre of mass, plane A on the negative side."""
+
+    mass_kg: float
+    """The whole rotor's mass M (kg)."""
+    transverse_inertia_kg_m2: float
+    """I_t about the centre of mass (kg m²)."""
+    polar_inertia_kg_m2: float
+    """I_p (kg m²)."""
+    rated_speed_rad_s: float
+    """Rated spin speed (rad/s)."""
+    bearing_z_m: tuple[float, float]
+    """Stations of bearings A and B (m), z_A < z_B."""
+    sensor_z_m: tuple[float, float]
+    """Stations of sensors A and B (m)."""
+
+
+@dataclass(frozen=True)
+class RotorDesign:
+    """The whole rotor's design (``controller::RotorDesign`` in Rust): one :class:`Design` per
+    bearing plane (A, then B) and, for a two-plane rotor, its :class:`Geometry`."""
+
+    planes: tuple[Design, ...]
+    geometry: Geometry | None
+
+    @property
+    def axes(self) -> int:
+        """2 (planar) or 4 (two-plane)."""
+        return 2 * len(self.planes)
+
+    @classmethod
+    def from_hello(cls, h: "wire.Hello") -> "RotorDesign":
+        """The design a hello of 2 or 4 axes carries."""
+        a = Design.from_hello(h)
+        if h.axes != wire.TWO_PLANE_AXES:
+            return cls(planes=(a,), geometry=None)
+        geometry = Geometry(
+            mass_kg=h.total_mass_kg,
+            transverse_inertia_kg_m2=h.transverse_inertia_kg_m2,
+            polar_inertia_kg_m2=h.polar_inertia_kg_m2,
+            rated_speed_rad_s=h.rated_speed_rad_s,
+            bearing_z_m=(h.bearing_a_z_m, h.bearing_b_z_m),
+            sensor_z_m=(h.sensor_a_z_m, h.sensor_b_z_m),
+        )
+        return cls(planes=(a, a.plane_b(h)), geometry=geometry)
+
+
 class Sample:
-    """One controller input: sample index, its simulated time (s), sensor voltages (V, x then y)."""
+    """One controller input of a per-plane law: sample index, its simulated time (s), the
+    plane's sensor voltages (V, x then y) and the keyphasor: the rotor's speed (rad/s) and angle
+    (rad, in [0, 2π), 0 when the unbalance points along +x)."""
 
-    __slots__ = ("seq", "t_s", "sensor_v")
+    __slots__ = ("seq", "t_s", "sensor_v", "speed_rad_s", "angle_rad")
 
-    def __init__(self, seq: int, t_s: float, sensor_v: tuple[float, float]):
+    def __init__(self, seq: int, t_s: float, sensor_v: tuple[float, float], speed_rad_s: float = 0.0,
+                 angle_rad: float = 0.0):
         self.seq = seq
         self.t_s = t_s
         self.sensor_v = sensor_v
+        self.speed_rad_s = speed_rad_s
+        self.angle_rad = angle_rad
 
     def __repr__(self) -> str:
-        return f"Sample(seq={self.seq}, t_s={self.t_s!r}, sensor_v={self.sensor_v!r})"
+        return (f"Sample(seq={self.seq}, t_s={self.t_s!r}, sensor_v={self.sensor_v!r}, "
+                f"speed_rad_s={self.speed_rad_s!r}, angle_rad={self.angle_rad!r})")
+
+
+class RotorSample:
+    """One controller input of a law of the whole rotor: every axis's sensor voltage (V), in
+    axis order (x, y or x_A, y_A, x_B, y_B), with the keyphasor."""
+
+    __slots__ = ("seq", "t_s", "sensor_v", "speed_rad_s", "angle_rad")
+
+    def __init__(self, seq: int, t_s: float, sensor_v: tuple[float, ...], speed_rad_s: float, angle_rad: float):
+        self.seq = seq
+        self.t_s = t_s
+        self.sensor_v = sensor_v
+        self.speed_rad_s = speed_rad_s
+        self.angle_rad = angle_rad
+
+    @property
+    def axes(self) -> int:
+        return len(self.sensor_v)
+
+    def plane(self, p: int) -> Sample:
+        """Bearing plane ``p``'s sample (0 = A, 1 = B)."""
+        return Sample(self.seq, self.t_s, (self.sensor_v[2 * p], self.sensor_v[2 * p + 1]), self.speed_rad_s,
+                      self.angle_rad)
+
+
+class Law(Protocol):
+    """A per-plane law, as :func:`amb_testbed_controller.serve` takes it: a class with these
+    members, built as ``Law(design, params)``."""
+
+    name: ClassVar[str]
+
+    def __init__(self, design: Design, params: "Params") -> None: ...
+
+    def update(self, sample: Sample) -> tuple[float, float]:
+        """The plane's coil currents (A), x then y, before the amplifier limit."""
+        ...
+
+
+class RotorLaw(Protocol):
+    """A law of the whole rotor: ``whole_rotor = True``, built as ``Law(rotor_design, params)``."""
+
+    name: ClassVar[str]
+    whole_rotor: ClassVar[bool]
+
+    def __init__(self, design: RotorDesign, params: "Params") -> None: ...
+
+    def update(self, sample: RotorSample) -> Sequence[float]:
+        """Every axis's coil current (A) in axis order, before the amplifier limits."""
+        ...
+
+
+LawClass = type[Law] | type[RotorLaw]
+"""What ``serve`` takes: law classes of either kind."""
 
 
 class DesignError(Exception):
     """A value of the common design is out of range for this law (Ack status 5, law rejected)."""
 
-    def __init__(self, key: str, value: float, unit: str, why: str):
+    def __init__(self, key: str, value: float, unit: str, why: str) -> None:
         super().__init__(f"{key} = {_number(value)}{_unit(unit)}: {why}")
 
 
@@ -101,7 +244,7 @@ class ParamError(Exception):
     """One of the law's parameters is refused (Ack status 7, parameters rejected)."""
 
 
-def toml_value(v) -> str:
+def toml_value(v: Any) -> str:
     """A TOML value as it would be written in the scene (for messages)."""
     if isinstance(v, bool):
         return "true" if v else "false"
@@ -127,7 +270,11 @@ def _unit(unit: str) -> str:
 class Check:
     """The range a number must lie in (``controller::Check`` in Rust)."""
 
-    def __init__(self, holds, why: str):
+    FINITE: ClassVar["Check"]
+    POSITIVE: ClassVar["Check"]
+    NON_NEGATIVE: ClassVar["Check"]
+
+    def __init__(self, holds: Callable[[float], bool], why: str) -> None:
         self.holds, self.why = holds, why
 
     @staticmethod
@@ -155,7 +302,7 @@ class Params:
     amb_testbed_controller.law.ParamError: law relev_py: controller.params.hold_ms = -5.0 ms: must be a finite number >= 0
     """
 
-    def __init__(self, law: str, table: dict):
+    def __init__(self, law: str, table: dict[str, Any]) -> None:
         self.law = law
         self.table = table
         self.read: list[str] = []
@@ -173,7 +320,7 @@ class Params:
         except tomllib.TOMLDecodeError as e:
             raise ParamError(f"the [controller.params] document is not valid TOML: {e}") from None
 
-    def error(self, key: str, value, unit: str, why: str) -> ParamError:
+    def error(self, key: str, value: Any, unit: str, why: str) -> ParamError:
         """An error about ``key``, whose value is ``value`` (a TOML value), in ``unit``."""
         return ParamError(f"law {self.law}: controller.params.{key} = {toml_value(value)}{_unit(unit)}: {why}")
 

@@ -17,11 +17,17 @@ What the Python bindings (iceoryx2 0.10.0) lack, and what stands in:
 * error variants: an ``open_or_create`` failure is one exception class whose
   text names the variant (``PublishSubscribeOpenError(IncompatibleTypes)``),
   so another protocol version is recognised by that text.
+* a service's static configuration: ``Service.details`` gives it only in its
+  text form, so the peer's type name (and so its protocol version) is read
+  from that text.
 """
 
 import ctypes
 import ctypes.util
+import re
 import time
+from collections.abc import Callable
+from typing import Any
 
 import iceoryx2 as iox2
 
@@ -43,6 +49,40 @@ class Incompatible(LinkError):
     """A service exists with other message types: the peer speaks another protocol version (exit code 2)."""
 
 
+def version_of(type_name: str) -> int | None:
+    """The protocol version in a type name ``amb_testbed.v<N>.<Struct>``."""
+    m = re.fullmatch(r"amb_testbed\.v(\d+)\..+", type_name)
+    return int(m.group(1)) if m else None
+
+
+def _peer_type(full: str) -> str | None:
+    """The payload type name the existing service ``full`` was created with, if readable."""
+    try:
+        details = iox2.Service.details(iox2.ServiceName.new(full), iox2.config.global_config(),
+                                       iox2.MessagingPattern.PublishSubscribe, iox2.ServiceType.Ipc)
+    except Exception:
+        return None
+    # Its str() is the Rust side's debug dump of the static configuration, type names included.
+    found = re.search(r"amb_testbed\.v\d+\.\w+", str(details)) if details is not None else None
+    return found.group(0) if found else None
+
+
+def incompatible_message(full: str, peer_type: str | None) -> str:
+    """What a side that finds another version's service says (as ``controller::link`` in Rust)."""
+    version = None if peer_type is None else version_of(peer_type)
+    if version == wire.PROTOCOL_VERSION:
+        peer = f"its type is {peer_type}: this protocol version, but another message on this service"
+    elif version is not None:
+        peer = f"the peer speaks protocol version {version}: its type is {peer_type}"
+    elif peer_type is not None:
+        peer = f"its type is {peer_type}, not of this testbed's protocol"
+    else:
+        peer = "another protocol version"
+    return (f"{full}: the peer uses other message types ({peer}; this side speaks version "
+            f"{wire.PROTOCOL_VERSION}, type names amb_testbed.v{wire.PROTOCOL_VERSION}.*): "
+            "run a plant and a controller of the same protocol version")
+
+
 def _fail(what: str, e: Exception) -> LinkError:
     return LinkError(f"{what}: {type(e).__name__}: {e}")
 
@@ -50,7 +90,7 @@ def _fail(what: str, e: Exception) -> LinkError:
 class _Fence:
     """A sequentially consistent fence (see the module doc)."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
         self._mutex = ctypes.create_string_buffer(64)  # >= sizeof(pthread_mutex_t) on Linux and BSDs
         if libc.pthread_mutex_init(self._mutex, None) != 0:
@@ -65,7 +105,7 @@ class _Fence:
 fence = _Fence()
 
 
-def node(run_id: str, role: str):
+def node(run_id: str, role: str) -> Any:
     """The node ``amb-testbed/<run_id>/<role>``, iceoryx2's signal handling off; dead nodes' leftovers removed."""
     full = wire.name(run_id, role)
     try:
@@ -112,7 +152,7 @@ def peer(run_id: str, role: str) -> str:
     return DEAD if dead else ABSENT
 
 
-def _pubsub(n, run_id: str, what: str, payload):
+def _pubsub(n: Any, run_id: str, what: str, payload: type[ctypes.Structure]) -> Any:
     full = wire.name(run_id, what)
     try:
         return (
@@ -128,14 +168,11 @@ def _pubsub(n, run_id: str, what: str, payload):
         )
     except iox2.PublishSubscribeOpenOrCreateError as e:
         if "IncompatibleTypes" in str(e):
-            raise Incompatible(
-                f"{full}: the peer uses other message types (another protocol version: this side speaks "
-                f"version {wire.PROTOCOL_VERSION}, type names amb_testbed.v{wire.PROTOCOL_VERSION}.*)"
-            ) from None
+            raise Incompatible(incompatible_message(full, _peer_type(full))) from None
         raise _fail(f"opening service {full}", e) from None
 
 
-def _event(n, run_id: str, what: str):
+def _event(n: Any, run_id: str, what: str) -> Any:
     full = wire.name(run_id, what)
     try:
         return (
@@ -153,7 +190,8 @@ def _event(n, run_id: str, what: str):
 class Mailbox:
     """A publisher of ``tx_type`` on ``<run_id>/<tx>`` and a subscriber of ``rx_type`` on ``<run_id>/<rx>``, polled."""
 
-    def __init__(self, n, run_id: str, tx: str, rx: str, tx_type, rx_type):
+    def __init__(self, n: Any, run_id: str, tx: str, rx: str, tx_type: type[ctypes.Structure],
+                 rx_type: type[ctypes.Structure]) -> None:
         self.tx_name, self.rx_name = wire.name(run_id, tx), wire.name(run_id, rx)
         tx_service = _pubsub(n, run_id, tx, tx_type)
         rx_service = _pubsub(n, run_id, rx, rx_type)
@@ -166,11 +204,11 @@ class Mailbox:
         self._rx_size = ctypes.sizeof(rx_type)
         self._rx_address = ctypes.addressof(self._rx)
 
-    def send(self, message) -> None:
+    def send(self, message: ctypes.Structure) -> None:
         """Publishes a message (copied into a loaned sample)."""
         self.publisher.send_copy(message)
 
-    def try_receive(self):
+    def try_receive(self) -> Any:
         """The next message, copied out (the sample is released), or ``None``.
 
         The returned structure is reused by the next call: copy what you keep.
@@ -192,7 +230,8 @@ class Endpoint:
     event service if it held a request.
     """
 
-    def __init__(self, n, run_id: str, tx: str, rx: str, tx_type, rx_type, spin_ns: int):
+    def __init__(self, n: Any, run_id: str, tx: str, rx: str, tx_type: type[ctypes.Structure],
+                 rx_type: type[ctypes.Structure], spin_ns: int) -> None:
         self.mail = Mailbox(n, run_id, tx, rx, tx_type, rx_type)
         try:
             self.notifier = _event(n, run_id, tx).notifier_builder().create()
@@ -211,7 +250,7 @@ class Endpoint:
         """Sets the busy-poll budget before blocking (ns)."""
         self.spin_max = self.spin = spin_ns
 
-    def send(self, frame) -> None:
+    def send(self, frame: ctypes.Structure) -> None:
         """Publishes a frame, then notifies the peer if it asked to be woken."""
         self.mail.send(frame)
         fence()
@@ -223,14 +262,14 @@ class Endpoint:
         if asked:
             self.notifier.notify()
 
-    def send_and_wake(self, frame) -> None:
+    def send_and_wake(self, frame: ctypes.Structure) -> None:
         """Publishes a frame and always notifies (the last frame of a run)."""
         self.mail.send(frame)
         while (request := self.wake_in.receive()) is not None:
             request.delete()
         self.notifier.notify()
 
-    def wait(self, slice_, keep_waiting):
+    def wait(self, slice_: Any, keep_waiting: Callable[[], bool]) -> Any:
         """The next frame: busy-polls for the spin budget, then blocks in slices of ``slice_``
         (an ``iceoryx2.Duration``), calling ``keep_waiting()`` after each; ``None`` when it says stop.
 
@@ -254,7 +293,7 @@ class Endpoint:
         self.spin = min(max(self.spin, 2 * waited), self.spin_max) if waited <= self.spin_max else self.spin // 2
         return frame
 
-    def _block(self, slice_, keep_waiting):
+    def _block(self, slice_: Any, keep_waiting: Callable[[], bool]) -> Any:
         self.blocks += 1
         try_receive = self.mail.try_receive
         while True:

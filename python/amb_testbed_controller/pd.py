@@ -11,20 +11,23 @@ difference ``(u_k − u_{k−1}) / T``, zero at the first sample.
 
 Python floats are IEEE binary64 and Python neither reorders nor fuses
 floating-point operations, so writing each expression in the Rust law's
-order (left to right, same parentheses) gives the same bits.
+order (left to right, same parentheses) gives the same bits. A per-plane
+law: on a two-plane rotor the kit runs one per plane, each from its plane's
+design, as the Rust controller does.
 """
 
 import math
+from typing import ClassVar
 
-from .law import DesignError
+from .law import Design, DesignError, Params, Sample
 
 
 class PD:
-    """The naively sampled PD of the design; no parameters of its own."""
+    """The naively sampled PD of one plane's design; no parameters of its own."""
 
-    name = "pd"
+    name: ClassVar[str] = "pd"
 
-    def __init__(self, design, params):
+    def __init__(self, design: Design, params: Params) -> None:
         k, xi, c = design.stiffness_n_per_m, design.damping_ratio, design.constants
         if not (math.isfinite(k) and k > 0.0):
             raise DesignError("controller.stiffness_n_per_m", k, "N/m", "must be > 0")
@@ -37,9 +40,9 @@ class PD:
         self.amp = c.amp_gain_a_per_v
         self.bias = (0.0, c.rotor_mass_kg * c.gravity_m_s2 / c.ki_n_per_a if design.gravity_bias else 0.0)
         self.period = design.period_s
-        self.prev = None
+        self.prev: tuple[float, float] | None = None
 
-    def update(self, sample):
+    def update(self, sample: Sample) -> tuple[float, float]:
         u = sample.sensor_v
         if self.prev is None:
             rate = (0.0, 0.0)

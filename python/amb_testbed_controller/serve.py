@@ -35,11 +35,14 @@ import signal
 import sys
 import time
 import traceback
+from collections.abc import Sequence
+from types import FrameType
+from typing import Any, NoReturn, TextIO
 
 import iceoryx2 as iox2
 
 from . import link, wire
-from .law import Design, DesignError, ParamError, Params, Sample, saturate
+from .law import DesignError, LawClass, ParamError, Params, RotorDesign, RotorSample, Sample, saturate
 
 OK, IO, BAD_INPUT, PLANT_LOST, INTERRUPTED = 0, 1, 2, 4, 130
 
@@ -71,25 +74,27 @@ class Interrupted(Ending):
 class _Signals:
     """SIGINT/SIGTERM set a flag, polled by the loops (as the Rust binary's ctrlc handler)."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.stop = False
         for s in (signal.SIGINT, signal.SIGTERM):
             signal.signal(s, self._handle)
 
-    def _handle(self, signum, frame):
+    def _handle(self, signum: int, frame: FrameType | None) -> None:
         self.stop = True
 
 
-def serve(*laws, argv=None) -> None:
+def serve(*laws: LawClass, argv: Sequence[str] | None = None) -> NoReturn:
     """Serves one run of the plant with the law the hello names among ``laws`` (classes), then exits.
 
-    A law class has a ``name`` (its ``controller.law``), is built as
-    ``Law(design, params)`` and answers ``update(sample) -> (i_x, i_y)``.
+    A per-plane law class (:class:`~amb_testbed_controller.law.Law`) has a ``name`` (its
+    ``controller.law``), is built as ``Law(design, params)`` and answers
+    ``update(sample) -> (i_x, i_y)``; on a two-plane rotor it runs once per plane. A law of the
+    whole rotor (:class:`~amb_testbed_controller.law.RotorLaw`) has ``whole_rotor = True``.
     """
     sys.exit(run(laws, argv))
 
 
-def run(laws, argv=None) -> int:
+def run(laws: Sequence[LawClass], argv: Sequence[str] | None = None) -> int:
     """As :func:`serve`, returning the exit code instead of exiting."""
     prog = os.path.basename(sys.argv[0]) or "controller"
     iox2.set_log_level_from_env_or(iox2.LogLevel.Fatal)
@@ -112,21 +117,24 @@ def run(laws, argv=None) -> int:
     return code
 
 
-IOX2_ERRORS = tuple(
+IOX2_ERRORS: tuple[type[Exception], ...] = tuple(
     c for c in vars(iox2).values()
     if isinstance(c, type) and issubclass(c, Exception) and c.__module__.startswith("iceoryx2")
 )
 """The exception classes of the iceoryx2 bindings: an IPC failure (exit code 1)."""
 
+_PASSED_ON: tuple[type[Exception], ...] = (Ending, link.LinkError, *IOX2_ERRORS)
+"""What the frame loop lets through as it is (any other exception is the law's failure)."""
 
-def _options(prog: str, argv) -> argparse.Namespace:
+
+def _options(prog: str, argv: Sequence[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog=prog, description="AMB controller process (Python): serves one plant run over iceoryx2")
     parser.add_argument("--run-id", default=os.environ.get("AMB_TESTBED_RUN_ID"),
                         help="the run id (default: $AMB_TESTBED_RUN_ID)")
     parser.add_argument("--connect-timeout-s", type=float, default=os.environ.get("AMB_TESTBED_CONNECT_TIMEOUT_S", "30"),
                         help="how long to wait for the plant's hello, s (default: $AMB_TESTBED_CONNECT_TIMEOUT_S, else 30)")
     parser.add_argument("--quiet", action="store_true", help="no start-up and end lines")
-    o = parser.parse_args(argv)  # exits 2 with a usage message on a bad argument
+    o = parser.parse_args(None if argv is None else list(argv))  # exits 2 with a usage message on a bad argument
     if o.run_id is None:
         raise BadInput("--run-id: missing (and AMB_TESTBED_RUN_ID is not set)")
     try:
@@ -166,13 +174,17 @@ def realtime(priority: int) -> list[str]:
     return refused
 
 
-def _check_hello(h: wire.Hello, run_id: str):
+Refusal = tuple[int, str]
+"""A refusal code (``wire.VERSION``, …) and its message."""
+
+
+def _check_hello(h: wire.Hello, run_id: str) -> Refusal | None:
     """``(refusal code, message)`` if this controller cannot serve the hello, else ``None``."""
     if h.protocol_version != wire.PROTOCOL_VERSION:
         return wire.VERSION, (f"protocol version {h.protocol_version} from the plant, "
                               f"this controller speaks {wire.PROTOCOL_VERSION}")
-    if h.axes != wire.AXES:
-        return wire.AXES_MISMATCH, f"the plant has {h.axes} axes, this controller drives {wire.AXES}"
+    if h.axes not in wire.SUPPORTED_AXES:
+        return wire.AXES_MISMATCH, f"the plant has {h.axes} axes, this controller drives 2 or 4"
     if h.units != wire.UNITS_SI:
         return wire.UNITS, f"units code {h.units} from the plant, this controller uses {wire.UNITS_SI} (SI)"
     got = wire.str_of(h.run_id)
@@ -181,17 +193,48 @@ def _check_hello(h: wire.Hello, run_id: str):
     return None
 
 
-def _build(laws, hello: wire.Hello):
-    """The law the hello asks for, built; or ``(refusal code, message)``."""
+class _Decentralised:
+    """Per-plane laws side by side: plane p's law reads and drives axes 2p, 2p + 1."""
+
+    whole_rotor = True
+
+    def __init__(self, planes: list[Any]) -> None:
+        self.planes = planes
+        self.name = planes[0].name
+
+    def update(self, sample: RotorSample) -> tuple[float, ...]:
+        out: list[float] = []
+        for p, law in enumerate(self.planes):
+            out.extend(law.update(sample.plane(p)))
+        return tuple(out)
+
+
+def _build(laws: Sequence[LawClass], hello: wire.Hello) -> tuple[Any, None] | tuple[None, Refusal]:
+    """The law the hello asks for, built for its rotor (a per-plane law once per plane); or
+    ``(None, (refusal code, message))``."""
     name = wire.str_of(hello.law)
     by_name = {law.name: law for law in laws}
     if name not in by_name:
         return None, (wire.LAW, f"unknown controller law `{name}` (this controller serves {', '.join(by_name)})")
+    cls: Any = by_name[name]
+    drives = tuple(getattr(cls, "axes", wire.SUPPORTED_AXES))
+    if hello.axes not in drives:
+        return None, (wire.AXES_MISMATCH, f"law {name} drives {' or '.join(map(str, drives))} axes; "
+                                          f"the plant has {hello.axes} axes")
     try:
-        params = Params.parse(name, hello.params_text())
-        law = by_name[name](Design.from_hello(hello), params)
-        params.finish()
-        return law, None
+        design = RotorDesign.from_hello(hello)
+        text = hello.params_text()
+        if getattr(cls, "whole_rotor", False):
+            params = Params.parse(name, text)
+            law = cls(design, params)
+            params.finish()
+            return law, None
+        planes = []
+        for plane in design.planes:
+            params = Params.parse(name, text)
+            planes.append(cls(plane, params))
+            params.finish()
+        return (planes[0] if len(planes) == 1 else _Decentralised(planes)), None
     except UnicodeDecodeError as e:
         return None, (wire.PARAMS, f"the [controller.params] document is not UTF-8: {e}")
     except ParamError as e:
@@ -201,6 +244,22 @@ def _build(laws, hello: wire.Hello):
     except Exception as e:
         traceback.print_exc()
         return None, (wire.LAW, f"law {name} could not be built: {type(e).__name__}: {e}")
+
+
+def _limits(design: RotorDesign) -> tuple[float, ...]:
+    """Each axis's current limit (A), in axis order."""
+    return tuple(plane.current_limit_a for plane in design.planes for _ in (0, 1))
+
+
+def _describe(name: str, design: RotorDesign, rate_hz: float) -> str:
+    a = design.planes[0]
+    if len(design.planes) == 1:
+        return (f"{name} (Python): k_e = {a.stiffness_n_per_m} N/m, xi_e = {a.damping_ratio}, "
+                f"i_max = {a.current_limit_a} A at {rate_hz} Hz")
+    b = design.planes[1]
+    return (f"{name} (Python): 4 axes, k_e = {a.stiffness_n_per_m} / {b.stiffness_n_per_m} N/m, "
+            f"xi_e = {a.damping_ratio} / {b.damping_ratio}, i_max = {a.current_limit_a} / {b.current_limit_a} A "
+            f"(planes A / B) at {rate_hz} Hz")
 
 
 def _ack(hello: wire.Hello, status: int, law: str, message: str) -> wire.Ack:
@@ -216,11 +275,12 @@ def _ack(hello: wire.Hello, status: int, law: str, message: str) -> wire.Ack:
     )
 
 
-def lock_run_id(run_id: str, role: str = "controller"):
+def lock_run_id(run_id: str, role: str = "controller") -> "_RunLock":
     """Takes ``<lock dir>/<run_id>.<role>.lock`` with an exclusive ``flock``, as the Rust side does
     (``controller/src/lock.rs``): one live controller per run id. The lock dir is
     ``$AMB_TESTBED_LOCK_DIR``, else ``$TMPDIR/amb-testbed`` (``/tmp/amb-testbed``). The kernel
-    releases the lock when the process ends, however it ends. Returns the open file (keep it).
+    releases the lock when the process ends, however it ends. Returns the held lock (keep it:
+    it deletes its file and releases the lock when it goes).
     """
     folder = os.environ.get("AMB_TESTBED_LOCK_DIR") or os.path.join(os.environ.get("TMPDIR") or "/tmp", "amb-testbed")
     path = os.path.join(folder, f"{run_id}.{role}.lock")
@@ -229,27 +289,58 @@ def lock_run_id(run_id: str, role: str = "controller"):
             os.makedirs(folder, exist_ok=True)
             with contextlib.suppress(OSError):
                 os.chmod(folder, 0o1777)  # machine-wide like /tmp: any user may add a lock
-        file = open(path, "a+")
     except OSError as e:
         raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
-    try:
-        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        file.seek(0)
-        holder = file.read().strip() or "a process that has not written its name yet"
+    # A holder deletes its file when it releases it (controller/src/lock.rs): a lock taken on a
+    # file that was deleted between our open and our lock is not the run id's; start again.
+    for _ in range(100):
+        try:
+            file = open(path, "a+")
+        except OSError as e:
+            raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+        try:
+            fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            file.seek(0)
+            holder = file.read().strip() or "a process that has not written its name yet"
+            file.close()
+            raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
+                           "pick another --run-id or stop that process") from None
+        except OSError as e:
+            file.close()
+            raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+        named: os.stat_result | None
+        try:
+            named = os.stat(path)
+        except OSError:
+            named = None
+        mine = os.fstat(file.fileno())
+        if named is not None and (named.st_dev, named.st_ino) == (mine.st_dev, mine.st_ino):
+            break
         file.close()
-        raise BadInput(f"run id {run_id} is in use by a live {role}: {holder} (lock {path}); "
-                       "pick another --run-id or stop that process") from None
-    except OSError as e:
-        file.close()
-        raise Ending(f"cannot lock run id {run_id} ({path}): {e}") from None
+    else:
+        raise Ending(f"cannot lock run id {run_id} ({path}): the file was deleted under this process 100 times")
     file.truncate(0)
     file.write(f"pid {os.getpid()} ({' '.join(sys.argv)})\n")
     file.flush()
-    return file
+    return _RunLock(file)
 
 
-def _serve(laws, o: argparse.Namespace, signals: _Signals) -> None:
+class _RunLock:
+    """A held run-id lock: when it goes, it deletes its file while still holding it, then
+    releases it, so that nothing is left behind (a process killed outright leaves its file to
+    the next Rust plant or controller, which deletes the files of dead holders)."""
+
+    def __init__(self, file: TextIO) -> None:
+        self.file = file
+
+    def __del__(self) -> None:
+        with contextlib.suppress(OSError):
+            os.unlink(self.file.name)
+        self.file.close()
+
+
+def _serve(laws: Sequence[LawClass], o: argparse.Namespace, signals: _Signals) -> None:
     run_id = o.run_id
     _lock = lock_run_id(run_id)  # held while the process serves
     if o.realtime_priority > 0:
@@ -282,22 +373,22 @@ def _serve(laws, o: argparse.Namespace, signals: _Signals) -> None:
         handshake.send(_ack(hello, code, "", message))
         raise BadInput(f"refused the plant's hello ({wire.REFUSAL[code]}): {message}")
 
-    design = Design.from_hello(hello)
-    limit = design.current_limit_a
-    description = (f"{law.name} (Python): k_e = {design.stiffness_n_per_m} N/m, xi_e = {design.damping_ratio}, "
-                   f"i_max = {limit} A at {hello.rate_hz} Hz")
+    assert law is not None  # built, since nothing refused it
+    design = RotorDesign.from_hello(hello)
+    description = _describe(law.name, design, hello.rate_hz)
     handshake.send(_ack(hello, wire.ACCEPTED, law.name, description))
     frames.set_spin(hello.spin_ns)
     if not o.quiet:
         print(f"{o.prog}: serving run {run_id} (session {hello.session}, pid {os.getpid()}): {description}",
               file=sys.stderr)
-    _loop(law, frames, hello.session, hello.token, limit, run_id, o, signals)
+    _loop(law, frames, hello.session, hello.token, hello.axes, _limits(design), run_id, o, signals)
 
 
-def _loop(law, frames: link.Endpoint, session: int, token: int, limit: float, run_id: str, o, signals) -> None:
+def _loop(law: Any, frames: link.Endpoint, session: int, token: int, axes: int, limits: tuple[float, ...],
+          run_id: str, o: argparse.Namespace, signals: _Signals) -> None:
     """One reply per sensor frame until STOP (returns), a signal or a lost plant (raises)."""
     now = time.monotonic_ns
-    state = {"heard": now(), "checked": now(), "lost": None}
+    state: dict[str, Any] = {"heard": now(), "checked": now(), "lost": None}
 
     def keep_waiting() -> bool:
         if signals.stop:
@@ -312,16 +403,18 @@ def _loop(law, frames: link.Endpoint, session: int, token: int, limit: float, ru
                 return False
         return True
 
-    reply = wire.CommandFrame(token=token, session=session, axes=wire.AXES)
+    reply = wire.CommandFrame(token=token, session=session, axes=axes)
     current = reply.current_a
     update = law.update
+    whole_rotor = getattr(law, "whole_rotor", False)
+    limit = limits[0]
     stop_bit = wire.SensorFrame.STOP
     answered = 0
     try:
         while True:
             if signals.stop:
                 frames.send_and_wake(wire.CommandFrame(status=wire.CommandFrame.STOPPING, session=session,
-                                                       token=token, axes=wire.AXES, sent_ns=now()))
+                                                       token=token, axes=axes, sent_ns=now()))
                 raise Interrupted(f"interrupted; told the plant (run {run_id}) and stopped")
             frame = frames.wait(SLICE, keep_waiting)
             if frame is None:
@@ -340,20 +433,27 @@ def _loop(law, frames: link.Endpoint, session: int, token: int, limit: float, ru
                 continue  # a frame of an earlier session, still in the buffer
             received_ns = now()
             sensor = frame.sensor_v
-            ix, iy = update(Sample(frame.seq, frame.t_s, (sensor[0], sensor[1])))
-            current[0] = saturate(ix, limit)
-            current[1] = saturate(iy, limit)
+            if whole_rotor:
+                currents = update(RotorSample(frame.seq, frame.t_s, tuple(sensor[:axes]), frame.speed_rad_s,
+                                              frame.angle_rad))
+                for k in range(axes):
+                    current[k] = saturate(currents[k], limits[k])
+            else:
+                ix, iy = update(Sample(frame.seq, frame.t_s, (sensor[0], sensor[1]), frame.speed_rad_s,
+                                       frame.angle_rad))
+                current[0] = saturate(ix, limit)
+                current[1] = saturate(iy, limit)
             reply.seq = frame.seq
             reply.received_ns = received_ns
             reply.sent_ns = now()
             frames.send(reply)
             answered += 1
-    except (Ending, link.LinkError, *IOX2_ERRORS):
+    except _PASSED_ON:
         raise
     except BaseException:
         # A failing law: tell the plant at once (it treats STOPPING as a lost controller), then
         # let the traceback end the process (exit code 1).
         with contextlib.suppress(Exception):
             frames.send_and_wake(wire.CommandFrame(status=wire.CommandFrame.STOPPING, session=session,
-                                                   token=token, axes=wire.AXES, sent_ns=now()))
+                                                   token=token, axes=axes, sent_ns=now()))
         raise

@@ -241,7 +241,8 @@ pub fn parse_programme(text: &str, path: &Path) -> Result<Programme, ShockError>
 /// Load a standalone programme file (`[[shock]]` tables at top level).
 /// Recorded files are resolved against the file's directory.
 pub fn load_programme(path: &Path) -> Result<Programme, ShockError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ShockError::Io { path: path.to_path_buf(), error })?;
+    let text = crate::input::read_text(path, crate::input::MAX_TOML_BYTES)
+        .map_err(|error| ShockError::Io { path: path.to_path_buf(), error })?;
     parse_programme(&text, path)
 }
 

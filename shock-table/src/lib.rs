@@ -40,6 +40,7 @@ pub mod config;
 pub mod double_half_sine;
 pub mod error;
 pub mod half_sine;
+pub mod input;
 pub mod kinematics;
 #[cfg(test)]
 mod numeric;

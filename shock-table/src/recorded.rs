@@ -124,27 +124,12 @@ impl Recorded {
     /// Read a record from a CSV file with header `t_s,accel_m_s2` (see the
     /// module doc). Errors name the file and the line.
     pub fn from_csv(path: &Path) -> Result<Self, ShockError> {
-        use std::io::Read;
         let io = |error| ShockError::Io { path: path.to_path_buf(), error };
         let refuse = |message: String| ShockError::Record { path: Some(path.to_path_buf()), line: None, message };
-        // Looked up before opening: opening a FIFO would wait for a writer.
-        let meta = std::fs::metadata(path).map_err(io)?;
-        if !meta.is_file() {
-            return Err(refuse("not a regular file: a record must be a CSV file".into()));
-        }
-        if meta.len() > MAX_RECORD_BYTES {
-            return Err(refuse(format!(
-                "{} bytes: a record file may have at most {MAX_RECORD_BYTES} bytes",
-                meta.len()
-            )));
-        }
-        // Read at most one byte past the bound, in case the file grows while it is read.
-        let file = std::fs::File::open(path).map_err(io)?;
-        let mut text = String::new();
-        file.take(MAX_RECORD_BYTES + 1).read_to_string(&mut text).map_err(io)?;
-        if text.len() as u64 > MAX_RECORD_BYTES {
-            return Err(refuse(format!("grew past {MAX_RECORD_BYTES} bytes while it was read")));
-        }
+        let text = crate::input::read_text(path, MAX_RECORD_BYTES).map_err(|e| match e.kind() {
+            std::io::ErrorKind::InvalidInput => refuse(format!("{e}: a record must be a CSV file")),
+            _ => io(e),
+        })?;
         Self::parse_csv(&text, Some(path))
     }
 

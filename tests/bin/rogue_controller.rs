@@ -6,7 +6,7 @@
 //! Modes:
 //! - `types`: opens the run's `ack` service with other message types, as a
 //!   controller of another protocol version would, and exits 2;
-//! - `version`: answers the hello with an ack of protocol version 4;
+//! - `version`: answers the hello with an ack of the next protocol version (5);
 //! - `other-session`: accepts the hello, then answers every sensor frame
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
@@ -84,7 +84,7 @@ fn main() -> ExitCode {
         session,
         axes: wire::AXES,
         current_a: wire::axes_of(controller::saturate(
-            law.update(&controller::Sample { seq: f.seq, t_s: f.t_s, sensor_v: f.sensor_xy() }),
+            law.update(&controller::Sample { seq: f.seq, t_s: f.t_s, sensor_v: f.sensor_xy(), ..Default::default() }),
             hello.current_limit_a,
         )),
         ..Default::default()

@@ -64,3 +64,43 @@ fn analyze_on_a_folder_without_a_run_exits_2() {
     assert_exit(&o, 2);
     assert!(stderr(&o).contains("scene.toml"), "{}", stderr(&o));
 }
+
+/// Issue 21 item 7: `plant analyze` read `trace.csv` without a bound (a link to `/dev/zero`
+/// ran forever, a FIFO blocked forever) and died by SIGTERM without a word. What is not a
+/// trace is refused at once (exit 2, naming the file), and a signal ends it with exit 130,
+/// saying what it wrote.
+#[cfg(target_os = "linux")]
+#[test]
+fn analyze_refuses_what_is_not_a_trace_and_exits_130_on_a_signal() {
+    let dir = TempDir::new("analyze-hostile");
+    let out = dir.join("run");
+    assert_exit(&output_within(&mut plant_run(&scene("paper-10g.toml"), &out, SHORT), LIMIT), 0);
+    for (name, make) in [
+        (
+            "zero",
+            &(|p: &std::path::Path| std::os::unix::fs::symlink("/dev/zero", p).unwrap()) as &dyn Fn(&std::path::Path),
+        ),
+        ("fifo", &|p: &std::path::Path| {
+            assert!(Command::new("mkfifo").arg(p).status().unwrap().success());
+        }),
+    ] {
+        let copy = dir.join(name);
+        std::fs::create_dir_all(&copy).unwrap();
+        std::fs::copy(out.join("scene.toml"), copy.join("scene.toml")).unwrap();
+        make(&copy.join("trace.csv"));
+        let o = output_within(Command::new(plant_bin()).arg("analyze").arg(&copy), LIMIT);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains("trace.csv") && stderr(&o).contains("not a regular file"), "{}", stderr(&o));
+        assert!(!copy.join("summary.json").exists(), "{name}: nothing is written");
+    }
+    let before = read_text(&out.join("summary.json"));
+    let analyze = Proc::spawn(Command::new(plant_bin()).arg("analyze").arg(&out));
+    wait_for_handler(analyze.id(), libc::SIGTERM);
+    analyze.signal(libc::SIGTERM);
+    let (code, log) = analyze.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    assert!(log.contains("plant: interrupted by a signal;"), "{log}");
+    if log.contains("nothing was written") {
+        assert_eq!(read_text(&out.join("summary.json")), before);
+    }
+}

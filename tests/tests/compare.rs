@@ -157,6 +157,8 @@ fn unknown_law_in_compare_is_bad_input() {
     );
     assert_exit(&o, 2);
     assert!(String::from_utf8_lossy(&o.stderr).contains("bang_bang"), "{}", String::from_utf8_lossy(&o.stderr));
+    // Issue 21 item 7: the folder it had created was left empty.
+    assert!(!dir.join("out").exists(), "a refused compare leaves no folder behind");
 }
 
 /// A CSV file of text fields with a header row.

@@ -52,9 +52,10 @@ fn target_dir() -> PathBuf {
 /// Issue 10 item 3: a controller crate outside the workspace, depending on `controller` by
 /// path, is built (offline, locked, into the workspace's target folder so the shared
 /// dependencies are reused) and run by the plant through `controller.command` in lockstep.
-/// Its trace is what its law gives: the example's own code, run here on the trace's sensor
-/// samples, reproduces every applied current bit for bit (delay 1: the current computed from
-/// sample k is in row k + 2), and differs from the plain PD's.
+/// Its trace is what its law gives: the run folder replayed through the example's own code
+/// (`plant::check::replay`) reproduces every applied current bit for bit, differs from the
+/// plain PD's, and the law run in the plant's process (`plant::check::run_law`) gives the
+/// same trace.
 #[test]
 fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace() {
     let crate_dir = workspace_root().join("examples").join("rust-controller");
@@ -92,34 +93,21 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     assert!(s["cosim"]["controller"].as_str().unwrap().starts_with("pd_notch:"), "{s:#}");
     assert_eq!(s["cosim"]["controller_command"][0].as_str(), Some(exe.display().to_string().as_str()));
 
-    let scene = plant::config::load_scene(&scene_file, &extra).expect("the scene");
-    let design = scene.design();
-    let mut law = pd_notch::build(&design, &scene.controller.params).expect("the law");
-    let mut pd = controller::build_law("pd", &design, &controller::Params::default()).unwrap();
+    // The run folder replayed through the crate's law (plant::check, issue 21 item 3): every
+    // applied current is the law's, bit for bit; through the plain PD it is not.
+    let replayed = plant::check::replay(&out, &pd_notch::LAW).expect("the replay");
+    eprintln!("replay of the out-of-tree crate's lockstep run through its law: {replayed}");
+    assert!(replayed.identical(), "{replayed}");
+    assert_eq!(replayed.compared, 1000);
+    let scene = plant::config::load_scene(&out.join("scene.toml"), &[]).expect("the run's scene");
+    let mut pd = controller::build_law("pd", &scene.design(), &controller::Params::default()).unwrap();
+    let pd = plant::check::replay_trace(&scene, &out.join("trace.csv"), pd.as_mut()).expect("the replay");
+    assert!(!pd.identical() && pd.largest_a > 1e-3, "the notch changed nothing: {pd}");
+    // And the same law run in the plant's process gives the same trace.
+    let in_process = plant::check::run_law(&scene, &pd_notch::LAW, &mut plant::run::Quiet).expect("the run");
     let trace = Csv::read(&out.join("trace.csv"));
-    let (t, dx, dy) = (trace.column("t_s"), trace.column("dx_m"), trace.column("dy_m"));
-    let (ix, iy) = (trace.column("ix_a"), trace.column("iy_a"));
-    let (gain, limit, period) = (design.constants.sensor_gain_v_per_m, design.current_limit_a, design.period_s);
-    let ticks = t.len() - 1;
-    assert_eq!(ticks, 1000);
-    let mut largest_difference_from_pd: f64 = 0.0;
-    for k in 0..ticks - 1 {
-        assert!((t[k] - k as f64 * period).abs() < 1e-12, "row {k} at t = {}", t[k]);
-        let sample =
-            controller::Sample { seq: k as u64, t_s: k as f64 * period, sensor_v: [gain * dx[k], gain * dy[k]] };
-        let i = controller::saturate(law.update(&sample), limit);
-        assert!(
-            ix[k + 2].to_bits() == i[0].to_bits() && iy[k + 2].to_bits() == i[1].to_bits(),
-            "sample {k}: the process applied ({}, {}) A, the law gives ({}, {}) A",
-            ix[k + 2],
-            iy[k + 2],
-            i[0],
-            i[1]
-        );
-        let p = controller::saturate(pd.update(&sample), limit);
-        largest_difference_from_pd = largest_difference_from_pd.max((p[0] - i[0]).abs()).max((p[1] - i[1]).abs());
-    }
-    assert!(largest_difference_from_pd > 1e-3, "the notch changed nothing: {largest_difference_from_pd} A");
+    assert_eq!(in_process.trace.ix_a, trace.column("ix_a"));
+    assert_eq!(in_process.trace.dy_m, trace.column("dy_m"));
 }
 
 /// Issue 10 item 4: the contract a command gets. The plant runs it exactly, with `--run-id
@@ -193,8 +181,14 @@ fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
             "refused",
             vec!["other message types", "exited before the handshake"],
         ),
-        (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 4", "speaks version 3"]),
-        (vec![&controller], Some("controller.law=\"nope\""), 2, "refused", vec!["law `nope` is not served"]),
+        (vec![&rogue, "--mode", "version"], None, 2, "refused", vec!["protocol version 5", "speaks version 4"]),
+        (
+            vec![&controller],
+            Some("controller.law=\"nope\""),
+            2,
+            "refused",
+            vec!["unknown controller law `nope`", "known laws: pd, pid"],
+        ),
     ];
     for (i, (argv, law, code, status, needles)) in cases.iter().enumerate() {
         let out = dir.join(&format!("run{i}"));
@@ -213,44 +207,113 @@ fn bad_controller_commands_are_named_with_their_exit_code_and_status() {
     }
 }
 
-/// Issue 10 item 6: `controller/include/amb_testbed_wire.h` compiles (its `_Static_assert`s
-/// hold) and gives every field of every message the size and offset `wire.rs` gives it.
-#[test]
-fn the_c_header_matches_the_rust_layout() {
-    use controller::wire::{Ack, CommandFrame, Hello, SensorFrame, WakeRequest};
-    use std::mem::{offset_of, size_of, size_of_val};
-    macro_rules! fields {
-        ($out:ident, $t:ident, $v:expr; $($f:ident),*) => {{
-            let v = $v;
-            $( $out.push((stringify!($t), stringify!($f), offset_of!($t, $f), size_of_val(&v.$f))); )*
-            $out.push((stringify!($t), "-", 0, size_of::<$t>()));
-        }};
-    }
-    let mut rust: Vec<(&str, &str, usize, usize)> = Vec::new();
-    fields!(rust, SensorFrame, SensorFrame::default(); seq, t_s, token, sent_ns, status, session, axes, reserved, sensor_v);
-    fields!(rust, CommandFrame, CommandFrame::default();
-        seq, token, received_ns, sent_ns, status, session, axes, reserved, current_a);
-    fields!(rust, WakeRequest, WakeRequest::default(); seq);
-    fields!(rust, Hello, Hello::example("x");
-        protocol_version, axes, units, session, token, rate_hz, period_s, run_id, law, stiffness_n_per_m,
-        damping_ratio, ki_n_per_a, ks_n_per_m, amp_gain_a_per_v, sensor_gain_v_per_m, rotor_mass_kg, gravity_m_s2,
-        current_limit_a, air_gap_m, delay_samples, gravity_bias, spin_ns, mode, plant_pid, params_len, reserved, params);
-    fields!(rust, Ack, Ack::new(1, 1, 0, "pd", "");
-        protocol_version, session, status, controller_pid, token, law, message, overrides_len, reserved, overrides);
+/// The header's `#define AMB_TESTBED_<NAME> value` lines, by name (the include guard and
+/// the helper macros left out); a value is a number (a `u` suffix dropped) or a string.
+fn header_defines(header: &str) -> Vec<(String, String)> {
+    header
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("#define AMB_TESTBED_"))
+        .filter_map(|rest| {
+            let (name, value) = rest.split_once(char::is_whitespace)?;
+            let value = value.split("/*").next().unwrap().trim();
+            Some((name.to_string(), value.trim_end_matches('u').to_string()))
+        })
+        .filter(|(name, _)| !matches!(name.as_str(), "STATIC_ASSERT" | "ALIGNOF"))
+        .collect()
+}
 
+/// The header's structs: `typedef struct amb_testbed_<Name> { … } amb_testbed_<Name>;`, each
+/// with its fields' names in order.
+fn header_structs(header: &str) -> Vec<(String, Vec<String>)> {
+    let mut out = Vec::new();
+    let mut current: Option<(String, Vec<String>)> = None;
+    for line in header.lines() {
+        let line = line.split("/*").next().unwrap().trim();
+        if let Some(rest) = line.strip_prefix("typedef struct amb_testbed_") {
+            current = Some((rest.trim_end_matches('{').trim().to_string(), Vec::new()));
+        } else if line.starts_with('}') {
+            out.extend(current.take());
+        } else if let Some((_, fields)) = current.as_mut() {
+            let decl = line.trim_end_matches(';');
+            let name = decl.split('[').next().unwrap().split_whitespace().last();
+            fields.extend(name.map(str::to_string));
+        }
+    }
+    out
+}
+
+/// Issue 20: the wire's constants and layouts reach the C header from one source or this test
+/// fails naming the difference. It reads every `#define` and every struct field of
+/// `controller/include/amb_testbed_wire.h`, compiles a program with the header (C11 and C++11,
+/// warnings as errors: its `_Static_assert`s hold) that prints each field's offset and size,
+/// and compares all of it with `controller::wire::constants()` and `layouts()`.
+#[test]
+fn the_c_header_has_every_constant_and_layout_of_wire_rs() {
+    use controller::wire::{constants, layouts, Constant};
+    let include = workspace_root().join("controller").join("include");
+    let header = std::fs::read_to_string(include.join("amb_testbed_wire.h")).unwrap();
+    let mut differences = Vec::new();
+
+    // Constants, both ways.
+    let in_header: Vec<(String, String)> = header_defines(&header).into_iter().filter(|(n, _)| n != "WIRE_H").collect();
+    let rust: Vec<(String, String)> = constants()
+        .into_iter()
+        .map(|(n, v)| match v {
+            Constant::Number(x) => (n, x.to_string()),
+            Constant::Text(t) => (n, format!("{t:?}")),
+        })
+        .collect();
+    for (name, value) in &rust {
+        match in_header.iter().find(|(n, _)| n == name) {
+            None => differences.push(format!("AMB_TESTBED_{name}: missing from the header (Rust: {value})")),
+            Some((_, v)) if v != value => {
+                differences.push(format!("AMB_TESTBED_{name}: the header says {v}, Rust {value}"))
+            }
+            Some(_) => {}
+        }
+    }
+    for (name, value) in &in_header {
+        if !rust.iter().any(|(n, _)| n == name) {
+            differences.push(format!("AMB_TESTBED_{name} = {value}: in the header, not in wire::constants()"));
+        }
+    }
+
+    // Structs and fields, by name and order.
+    let structs = header_structs(&header);
+    let rust_layouts = layouts();
+    let names =
+        |fields: &[controller::wire::FieldLayout]| fields.iter().map(|f| f.name.to_string()).collect::<Vec<_>>();
+    for m in &rust_layouts {
+        match structs.iter().find(|(n, _)| n == m.name) {
+            None => differences.push(format!("amb_testbed_{}: missing from the header", m.name)),
+            Some((_, fields)) if *fields != names(&m.fields) => differences.push(format!(
+                "amb_testbed_{}: the header's fields {fields:?}, Rust's {:?}",
+                m.name,
+                names(&m.fields)
+            )),
+            Some(_) => {}
+        }
+    }
+    for (name, _) in &structs {
+        if !rust_layouts.iter().any(|m| m.name == name) {
+            differences.push(format!("amb_testbed_{name}: in the header, not in wire::layouts()"));
+        }
+    }
+
+    // Sizes, alignments and offsets as the C compiler lays the header's structs out.
     let mut program = String::from("#include <stdio.h>\n#include \"amb_testbed_wire.h\"\nint main(void) {\n");
-    for (t, f, _, _) in &rust {
-        let ty = format!("amb_testbed_{t}");
-        if *f == "-" {
-            program += &format!("    printf(\"{t} - 0 %zu\\n\", sizeof({ty}));\n");
-        } else {
-            program += &format!("    printf(\"{t} {f} %zu %zu\\n\", offsetof({ty}, {f}), sizeof((({ty} *)0)->{f}));\n");
+    for (name, fields) in &structs {
+        let ty = format!("amb_testbed_{name}");
+        program += &format!("    printf(\"{name} - %zu %zu\\n\", sizeof({ty}), (size_t)AMB_TESTBED_ALIGNOF({ty}));\n");
+        for f in fields {
+            program +=
+                &format!("    printf(\"{name} {f} %zu %zu\\n\", offsetof({ty}, {f}), sizeof((({ty} *)0)->{f}));\n");
         }
     }
     program += "    return 0;\n}\n";
     let dir = TempDir::new("c-header");
-    std::fs::write(dir.join("layout.c"), program).unwrap();
-    let include = workspace_root().join("controller").join("include");
+    std::fs::write(dir.join("layout.c"), &program).unwrap();
+    std::fs::write(dir.join("layout.cpp"), &program).unwrap();
     let exe = dir.join("layout");
     let compiled = output(
         Command::new("cc")
@@ -261,15 +324,118 @@ fn the_c_header_matches_the_rust_layout() {
             .arg(&exe),
     );
     assert!(compiled.status.success(), "cc failed:\n{}", stderr(&compiled));
+    let cpp = output(
+        Command::new("c++")
+            .args(["-std=c++11", "-Wall", "-Wextra", "-Werror", "-fsyntax-only", "-I"])
+            .arg(&include)
+            .arg(dir.join("layout.cpp")),
+    );
+    assert!(cpp.status.success(), "c++ failed:\n{}", stderr(&cpp));
     let ran = output(&mut Command::new(&exe));
     assert!(ran.status.success());
     let c: Vec<String> = String::from_utf8_lossy(&ran.stdout).lines().map(str::to_string).collect();
-    let expected: Vec<String> = rust.iter().map(|(t, f, o, s)| format!("{t} {f} {o} {s}")).collect();
-    assert_eq!(c, expected);
-    // And the sizes the protocol table promises.
-    let total = |name: &str| expected.iter().find(|l| l.starts_with(&format!("{name} - "))).cloned().unwrap();
-    assert_eq!(
-        ["SensorFrame", "CommandFrame", "WakeRequest", "Hello", "Ack"].map(total),
-        ["SensorFrame - 0 112", "CommandFrame - 0 112", "WakeRequest - 0 8", "Hello - 0 4312", "Ack - 0 4416"]
+    for m in &rust_layouts {
+        let whole = format!("{} - {} {}", m.name, m.size, m.align);
+        if !c.contains(&whole) {
+            differences.push(format!(
+                "amb_testbed_{}: C gives {:?}, Rust {whole}",
+                m.name,
+                c.iter().find(|l| l.starts_with(&format!("{} - ", m.name)))
+            ));
+        }
+        for f in &m.fields {
+            let line = format!("{} {} {} {}", m.name, f.name, f.offset, f.size);
+            if !c.contains(&line) {
+                let got = c.iter().find(|l| l.starts_with(&format!("{} {} ", m.name, f.name)));
+                differences.push(format!(
+                    "amb_testbed_{}.{}: C gives {got:?}, Rust (offset, size) ({}, {})",
+                    m.name, f.name, f.offset, f.size
+                ));
+            }
+        }
+    }
+    assert!(differences.is_empty(), "the C header differs from controller::wire:\n{}", differences.join("\n"));
+    let lines: usize = rust_layouts.iter().map(|m| 1 + m.fields.len()).sum();
+    assert!(
+        rust.len() >= 29 && c.len() == lines,
+        "{} constants; {} C lines for {lines} sizes and fields",
+        rust.len(),
+        c.len()
     );
+}
+
+/// Issue 21 item 5: the controller inherited the plant's stdout; when that was a pipe nobody
+/// drained, a chatty controller blocked before its hello and the plant exited 4 after the
+/// connect timeout with no hint why. Its output now goes to `controller.log` in the run
+/// folder (bounded), drained as it comes: the run completes with the plant's stdout a pipe
+/// nobody reads, and a controller that fails is quoted, naming the file.
+#[cfg(unix)]
+#[test]
+fn the_controllers_output_goes_to_controller_log_and_never_blocks_it() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("controller-log");
+    let chatty = dir.join("chatty.sh");
+    // 3 MiB on stdout (a pipe holds 64 KiB), a line on stderr, then the real controller.
+    std::fs::write(
+        &chatty,
+        format!(
+            "#!/bin/sh\nhead -c 3145728 /dev/zero | tr '\\0' x\necho 'chatty: starting' >&2\nexec {:?} \"$@\"\n",
+            controller_bin().display().to_string()
+        ),
+    )
+    .unwrap();
+    let failing = dir.join("failing.sh");
+    std::fs::write(&failing, "#!/bin/sh\necho 'failing: cannot open my gains file' >&2\nexit 3\n").unwrap();
+    for script in [&chatty, &failing] {
+        std::fs::set_permissions(script, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+
+    let out = dir.join("run");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&chatty.display().to_string()])]);
+    let mut cmd = plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra));
+    let stderr_file = dir.join("plant.stderr");
+    // The plant's stdout: a pipe that nobody reads (kept open, never drained).
+    let mut plant = cmd
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_file).unwrap())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = plant.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed() > LIMIT {
+            let _ = plant.kill();
+            panic!("the run did not end within {LIMIT:?}: {}", std::fs::read_to_string(&stderr_file).unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(0), "{}", std::fs::read_to_string(&stderr_file).unwrap());
+    let log = std::fs::read(out.join("controller.log")).unwrap();
+    let text = String::from_utf8_lossy(&log);
+    assert!(text.starts_with("--- plant: started `"), "{}", &text[..200]);
+    assert!(text.contains("chatty: starting"), "the last output is kept");
+    assert!(text.contains("bytes of the controller's output left out here"));
+    assert!(log.len() < 2 << 20, "controller.log is bounded: {} bytes", log.len());
+
+    let out = dir.join("failed");
+    let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&failing.display().to_string()])]);
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &as_strs(&extra)));
+    assert_exit(&run, 4);
+    let err = stderr(&run);
+    assert!(
+        err.contains("controller.log")
+            && err.contains("failing: cannot open my gains file")
+            && err.contains("exit status: 3"),
+        "{err}"
+    );
+    assert!(read_json(&out.join("summary.json"))["error"]
+        .as_str()
+        .unwrap_or_default()
+        .contains("cannot open my gains file"));
+    assert!(std::fs::read_to_string(out.join("controller.log"))
+        .unwrap()
+        .contains("failing: cannot open my gains file"));
 }

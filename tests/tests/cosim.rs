@@ -16,6 +16,8 @@
 //! [`Proc`] waits at most a minute for a line or an exit).
 
 mod common;
+#[path = "common/v3.rs"]
+mod v3;
 
 use common::{
     assert_exit, controller_bin, num, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv, Proc,
@@ -505,6 +507,7 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
     let mut law = controller::build_law(&law_name, &hello.design(), &params).expect("law");
     handshake.send(Ack::new(hello.session, hello.token, 0, &law_name, "test controller")).expect("ack");
     let mut answered = 0u64;
+    let mut keyphasor: Vec<(f64, f64)> = Vec::new();
     loop {
         let frame = frames
             .wait(Duration::from_millis(1), || Instant::now() < deadline)
@@ -516,7 +519,9 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
         if frame.status & SensorFrame::STOP != 0 {
             break;
         }
-        let sample = controller::Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy() };
+        keyphasor.push((frame.speed_rad_s, frame.angle_rad));
+        let sample =
+            controller::Sample { seq: frame.seq, t_s: frame.t_s, sensor_v: frame.sensor_xy(), ..Default::default() };
         let current = controller::saturate(law.update(&sample), hello.current_limit_a);
         let reply = CommandFrame {
             seq: frame.seq,
@@ -534,6 +539,21 @@ fn a_command_frame_with_a_foreign_token_is_never_applied() {
     let (code, log) = plant.finish();
     assert_eq!(code, Some(0), "{log}");
     assert_eq!(answered, TICKS);
+    // Protocol 4's keyphasor: the rotor's speed (the scene's 500 Hz, held by the drive) and its
+    // angle in [0, 2π), advancing by the speed times the period from frame to frame.
+    let tau = std::f64::consts::TAU;
+    for (k, w) in keyphasor.windows(2).enumerate() {
+        let ((w0, a0), (w1, a1)) = (w[0], w[1]);
+        assert!((0.0..tau).contains(&a0) && (0.0..tau).contains(&a1), "frame {k}: angle {a0}, {a1}");
+        assert!((w0 / (tau * 500.0) - 1.0).abs() < 0.05, "frame {k}: speed {w0} rad/s");
+        let step = (a1 - a0 - 0.5 * (w0 + w1) * hello.period_s).rem_euclid(tau);
+        assert!(
+            step.min(tau - step) < 1e-6,
+            "frame {k}: the angle moved {} rad, the speed says {}",
+            a1 - a0,
+            w0 * hello.period_s
+        );
+    }
     let s = read_json(&out.join("summary.json"));
     assert_eq!(num(&s["cosim"], "foreign_frames") as u64, TICKS, "{s:#}");
     assert_eq!(num(&s["cosim"], "stale_replies"), 0.0, "{s:#}");
@@ -589,21 +609,122 @@ fn the_controller_ignores_sensor_frames_of_another_token() {
 }
 
 /// Issue 11 item 7: message types that do not match (a peer of another protocol version)
-/// exited 1, "an output could not be written". They are bad input: exit 2, saying so.
+/// exited 1, "an output could not be written". They are bad input: exit 2, saying so. With
+/// protocol 4 the side that comes second names the other's version (from the type name the
+/// services were created with): here a version-3 controller holds the run's services first.
 #[test]
 fn a_peer_of_another_protocol_version_is_refused_with_exit_2() {
-    use controller::link::{self, Mailbox};
-    use controller::wire::SensorFrame;
     let id = run_id("version");
-    // Another version's hello service: same name, another payload type.
-    let node = link::node(&id, "controller").expect("node");
-    let _old: Mailbox<SensorFrame, SensorFrame> = Mailbox::open(&node, &id, "hello", "old-ack").expect("service");
+    let _old = v3::Peer::controller(&id);
     let dir = TempDir::new("cosim-version");
     let out = dir.join("run");
     let (code, log) = Proc::spawn(&mut external_plant(&out, &id, &["controller.mode=lockstep"])).finish();
     assert_eq!(code, Some(2), "{log}");
-    assert!(log.contains("other message types") && log.contains("another protocol version"), "{log}");
+    for needle in [
+        "other message types",
+        "the peer speaks protocol version 3: its type is amb_testbed.v3.Hello",
+        "this side speaks version 4, type names amb_testbed.v4.*",
+    ] {
+        assert!(log.contains(needle), "no {needle:?} in\n{log}");
+    }
     assert_eq!(read_json(&out.join("summary.json"))["status"], "refused");
+}
+
+/// The other way round: a version-4 controller that finds a version-3 plant's services says
+/// which version it met and exits 2.
+#[test]
+fn a_controller_meeting_a_plant_of_another_version_names_it_and_exits_2() {
+    let id = run_id("old-plant");
+    let _old = v3::Peer::plant(&id);
+    let out = output_within(&mut controller(&id, &["--connect-timeout-s", "5"]), Duration::from_secs(60));
+    assert_exit(&out, 2);
+    let err = stderr(&out);
+    for needle in [
+        "the peer speaks protocol version 3: its type is amb_testbed.v3.Ack",
+        "this side speaks version 4",
+        "run a plant and a controller of the same protocol version",
+    ] {
+        assert!(err.contains(needle), "no {needle:?} in\n{err}");
+    }
+}
+
+/// Issue 17: the `controller` binary serves the two-plane rotor. A four-axis hello naming
+/// `modal` is answered frame by frame with the currents of the law built in this process from
+/// the hello's rotor design (every axis, each plane's limit, the keyphasor's speed used by the
+/// cross-feedback), bit for bit; `modal` on a planar hello is refused with Ack status 3 (axes).
+#[test]
+fn the_controller_serves_a_four_axis_rotor_with_modal_and_refuses_modal_on_two_axes() {
+    use controller::link::{self, Endpoint, Mailbox};
+    use controller::wire::{self, Ack, CommandFrame, Hello, SensorFrame};
+    let id = run_id("four-axes");
+    let node = link::node(&id, "plant").expect("node");
+    let handshake: Mailbox<Hello, Ack> = Mailbox::open(&node, &id, "hello", "ack").expect("handshake");
+    let mut frames: Endpoint<SensorFrame, CommandFrame> =
+        Endpoint::open(&node, &id, "sensor", "command", Duration::from_micros(200)).expect("frames");
+    let ctl = Proc::spawn(&mut controller(&id, &["--connect-timeout-s", "60"]));
+    let params = "conical_damping_ratio = 0.1\ngyroscopic_cross_feedback = 0.5\n";
+    let mut design = controller::RotorDesign::symmetric_study();
+    if let controller::RotorDesign::TwoPlane { planes, geometry } = &mut design {
+        planes[1].current_limit_a = 0.5;
+        geometry.bearing_z_m = [-0.15, 0.21];
+    }
+    let mut hello = Hello::for_rotor(&id, "modal", &design, 20_000.0, params).unwrap();
+    (hello.session, hello.token, hello.spin_ns) = (1, 0x4444_0000_1111_2222, 200_000);
+    let ack = handshake_as_plant(&handshake, hello);
+    let message = wire::str_of(&ack.message).into_owned();
+    assert_eq!((ack.status, wire::str_of(&ack.law).as_ref()), (0, "modal"), "{message}");
+    assert!(message.starts_with("modal: 4 axes"), "{message}");
+    let mut law =
+        controller::build_rotor_law("modal", &design, &controller::Params::parse(params).unwrap()).expect("modal");
+    let limits = design.current_limits();
+    let inputs = [[1e-3, 2e-3, -1e-3, 0.5e-3], [0.2, 0.1, -0.1, 0.3], [0.25, 0.05, -0.2, 0.35], [3.0, -2.0, 1.0, 0.5]];
+    for (seq, v) in inputs.iter().enumerate() {
+        let frame = SensorFrame {
+            seq: seq as u64,
+            t_s: seq as f64 * PERIOD,
+            token: hello.token,
+            session: hello.session,
+            axes: wire::TWO_PLANE_AXES,
+            sensor_v: wire::rotor_axes_of(*v, 4),
+            speed_rad_s: 2000.0,
+            angle_rad: 1.0,
+            ..Default::default()
+        };
+        frames.send_and_wake(frame).expect("frame");
+        let until = Instant::now() + Duration::from_secs(30);
+        let reply = frames.wait(Duration::from_millis(1), || Instant::now() < until).expect("wait").expect("a reply");
+        assert_eq!((reply.seq, reply.axes), (seq as u64, 4));
+        let want = controller::saturate_axes(law.update(&frame.rotor_sample()), limits);
+        assert_eq!(
+            reply.current_axes().map(f64::to_bits),
+            want.map(f64::to_bits),
+            "sample {seq}: {:?}",
+            reply.current_axes()
+        );
+        assert!(reply.current_a[4..].iter().all(|&i| i == 0.0));
+    }
+    frames
+        .send_and_wake(SensorFrame { status: SensorFrame::STOP, token: hello.token, session: 1, ..Default::default() })
+        .expect("stop");
+    let (code, log) = ctl.finish();
+    assert_eq!(code, Some(0), "{log}");
+
+    // The same law asked of a planar rotor.
+    let id = run_id("modal-planar");
+    let node = link::node(&id, "plant").expect("node");
+    let handshake: Mailbox<Hello, Ack> = Mailbox::open(&node, &id, "hello", "ack").expect("handshake");
+    let _frames: Endpoint<SensorFrame, CommandFrame> =
+        Endpoint::open(&node, &id, "sensor", "command", Duration::from_micros(200)).expect("frames");
+    let ctl = Proc::spawn(&mut controller(&id, &["--connect-timeout-s", "60"]));
+    let mut hello = Hello::example(&id);
+    hello.law = wire::fixed_str("modal");
+    let ack = handshake_as_plant(&handshake, hello);
+    let message = wire::str_of(&ack.message).into_owned();
+    assert_eq!(ack.status, 3, "{message}");
+    assert!(message.contains("law modal drives a two-plane rotor (4 axes) only; this rotor has 2 axes"), "{message}");
+    let (code, log) = ctl.finish();
+    assert_eq!(code, Some(2), "{log}");
+    assert!(log.contains("axis count mismatch"), "{log}");
 }
 
 /// `--set` overrides giving a scene the rogue controller in `mode` as its command.
@@ -823,22 +944,31 @@ fn a_controller_that_never_wakes_the_plant_is_warned_about() {
     assert!(num(c, "blocking_waits") >= 50.0, "{c:#}");
 }
 
-/// A controller that answers with a non-finite current: the plant holds the last valid
-/// current (docs/wire-protocol.md), counts every such reply, and says so once, naming the
-/// sample and its time, instead of completing silently.
+/// A controller that answers NaN from sample 100 on (the rogue `nan` mode). Within a budget
+/// that allows it, the last valid current is held for every such reply, counted, and the
+/// first one said. With the default budget (issue 21 item 4: such a run "completed" with exit
+/// 0) the run ends once more than `controller.max_invalid_burst` = 10 replies in a row were
+/// non-finite, status `invalid_commands`, exit 8, naming the samples; its outputs are written.
 #[test]
 fn non_finite_currents_are_held_counted_and_said_once() {
     let dir = TempDir::new("cosim-nan");
     let out = dir.join("run");
-    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("nan")];
+    let extra = [
+        "controller.mode=lockstep".to_string(),
+        "scene.duration_s=0.01".into(),
+        rogue("nan"),
+        "controller.max_invalid_burst=1000000".into(),
+        "controller.max_invalid_fraction=1".into(),
+    ];
     let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
     let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
     assert_exit(&run, 0);
     let err = stderr(&run);
-    assert_eq!(err.matches("non-finite current").count(), 1, "{err}");
+    assert_eq!(err.matches("is non-finite").count(), 1, "{err}");
     assert!(err.contains("sample 100 ") && err.contains("t = 0.005 s"), "{err}");
-    let c = &read_json(&out.join("summary.json"))["cosim"];
-    assert_eq!(num(c, "invalid_replies"), 100.0, "{c:#}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(num(&s["cosim"], "invalid_replies"), 100.0, "{s:#}");
+    assert_eq!(num(&s, "invalid_commands"), 100.0, "{s:#}");
     // The held x current: finite throughout, and one value once the held command is applied
     // (sample 100's command is due a tick later, through the one-sample delay line).
     let trace = std::fs::read_to_string(out.join("trace.csv")).unwrap();
@@ -855,4 +985,22 @@ fn non_finite_currents_are_held_counted_and_said_once() {
     assert!(rows.iter().all(|(_, i)| i.is_finite()), "a NaN current reached the trace");
     let held: Vec<f64> = rows.iter().filter(|(t, _)| *t >= 0.0052).map(|(_, i)| *i).collect();
     assert!(held.len() > 50 && held.iter().all(|i| *i == held[0]), "x current not held: {held:?}");
+
+    // The default budget.
+    let out = dir.join("default");
+    let extra = ["controller.mode=lockstep".to_string(), "scene.duration_s=0.01".into(), rogue("nan")];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 8);
+    let err = stderr(&run);
+    assert!(
+        err.contains("non-finite for 11 samples in a row, from sample 100 (t = 0.005 s) to sample 110")
+            && err.contains("controller.max_invalid_burst = 10"),
+        "{err}"
+    );
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "invalid_commands", "{s:#}");
+    assert!(s["error"].as_str().unwrap_or_default().contains("max_invalid_burst"), "{s:#}");
+    assert_eq!(num(&s, "invalid_commands"), 11.0, "{s:#}");
+    assert!(out.join("trace.csv").is_file() && out.join("scene.toml").is_file());
 }

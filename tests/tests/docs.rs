@@ -284,3 +284,164 @@ fn the_link_reader_finds_links_and_skips_code() {
     assert!(a.contains("the-plant-cli") && a.contains("bounds") && a.contains("bounds-1"), "{a:?}");
     assert!(a.contains("big-sweeps-on-a-cluster-slurm"), "{a:?}");
 }
+
+/// The key table of `docs/guide/scenes.md`: for each `[table]` row, the keys its cell lists
+/// outside parentheses, each with the text of the parentheses that follow it (its default and
+/// notes), if any.
+fn guide_key_table() -> HashMap<String, Vec<(String, Option<String>)>> {
+    let text = fs::read_to_string(common::workspace_root().join("docs/guide/scenes.md")).expect("scenes.md");
+    let mut rows = HashMap::new();
+    for line in text.lines() {
+        let Some(rest) = line.strip_prefix("| `[") else { continue };
+        let Some((table, cell)) = rest.split_once("]` |") else { continue };
+        let cell = cell.trim().trim_end_matches('|');
+        let chars: Vec<char> = cell.chars().collect();
+        let (mut i, mut depth, mut keys) = (0, 0usize, Vec::new());
+        while i < chars.len() {
+            match chars[i] {
+                '`' => {
+                    let end = (i + 1..chars.len()).find(|&j| chars[j] == '`').unwrap_or(chars.len());
+                    let token: String = chars[i + 1..end].iter().collect();
+                    i = end + 1;
+                    if depth > 0 {
+                        continue;
+                    }
+                    let mut j = i;
+                    while j < chars.len() && chars[j] == ' ' {
+                        j += 1;
+                    }
+                    let mut note = None;
+                    if j < chars.len() && chars[j] == '(' {
+                        // The balanced parentheses after the key (code spans inside are skipped).
+                        let (mut k, mut d, mut code) = (j, 0usize, false);
+                        while k < chars.len() {
+                            match chars[k] {
+                                '`' => code = !code,
+                                '(' if !code => d += 1,
+                                ')' if !code => {
+                                    d -= 1;
+                                    if d == 0 {
+                                        break;
+                                    }
+                                }
+                                _ => {}
+                            }
+                            k += 1;
+                        }
+                        note = Some(chars[j + 1..k.min(chars.len())].iter().collect());
+                        i = k + 1;
+                    }
+                    keys.push((token, note));
+                }
+                '(' => {
+                    depth += 1;
+                    i += 1;
+                }
+                ')' => {
+                    depth = depth.saturating_sub(1);
+                    i += 1;
+                }
+                _ => i += 1,
+            }
+        }
+        rows.insert(table.to_string(), keys);
+    }
+    rows
+}
+
+/// What a note in the guide says the default is: its first word, before any `;`, `,`, `:` or
+/// `\|` (a list of choices starts with the default).
+#[derive(Debug, PartialEq)]
+enum GuideDefault {
+    Number(f64),
+    Bool(bool),
+    Literal(String),
+    Absent,
+    /// Words, not a value (`(file stem)`, `(per-group overrides)`): not checked.
+    Described,
+}
+
+fn guide_default(note: &str) -> GuideDefault {
+    let head = note.split([';', ',', ':']).next().unwrap_or_default();
+    let head = head.split("\\|").next().unwrap_or_default().trim();
+    let first = head.split_whitespace().next().unwrap_or_default();
+    if let Some(lit) = first.strip_prefix('`').and_then(|s| s.strip_suffix('`')) {
+        return GuideDefault::Literal(lit.to_string());
+    }
+    match first {
+        "true" => GuideDefault::Bool(true),
+        "false" => GuideDefault::Bool(false),
+        "none" => GuideDefault::Absent,
+        _ => first.replace('−', "-").parse().map_or(GuideDefault::Described, GuideDefault::Number),
+    }
+}
+
+/// Every key that `scene_table!` declares (plant/src/config/raw.rs) is in the guide's key table,
+/// with the declared default where the guide gives one, and the guide gives no default for a
+/// key that is not declared.
+#[test]
+fn the_guides_scene_keys_and_defaults_are_the_declared_ones() {
+    let guide = guide_key_table();
+    let defaults = toml::Table::try_from(plant::config::RawScene::default()).expect("the default scene serialises");
+    let mut problems = Vec::new();
+    for (table, keys) in plant::config::RawScene::tables() {
+        let declared = defaults[table].as_table().expect("a table");
+        for k in declared.keys() {
+            assert!(keys.contains(&k.as_str()), "[{table}] {k} is serialised but not in KEYS");
+        }
+        let Some(row) = guide.get(table) else {
+            problems.push(format!("[{table}]: no row in the key table"));
+            continue;
+        };
+        for key in keys {
+            let Some((_, note)) = row.iter().find(|(k, _)| k == key) else {
+                problems.push(format!("{table}.{key}: declared, not in the guide"));
+                continue;
+            };
+            let value = declared.get(*key);
+            let agrees = match note.as_deref().map(guide_default) {
+                None | Some(GuideDefault::Described) => true,
+                Some(GuideDefault::Number(x)) => match value {
+                    Some(toml::Value::Float(f)) => *f == x,
+                    Some(toml::Value::Integer(i)) => *i as f64 == x,
+                    _ => false,
+                },
+                Some(GuideDefault::Bool(b)) => value == Some(&toml::Value::Boolean(b)),
+                Some(GuideDefault::Literal(s)) => match value {
+                    Some(toml::Value::String(v)) => *v == s,
+                    Some(v) => v.to_string() == s,
+                    None => false,
+                },
+                Some(GuideDefault::Absent) => value.is_none(),
+            };
+            if !agrees {
+                problems.push(format!(
+                    "{table}.{key}: the guide says ({}), the default is {value:?}",
+                    note.as_deref().unwrap_or("")
+                ));
+            }
+        }
+        for (k, note) in row {
+            if note.is_some() && !keys.contains(&k.as_str()) {
+                problems.push(format!("{table}.{k}: in the guide with a default, not declared"));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "docs/guide/scenes.md against plant/src/config/raw.rs:\n  {}", problems.join("\n  "));
+}
+
+#[test]
+fn the_key_table_reader_reads_keys_notes_and_defaults() {
+    assert_eq!(guide_default("1.5; at most 1e6"), GuideDefault::Number(1.5));
+    assert_eq!(guide_default("−90: ball 0 straight down"), GuideDefault::Number(-90.0));
+    assert_eq!(guide_default("`held` \\| `free`"), GuideDefault::Literal("held".into()));
+    assert_eq!(guide_default("`[]`, e.g. `[0, 1]`"), GuideDefault::Literal("[]".into()));
+    assert_eq!(guide_default("0 = `substeps`: substeps while"), GuideDefault::Number(0.0));
+    assert_eq!(guide_default("none: the built-in `controller`"), GuideDefault::Absent);
+    assert_eq!(guide_default("file stem"), GuideDefault::Described);
+    let rows = guide_key_table();
+    let rotor = &rows["rotor"];
+    assert!(rotor.contains(&("mass_kg".to_string(), Some("11.5".to_string()))), "{rotor:?}");
+    let touchdown = &rows["touchdown"];
+    assert!(!touchdown.iter().any(|(k, _)| k.contains('+')), "a code span inside a note is not a key");
+}

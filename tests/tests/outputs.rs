@@ -174,6 +174,14 @@ fn a_divergence_at_t0_exits_3_with_its_time_and_state() {
     assert_eq!(s["status"], "diverged");
     assert_eq!(num(&s, "failure_time_s"), 0.0);
     assert!(s["error"].as_str().unwrap_or_default().contains("at t = 0 s"), "{s:#}");
+    // Issue 21 item 7: the run reached t = 0, not the end of the failing macro step (the
+    // report said "results up to t = 0.00005 s", one sample off), and no row came before the
+    // failure, so there is no largest radius (it said 0.0).
+    assert_eq!(num(&s, "simulated_s"), 0.0, "{s:#}");
+    assert!(err.contains("results up to t = 0 s were written"), "{err}");
+    for key in ["max_radius_m", "max_contact_force_n", "max_race_speed_rpm"] {
+        assert!(s[key].is_null(), "{key}: {s:#}");
+    }
 }
 
 #[test]
@@ -273,5 +281,32 @@ fn a_run_killed_with_sigkill_leaves_whole_rows_that_analyze_reads() {
         assert!(text.lines().all(|l| l.split(',').count() == 19), "run {i}: a ragged row");
         let analyzed = analyze(&out);
         assert_exit(&analyzed, 0);
+    }
+}
+
+/// Issue 21 item 7: a SIGINT or SIGTERM that came while a run wrote its outputs was
+/// swallowed (exit 0, `completed`, 9 of 9). Signalled once `summary.json` is written (the
+/// charts come after it), the run still writes every output, says `interrupted` and exits 130.
+#[cfg(unix)]
+#[test]
+fn a_signal_while_the_outputs_are_written_gives_130() {
+    let dir = TempDir::new("outputs-late-signal");
+    let out = dir.join("run");
+    let sets = ["scene.duration_s=0.05", "shock[0].start_s=0.01", "output.plots=true"];
+    let run = Proc::spawn(&mut plant_run(&scene("paper-3g.toml"), &out, &sets));
+    let summary = out.join("summary.json");
+    let deadline = std::time::Instant::now() + LIMIT;
+    while !summary.exists() {
+        assert!(std::time::Instant::now() < deadline, "no summary.json");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    run.signal(libc::SIGTERM);
+    let (code, log) = run.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    let s = read_json(&summary);
+    assert_eq!(s["status"], "interrupted", "{s:#}");
+    assert_eq!(num(&s, "simulated_s"), 0.05, "the run itself reached its end");
+    for chart in ["orbit.png", "radius.png", "currents.png", "spectrum.png"] {
+        assert!(out.join(chart).is_file(), "{chart}: nothing already written is lost");
     }
 }

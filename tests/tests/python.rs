@@ -1,20 +1,26 @@
 //! End-to-end tests of the Python controller kit (`python/`, issue 10 item 5).
 //!
-//! What is pinned: the kit's structures have the Rust layouts and iceoryx2
-//! type names; `pd` in Python, served by the kit in lockstep, writes the Rust
-//! `pd`'s trace byte for byte; the kit answers the handshake as the Rust
+//! What is pinned: the kit's structures and constants are the Rust ones
+//! (`controller::wire::layouts()` and `constants()`: every size, offset, type
+//! name and constant); `pd` in Python, served by the kit in lockstep, writes
+//! the Rust `pd`'s trace byte for byte, and answers a four-axis run as the
+//! Rust `pd` does, plane by plane, bit for bit; the kit answers the handshake as the Rust
 //! controller does (token echo, no overrides, each refusal with its code and a
 //! message naming law, key, value and unit) and exits with its codes (0, 2, 4,
 //! 130); a law's parameters are checked with the Rust laws' messages; the
-//! re-levitation example recovers the rotor.
+//! re-levitation example recovers the rotor; the kit's own pytest suite
+//! (`python/tests`, with its `mypy --strict` check) passes.
 //!
 //! The kit runs in a virtual environment the tests make once, under the target
 //! folder (`target/python-venv`: `python3 -m venv`, then `pip install -e
-//! python/`, which brings the pinned `iceoryx2` from PyPI); it is reused while
+//! 'python/[test]'`, which brings the pinned `iceoryx2`, `pytest` and `mypy`
+//! from PyPI); it is reused while
 //! its stamp (the kit's `pyproject.toml`) matches. `python3` ≥ 3.11 must be on
 //! `PATH`. Every process is bounded in time.
 
 mod common;
+#[path = "common/v3.rs"]
+mod v3;
 
 use common::{assert_exit, num, output_within, plant_run, read_json, scene, stderr, workspace_root, Proc, TempDir};
 use controller::link::{self, Endpoint, Mailbox};
@@ -74,7 +80,7 @@ fn prepare_venv() -> PathBuf {
     let install = output_within(
         Command::new(dir.join("bin/python"))
             .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "--editable"])
-            .arg(&kit),
+            .arg(format!("{}[test]", kit.display())),
         Duration::from_secs(600),
     );
     assert_exit(&install, 0);
@@ -175,42 +181,92 @@ fn the_kit_pins_the_iceoryx2_release_of_cargo_lock() {
     );
 }
 
-/// The kit's ctypes structures against the Rust ones: sizes, alignments, every field's
-/// offset, and the iceoryx2 type names (what `open_or_create` compares).
+/// Issue 20: the kit's wire constants and ctypes layouts come from the Rust definitions or
+/// this test fails naming the difference: `wire.describe()` (every constant of `wire.CONSTANTS`,
+/// every structure's type name, size, alignment and each field's offset and size as ctypes lays
+/// them out) against `controller::wire::constants()` and `layouts()`, both ways.
 #[test]
-fn python_structs_have_the_rust_layouts_and_type_names() {
-    use iceoryx2::prelude::ZeroCopySend;
-    use std::mem::{align_of, offset_of, size_of};
-    let script = r#"
-import ctypes
-from amb_testbed_controller import wire
-for cls in (wire.SensorFrame, wire.CommandFrame, wire.WakeRequest, wire.Hello, wire.Ack):
-    fields = " ".join(f"{name}={getattr(cls, name).offset}" for name, _ in cls._fields_)
-    print(cls.type_name(), ctypes.sizeof(cls), ctypes.alignment(cls), fields)
-"#;
+fn python_constants_and_structs_are_the_rust_ones() {
+    use controller::wire::{constants, layouts, Constant};
+    let script = "import json\nfrom amb_testbed_controller import wire\nprint(json.dumps(wire.describe()))";
     let out = output_within(Command::new(python()).args(["-c", script]), LIMIT);
     assert_exit(&out, 0);
-    macro_rules! layout {
-        ($t:ty; $($f:ident),*) => {{
-            // SAFETY: type_name has no preconditions (unsafe only for implementors).
-            let name = unsafe { <$t>::type_name() };
-            let fields: Vec<String> = vec![$(format!("{}={}", stringify!($f), offset_of!($t, $f))),*];
-            format!("{} {} {} {}", name, size_of::<$t>(), align_of::<$t>(), fields.join(" "))
-        }};
+    let py: serde_json::Value = serde_json::from_slice(&out.stdout).expect("describe() as JSON");
+    let mut differences = Vec::new();
+    let py_constants = py["constants"].as_object().expect("constants");
+    let rust_constants = constants();
+    for (name, value) in &rust_constants {
+        let want = match value {
+            Constant::Number(n) => serde_json::json!(n),
+            Constant::Text(t) => serde_json::json!(t),
+        };
+        match py_constants.get(name) {
+            None => differences.push(format!("wire.CONSTANTS lacks {name} (Rust: {want})")),
+            Some(v) if *v != want => differences.push(format!("wire.CONSTANTS[{name:?}] = {v}, Rust {want}")),
+            Some(_) => {}
+        }
     }
-    let rust = [
-        layout!(SensorFrame; seq, t_s, token, sent_ns, status, session, axes, reserved, sensor_v),
-        layout!(CommandFrame; seq, token, received_ns, sent_ns, status, session, axes, reserved, current_a),
-        layout!(wire::WakeRequest; seq),
-        layout!(Hello; protocol_version, axes, units, session, token, rate_hz, period_s, run_id, law,
-            stiffness_n_per_m, damping_ratio, ki_n_per_a, ks_n_per_m, amp_gain_a_per_v, sensor_gain_v_per_m,
-            rotor_mass_kg, gravity_m_s2, current_limit_a, air_gap_m, delay_samples, gravity_bias, spin_ns, mode,
-            plant_pid, params_len, reserved, params),
-        layout!(Ack; protocol_version, session, status, controller_pid, token, law, message, overrides_len, reserved,
-            overrides),
-    ];
-    let python: Vec<&str> = std::str::from_utf8(&out.stdout).unwrap().lines().collect();
-    assert_eq!(python, rust);
+    for name in py_constants.keys() {
+        if !rust_constants.iter().any(|(n, _)| n == name) {
+            differences.push(format!("wire.CONSTANTS[{name:?}]: not in controller::wire::constants()"));
+        }
+    }
+    let messages = py["messages"].as_array().expect("messages");
+    let rust_layouts = layouts();
+    for m in &rust_layouts {
+        let Some(p) = messages.iter().find(|p| p["name"] == m.name) else {
+            differences.push(format!("the kit has no structure {}", m.name));
+            continue;
+        };
+        for (key, want) in
+            [("type_name", serde_json::json!(m.type_name)), ("size", m.size.into()), ("align", m.align.into())]
+        {
+            if p[key] != want {
+                differences.push(format!("{}.{key}: Python {}, Rust {want}", m.name, p[key]));
+            }
+        }
+        let fields: Vec<(String, u64, u64)> = p["fields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| (f[0].as_str().unwrap().to_string(), f[1].as_u64().unwrap(), f[2].as_u64().unwrap()))
+            .collect();
+        let rust: Vec<(String, u64, u64)> =
+            m.fields.iter().map(|f| (f.name.to_string(), f.offset as u64, f.size as u64)).collect();
+        if fields != rust {
+            differences.push(format!("{}: Python's (field, offset, size) {fields:?}\n  Rust's {rust:?}", m.name));
+        }
+    }
+    if messages.len() != rust_layouts.len() {
+        differences.push(format!("the kit has {} structures, Rust {}", messages.len(), rust_layouts.len()));
+    }
+    assert!(differences.is_empty(), "the Python kit differs from controller::wire:\n{}", differences.join("\n"));
+}
+
+/// Issue 20: the kit's own tests (pytest, `python/tests`: its structures, each plane's design
+/// from a hello, the handshake's refusals, the per-plane lifting, `pd` against its documented
+/// form, and `mypy --strict` on the kit and on a law written against its `Law` protocol).
+#[test]
+fn the_kits_pytest_suite_passes() {
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let out = output_within(
+        Command::new(python())
+            .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            .current_dir(workspace_root().join("python"))
+            .env("MYPY_CACHE_DIR", target.join("python-kit-mypy-cache"))
+            .env("PYTHONDONTWRITEBYTECODE", "1"),
+        LIMIT,
+    );
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), stderr(&out));
+    assert_exit(&out, 0);
+    let passed: usize = text
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[1].starts_with("passed"))
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or(0);
+    assert!(passed >= 15, "pytest ran {passed} tests:\n{text}");
 }
 
 /// The bit-identity promise: the Python `pd` in lockstep writes the trace of the Rust `pd`
@@ -263,7 +319,10 @@ fn python_controller_answers_the_handshake_and_frames_as_the_rust_one() {
     let ctl = Proc::spawn(&mut python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "60"]));
     let h = hello(&id);
     let ack = plant.handshake(h);
-    assert_eq!((ack.status, ack.session, ack.token, ack.protocol_version), (0, h.session, h.token, 3));
+    assert_eq!(
+        (ack.status, ack.session, ack.token, ack.protocol_version),
+        (0, h.session, h.token, wire::PROTOCOL_VERSION)
+    );
     assert_eq!((wire::str_of(&ack.law).as_ref(), ack.overrides_len, ack.controller_pid), ("pd", 0, ctl.id()));
     assert!(wire::str_of(&ack.message).contains("(Python)"), "{}", wire::str_of(&ack.message));
 
@@ -277,7 +336,7 @@ fn python_controller_answers_the_handshake_and_frames_as_the_rust_one() {
         let reply = plant.reply_within(Duration::from_secs(30)).expect("a reply");
         assert_eq!((reply.seq, reply.token, reply.session, reply.axes, reply.status), (seq, h.token, 1, 2, 0));
         let want = controller::saturate(
-            law.update(&controller::Sample { seq, t_s: seq as f64 * h.period_s, sensor_v: *v }),
+            law.update(&controller::Sample { seq, t_s: seq as f64 * h.period_s, sensor_v: *v, ..Default::default() }),
             h.current_limit_a,
         );
         let got = reply.current_xy();
@@ -293,6 +352,74 @@ fn python_controller_answers_the_handshake_and_frames_as_the_rust_one() {
     let (code, log) = ctl.finish_within(Duration::from_secs(30));
     assert_eq!(code, Some(0), "{log}");
     assert!(log.contains("answered 3 frames"), "{log}");
+}
+
+/// Issue 17: on a two-plane rotor (4 axes) the kit runs `pd` once per bearing plane, each
+/// from its own plane's design (plane B differs here in k_e, mass share, k_i, sensor gain and
+/// current limit), and answers every frame with the Rust controller's decentralised `pd`'s
+/// currents, bit for bit, each saturated at its plane's limit; the keyphasor reaches it.
+#[test]
+fn python_pd_on_four_axes_answers_as_the_rust_pd_bit_for_bit() {
+    let id = run_id("four-axes");
+    let mut plant = TestPlant::open(&id);
+    let ctl = Proc::spawn(&mut python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "60"]));
+    let mut h = Hello::example_two_plane(&id);
+    h.token = 0x0fed_cba9_8765_4321;
+    (h.b_stiffness_n_per_m, h.b_rotor_mass_kg, h.b_ki_n_per_a, h.b_sensor_gain_v_per_m) = (1.5e6, 9.0, 190.0, 24_000.0);
+    h.b_current_limit_a = 1.0;
+    let ack = plant.handshake(h);
+    let message = wire::str_of(&ack.message).into_owned();
+    assert_eq!(ack.status, 0, "{message}");
+    assert!(message.starts_with("pd (Python): 4 axes, k_e = 1000000.0 / 1500000.0 N/m"), "{message}");
+    let design = h.rotor_design().expect("a two-plane hello");
+    let mut law = controller::build_rotor_law("pd", &design, &controller::Params::default()).unwrap();
+    let limits = design.current_limits();
+    let inputs = [
+        [0.1234567891234, -0.0987654321987, 0.3123456789, 0.0456789123],
+        [0.1334567891234, -0.1087654321987, 0.2923456789, 0.0556789123],
+        [3.0, -3.0, 0.75, -0.9],
+    ];
+    for (seq, v) in inputs.iter().enumerate() {
+        let seq = seq as u64;
+        let frame = SensorFrame {
+            axes: wire::TWO_PLANE_AXES,
+            sensor_v: wire::rotor_axes_of(*v, 4),
+            speed_rad_s: 3141.5,
+            angle_rad: 0.25 * seq as f64,
+            ..sensor_frame(&h, seq, h.token, [0.0; 2])
+        };
+        plant.frames.send_and_wake(frame).unwrap();
+        let reply = plant.reply_within(Duration::from_secs(30)).expect("a reply");
+        assert_eq!((reply.seq, reply.axes, reply.status), (seq, 4, 0));
+        let want = controller::saturate_axes(law.update(&frame.rotor_sample()), limits);
+        let got = reply.current_axes();
+        assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "sample {seq}: {got:?} against {want:?}");
+        assert!(reply.current_a[4..].iter().all(|&i| i == 0.0));
+    }
+    plant
+        .frames
+        .send_and_wake(SensorFrame { status: SensorFrame::STOP, ..sensor_frame(&h, 0, h.token, [0.0; 2]) })
+        .unwrap();
+    let (code, log) = ctl.finish_within(Duration::from_secs(30));
+    assert_eq!(code, Some(0), "{log}");
+}
+
+/// A Python controller that finds a version-3 plant's services names the version it met and
+/// exits 2, as the Rust controller does.
+#[test]
+fn the_python_controller_names_a_plant_of_another_version_and_exits_2() {
+    let id = run_id("old-plant");
+    let _old = v3::Peer::plant(&id);
+    let out = output_within(&mut python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "5"]), LIMIT);
+    assert_exit(&out, 2);
+    let err = stderr(&out);
+    for needle in [
+        "the peer speaks protocol version 3: its type is amb_testbed.v3.Ack",
+        "this side speaks version 4",
+        "run a plant and a controller of the same protocol version",
+    ] {
+        assert!(err.contains(needle), "no {needle:?} in\n{err}");
+    }
 }
 
 /// Plays the plant for one hello spoiled by `spoil`: the controller `script` must refuse it
@@ -326,8 +453,8 @@ fn set_params(h: &mut Hello, doc: &str) {
 /// exits 2 saying why.
 #[test]
 fn python_controller_refuses_hellos_with_the_codes_of_the_protocol() {
-    assert_refused("version", "pd.py", |h| h.protocol_version = 2, 1, &["protocol version 2", "speaks 3"]);
-    assert_refused("axes", "pd.py", |h| h.axes = 4, 3, &["4 axes", "drives 2"]);
+    assert_refused("version", "pd.py", |h| h.protocol_version = 3, 1, &["protocol version 3", "speaks 4"]);
+    assert_refused("axes", "pd.py", |h| h.axes = 3, 3, &["3 axes", "drives 2 or 4"]);
     assert_refused("run-id", "pd.py", |h| h.run_id = wire::fixed_str("another-run"), 6, &["'another-run'"]);
     assert_refused(
         "law",
@@ -524,6 +651,7 @@ fn a_second_python_controller_under_a_live_run_id_is_refused() {
     first.signal(libc::SIGTERM);
     let (code, log) = first.finish_within(Duration::from_secs(30));
     assert_eq!(code, Some(130), "{log}");
+    assert!(!lock.exists(), "the released lock's file is left behind (issue 21 item 7)");
     let third = output_within(
         python_controller("pd.py", &["--run-id", &id, "--connect-timeout-s", "0.3"])
             .env("AMB_TESTBED_LOCK_DIR", dir.join("locks")),

@@ -153,7 +153,7 @@ fn an_impossible_criterion_exits_5_and_names_it() {
 fn malformed_programmes_exit_2_naming_the_key() {
     let dir = TempDir::new("soak-bad");
     let scene = workspace_root().join("config").join("cosim-10g.toml");
-    let cases: [(&str, &str); 4] = [
+    let cases: [(&str, &str); 8] = [
         ("settle_s = 1.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\nbogus = 3\n", "bogus"),
         ("settle_s = 1.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [0.1, 0.2]\n", "random.spacing_s"),
         (
@@ -161,6 +161,21 @@ fn malformed_programmes_exit_2_naming_the_key() {
             "random.peak_g = [5, 2] G",
         ),
         ("settle_s = 1.0\nmode = \"fast\"\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\n", "mode = \"fast\""),
+        // Issue 21 item 7: no lower bound (a row of rss.csv per tick and more).
+        (
+            "settle_s = 1.0\nrss_every_s = 1e-300\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\n",
+            "rss_every_s = 1e-300 s",
+        ),
+        // Issue 21 item 7: large settle_s or start_s were reported as scene.duration_s.
+        ("settle_s = 1e7\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\n", "settle_s = 10000000 s"),
+        (
+            "settle_s = 2000.0\n[random]\ncount = 5\nseed = 1\nspacing_s = [1.0, 1.2]\n",
+            "settle_s = 2000 s: the soak lasts",
+        ),
+        (
+            "settle_s = 1.0\n[[shock]]\nkind = \"half_sine\"\npeak_g = 2.0\nduration_s = 0.01\nstart_s = 5e6\n",
+            "shock[0].start_s = 5000000 s: the soak lasts",
+        ),
     ];
     for (i, (body, needle)) in cases.iter().enumerate() {
         let programme = dir.join(&format!("bad{i}.toml"));
@@ -170,6 +185,21 @@ fn malformed_programmes_exit_2_naming_the_key() {
         assert!(stderr(&run).contains(needle), "case {i}: expected {needle:?} in:\n{}", stderr(&run));
     }
     assert!(!dir.join("out").exists(), "nothing runs on bad input");
+}
+
+/// Issue 21 item 7: a soak whose controller never starts left no `soak.json`; it says why
+/// (status `not_started`, the error) beside `scene.toml`, like a run's `summary.json`.
+#[test]
+fn a_soak_whose_controller_never_starts_leaves_soak_json() {
+    let dir = TempDir::new("soak-not-started");
+    let out = dir.join("out");
+    let run = output_within(&mut soak(&short_programme(), &out, &["controller.command=[\"false\"]"]), LIMIT);
+    assert_exit(&run, 4);
+    let report = read_json(&out.join("soak.json"));
+    assert_eq!(report["status"], "not_started", "{report:#}");
+    assert!(report["error"].as_str().unwrap_or_default().contains("exited before the handshake"), "{report:#}");
+    assert_eq!(report["passed"], false);
+    assert!(out.join("scene.toml").is_file());
 }
 
 /// Issue 11 item 8: a soak killed with SIGKILL leaves every file it writes as it goes with

@@ -1,5 +1,6 @@
 //! End-to-end tests of `plant sweep`: a tiny sweep, shards merged equal one
-//! unsharded run, and an interrupted sweep resumes.
+//! unsharded run, an interrupted sweep resumes, and the hostile inputs of issue 21
+//! (item 7) that the grid engine refuses or cleans up.
 
 mod common;
 
@@ -75,6 +76,17 @@ fn shards_merged_equal_an_unsharded_sweep() {
     assert_exit(&output(&mut plant_sweep(&file, &a, &["--merge"])), 0);
     assert_eq!(read_text(&a.join("points.csv")), read_text(&whole.join("points.csv")));
     assert_eq!(read_text(&a.join("poincare.csv")), read_text(&whole.join("poincare.csv")));
+    // Issue 21 item 7: a signal during `--merge` killed it outright; it finishes its files
+    // (each whole) and exits 130.
+    #[cfg(target_os = "linux")]
+    {
+        let merge = Proc::spawn(&mut plant_sweep(&file, &a, &["--merge"]));
+        wait_for_handler(merge.id(), libc::SIGTERM);
+        merge.signal(libc::SIGTERM);
+        let (code, log) = merge.finish_within(std::time::Duration::from_secs(300));
+        assert_eq!(code, Some(130), "{log}");
+        assert_eq!(read_text(&a.join("points.csv")), read_text(&whole.join("points.csv")));
+    }
 }
 
 #[test]
@@ -169,4 +181,97 @@ fn two_key_map_writes_value2_and_the_mode_map() {
     // The first key varies fastest; log spacing of the second.
     assert_eq!(pairs, vec![(1.0, 0.01), (10.0, 0.01), (1.0, 0.1), (10.0, 0.1)]);
     assert!(std::fs::read(out.join("map.png")).unwrap_or_default().starts_with(b"\x89PNG"));
+}
+
+/// Issue 21, item 7: `--jobs 1000000` started 4,015 threads. The bound is the engine's, so it
+/// holds for `plant sweep` and `plant ensemble` alike, and nothing runs.
+#[test]
+fn jobs_past_the_bound_exit_2_naming_the_value_and_the_limit() {
+    let dir = TempDir::new("sweep-jobs");
+    let file = sweep_file(&dir, 2);
+    let out = dir.join("out");
+    let o = output(&mut plant_sweep(&file, &out, &["--jobs", "1000000"]));
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("1000000") && stderr(&o).contains("at most 1024"), "{}", stderr(&o));
+    assert!(!out.exists(), "nothing may run");
+    let mut ensemble = std::process::Command::new(plant_bin());
+    ensemble.arg("ensemble").arg(scene("paper-10g.toml")).arg("--out").arg(&out).args(["--jobs", "1025"]);
+    let o = output(&mut ensemble);
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("1025") && stderr(&o).contains("at most 1024"), "{}", stderr(&o));
+    assert!(!out.exists(), "nothing may run");
+}
+
+/// Issue 21, item 7: `--round 1` was accepted on a sweep without ensembles (and ran it whole).
+#[test]
+fn a_round_past_a_single_run_sweeps_only_round_exits_2() {
+    let dir = TempDir::new("sweep-round");
+    let file = sweep_file(&dir, 2);
+    let out = dir.join("out");
+    let o = output(&mut plant_sweep(&file, &out, &["--round", "1"]));
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("--round = 1") && stderr(&o).contains("one round"), "{}", stderr(&o));
+    assert!(!out.join("points").exists(), "nothing may run");
+    // Round 0 is the whole sweep.
+    assert_exit(&output(&mut plant_sweep(&file, &out, &["--round", "0"])), 0);
+    assert!(out.join("points.csv").exists());
+}
+
+/// Issue 21, item 7: a temporary point file that a SIGKILL left half-written survived the
+/// resume. A resume (or a merge) removes the temporaries of dead writers, in the folder, in
+/// `points/` and in a point's member folder, and leaves a live writer's (another shard's:
+/// it holds a lock on it) alone.
+#[test]
+fn a_resume_removes_what_killed_writes_left_and_keeps_live_ones() {
+    let dir = TempDir::new("sweep-temporaries");
+    let file = sweep_file(&dir, 2);
+    let out = dir.join("out");
+    assert_exit(&output(&mut plant_sweep(&file, &out, &[])), 0);
+    let points = read_text(&out.join("points.csv"));
+    // What a write killed half-way leaves: the temporary of an atomic write (its pid long gone).
+    let dead = [
+        out.join("points").join(".00001.json.tmp4194000-7"),
+        out.join(".points.csv.tmp4194000-9"),
+        out.join("points").join("00001").join(".00003.json.tmp4194000-8"),
+    ];
+    std::fs::create_dir_all(out.join("points").join("00001")).expect("member folder");
+    for d in &dead {
+        std::fs::write(d, b"{\"key\":\"12").expect("a half-written temporary");
+    }
+    let live = out.join("points").join(".00000.json.tmp4194001-0");
+    std::fs::write(&live, b"{").expect("a live temporary");
+    let holder = std::fs::OpenOptions::new().write(true).open(&live).expect("open");
+    holder.lock().expect("lock");
+    let o = output(&mut plant_sweep(&file, &out, &[]));
+    assert_exit(&o, 0);
+    assert!(stderr(&o).contains("removed 3 temporary file(s)"), "{}", stderr(&o));
+    for d in &dead {
+        assert!(!d.exists(), "{} survived the resume", d.display());
+    }
+    assert!(live.exists(), "a live writer's temporary was removed");
+    assert_eq!(read_text(&out.join("points.csv")), points);
+    drop(holder);
+    assert_exit(&output(&mut plant_sweep(&file, &out, &["--merge"])), 0);
+    assert!(!live.exists(), "--merge leaves a dead writer's temporary");
+}
+
+/// Issue 21, item 7: a type error in a sweep file pointed at line 1, column 1 without the key
+/// (the swept key's fields were read through `#[serde(flatten)]`).
+#[test]
+fn sweep_file_type_errors_point_at_the_key() {
+    let dir = TempDir::new("sweep-types");
+    let path = dir.join("bad.toml");
+    let scene = scene("paper-10g.toml").display().to_string();
+    for (body, line) in [
+        ("key = \"rotor.mass_kg\"\nfrom = 1.0\nto = \"two\"\npoints = 2\n", "to = \"two\""),
+        ("key = \"rotor.mass_kg\"\nfrom = 1.0\nto = 2.0\npoints = 2.5\n", "points = 2.5"),
+        ("key = \"rotor.mass_kg\"\nfrom = 1.0\nto = 2.0\npoints = 2\nspacing = 3\n", "spacing = 3"),
+        ("key = \"rotor.mass_kg\"\nfrom = 1.0\nto = 2.0\npoints = 2\nbogus = 1\n", "bogus = 1"),
+    ] {
+        std::fs::write(&path, format!("scene = {scene:?}\n{body}")).expect("write");
+        let o = output(&mut plant_sweep(&path, &dir.join("out"), &[]));
+        assert_exit(&o, 2);
+        let err = stderr(&o);
+        assert!(err.contains(line) && !err.contains("line 1, column 1"), "{body}: {err}");
+    }
 }

@@ -17,10 +17,10 @@
 //! (continuous rubbing; its whirl frequency and direction come from the mean
 //! angular rate of the orbit), `rebound` otherwise (repeated impacts).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// How the steady response repeats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyClass {
     /// One Poincaré point.
@@ -36,6 +36,15 @@ pub enum SteadyClass {
 }
 
 impl SteadyClass {
+    /// Every class.
+    pub const ALL: [SteadyClass; 5] = [
+        SteadyClass::Periodic,
+        SteadyClass::KtPeriodic,
+        SteadyClass::QuasiPeriodic,
+        SteadyClass::Irregular,
+        SteadyClass::Unknown,
+    ];
+
     /// The name written in the outputs (`kt_periodic`, …).
     pub fn name(self) -> &'static str {
         match self {
@@ -49,7 +58,7 @@ impl SteadyClass {
 }
 
 /// What the rotor does after the shock.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MotionMode {
     /// Back on its small unbalance orbit, no contact.
@@ -58,6 +67,29 @@ pub enum MotionMode {
     DryWhirl,
     /// Repeated impacts.
     Rebound,
+}
+
+impl MotionMode {
+    /// The name written in the outputs (`recovered`, `dry_whirl`, `rebound`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionMode::Recovered => "recovered",
+            MotionMode::DryWhirl => "dry_whirl",
+            MotionMode::Rebound => "rebound",
+        }
+    }
+}
+
+impl std::fmt::Display for MotionMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::fmt::Display for SteadyClass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Largest period tested.
@@ -268,14 +300,11 @@ mod tests {
 
     #[test]
     fn names_are_the_serialised_names() {
-        for c in [
-            SteadyClass::Periodic,
-            SteadyClass::KtPeriodic,
-            SteadyClass::QuasiPeriodic,
-            SteadyClass::Irregular,
-            SteadyClass::Unknown,
-        ] {
+        for c in SteadyClass::ALL {
             assert_eq!(serde_json::to_value(c).unwrap(), c.name());
+        }
+        for m in [MotionMode::Recovered, MotionMode::DryWhirl, MotionMode::Rebound] {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.name());
         }
     }
 

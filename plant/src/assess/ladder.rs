@@ -13,10 +13,11 @@
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
 use crate::ensemble::member::{
-    close_to_decision, figures, member_overrides, shock_size, verify_overrides, MemberResult, Point,
+    close_to_decision, figures, member_overrides, shock_size, verify_overrides, MemberResult,
 };
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
+use crate::grid::Point;
 use crate::hooks::Cancel;
 use crate::run::{run_into, Outcome, RunResult};
 use crate::trace::Trace;
@@ -174,6 +175,12 @@ pub struct LadderResult {
 #[error("{0}")]
 pub struct ControllerLost(pub String);
 
+/// A member's controller sent non-finite commands past the scene's budget: the ladder stops
+/// there, keeping the rungs it has (such a member says nothing of the controller's recovery).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct NotControlling(pub String);
+
 /// A member's outcome with the duty of its counted run.
 struct Counted {
     result: MemberResult,
@@ -182,7 +189,7 @@ struct Counted {
 
 /// The overrides that give rung peak `g` (G) to the scene's programme.
 pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
-    let raw = crate::ensemble::resolved(scene)?;
+    let raw = scene.resolved()?;
     let first = raw.shock.first().and_then(shock_size).map(|(_, v)| v);
     let Some(first) = first.filter(|v| *v > 0.0) else {
         anyhow::bail!("the shock ladder needs a scene whose first [[shock]] has a size (peak_g, amplitude_g or scale)");
@@ -219,6 +226,7 @@ fn run_counted(
             Outcome::PeerLost(why) | Outcome::MissBudget(why) => {
                 return Err(ControllerLost(why.clone()).into());
             }
+            Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),
             Outcome::Completed | Outcome::Diverged(_) => {}
         }
         Ok(Some((RunResult { trace, run }, duty)))
@@ -231,7 +239,7 @@ fn run_counted(
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
         let mut sets = point.sets.to_vec();
-        sets.extend(verify_overrides(point.scene, spec.verify_rtol));
+        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
         sets.extend(drawn.iter().cloned());
         let reference = load_scene(point.path, &sets)?;
         let Some((result, d)) = run(&reference)? else { return Ok(None) };
@@ -277,7 +285,7 @@ pub fn ladder(
         s.extend(rung_overrides(&base, *g)?);
         s.push("output.plots=false".into());
         let scene = load_scene(path, &s)?;
-        points.push((i, s, scene));
+        points.push(Point { path, sets: s, scene, index: i, values: vec![*g] });
     }
     let member_setting = crate::ensemble::member::setting_description(&base, &spec);
     let mut counted: Vec<Vec<Counted>> = points.iter().map(|_| Vec::new()).collect();
@@ -299,14 +307,8 @@ pub fn ladder(
             work.len(),
             work.iter().map(|w| w.0).collect::<std::collections::BTreeSet<_>>().len()
         ));
-        let done: Vec<anyhow::Result<Option<Counted>>> = work
-            .par_iter()
-            .map(|&(i, j)| {
-                let (index, sets, scene) = &points[i];
-                let point = Point { path, sets, scene, index: *index };
-                run_counted(&point, &spec, j, bearing, stop)
-            })
-            .collect();
+        let done: Vec<anyhow::Result<Option<Counted>>> =
+            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, stop)).collect();
         for r in done {
             match r {
                 Ok(Some(c)) => {
@@ -328,7 +330,7 @@ pub fn ladder(
         }
         for (i, c) in counted.iter().enumerate() {
             let n = c.len();
-            let k = c.iter().filter(|m| m.result.counted().mode == "recovered").count();
+            let k = c.iter().filter(|m| m.result.counted().mode == crate::grid::Mode::Recovered).count();
             let [lo, hi] = wilson(k, n);
             decided[i] = decided[i] || lo >= settings.min_p || hi < settings.min_p || n >= spec.members;
         }
@@ -337,7 +339,9 @@ pub fn ladder(
     for (i, c) in counted.iter_mut().enumerate() {
         c.sort_by_key(|m| m.result.member);
         let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
-        let stats = crate::ensemble::point::point_stats(i, &refs, "");
+        // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
+        // is not read.
+        let stats = crate::ensemble::point::point_stats(i, &refs, crate::ensemble::point::StoppedBy::Members);
         let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
         rungs.push(Rung {
             peak_g: settings.peaks_g[i],

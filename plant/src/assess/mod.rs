@@ -64,6 +64,8 @@ pub enum Failure {
     NotGradable,
     /// The controller process was lost (exit 4).
     PeerLost,
+    /// The controller's commands were non-finite past the scene's budget (exit 8).
+    InvalidCommands,
     /// A run diverged (exit 3).
     Diverged,
     /// Interrupted by SIGINT/SIGTERM (exit 130).
@@ -73,21 +75,11 @@ pub enum Failure {
 }
 
 impl Failure {
-    /// The exit code.
-    pub fn exit_code(self) -> u8 {
-        match self {
-            Failure::NotGradable => 9,
-            Failure::PeerLost => 4,
-            Failure::Diverged => 3,
-            Failure::Interrupted => 130,
-            Failure::Other => 1,
-        }
-    }
-
     fn rank(self) -> u8 {
         match self {
-            Failure::Interrupted => 5,
-            Failure::PeerLost => 4,
+            Failure::Interrupted => 6,
+            Failure::PeerLost => 5,
+            Failure::InvalidCommands => 4,
             Failure::Diverged => 3,
             Failure::NotGradable => 2,
             Failure::Other => 1,
@@ -223,6 +215,7 @@ fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)
         Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
         Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
         Outcome::MissBudget(why) => Some((Failure::PeerLost, why.clone())),
+        Outcome::InvalidCommands(why) => Some((Failure::InvalidCommands, why.clone())),
     }
 }
 
@@ -485,7 +478,7 @@ fn controller_starts(scene: &Scene, stop: &AtomicBool) -> anyhow::Result<()> {
 
 /// The bearing of a scene with the assessment's materials.
 fn bearing(scene: &Scene, a: &Assessment) -> anyhow::Result<duty::Bearing> {
-    let raw = crate::ensemble::resolved(scene)?;
+    let raw = scene.resolved()?;
     let t = &raw.touchdown;
     Ok(duty::Bearing::new(
         a.materials,
@@ -564,6 +557,8 @@ fn assess_controller(
             let kind = |e: &anyhow::Error| {
                 if interrupted() {
                     Failure::Interrupted
+                } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
+                    Failure::InvalidCommands
                 } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
                     Failure::PeerLost
                 } else {

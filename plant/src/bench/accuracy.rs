@@ -18,7 +18,7 @@
 //! `scene_<scene>.toml`, `work_precision_<scene>.png` and
 //! `failure_<scene>_<method>.png` (columns in [`super::rows`]).
 
-use super::rows::{self, AccuracyRow, ReferenceRow, StabilityRow};
+use super::rows::{self, AccuracyRow, AccuracyStatus, ReferenceRow, StabilityRow};
 use super::{atol_scale, measure, method_name, window_error, with_integrator, BenchScene, IntegratorSetting, WINDOW};
 use crate::config::Scene;
 use crate::integrate::Method;
@@ -167,7 +167,7 @@ fn timed_row(
         setting: text,
         rtol,
         substeps,
-        status: if ok { "ok".into() } else { "diverged".into() },
+        status: if ok { AccuracyStatus::Ok } else { AccuracyStatus::Diverged },
         err_rms: Some(rms),
         err_max: Some(max),
         wall_s_per_sim_s: m.best_wall / b.scene.duration,
@@ -319,7 +319,7 @@ pub fn charts(out: &Path, rows: &[AccuracyRow], floors: &[(String, (f64, f64))])
         let mut lines: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
         let (mut dx, mut dy) = (Vec::new(), Vec::new());
         let here: Vec<&AccuracyRow> = rows.iter().filter(|r| r.scene == scene).collect();
-        let top = here.iter().filter(|r| r.status == "ok").map(|r| r.rms()).fold(1.0, f64::max);
+        let top = here.iter().filter(|r| r.status == AccuracyStatus::Ok).map(|r| r.rms()).fold(1.0, f64::max);
         for r in &here {
             let name = format!("{} {}", r.implementation, r.method);
             let at = match lines.iter().position(|l| l.0 == name) {
@@ -329,7 +329,7 @@ pub fn charts(out: &Path, rows: &[AccuracyRow], floors: &[(String, (f64, f64))])
                     lines.len() - 1
                 }
             };
-            if r.status == "ok" && r.rms() > 0.0 {
+            if r.status == AccuracyStatus::Ok && r.rms() > 0.0 {
                 lines[at].1.push(r.wall_s_per_sim_s);
                 lines[at].2.push(r.rms());
             } else if r.wall_s_per_sim_s.is_finite() && r.wall_s_per_sim_s > 0.0 {
@@ -387,7 +387,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
         .map(|p| rows::read_accuracy(p).map_err(|e| super::BadArgument(format!("--peer-rows: {e:#}"))))
         .transpose()?
         .unwrap_or_default();
-    let mut report = accuracy(req.config, &dir, req.quick, req.repeats.max(1), peer.as_ref(), log)?;
+    let mut report = accuracy(req.config, &dir, req.quick, req.repeats, peer.as_ref(), log)?;
     let mut written = vec![dir.join("accuracy.csv"), dir.join("stability.csv")];
     if !earlier.is_empty() {
         report.rows.extend(earlier.into_iter().filter(|r| !r.implementation.starts_with("rust")));

@@ -11,9 +11,11 @@
 
 use super::rows::{EngineeringRow, ENGINEERING_HEADER};
 use super::{measure, with_integrator, IntegratorSetting};
+use crate::analysis::classify::{MotionMode, SteadyClass};
 use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::run::Outcome;
+use crate::status::Status;
 use crate::summary::{snake_name, Summary};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -26,7 +28,7 @@ pub struct Figures {
     /// What ran (method, setting, model).
     pub label: String,
     /// `completed` or `diverged`.
-    pub status: String,
+    pub status: Status,
     /// Peak contact force (N).
     pub peak_contact_force_n: f64,
     /// Largest rotor radius (m).
@@ -34,9 +36,9 @@ pub struct Figures {
     /// Contact fraction over the last 200 revolutions.
     pub contact_fraction: f64,
     /// Post-shock mode.
-    pub post_shock_mode: String,
+    pub post_shock_mode: MotionMode,
     /// Steady class of the end of the run.
-    pub steady_class: String,
+    pub steady_class: SteadyClass,
     /// Wall seconds per simulated second (fastest of the repeats).
     pub wall_s_per_sim_s: f64,
 }
@@ -47,12 +49,12 @@ fn figures(scene_name: &str, label: String, scene: &Scene, repeats: usize) -> an
     Ok(Figures {
         scene: scene_name.into(),
         label,
-        status: if m.result.run.outcome == Outcome::Completed { "completed".into() } else { "diverged".into() },
-        peak_contact_force_n: s.max_contact_force_n,
-        max_radius_m: s.max_radius_m,
+        status: if m.result.run.outcome == Outcome::Completed { Status::Completed } else { Status::Diverged },
+        peak_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
+        max_radius_m: s.max_radius_m.unwrap_or(f64::NAN),
         contact_fraction: s.contact_fraction,
-        post_shock_mode: snake_name(&s.analysis.post_shock_mode),
-        steady_class: snake_name(&s.analysis.steady_class),
+        post_shock_mode: s.analysis.post_shock_mode,
+        steady_class: s.analysis.steady_class,
         wall_s_per_sim_s: m.best_wall / scene.duration,
     })
 }
@@ -103,12 +105,12 @@ pub fn table(figures: &[Figures]) -> Vec<EngineeringRow> {
             Some(EngineeringRow {
                 scene: r.scene.clone(),
                 setting: r.label.clone(),
-                status: r.status.clone(),
+                status: r.status,
                 peak_contact_force_n: r.peak_contact_force_n,
                 max_radius_m: r.max_radius_m,
                 contact_fraction: r.contact_fraction,
-                post_shock_mode: r.post_shock_mode.clone(),
-                steady_class: r.steady_class.clone(),
+                post_shock_mode: r.post_shock_mode,
+                steady_class: r.steady_class,
                 wall_s_per_sim_s: r.wall_s_per_sim_s,
                 peak_force_rel_diff: rel(r.peak_contact_force_n, reference.peak_contact_force_n),
                 max_radius_rel_diff: rel(r.max_radius_m, reference.max_radius_m),
@@ -136,7 +138,7 @@ pub fn engineering(
         let reference = with_integrator(&free, Method::Dop853, IntegratorSetting::Rtol(1e-12));
         log(&format!("{name}: reference (DOP853 rtol 1e-12, {} s)", scene.duration));
         let r = figures(name, "reference: dop853 rtol=1e-12".into(), &reference, 1)?;
-        anyhow::ensure!(r.status == "completed", "{name}: the reference did not complete");
+        anyhow::ensure!(r.status == Status::Completed, "{name}: the reference did not complete");
         log(&format!(
             "{name}: reference: peak contact {:.1} N, max radius {:.2} µm, contact fraction {:.4}, mode {}, {:.3e} s/s",
             r.peak_contact_force_n,
@@ -175,7 +177,7 @@ pub fn command(
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
     let dir = super::out_dir(out, "bench-engineering");
-    engineering(config, &dir, repeats.max(1), log)?;
+    engineering(config, &dir, repeats, log)?;
     Ok(dir.join("engineering.csv"))
 }
 
@@ -183,16 +185,16 @@ pub fn command(
 mod tests {
     use super::*;
 
-    fn run(scene: &str, label: &str, force: f64, radius: f64, fraction: f64, mode: &str) -> Figures {
+    fn run(scene: &str, label: &str, force: f64, radius: f64, fraction: f64, mode: MotionMode) -> Figures {
         Figures {
             scene: scene.into(),
             label: label.into(),
-            status: "completed".into(),
+            status: Status::Completed,
             peak_contact_force_n: force,
             max_radius_m: radius,
             contact_fraction: fraction,
-            post_shock_mode: mode.into(),
-            steady_class: "periodic".into(),
+            post_shock_mode: mode,
+            steady_class: SteadyClass::Periodic,
             wall_s_per_sim_s: 0.1,
         }
     }
@@ -200,11 +202,11 @@ mod tests {
     #[test]
     fn each_row_is_compared_with_its_own_scenes_reference() {
         let figures = [
-            run("impact", "reference: dop853 rtol=1e-12", 1000.0, 2e-4, 0.0, "recovered"),
-            run("rub", "reference: dop853 rtol=1e-12", 4000.0, 3e-4, 0.5, "dry_whirl"),
-            run("impact", "rk4 substeps=4", 1010.0, 1.9e-4, 0.0, "recovered"),
-            run("rub", "rk4 substeps=4", 3000.0, 3e-4, 0.75, "recovered"),
-            run("orphan", "rk4 substeps=4", 1.0, 1.0, 1.0, "recovered"),
+            run("impact", "reference: dop853 rtol=1e-12", 1000.0, 2e-4, 0.0, MotionMode::Recovered),
+            run("rub", "reference: dop853 rtol=1e-12", 4000.0, 3e-4, 0.5, MotionMode::DryWhirl),
+            run("impact", "rk4 substeps=4", 1010.0, 1.9e-4, 0.0, MotionMode::Recovered),
+            run("rub", "rk4 substeps=4", 3000.0, 3e-4, 0.75, MotionMode::Recovered),
+            run("orphan", "rk4 substeps=4", 1.0, 1.0, 1.0, MotionMode::Recovered),
         ];
         let rows = table(&figures);
         assert_eq!(rows.len(), 4, "a scene without a reference has no row");

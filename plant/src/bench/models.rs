@@ -135,6 +135,6 @@ pub fn command(
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
     let dir = super::out_dir(out, "bench-models");
-    models(config, &dir, repeats.max(1), log)?;
+    models(config, &dir, repeats, log)?;
     Ok(dir.join("models.csv"))
 }

@@ -22,6 +22,24 @@ pub const ACCURACY_HEADER: &str =
 
 /// One row of `accuracy.csv`: one implementation, method and setting on one scene.
 ///
+/// How a run of the accuracy bench ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AccuracyStatus {
+    /// Completed with a finite error.
+    Ok,
+    /// A Rust run that did not complete, or whose error is not finite.
+    Diverged,
+    /// A peer run that failed (solve_ivp's status, non-finite values, or its time limit).
+    Failed,
+}
+
+impl std::fmt::Display for AccuracyStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(crate::summary::snake_name(self).as_str())
+    }
+}
+
 /// The peer's rows are read by column name; a peer run that failed leaves its error columns
 /// (and possibly `rhs_evals`, `sim_s`) empty: `None` here, empty again when written.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,7 +58,7 @@ pub struct AccuracyRow {
     /// Substeps per controller period (fixed-step methods).
     pub substeps: Option<u32>,
     /// `ok`, `diverged` (Rust) or `failed` (peer).
-    pub status: String,
+    pub status: AccuracyStatus,
     /// RMS scaled error (infinite for a run that did not complete).
     #[serde(with = "sci_or_empty")]
     pub err_rms: Option<f64>,
@@ -162,7 +180,7 @@ pub struct EngineeringRow {
     /// What ran (method, setting, model).
     pub setting: String,
     /// `completed` or `diverged`.
-    pub status: String,
+    pub status: crate::status::Status,
     /// Peak contact force (N).
     #[serde(with = "sci")]
     pub peak_contact_force_n: f64,
@@ -173,9 +191,9 @@ pub struct EngineeringRow {
     #[serde(with = "sci")]
     pub contact_fraction: f64,
     /// Post-shock mode.
-    pub post_shock_mode: String,
+    pub post_shock_mode: crate::analysis::classify::MotionMode,
     /// Steady class of the end of the run.
-    pub steady_class: String,
+    pub steady_class: crate::analysis::classify::SteadyClass,
     /// Wall seconds per simulated second (fastest of the repeats).
     #[serde(with = "sci")]
     pub wall_s_per_sim_s: f64,
@@ -207,7 +225,7 @@ mod tests {
             setting: "rtol=1e-4".into(),
             rtol: Some(1e-4),
             substeps: None,
-            status: "ok".into(),
+            status: AccuracyStatus::Ok,
             err_rms: Some(1.0),
             err_max: Some(f64::INFINITY),
             wall_s_per_sim_s: 0.5,
@@ -244,12 +262,12 @@ mod tests {
         let e = EngineeringRow {
             scene: "impact".into(),
             setting: "rk4 substeps=4".into(),
-            status: "completed".into(),
+            status: crate::status::Status::Completed,
             peak_contact_force_n: 1724.5,
             max_radius_m: 1.79e-4,
             contact_fraction: 0.0,
-            post_shock_mode: "recovered".into(),
-            steady_class: "periodic".into(),
+            post_shock_mode: crate::analysis::classify::MotionMode::Recovered,
+            steady_class: crate::analysis::classify::SteadyClass::Periodic,
             wall_s_per_sim_s: 0.25,
             peak_force_rel_diff: -1e-3,
             max_radius_rel_diff: 0.0,
@@ -287,7 +305,7 @@ mod tests {
         assert_eq!((ok.rtol, ok.substeps), (Some(1e-6), None));
         assert_eq!((ok.err_rms, ok.err_max, ok.wall_s_per_sim_s), (Some(1.23e-4), Some(5e-4), 0.75));
         assert_eq!((ok.rhs_evals, ok.sim_s), (Some(1892), Some(0.07)));
-        assert_eq!(failed.status, "failed");
+        assert_eq!(failed.status, AccuracyStatus::Failed);
         assert_eq!((failed.err_rms, failed.err_max, failed.rhs_evals, failed.sim_s), (None, None, None, None));
         assert_eq!(failed.rms(), f64::INFINITY);
         // Written back: our columns and order, the failed run's empty fields kept empty.

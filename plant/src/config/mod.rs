@@ -106,6 +106,10 @@ pub struct ControllerSettings {
     pub params: controller::Params,
     /// Co-simulation settings (used in `lockstep` and `realtime`).
     pub cosim: CosimSettings,
+    /// The most non-finite commands in a row before the run ends ([`crate::invalid`]).
+    pub max_invalid_burst: u64,
+    /// The largest share of non-finite commands ([`crate::invalid`]).
+    pub max_invalid_fraction: f64,
 }
 
 /// Co-simulation settings, validated (SI).
@@ -248,6 +252,14 @@ impl Scene {
             .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
     }
 
+    /// The scene as resolved, read back from [`Scene::to_toml`] (every key, overrides applied,
+    /// recorded files absolute): what sweeps and ensembles key their units on and draw
+    /// relative to.
+    pub fn resolved(&self) -> Result<RawScene, ConfigError> {
+        toml::from_str(&self.to_toml()?)
+            .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
+    }
+
     /// The same scene with more `--set` overrides, validated again.
     pub fn reload(&self, overrides: &[String]) -> Result<Scene, ConfigError> {
         let mut table = self.table()?;
@@ -309,8 +321,8 @@ impl Scene {
 
 /// Reads a scene file, applies `--set` overrides, validates.
 pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+    let text = shock_table::input::read_text(path, shock_table::input::MAX_TOML_BYTES)
+        .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
     let mut value: toml::Table = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     // The file alone first, so that its own mistakes are blamed on it, then with the overrides.

@@ -410,6 +410,11 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         gravity_bias: ctl.gravity_bias,
         params,
         cosim: cosim_settings(ctl)?,
+        max_invalid_burst: ctl.max_invalid_burst,
+        max_invalid_fraction: match ctl.max_invalid_fraction {
+            f if f.is_finite() && (0.0..=1.0).contains(&f) => f,
+            f => return Err(range("controller.max_invalid_fraction", f, "", "must be between 0 and 1")),
+        },
     };
     if ctl.delay_samples > 1000 {
         return Err(range("controller.delay_samples", ctl.delay_samples, "samples", "must be <= 1000"));

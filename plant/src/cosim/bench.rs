@@ -46,7 +46,7 @@ pub fn bench_round_trips(
         if k == warmup {
             s.reset_figures();
         }
-        let sample = Sample { seq: k, t_s: k as f64 * hello.period_s, sensor_v: [0.0; 2] };
+        let sample = Sample { seq: k, t_s: k as f64 * hello.period_s, sensor_v: [0.0; 2], ..Default::default() };
         if let Err(halt) = s.lockstep(&sample, hooks) {
             let why = match halt {
                 Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) => w,

@@ -56,6 +56,7 @@
 //! `foreign_frames`.
 
 mod bench;
+pub mod log;
 pub mod process;
 pub mod session;
 pub mod stats;
@@ -86,12 +87,16 @@ pub struct Launch {
     pub controller: ControllerProcess,
     /// Run id; `None` = a fresh one (process id, counter, time).
     pub run_id: Option<String>,
+    /// The file that gets the output of the controller processes the plant starts
+    /// (`controller.log` in the run folder); `None`: drained, only its last lines kept for the
+    /// messages ([`log`]).
+    pub log: Option<PathBuf>,
 }
 
 impl Default for Launch {
     /// The plant starts the `controller` next to its own executable, with a fresh run id.
     fn default() -> Self {
-        Self { controller: ControllerProcess::Spawn(None), run_id: None }
+        Self { controller: ControllerProcess::Spawn(None), run_id: None, log: None }
     }
 }
 
@@ -146,8 +151,8 @@ pub enum CosimError {
         /// OS error.
         why: String,
     },
-    /// The child exited before the handshake (its own message is above).
-    #[error("the controller process {program} exited before the handshake ({status}{hint})", hint = exit_hint(*code))]
+    /// The child exited before the handshake.
+    #[error("the controller process {program} exited before the handshake ({status}{hint}){output}", hint = exit_hint(*code))]
     ControllerExited {
         /// What was started.
         program: String,
@@ -155,6 +160,8 @@ pub enum CosimError {
         status: String,
         /// Exit code, if any.
         code: Option<i32>,
+        /// Its last output and where the rest is (`; its last output (…/controller.log): "…"`).
+        output: String,
     },
     /// `controller.command` does not exist or is not executable (nothing was started).
     #[error("controller.command: cannot run {argv0:?}: {why}")]
@@ -208,9 +215,9 @@ pub enum CosimError {
 /// What an early exit code of a controller says (the codes of `controller::serve`).
 fn exit_hint(code: Option<i32>) -> &'static str {
     match code {
-        Some(2) => ": it refused the run, or found a peer of another protocol version (its message is above)",
+        Some(2) => ": it refused the run, or found a peer of another protocol version",
         Some(4) => ": it saw no plant",
-        Some(1) => ": an IPC failure or an error of its own, its message is above",
+        Some(1) => ": an IPC failure or an error of its own",
         _ => "",
     }
 }

@@ -3,8 +3,8 @@
 //! that speaks the wire protocol).
 //!
 //! The child runs in its own process group with stdin from `/dev/null` and
-//! the plant's stdout/stderr, so a Ctrl-C in the terminal reaches the plant
-//! only, which then ends the run in order (a STOP frame, then the child
+//! its stdout and stderr into a pipe the plant drains into `controller.log`
+//! ([`super::log`]), so a Ctrl-C in the terminal reaches the plant only, which then ends the run in order (a STOP frame, then the child
 //! exits 0). Dropping a [`Child`] that is still running sends SIGTERM, then
 //! SIGKILL after a grace period, and waits for it: no controller outlives a
 //! plant that exits (a plant killed with SIGKILL cannot do this; its
@@ -122,8 +122,8 @@ pub struct Args<'a> {
 }
 
 impl Child {
-    /// Starts the program (see [`Program`] and the module doc).
-    pub fn spawn(program: &Program, args: &Args) -> Result<Self, CosimError> {
+    /// Starts the program (see [`Program`] and the module doc), its output into `log`.
+    pub fn spawn(program: &Program, args: &Args, log: &mut super::log::OutputLog) -> Result<Self, CosimError> {
         let mut cmd = match program {
             Program::Builtin(exe) => {
                 let mut cmd = Command::new(exe);
@@ -143,9 +143,14 @@ impl Child {
                 cmd
             }
         };
+        let (out, err) = log.attach(&format!("{} for run {}", program.describe(), args.run_id)).map_err(|e| {
+            CosimError::Spawn { path: PathBuf::from(program.describe()), why: format!("a pipe for its output: {e}") }
+        })?;
         cmd.env(RUN_ID_ENV, args.run_id)
             .env(CONNECT_TIMEOUT_ENV, args.connect_timeout_s.to_string())
             .stdin(Stdio::null())
+            .stdout(out)
+            .stderr(err)
             .process_group(0);
         if args.realtime_priority > 0 {
             cmd.env(REALTIME_PRIORITY_ENV, args.realtime_priority.to_string());

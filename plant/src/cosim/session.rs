@@ -7,6 +7,7 @@ mod handshake;
 
 use handshake::Pending;
 
+use super::log::OutputLog;
 use super::process::{Child, Program};
 use super::stats::{CosimReport, Figures, Scheduling};
 use super::{CosimError, PeerEvent};
@@ -94,6 +95,8 @@ pub struct Session {
     _node: Node<Ipc>,
     child: Option<Child>,
     program: Option<Program>,
+    /// The output of the controllers started (after `child`: dropped once it is reaped).
+    log: OutputLog,
     _lock: RunLock,
     hello: Hello,
     limit: f64,
@@ -195,26 +198,20 @@ impl Session {
             axes: wire::AXES,
             reserved: 0,
             sensor_v: wire::axes_of(sample.sensor_v),
+            speed_rad_s: sample.speed_rad_s,
+            angle_rad: sample.angle_rad,
         }
     }
 
-    /// Checks a reply's currents; non-finite ones are counted and the last current held, and
-    /// the first one is said (a run that holds currents is not the law's run).
-    fn accept(&mut self, reply: &CommandFrame, sample: &Sample, hooks: &mut dyn Hooks) -> [f64; 2] {
-        let current = reply.current_xy();
+    /// A reply's currents, saturated. A non-finite one is passed on as it is (the run loop
+    /// holds, counts and judges them, [`crate::invalid`]) and is not kept as the last current
+    /// (held on a miss or a loss).
+    fn accept(&mut self, reply: &CommandFrame) -> [f64; 2] {
+        let current = saturate(reply.current_xy(), self.limit);
         if current.iter().all(|i| i.is_finite()) {
-            self.last_cmd = saturate(current, self.limit);
-        } else {
-            if self.figures.invalid == 0 {
-                hooks.note(&format!(
-                    "warning: the controller sent a non-finite current {current:?} A for sample {} (t = {} s); \
-                     the last valid current is held for it and for every later non-finite reply (counted in summary.json, cosim.invalid_replies)",
-                    sample.seq, sample.t_s
-                ));
-            }
-            self.figures.invalid += 1;
+            self.last_cmd = current;
         }
-        self.last_cmd
+        current
     }
 
     /// The command for sample `k` to push into the delay line: the reply to
@@ -241,12 +238,12 @@ impl Session {
         let mut verdict = Verdict::Wait;
         let mut seen = Seen::default();
         loop {
-            let (run_id, child) = (&self.run_id, &mut self.child);
+            let (run_id, child, log) = (&self.run_id, &mut self.child, &mut self.log);
             let waited = self.frames.wait(SLICE, || {
                 if hooks.cancelled() {
                     return false;
                 }
-                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child);
+                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child, log);
                 matches!(verdict, Verdict::Wait)
             });
             let reply = match waited {
@@ -289,7 +286,7 @@ impl Session {
                 if t0.elapsed() < deadline {
                     continue;
                 }
-                return match controller_gone(&self.run_id, &mut self.child) {
+                return match controller_gone(&self.run_id, &mut self.child, &mut self.log) {
                     Some(why) => self.on_lost(sample, why, hooks),
                     None => self.on_silent(sample, &seen, hooks),
                 };
@@ -297,7 +294,7 @@ impl Session {
             self.figures.round_trip.record(t0.elapsed().as_nanos() as u64);
             self.figures.latency.record(reply.sent_ns.saturating_sub(frame.sent_ns));
             self.warn_if_never_woken(hooks);
-            return Ok(self.accept(&reply, sample, hooks));
+            return Ok(self.accept(&reply));
         }
     }
 
@@ -451,7 +448,7 @@ impl Session {
             match fresh {
                 Some(reply) => {
                     self.figures.misses.record(false);
-                    self.accept(&reply, sample, hooks)
+                    self.accept(&reply)
                 }
                 None => {
                     self.figures.misses.record(true);
@@ -460,7 +457,7 @@ impl Session {
                     }
                     if self.last_heard.elapsed() >= self.next_check {
                         self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
-                        if let Some(why) = controller_gone(&self.run_id, &mut self.child) {
+                        if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
                             return self.on_lost(sample, why, hooks);
                         }
                     }
@@ -514,7 +511,7 @@ impl Session {
             messages_received: f.received,
             sequence_gaps: f.gaps,
             stale_replies: f.stale,
-            invalid_replies: f.invalid,
+            invalid_replies: 0, // counted by the run loop, which fills it in
             foreign_frames: f.foreign,
             deadline_misses: f.misses.total,
             deadline_miss_fraction: f.miss_fraction(),
@@ -544,13 +541,14 @@ fn check_silence(
     deadline: Duration,
     run_id: &str,
     child: &mut Option<Child>,
+    log: &mut OutputLog,
 ) -> Verdict {
     let waited = t0.elapsed();
     if waited < *next_check {
         return Verdict::Wait;
     }
     *next_check = waited + timeout;
-    if let Some(why) = controller_gone(run_id, child) {
+    if let Some(why) = controller_gone(run_id, child, log) {
         return Verdict::Gone(why);
     }
     if waited >= deadline {
@@ -560,19 +558,33 @@ fn check_silence(
     }
 }
 
-/// `Some(why)` if the controller's process is gone: our child exited, or
-/// its node is dead or absent.
-fn controller_gone(run_id: &str, child: &mut Option<Child>) -> Option<String> {
+/// `Some(why)` if the controller's process is gone: our child exited (with its last output),
+/// or its node is dead or absent.
+fn controller_gone(run_id: &str, child: &mut Option<Child>, log: &mut OutputLog) -> Option<String> {
     if let Some(c) = child.as_mut() {
         if let Some(status) = c.exited() {
-            return Some(format!("the controller process exited ({status})"));
+            log.settle();
+            return Some(format!("the controller process exited ({status}){}", log.quote(3)));
         }
     }
-    match link::peer(run_id, "controller") {
-        Peer::Alive => None,
-        Peer::Dead => Some("the controller's node is dead (its process died)".into()),
-        Peer::Absent => Some("the controller's node is gone".into()),
+    let why = match link::peer(run_id, "controller") {
+        Peer::Alive => return None,
+        Peer::Dead => "the controller's node is dead (its process died)",
+        Peer::Absent => "the controller's node is gone",
+    };
+    // A child of ours whose node went is on its way out: its exit status and last words say why.
+    if let Some(c) = child.as_mut() {
+        let until = Instant::now() + Duration::from_millis(500);
+        while Instant::now() < until {
+            if let Some(status) = c.exited() {
+                log.settle();
+                return Some(format!("{why}: the controller process exited ({status}){}", log.quote(3)));
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        return Some(format!("{why}{}", log.quote(3)));
     }
+    Some(why.into())
 }
 
 /// Waits for a wall-clock instant: sleeps while it is far, then spins.

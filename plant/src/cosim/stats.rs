@@ -123,8 +123,6 @@ pub struct Figures {
     pub gaps: u64,
     /// Replies to an older sample (or late, realtime).
     pub stale: u64,
-    /// Replies with non-finite currents.
-    pub invalid: u64,
     /// Frames and acks with another run's token.
     pub foreign: u64,
     /// Deadline misses (realtime).
@@ -196,7 +194,8 @@ pub struct CosimReport {
     pub sequence_gaps: u64,
     /// Replies that came after their tick (realtime) or answered an older sample.
     pub stale_replies: u64,
-    /// Replies with non-finite currents (the last current was held).
+    /// Replies with non-finite currents (the last valid command was held), counted by the run
+    /// loop (`invalid_commands` of the summary, the same number in co-simulation).
     pub invalid_replies: u64,
     /// Frames and handshake answers carrying another run's token (never applied).
     pub foreign_frames: u64,

@@ -6,8 +6,9 @@
 //! reports members per core-second of each and how many members the fast setting classifies
 //! as the scene's own setting does, and writes one row per member to `bench.csv`.
 
-use crate::ensemble::member::{run_member, setting_description, MemberResult, Point};
+use crate::ensemble::member::{run_member, setting_description, MemberResult};
 use crate::ensemble::spec::{EnsembleSpec, MemberSetting};
+use crate::grid::{Mode, Point};
 use anyhow::Context;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -33,12 +34,12 @@ pub struct BenchArgs {
 
 /// One member of `bench.csv`.
 #[derive(Serialize)]
-struct BenchCsvRow<'a> {
+struct BenchCsvRow {
     member: usize,
     angle_deg: Option<f64>,
-    fast_mode: &'a str,
-    verified_mode: &'a str,
-    scene_mode: &'a str,
+    fast_mode: Mode,
+    verified_mode: Mode,
+    scene_mode: Mode,
     fast_agrees_with_scene: bool,
     fast_recovery_s: Option<f64>,
     scene_recovery_s: Option<f64>,
@@ -73,7 +74,7 @@ pub fn bench(args: &BenchArgs, log: &mut dyn FnMut(&str)) -> anyhow::Result<Benc
     let mut sets = args.set.clone();
     sets.push("output.plots=false".into());
     let scene = crate::config::load_scene(&args.scene, &sets)?;
-    let base = EnsembleSpec::from_table(&crate::ensemble::resolved(&scene)?.ensemble.unwrap_or_default())?;
+    let base = EnsembleSpec::from_table(&scene.resolved()?.ensemble.unwrap_or_default())?;
     if !(1..=crate::ensemble::spec::MAX_MEMBERS).contains(&args.members) {
         return Err(crate::config::ConfigError::Range {
             key: "--members".into(),
@@ -85,7 +86,7 @@ pub fn bench(args: &BenchArgs, log: &mut dyn FnMut(&str)) -> anyhow::Result<Benc
     }
     let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join("bench-ensemble"));
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let point = Point { path: &args.scene, sets: &sets, scene: &scene, index: 0 };
+    let point = Point { path: &args.scene, sets: sets.clone(), scene: scene.clone(), index: 0, values: Vec::new() };
     let stop = AtomicBool::new(false);
     let ways = [
         ("fast", EnsembleSpec { integrator: MemberSetting::Fast, verify: false, ..base.clone() }),
@@ -132,9 +133,9 @@ pub fn bench(args: &BenchArgs, log: &mut dyn FnMut(&str)) -> anyhow::Result<Benc
         w.serialize(BenchCsvRow {
             member: f.member,
             angle_deg: f.angle_deg,
-            fast_mode: &f.run.mode,
-            verified_mode: &v.counted().mode,
-            scene_mode: &s.run.mode,
+            fast_mode: f.run.mode,
+            verified_mode: v.counted().mode,
+            scene_mode: s.run.mode,
             fast_agrees_with_scene: agrees,
             fast_recovery_s: f.run.recovery_s,
             scene_recovery_s: s.run.recovery_s,

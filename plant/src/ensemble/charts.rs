@@ -10,34 +10,34 @@
 //! tab10 colours, viridis (plotters' colour map, through `plot::viridis`).
 
 use crate::ensemble::member::MemberResult;
-use crate::ensemble::point::PointStats;
+use crate::ensemble::point::{PointStats, StoppedBy};
 use crate::ensemble::stats::Threshold;
+use crate::grid::{Grid, Mode, Spacing};
 use crate::plot::{self, PointGroup};
-use crate::sweep::{Spacing, Sweep};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
 const FONT: &str = plot::FONT_FAMILY;
 const BLUE: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
-const MODE_COLOURS: [(&str, RGBColor); 4] = [
-    ("recovered", RGBColor(0x1f, 0x77, 0xb4)),
-    ("dry_whirl", RGBColor(0xff, 0x7f, 0x0e)),
-    ("rebound", RGBColor(0x2c, 0xa0, 0x2c)),
-    ("diverged", RGBColor(0x7f, 0x7f, 0x7f)),
+const MODE_COLOURS: [(Mode, RGBColor); 4] = [
+    (Mode::Recovered, RGBColor(0x1f, 0x77, 0xb4)),
+    (Mode::DryWhirl, RGBColor(0xff, 0x7f, 0x0e)),
+    (Mode::Rebound, RGBColor(0x2c, 0xa0, 0x2c)),
+    (Mode::Diverged, RGBColor(0x7f, 0x7f, 0x7f)),
 ];
 const SENSITIVE: RGBColor = RGBColor(0xd6, 0x27, 0x28);
 
 /// Poincaré points of one mode: (mode, colour, points).
-type ModeGroup<'a> = (&'a str, RGBColor, Vec<(f64, f64)>);
+type ModeGroup = (Mode, RGBColor, Vec<(f64, f64)>);
 
 fn draw_err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> anyhow::Error + '_ {
     move |e| anyhow::anyhow!("drawing {} failed: {e:?}", path.display())
 }
 
 /// The swept axis as drawn: values (log10 for a log axis) and label.
-fn axis(sweep: &Sweep, k: usize) -> Option<(Vec<f64>, String)> {
-    let a = sweep.axes.get(k)?;
+fn axis(grid: &Grid, k: usize) -> Option<(Vec<f64>, String)> {
+    let a = grid.axes.get(k)?;
     let log = a.spacing == Spacing::Log;
     let values = a.values().into_iter().map(|v| if log { v.log10() } else { v }).collect();
     Some((values, if log { format!("log10({})", a.key) } else { a.key.clone() }))
@@ -143,21 +143,21 @@ fn band_panel(
     Ok(())
 }
 
-/// The charts of an ensemble sweep.
+/// The charts of an ensemble grid.
 pub fn sweep_charts(
-    sweep: &Sweep,
+    grid: &Grid,
     dir: &Path,
     stats: &[PointStats],
-    counted: &[(Vec<&MemberResult>, &'static str)],
+    counted: &[(Vec<&MemberResult>, StoppedBy)],
     thresholds: &[Threshold],
 ) -> anyhow::Result<()> {
     plot::ensure_font(dir)?;
-    let scene = sweep.scene_name();
-    let Some((x, x_label)) = axis(sweep, 0) else { return Ok(()) };
-    if let Some((y, y_label)) = axis(sweep, 1) {
-        return probability_map(&dir.join("map.png"), sweep, (&x, &x_label), (&y, &y_label), stats, &scene);
+    let scene = grid.scene_name();
+    let Some((x, x_label)) = axis(grid, 0) else { return Ok(()) };
+    if let Some((y, y_label)) = axis(grid, 1) {
+        return probability_map(&dir.join("map.png"), grid, (&x, &x_label), (&y, &y_label), stats, &scene);
     }
-    let log = sweep.axes[0].spacing == Spacing::Log;
+    let log = grid.axes[0].spacing == Spacing::Log;
     let t: Vec<(f64, [f64; 2])> = thresholds
         .iter()
         .map(|t| {
@@ -166,7 +166,7 @@ pub fn sweep_charts(
         })
         .collect();
     let xr = range(x.iter().copied());
-    let key = &sweep.axes[0].key;
+    let key = &grid.axes[0].key;
     let path = dir.join("recovery_probability.png");
     {
         let root = BitMapBackend::new(&path, (1200, 800)).into_drawing_area();
@@ -213,7 +213,7 @@ pub fn sweep_charts(
             chart
                 .draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled())))
                 .map_err(draw_err(&path))?
-                .label(*name)
+                .label(name.name())
                 .legend(move |(x, y)| Circle::new((x + 11, y), 5, colour.filled()));
         }
         chart
@@ -234,7 +234,7 @@ pub fn sweep_charts(
 /// cells with numerically sensitive members crossed in red.
 fn probability_map(
     path: &Path,
-    sweep: &Sweep,
+    grid: &Grid,
     (x, x_label): (&[f64], &str),
     (y, y_label): (&[f64], &str),
     stats: &[PointStats],
@@ -255,7 +255,7 @@ fn probability_map(
     let (xe, ye) = (edges(x), edges(y));
     let root = BitMapBackend::new(path, (1200, 800)).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err(path))?;
-    let title = format!("{scene}: probability of recovery over {} × {}", sweep.axes[0].key, sweep.axes[1].key);
+    let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
     let root = root.titled(&title, (FONT, 26)).map_err(draw_err(path))?;
     let (main, bar) = root.split_horizontally(1030);
     let mut chart = ChartBuilder::on(&main)
@@ -325,7 +325,7 @@ fn probability_map(
 /// A single scene's members: recovery time against the rotor's angle at the shock's arrival
 /// (or the member index without an angle draw), coloured by mode; members that never
 /// recovered sit at the end of the run; numerically sensitive members form their own group.
-pub fn members_chart(sweep: &Sweep, dir: &Path, members: &[&MemberResult]) -> Result<(), plot::PlotError> {
+pub fn members_chart(grid: &Grid, dir: &Path, members: &[&MemberResult]) -> Result<(), plot::PlotError> {
     let mut groups: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     let angle = members.iter().all(|m| m.angle_deg.is_some());
     let x_of = |m: &MemberResult| m.angle_deg.unwrap_or(m.member as f64);
@@ -333,7 +333,7 @@ pub fn members_chart(sweep: &Sweep, dir: &Path, members: &[&MemberResult]) -> Re
     for (name, _) in MODE_COLOURS {
         let sel: Vec<&&MemberResult> = members.iter().filter(|m| m.counted().mode == name && !m.sensitive()).collect();
         groups.push((
-            name.to_string(),
+            name.name().to_string(),
             sel.iter().map(|m| x_of(m)).collect(),
             sel.iter().map(|m| m.counted().recovery_s.unwrap_or(end)).collect(),
         ));
@@ -348,7 +348,7 @@ pub fn members_chart(sweep: &Sweep, dir: &Path, members: &[&MemberResult]) -> Re
         groups.iter().filter(|g| !g.1.is_empty()).map(|g| PointGroup { label: &g.0, x: &g.1, y: &g.2 }).collect();
     plot::scatter(
         &dir.join("members.png"),
-        &format!("{}: members' recovery time", sweep.scene_name()),
+        &format!("{}: members' recovery time", grid.scene_name()),
         if angle { "rotor angle at the shock's arrival (deg)" } else { "member" },
         "time from the shock to the last contact (s)",
         &pg,

@@ -22,15 +22,17 @@
 //! scaled per component (r_0, 2π, r_0 Ω, Ω), the race free. The verified run counts; when its
 //! mode differs from the first run's the member is `numerically_sensitive`.
 
+use crate::analysis::classify::SteadyClass;
 use crate::config::{load_scene, Scene};
 use crate::ensemble::spec::{Draw, EnsembleSpec, MemberSetting};
+use crate::grid::{Mode, Point};
 use crate::hooks::Cancel;
 use crate::integrate::Method;
 use crate::run::{run, Outcome, RunResult};
+use crate::status::Status;
 use crate::summary::{snake_name, Summary};
 use serde::{Deserialize, Serialize};
 use shock_table::ShockSpec;
-use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// Members whose Poincaré points are kept (for the bifurcation diagrams and `poincare.csv`).
@@ -39,12 +41,12 @@ pub const POINCARE_MEMBERS: usize = 8;
 /// The figures of one run of a member.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Figures {
-    /// `completed` or `diverged`.
-    pub status: String,
+    /// How the run ended (`completed`, `diverged`, …).
+    pub status: Status,
     /// `recovered`, `dry_whirl`, `rebound`, or `diverged` when the run did not complete.
-    pub mode: String,
+    pub mode: Mode,
     /// Steady class.
-    pub steady_class: String,
+    pub steady_class: SteadyClass,
     /// Period k.
     pub period_k: Option<u32>,
     /// Time from the first shock's start to the last contact (s); `None` if still touching.
@@ -98,17 +100,16 @@ impl MemberResult {
 pub fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
     let s = Summary::new(scene, result);
     let a = &s.analysis;
-    let completed = s.status == crate::status::Status::Completed;
     let f = Figures {
-        status: s.status.name().to_string(),
-        mode: if completed { snake_name(&a.post_shock_mode) } else { "diverged".into() },
-        steady_class: snake_name(&a.steady_class),
+        status: s.status,
+        mode: Mode::of_run(s.status, a.post_shock_mode),
+        steady_class: a.steady_class,
         period_k: a.period_k,
         recovery_s: s.recovery_s,
         contact_fraction: s.contact_fraction,
         whirl_hz: a.whirl_hz,
-        max_radius_m: s.max_radius_m,
-        max_contact_force_n: s.max_contact_force_n,
+        max_radius_m: s.max_radius_m.unwrap_or(0.0), // stored as a number (null would not read back)
+        max_contact_force_n: s.max_contact_force_n.unwrap_or(0.0),
         steady_window_start_s: s.steady_window_start_s,
         wall_time_s: s.wall_time_s,
     };
@@ -201,7 +202,7 @@ fn shock_direction(s: &ShockSpec) -> f64 {
 /// before the shock is held by the drive, so the same holds to within the drive's error.
 pub fn draw_overrides(scene: &Scene, spec: &EnsembleSpec, draw: &Draw) -> Vec<String> {
     // The scene loaded once already: reading it back cannot fail but for a bug; then no draw.
-    let Ok(raw) = crate::ensemble::resolved(scene) else { return Vec::new() };
+    let Ok(raw) = scene.resolved() else { return Vec::new() };
     let mut out = Vec::new();
     if let Some(angle) = draw.angle_deg {
         let turned = raw.rotor.speed_hz * 360.0 * scene.first_shock_start();
@@ -226,24 +227,12 @@ pub fn draw_overrides(scene: &Scene, spec: &EnsembleSpec, draw: &Draw) -> Vec<St
     out
 }
 
-/// The point of a sweep a member belongs to: its scene file, its overrides, its loaded scene.
-pub struct Point<'a> {
-    /// Scene file.
-    pub path: &'a Path,
-    /// The point's overrides (sweep `set`, swept values, `output.plots=false`).
-    pub sets: &'a [String],
-    /// The point's scene.
-    pub scene: &'a Scene,
-    /// Point index.
-    pub index: usize,
-}
-
 /// The overrides of member `j`'s first run, and its draw.
 pub fn member_overrides(point: &Point, spec: &EnsembleSpec, j: usize) -> (Vec<String>, Draw, Vec<String>) {
     let draw = spec.draw(j);
-    let drawn = draw_overrides(point.scene, spec, &draw);
-    let mut sets = point.sets.to_vec();
-    sets.extend(setting_overrides(point.scene, spec.integrator));
+    let drawn = draw_overrides(&point.scene, spec, &draw);
+    let mut sets = point.sets.clone();
+    sets.extend(setting_overrides(&point.scene, spec.integrator));
     sets.extend(drawn.iter().cloned());
     (sets, draw, drawn)
 }
@@ -251,14 +240,14 @@ pub fn member_overrides(point: &Point, spec: &EnsembleSpec, j: usize) -> (Vec<St
 /// True when a run's outcome is close to a decision (see the module doc).
 pub fn close_to_decision(f: &Figures, shock_start: f64, spec: &EnsembleSpec) -> bool {
     let late = spec.verify_late;
-    match f.mode.as_str() {
-        "diverged" => true,
-        "rebound" => f.contact_fraction < spec.verify_rebound,
-        "recovered" => {
+    match f.mode {
+        Mode::Diverged => true,
+        Mode::Rebound => f.contact_fraction < spec.verify_rebound,
+        Mode::Recovered => {
             let span = f.steady_window_start_s - shock_start;
             f.recovery_s.is_some_and(|r| span > 0.0 && r > late * span)
         }
-        _ => false,
+        Mode::DryWhirl => false,
     }
 }
 
@@ -279,8 +268,8 @@ pub fn run_member(
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
-        let mut sets = point.sets.to_vec();
-        sets.extend(verify_overrides(point.scene, spec.verify_rtol));
+        let mut sets = point.sets.clone();
+        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
         sets.extend(drawn.iter().cloned());
         let reference = load_scene(point.path, &sets)?;
         let result = run(&reference, &mut Cancel(stop))?;
@@ -309,11 +298,11 @@ pub fn run_member(
 mod tests {
     use super::*;
 
-    fn figures(mode: &str, recovery_s: Option<f64>, contact_fraction: f64) -> Figures {
+    fn figures(mode: Mode, recovery_s: Option<f64>, contact_fraction: f64) -> Figures {
         Figures {
-            status: "completed".into(),
-            mode: mode.into(),
-            steady_class: "periodic".into(),
+            status: Status::Completed,
+            mode,
+            steady_class: SteadyClass::Periodic,
             period_k: Some(1),
             recovery_s,
             contact_fraction,
@@ -329,11 +318,11 @@ mod tests {
     fn close_calls_are_late_recoveries_intermittent_rebounds_and_divergences() {
         let spec = EnsembleSpec::default();
         // Shock at 0.02 s, window from 1.1 s: "late" is after 0.75 × 1.08 = 0.81 s.
-        assert!(!close_to_decision(&figures("recovered", Some(0.55), 0.0), 0.02, &spec));
-        assert!(close_to_decision(&figures("recovered", Some(0.9), 0.0), 0.02, &spec));
-        assert!(close_to_decision(&figures("rebound", None, 0.17), 0.02, &spec));
-        assert!(!close_to_decision(&figures("rebound", None, 0.58), 0.02, &spec));
-        assert!(!close_to_decision(&figures("dry_whirl", None, 1.0), 0.02, &spec));
-        assert!(close_to_decision(&figures("diverged", None, 0.0), 0.02, &spec));
+        assert!(!close_to_decision(&figures(Mode::Recovered, Some(0.55), 0.0), 0.02, &spec));
+        assert!(close_to_decision(&figures(Mode::Recovered, Some(0.9), 0.0), 0.02, &spec));
+        assert!(close_to_decision(&figures(Mode::Rebound, None, 0.17), 0.02, &spec));
+        assert!(!close_to_decision(&figures(Mode::Rebound, None, 0.58), 0.02, &spec));
+        assert!(!close_to_decision(&figures(Mode::DryWhirl, None, 1.0), 0.02, &spec));
+        assert!(close_to_decision(&figures(Mode::Diverged, None, 0.0), 0.02, &spec));
     }
 }

@@ -6,24 +6,28 @@
 //! full run with its own draws ([`spec`]), on a cheap integrator setting with the members
 //! close to a decision verified at a tight one ([`member`]), adding members where the outcome
 //! is uncertain ([`point`]), and reports the probability of recovery with its 95 % interval,
-//! the recovery times, the worst contact force and the mode counts ([`stats`], [`charts`]).
+//! the recovery times, the worst contact force and the mode counts ([`stats`], [`merge`],
+//! [`charts`]).
 //!
 //! `plant ensemble SCENE.toml` runs one scene's `[ensemble]`; a sweep file's `[ensemble]`
-//! table makes every point of `plant sweep` an ensemble. Both go through
-//! [`crate::sweep`]'s machinery (resumable unit files, shards, rounds, manifest, merge).
+//! table makes every point of `plant sweep` an ensemble. Both run on the grid engine
+//! ([`crate::grid`]: resumable unit files, shards, rounds, manifest, merge) with
+//! [`work::Ensemble`] as the work of a point.
 
 pub mod bench;
 pub mod charts;
 pub mod member;
+pub mod merge;
 pub mod point;
 pub mod spec;
 pub mod stats;
+pub mod work;
 
-use crate::config::raw::RawScene;
-use crate::config::{ConfigError, Scene};
-use crate::sweep::run::{execute, RunArgs};
-use crate::sweep::Sweep;
+use crate::config::load_scene;
+use crate::grid::{execute, Grid, Kind, RunArgs};
+use spec::EnsembleSpec;
 use std::path::PathBuf;
+use work::Ensemble;
 
 /// `plant ensemble` arguments.
 #[derive(clap::Args, Debug, Clone)]
@@ -40,19 +44,21 @@ pub struct EnsembleArgs {
     pub run: RunArgs,
 }
 
-/// `plant ensemble`: loads the scene and its `[ensemble]` (exit 2 on bad input), runs or
-/// merges it into `--out` (default `runs/ensemble-<scene stem>`).
+/// `plant ensemble`: loads the scene and its `[ensemble]` (exit 2 on bad input): one point, no
+/// swept key; runs or merges it into `--out` (default `runs/ensemble-<scene stem>`).
 pub fn command(args: &EnsembleArgs) -> anyhow::Result<()> {
-    let sweep = Sweep::single(&args.scene, &args.set)?;
+    let scene = load_scene(&args.scene, &args.set)?;
+    let table = scene.resolved()?.ensemble.unwrap_or_default();
+    let work = Ensemble { spec: EnsembleSpec::from_table(&table)? };
+    let grid = Grid {
+        kind: Kind::Ensemble,
+        definition: serde_json::json!({ "scene": args.scene, "set": args.set }),
+        scene_path: args.scene.clone(),
+        set: args.set.clone(),
+        axes: Vec::new(),
+    };
+    grid.validate(&work)?;
     let stem = args.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = args.run.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("ensemble-{stem}")));
-    execute(&sweep, &dir, &args.run)
-}
-
-/// The scene as resolved (every key, overrides applied), read back from
-/// [`Scene::to_toml`]: the one place ensembles read the raw scene (its `[ensemble]` table, the
-/// shocks and rotor keys the draws are relative to, the text unit keys are made from).
-pub fn resolved(scene: &Scene) -> Result<RawScene, ConfigError> {
-    let text = scene.to_toml()?;
-    toml::from_str(&text).map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
+    execute(&grid, &work, &dir, &args.run)
 }

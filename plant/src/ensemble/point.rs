@@ -9,33 +9,29 @@
 //! members were sharded, threaded or ordered, and points whose probability lies strictly
 //! between 0 and 1 get more members.
 
+use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
+use crate::grid::{Mode, Progress};
+use crate::status::Status;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-/// Where a point stands.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Progress {
-    /// Enough members: the first `members` count; `stopped_by` says which rule.
-    Decided {
-        /// Members counted.
-        members: usize,
-        /// `members`, `width` or `agree`.
-        stopped_by: &'static str,
-    },
-    /// Batch `round` is needed; `missing` lists its members not present.
-    Needs {
-        /// The round (batch index).
-        round: usize,
-        /// Members of that batch not present.
-        missing: Vec<usize>,
-    },
+/// Which rule decided a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StoppedBy {
+    /// It has `ensemble.members` members.
+    Members,
+    /// Its interval is at most `ensemble.target_width` wide.
+    Width,
+    /// At least `ensemble.agree` members all agree.
+    Agree,
 }
 
 /// Applies the stopping rule to the members present (`present[j]` = recovered?).
-pub fn progress(spec: &EnsembleSpec, present: &BTreeMap<usize, bool>) -> Progress {
+pub fn progress(spec: &EnsembleSpec, present: &BTreeMap<usize, bool>) -> Progress<StoppedBy> {
     let mut recovered = 0usize;
     for r in 0..spec.rounds() {
         let batch = spec.batch_members(r);
@@ -46,17 +42,17 @@ pub fn progress(spec: &EnsembleSpec, present: &BTreeMap<usize, bool>) -> Progres
         recovered += batch.clone().filter(|j| present[j]).count();
         let n = batch.end;
         if n >= spec.members {
-            return Progress::Decided { members: n, stopped_by: "members" };
+            return Progress::Decided { counted: n, decision: StoppedBy::Members };
         }
         let [lo, hi] = wilson(recovered, n);
         if spec.target_width > 0.0 && hi - lo <= spec.target_width {
-            return Progress::Decided { members: n, stopped_by: "width" };
+            return Progress::Decided { counted: n, decision: StoppedBy::Width };
         }
         if spec.agree > 0 && n >= spec.agree && (recovered == 0 || recovered == n) {
-            return Progress::Decided { members: n, stopped_by: "agree" };
+            return Progress::Decided { counted: n, decision: StoppedBy::Agree };
         }
     }
-    Progress::Decided { members: spec.members, stopped_by: "members" }
+    Progress::Decided { counted: spec.members, decision: StoppedBy::Members }
 }
 
 /// Statistics of a point over its counted members.
@@ -91,11 +87,12 @@ pub struct PointStats {
     /// Verified members whose mode changed.
     pub numerically_sensitive: usize,
     /// Which rule stopped the point: `members`, `width` or `agree`.
-    pub stopped_by: String,
-    /// The most frequent mode (ties: recovered, dry whirl, rebound, diverged).
-    pub post_shock_mode: String,
-    /// The most frequent steady class.
-    pub steady_class: String,
+    pub stopped_by: StoppedBy,
+    /// The most frequent mode (ties: recovered, dry whirl, rebound, diverged); none without
+    /// members.
+    pub post_shock_mode: Option<Mode>,
+    /// The most frequent steady class (ties: the first by name); none without members.
+    pub steady_class: Option<SteadyClass>,
     /// The most frequent period k among members of that class.
     pub period_k: Option<u32>,
     /// Mean contact fraction.
@@ -105,47 +102,48 @@ pub struct PointStats {
     /// Largest rotor radius of all members (m).
     pub max_radius_m: f64,
     /// `completed` if every counted run completed, else `diverged`.
-    pub status: String,
+    pub status: Status,
 }
 
-fn most_frequent<T: Ord + Clone>(items: impl Iterator<Item = T>, order: &[T]) -> Option<T> {
-    let mut counts: BTreeMap<T, usize> = BTreeMap::new();
-    for i in items {
-        *counts.entry(i).or_default() += 1;
-    }
-    let best = counts.values().copied().max()?;
-    // Ties: the first in `order`, then the smallest.
-    order
-        .iter()
-        .find(|o| counts.get(*o) == Some(&best))
-        .cloned()
-        .or_else(|| counts.iter().find(|(_, c)| **c == best).map(|(k, _)| k.clone()))
+/// The most frequent item, ties broken by `order` (the first there wins); `None` without items.
+fn most_frequent<T: PartialEq + Copy>(items: &[T], order: &[T]) -> Option<T> {
+    let count = |o: &T| items.iter().filter(|i| *i == o).count();
+    let best = order.iter().map(count).max().filter(|&c| c > 0)?;
+    order.iter().copied().find(|o| count(o) == best)
 }
 
 /// The statistics of a point's counted members (`members` sorted by index).
-pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: &str) -> PointStats {
+pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedBy) -> PointStats {
     let n = members.len();
-    let count = |mode: &str| members.iter().filter(|m| m.counted().mode == mode).count();
-    let recovered = count("recovered");
+    let count = |mode: Mode| members.iter().filter(|m| m.counted().mode == mode).count();
+    let recovered = count(Mode::Recovered);
     let [p_lo, p_hi] = wilson(recovered, n);
     let times: Vec<f64> =
-        members.iter().filter(|m| m.counted().mode == "recovered").filter_map(|m| m.counted().recovery_s).collect();
-    let modes = ["recovered", "dry_whirl", "rebound", "diverged"].map(String::from);
-    let mode = most_frequent(members.iter().map(|m| m.counted().mode.clone()), &modes).unwrap_or_default();
-    let class = most_frequent(members.iter().map(|m| m.counted().steady_class.clone()), &[]).unwrap_or_default();
-    let period_k = most_frequent(
-        members.iter().filter(|m| m.counted().steady_class == class).filter_map(|m| m.counted().period_k),
-        &[],
-    );
+        members.iter().filter(|m| m.counted().mode == Mode::Recovered).filter_map(|m| m.counted().recovery_s).collect();
+    let modes: Vec<Mode> = members.iter().map(|m| m.counted().mode).collect();
+    let mode = most_frequent(&modes, &Mode::ALL);
+    let classes: Vec<SteadyClass> = members.iter().map(|m| m.counted().steady_class).collect();
+    let mut by_name = SteadyClass::ALL;
+    by_name.sort_by_key(|c| c.name());
+    let class = most_frequent(&classes, &by_name);
+    let ks: Vec<u32> = members
+        .iter()
+        .filter(|m| Some(m.counted().steady_class) == class)
+        .filter_map(|m| m.counted().period_k)
+        .collect();
+    let mut k_order = ks.clone();
+    k_order.sort_unstable();
+    k_order.dedup();
+    let period_k = most_frequent(&ks, &k_order);
     let whirl: Vec<f64> = members.iter().map(|m| m.counted().whirl_hz).collect();
     let max = |f: fn(&MemberResult) -> f64| members.iter().map(|m| f(m)).filter(|v| v.is_finite()).fold(0.0, f64::max);
     PointStats {
         index,
         members: n,
         recovered,
-        dry_whirl: count("dry_whirl"),
-        rebound: count("rebound"),
-        diverged: count("diverged"),
+        dry_whirl: count(Mode::DryWhirl),
+        rebound: count(Mode::Rebound),
+        diverged: count(Mode::Diverged),
         p_recovered: if n > 0 { recovered as f64 / n as f64 } else { 0.0 },
         p_lo,
         p_hi,
@@ -154,7 +152,7 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: &str) ->
         worst_contact_force_n: max(|m| m.counted().max_contact_force_n),
         verified: members.iter().filter(|m| m.verified.is_some()).count(),
         numerically_sensitive: members.iter().filter(|m| m.sensitive()).count(),
-        stopped_by: stopped_by.to_string(),
+        stopped_by,
         post_shock_mode: mode,
         steady_class: class,
         period_k,
@@ -165,8 +163,11 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: &str) ->
         },
         whirl_hz: quantile(&whirl, 0.5).unwrap_or(0.0),
         max_radius_m: max(|m| m.counted().max_radius_m),
-        status: if members.iter().all(|m| m.counted().status == "completed") { "completed" } else { "diverged" }
-            .to_string(),
+        status: if members.iter().all(|m| m.counted().status == Status::Completed) {
+            Status::Completed
+        } else {
+            Status::Diverged
+        },
     }
 }
 
@@ -182,7 +183,7 @@ mod tests {
     fn a_point_that_agrees_stops_after_its_first_batch() {
         let s = spec("members = 64\nbatch = 16\nagree = 16");
         let all: BTreeMap<usize, bool> = (0..16).map(|j| (j, true)).collect();
-        assert_eq!(progress(&s, &all), Progress::Decided { members: 16, stopped_by: "agree" });
+        assert_eq!(progress(&s, &all), Progress::Decided { counted: 16, decision: StoppedBy::Agree });
         let mixed: BTreeMap<usize, bool> = (0..16).map(|j| (j, j % 2 == 0)).collect();
         assert_eq!(progress(&s, &mixed), Progress::Needs { round: 1, missing: (16..32).collect() });
     }
@@ -192,8 +193,8 @@ mod tests {
         let s = spec("members = 48\nbatch = 16\ntarget_width = 0.3");
         let half: BTreeMap<usize, bool> = (0..48).map(|j| (j, j % 2 == 0)).collect();
         // 8/16: width 0.44; 16/32: 0.33; 24/48: the maximum.
-        assert_eq!(progress(&s, &half), Progress::Decided { members: 48, stopped_by: "members" });
+        assert_eq!(progress(&s, &half), Progress::Decided { counted: 48, decision: StoppedBy::Members });
         let s = spec("members = 64\nbatch = 16\ntarget_width = 0.4");
-        assert_eq!(progress(&s, &half), Progress::Decided { members: 32, stopped_by: "width" });
+        assert_eq!(progress(&s, &half), Progress::Decided { counted: 32, decision: StoppedBy::Width });
     }
 }

@@ -293,11 +293,14 @@ fn peak_of(spec: &ShockSpec) -> f64 {
     }
 }
 
+/// Most RSS samples over a soak (rows of `rss.csv`).
+pub const MAX_RSS_SAMPLES: f64 = 1e6;
+
 /// Reads a programme file, applies the programme's and then `cli_set`
 /// overrides to its scene, and validates everything.
 pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+    let text = shock_table::input::read_text(path, shock_table::input::MAX_TOML_BYTES)
+        .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
     let mut raw: RawProgramme = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     if raw.name.is_empty() {
@@ -307,6 +310,14 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
     let mode = ControlMode::from(raw.mode);
     let settle = positive("settle_s", raw.settle_s, "s")?;
     let rss_every = positive("rss_every_s", raw.rss_every_s, "s")?;
+    if settle > crate::config::validate::MAX_DURATION_S {
+        return Err(range(
+            "settle_s",
+            settle,
+            "s",
+            &format!("must be <= {:e} s", crate::config::validate::MAX_DURATION_S),
+        ));
+    }
     let hold = positive("recovery.hold_s", raw.recovery.hold_s, "s")?;
     let fraction = raw.recovery.radius_fraction;
     if !(fraction.is_finite() && fraction > 0.0 && fraction <= 1.0) {
@@ -377,7 +388,37 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
         "output.plots=false".to_string(),
     ];
     // Shock files (recorded pulses) are relative to the programme file, like its other paths.
-    let scene = base.with_shocks(&specs, dir, &programme_set)?;
+    // A bound of the scene's duration is the programme's to blame: its last shock's end plus
+    // `settle_s` (the scene would name `scene.duration_s`, which the programme sets).
+    let scene = base.with_shocks(&specs, dir, &programme_set).map_err(|e| match e {
+        ConfigError::Range { key, value, unit, why } if key == "scene.duration_s" || why.contains("scene.duration_s") => {
+            let (blame, shown) = if settle >= last || list_key != "shock" {
+                ("settle_s".to_string(), settle.to_string())
+            } else {
+                (format!("shock[{}].start_s", shocks.len() - 1), shocks[shocks.len() - 1].start_s.to_string())
+            };
+            let why = format!(
+                "the soak lasts its last shock's end ({last} s) plus settle_s ({settle} s) = {} s, so {key} = {value}{unit}: {why}",
+                last + settle
+            );
+            range(&blame, shown, "s", &why)
+        }
+        e => e,
+    })?;
+    // One RSS sample per tick at most, and a bounded number of them (each is a row of rss.csv
+    // and a few numbers in memory).
+    let period = scene.controller.period;
+    if rss_every < period || scene.duration / rss_every > MAX_RSS_SAMPLES {
+        return Err(range(
+            "rss_every_s",
+            rss_every,
+            "s",
+            &format!(
+                "must be at least the controller period ({period} s) and give at most {MAX_RSS_SAMPLES:e} samples over the soak's {} s",
+                scene.duration
+            ),
+        ));
+    }
     if hold < 10.0 * scene.output_interval {
         return Err(range(
             "recovery.hold_s",

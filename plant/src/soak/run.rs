@@ -197,7 +197,25 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         rss_csv,
         error: None,
     };
-    let result = run_into(scene, &opts.launch, &mut hooks, &mut sink)?;
+    let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
+    let mut result = match run_into(scene, &launch, &mut hooks, &mut sink) {
+        Ok(r) => r,
+        Err(e) => {
+            // The programme loaded: the folder records why the soak did not start.
+            let record = serde_json::json!({
+                "programme": prog.name,
+                "programme_file": programme_file.display().to_string(),
+                "status": e.status(),
+                "error": e.to_string(),
+                "simulated_s": 0.0,
+                "planned_s": scene.duration,
+                "shocks": prog.shocks.len(),
+                "passed": false,
+            });
+            crate::output::write_json(&dir.join("soak.json"), &record).context("writing soak.json").map_err(io)?;
+            return Err(e.into());
+        }
+    };
     if let Some(bar) = &hooks.bar {
         bar.finish_and_clear();
     }
@@ -206,11 +224,28 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         return Err(io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
     }
 
-    let report = report(prog, programme_file, &result, &sink.figures, &hooks.rss, started);
-    let json = serde_json::to_string_pretty(&report).context("serialising soak.json").map_err(io)?;
-    crate::atomic::write(&dir.join("soak.json"), (json + "\n").as_bytes()).map_err(io)?;
+    // A signal that comes once the loop has completed, while the outputs are written: every
+    // output is still written, and the soak is `interrupted` (exit 130).
+    let stopped = || opts.stop.load(Ordering::Relaxed);
+    let late = |result: &mut crate::run::SinkRun| {
+        let late = stopped() && result.outcome == crate::run::Outcome::Completed;
+        if late {
+            result.outcome = crate::run::Outcome::Interrupted;
+        }
+        late
+    };
+    late(&mut result);
+    let write = |report: &super::Report| {
+        crate::output::write_json(&dir.join("soak.json"), report).context("writing soak.json").map_err(io)
+    };
+    let mut report = report(prog, programme_file, &result, &sink.figures, &hooks.rss, started);
+    write(&report)?;
     if prog.plots {
         super::plots::write_plots(dir, prog, &sink.figures, &hooks.rss).context("writing plots").map_err(io)?;
+    }
+    if late(&mut result) {
+        report = super::report::report(prog, programme_file, &result, &sink.figures, &hooks.rss, started);
+        write(&report)?;
     }
     Ok(Finished { outcome: result.outcome, report })
 }

@@ -206,6 +206,31 @@ impl Proc {
     }
 }
 
+/// Waits (up to 60 s) until process `pid` catches `signal` (its handler is installed, from
+/// `/proc/PID/status`), so that a test signals it at a moment its handling is defined; panics
+/// if the process ends first.
+#[cfg(target_os = "linux")]
+pub fn wait_for_handler(pid: u32, signal: i32) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let bit = 1u64 << (signal - 1);
+    loop {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status"))
+            .unwrap_or_else(|e| panic!("process {pid} ended before it caught signal {signal}: {e}"));
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+            .unwrap_or(0);
+        let state = status.lines().find_map(|l| l.strip_prefix("State:")).unwrap_or("").trim().to_string();
+        assert!(!state.starts_with('Z'), "process {pid} ended before it caught signal {signal}");
+        if caught & bit != 0 {
+            return;
+        }
+        assert!(std::time::Instant::now() < deadline, "process {pid} never caught signal {signal}");
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+}
+
 impl Drop for Proc {
     fn drop(&mut self) {
         let _ = self.child.kill();

@@ -5,6 +5,7 @@
 
 use super::{Session, RING};
 use crate::config::{ControlMode, CosimSettings, Scene};
+use crate::cosim::log::OutputLog;
 use crate::cosim::process::{self, Child, Program};
 use crate::cosim::stats::{Figures, Scheduling};
 use crate::cosim::{ControllerProcess, CosimError, Launch};
@@ -112,6 +113,10 @@ impl Session {
             }
         }
         scheduling.plant = link::policy(0).to_string();
+        let log = OutputLog::create(launch.log.as_deref()).map_err(|e| CosimError::Spawn {
+            path: launch.log.clone().unwrap_or_default(),
+            why: format!("cannot create the file for the controller's output: {e}"),
+        })?;
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
@@ -123,6 +128,7 @@ impl Session {
             _node: node,
             child: None,
             program,
+            log,
             _lock: lock,
             hello,
             limit: hello.current_limit_a,
@@ -167,7 +173,7 @@ impl Session {
                 connect_timeout_s: self.settings.connect_timeout.max(1.0),
                 realtime_priority: self.settings.realtime_priority,
             };
-            self.child = Some(Child::spawn(program, &args)?);
+            self.child = Some(Child::spawn(program, &args, &mut self.log)?);
         }
         Ok(())
     }
@@ -254,10 +260,12 @@ impl Session {
             }
             if let Some(child) = self.child.as_mut() {
                 if let Some(status) = child.exited() {
+                    self.log.settle();
                     return Err(CosimError::ControllerExited {
                         program: child.program().describe(),
                         status: status.to_string(),
                         code: status.code(),
+                        output: self.log.quote(3),
                     });
                 }
             }
@@ -265,7 +273,11 @@ impl Session {
             if waited > timeout {
                 self.pending = None;
                 let hint = match &self.child {
-                    Some(c) => format!(" (the controller {} was started but did not answer)", c.program().describe()),
+                    Some(c) => format!(
+                        " (the controller {} was started but did not answer{})",
+                        c.program().describe(),
+                        self.log.quote(3)
+                    ),
                     None => format!("; start one with `controller --run-id {}`", self.run_id),
                 };
                 return Err(CosimError::NoController { waited_s: timeout, run_id: self.run_id.clone(), hint });

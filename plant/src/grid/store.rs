@@ -1,4 +1,4 @@
-//! The files of a sweep folder and how they are checked.
+//! The files of a sweep or ensemble folder and how they are checked.
 //!
 //! * `manifest.json`: what the folder is for: the program (`plant 0.1.0`), the kind, the sweep
 //!   or ensemble definition, the resolved scene (TOML text, `set` overrides applied) and the
@@ -63,7 +63,7 @@ impl Unit {
 
 /// The key of a unit made from `scene` (see the module doc).
 pub fn unit_key(scene: &Scene, unit: Unit, verification: Option<String>) -> anyhow::Result<String> {
-    let mut raw = crate::ensemble::resolved(scene)?;
+    let mut raw = scene.resolved()?;
     raw.ensemble = None;
     let text = toml::to_string(&raw).context("serialising a unit's scene")?;
     Ok(sha256_hex(
@@ -140,6 +140,16 @@ pub fn read_unit<T: DeserializeOwned>(
     Found::Good(result)
 }
 
+/// Removes the temporaries of unit and output writes killed half-way (a SIGKILL during an
+/// atomic write) from the folder, its `points/` and each point's member folder, leaving those
+/// of live writers (another shard's); returns what it removed.
+pub fn remove_temporaries(dir: &Path) -> Vec<PathBuf> {
+    let points = dir.join("points");
+    let members = std::fs::read_dir(&points).into_iter().flatten().flatten().map(|e| e.path()).filter(|p| p.is_dir());
+    let folders: Vec<PathBuf> = [dir.to_path_buf(), points.clone()].into_iter().chain(members).collect();
+    folders.iter().flat_map(|f| crate::atomic::remove_stale(f)).collect()
+}
+
 /// The unit files present in a folder (temporary files of atomic writes are skipped), and
 /// the other files found under `points/`.
 pub fn present(dir: &Path) -> (Vec<Unit>, Vec<PathBuf>) {
@@ -203,22 +213,18 @@ pub struct Manifest {
 }
 
 impl Manifest {
-    /// The manifest of a sweep.
-    pub fn of(sweep: &super::Sweep) -> anyhow::Result<Self> {
-        let base = crate::config::load_scene(&sweep.scene_path, &sweep.set)?;
-        let mut raw = crate::ensemble::resolved(&base)?;
+    /// The manifest of a grid run by `work`.
+    pub fn of<W: super::Work>(grid: &super::Grid, work: &W) -> anyhow::Result<Self> {
+        let base = grid.base_scene()?;
+        let mut raw = base.resolved()?;
         raw.ensemble = None;
-        let definition = match &sweep.spec {
-            Some(spec) => serde_json::to_value(spec)?,
-            None => serde_json::json!({ "scene": sweep.scene_path, "set": sweep.set }),
-        };
         let mut m = Manifest {
             program: PROGRAM.to_string(),
-            kind: crate::summary::snake_name(&sweep.kind),
-            definition,
+            kind: crate::summary::snake_name(&grid.kind),
+            definition: grid.definition.clone(),
             scene: toml::to_string(&raw)?,
-            ensemble: sweep.ensemble.as_ref().map(serde_json::to_value).transpose()?,
-            member_setting: sweep.ensemble.as_ref().map(|e| crate::ensemble::member::setting_description(&base, e)),
+            ensemble: work.manifest()?,
+            member_setting: work.describe(&base),
             hash: String::new(),
         };
         m.hash = sha256_hex(serde_json::to_string(&m)?.as_bytes());
