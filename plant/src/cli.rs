@@ -117,6 +117,10 @@ pub enum Command {
     /// (each point an ensemble with an `[ensemble]` table); writes points.csv, poincare.csv and
     /// bifurcation diagrams. Resumes an interrupted sweep.
     Sweep(plant::sweep::SweepArgs),
+    /// Judge controllers the way the field does: the stability margin of each axis (ISO 14839-3
+    /// sensitivity, measured through the loop), the vibration (ISO 14839-2), the shock ladder
+    /// and the touchdown bearing's duty; writes report.html, report.json and PNG charts.
+    Assess(plant::assess::AssessArgs),
     /// Run a scene's ensemble (`[ensemble]`): members drawn around the scene; writes
     /// ensemble.csv, members.csv, ensemble.json and members.png.
     Ensemble(plant::ensemble::EnsembleArgs),

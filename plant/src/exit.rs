@@ -6,6 +6,7 @@
 //!
 //! The table users read is `docs/guide/running.md`, "Exit codes".
 
+use crate::assess::{AssessError, Failure};
 use crate::claim::ClaimError;
 use crate::config::ConfigError;
 use crate::cosim::CosimError;
@@ -34,13 +35,16 @@ pub enum Code {
     /// The controller's commands were non-finite past `controller.max_invalid_burst` or
     /// `controller.max_invalid_fraction` (status `invalid_commands`).
     InvalidCommands = 8,
+    /// `plant assess`: a controller could not be graded (its rotor not levitated before the
+    /// shock, or the excitation drove it into the touchdown bearing); the report was written.
+    NotGradable = 9,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     Interrupted = 130,
 }
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 9] = [
+    pub const ALL: [Code; 10] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -49,6 +53,7 @@ impl Code {
         Code::MissBudget,
         Code::Incomplete,
         Code::InvalidCommands,
+        Code::NotGradable,
         Code::Interrupted,
     ];
 }
@@ -64,6 +69,7 @@ const _: fn(Code) = |c| match c {
     | Code::MissBudget
     | Code::Incomplete
     | Code::InvalidCommands
+    | Code::NotGradable
     | Code::Interrupted => {}
 };
 
@@ -105,6 +111,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         shock_table::ShockError,
         crate::bench::BadArgument,
         AnalyzeError,
+        AssessError,
     );
     None
 }
@@ -213,6 +220,19 @@ impl HasExitCode for AnalyzeError {
     }
 }
 
+impl HasExitCode for AssessError {
+    fn exit_code(&self) -> Code {
+        match self.kind {
+            Failure::NotGradable => Code::NotGradable,
+            Failure::PeerLost => Code::PeerLost,
+            Failure::InvalidCommands => Code::InvalidCommands,
+            Failure::Diverged => Code::Diverged,
+            Failure::Interrupted => Code::Interrupted,
+            Failure::Other => Code::Io,
+        }
+    }
+}
+
 /// Bad input, whatever the variant.
 macro_rules! bad_input {
     ($($t:ty),* $(,)?) => {
@@ -238,6 +258,10 @@ mod tests {
 
     fn exited(code: Option<i32>) -> CosimError {
         CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
+    }
+
+    fn assessed(kind: Failure) -> anyhow::Error {
+        AssessError { kind, message: "m".into(), dir: "d".into() }.into()
     }
 
     #[test]
@@ -293,6 +317,12 @@ mod tests {
             ),
             (GridError::Interrupted.into(), 130),
             (ClaimError::InUse { path: "d".into(), holder: String::new() }.into(), 2),
+            (assessed(Failure::NotGradable), 9),
+            (assessed(Failure::PeerLost), 4),
+            (assessed(Failure::InvalidCommands), 8),
+            (assessed(Failure::Diverged), 3),
+            (assessed(Failure::Interrupted), 130),
+            (assessed(Failure::Other), 1),
             // An output that could not be written, whatever its message says.
             (anyhow::Error::from(std::io::Error::other("bad input")).context("writing summary.json"), 1),
         ];

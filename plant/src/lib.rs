@@ -16,6 +16,7 @@
 pub use plant_physics::{force, integrate, model, park};
 
 pub mod analysis;
+pub mod assess;
 pub mod atomic;
 pub mod bench;
 pub mod bounded;

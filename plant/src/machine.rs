@@ -5,6 +5,7 @@
 
 use crate::model::{Control, Model, Params, Release};
 use crate::park::{self, GapMotion};
+use crate::run::Sink;
 use crate::trace::{self, Record};
 use plant_physics::integrate::System;
 use plant_physics::two_plane;
@@ -48,10 +49,20 @@ pub trait Machine<const N: usize>: System<N> {
 
     /// The output sample of state `y` at time `t`.
     fn record(&self, t: f64, y: &[f64; N]) -> Record;
+
+    /// Hands the output sample of state `y` at time `t` to `sink`.
+    fn feed(&self, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
+        sink.sample(&self.record(t, y));
+    }
 }
 
 impl Machine<{ crate::model::N }> for Model {
     const PLANES: usize = 1;
+
+    fn feed(&self, sink: &mut dyn Sink, t: f64, y: &crate::model::State) {
+        sink.sample(&self.record(t, y));
+        sink.planar_state(self, t, y);
+    }
 
     fn bearing(&self, _i: usize) -> &Params {
         &self.params

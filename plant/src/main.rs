@@ -106,6 +106,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Sweep(args) => plant::sweep::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),
+        Command::Assess(args) => {
+            let dir = plant::assess::command(&args, &plant::interrupt::stop_flag())?;
+            eprintln!("plant assess: report in {}", dir.join("report.html").display());
+            Ok(())
+        }
         Command::Bench { what } => match what {
             BenchCommand::Ensemble(args) => {
                 plant::ensemble::bench::bench(&args, &mut |l| eprintln!("plant bench: {l}")).map(|_| ())

@@ -110,6 +110,11 @@ pub enum SetupError {
 pub trait Sink {
     /// The sample at one output time: the state's row(s) with the forces the model gives there.
     fn sample(&mut self, record: &Record);
+
+    /// The same sample as the planar model's state, after [`Sink::sample`] (planar runs only):
+    /// for a sink that needs what a row does not hold (the race's angle and acceleration, each
+    /// ball's load: the assessment's touchdown-bearing duty). The default ignores it.
+    fn planar_state(&mut self, _model: &crate::model::Model, _t: f64, _y: &crate::model::State) {}
 }
 
 impl Sink for Trace {
@@ -317,11 +322,17 @@ fn drive<const N: usize, M: Machine<N>>(
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
     let planes = M::PLANES;
+    // Plane A's continuous PD, for an excitation hook (ISO 14839-3's summing point).
+    let continuous_gains = match source {
+        Source::Continuous => plane_gains(scene)?.first().copied(),
+        _ => None,
+    };
+    let mut excited = false;
     let mut integrator = Integrator::new(settings);
     let period = scene.controller.period;
     let ticks = (scene.duration / period).ceil() as u64;
     let out_dt = scene.output_interval;
-    sink.sample(&model.record(0.0, &y));
+    model.feed(sink, 0.0, &y);
     let mut next_out: u64 = 1;
     // Output samples per tick; a period longer than the run holds only the run's samples.
     let mut out_times: Vec<f64> = Vec::with_capacity((period.min(scene.duration) / out_dt).ceil() as usize + 2);
@@ -372,35 +383,47 @@ fn drive<const N: usize, M: Machine<N>>(
                 sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
             }
         };
+        if !matches!(source, Source::Continuous) {
+            read(&mut sensor, &mut sample);
+        }
+        // The summing point of a sensitivity measurement (plane A's axes): added to what a law
+        // reads, handed to the continuous PD, which reads it inside the derivative.
+        let excitation = hooks.excitation(k, t0, &sample.sensor_v[..2 * planes]);
+        if let Some(sine) = excitation {
+            sample.sensor_v.iter_mut().zip(sine.at(t0).0).for_each(|(v, e)| *v += e);
+        }
+        if let (Source::Continuous, Some(gains)) = (&source, continuous_gains) {
+            if excitation.is_some() || excited {
+                model.set_control(
+                    0,
+                    excitation.map_or(Control::Continuous(gains), |e| Control::ContinuousExcited(gains, e)),
+                );
+            }
+            excited = excitation.is_some();
+        }
         let command = match &mut source {
             Source::Continuous => None,
-            Source::InProcess(law) => {
-                read(&mut sensor, &mut sample);
-                Some(saturate_axes(law.update(&sample), limits))
-            }
-            Source::Cosim(session) => {
-                read(&mut sensor, &mut sample);
-                match session.command(&sample, hooks) {
-                    Ok(cmd) => {
-                        let pid = session.controller_pid();
-                        if pid != controller_pid {
-                            controller_pid = pid;
-                            if let Some(pid) = pid {
-                                hooks.controller_connected(pid);
-                            }
+            Source::InProcess(law) => Some(saturate_axes(law.update(&sample), limits)),
+            Source::Cosim(session) => match session.command(&sample, hooks) {
+                Ok(cmd) => {
+                    let pid = session.controller_pid();
+                    if pid != controller_pid {
+                        controller_pid = pid;
+                        if let Some(pid) = pid {
+                            hooks.controller_connected(pid);
                         }
-                        Some(cmd)
                     }
-                    Err(halt) => {
-                        outcome = match halt {
-                            Halt::Lost(why) => Outcome::PeerLost(why),
-                            Halt::Interrupted(_) => Outcome::Interrupted,
-                            Halt::MissBudget(why) => Outcome::MissBudget(why),
-                        };
-                        break;
-                    }
+                    Some(cmd)
                 }
-            }
+                Err(halt) => {
+                    outcome = match halt {
+                        Halt::Lost(why) => Outcome::PeerLost(why),
+                        Halt::Interrupted(_) => Outcome::Interrupted,
+                        Halt::MissBudget(why) => Outcome::MissBudget(why),
+                    };
+                    break;
+                }
+            },
         };
         if let Some(cmd) = command {
             let cmd = match invalid.check(cmd, &sample) {
@@ -469,7 +492,7 @@ fn drive<const N: usize, M: Machine<N>>(
             &mut y,
             &out_times,
             (&breakpoints, &mut next_breakpoint),
-            |ts, ys| sink.sample(&model.record(ts, ys)),
+            |ts, ys| model.feed(sink, ts, ys),
         );
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(&model, t1, &y)) {

@@ -13,6 +13,8 @@
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
 //! - `nan`: answers with the law's currents, but NaN on x from sample 100 on;
+//! - `die`: answers with the law's currents until sample `--die-at` (default 4000), then
+//!   kills itself with SIGKILL, as a controller killed in the middle of a run;
 //! - `no-wake`: answers every frame with the law's currents but never wakes
 //!   the plant: it polls every millisecond, asks for no wake-up and does not
 //!   serve `command/wake`.
@@ -30,6 +32,7 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().collect();
     let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1)).cloned();
     let mode = value("--mode").unwrap_or_default();
+    let die_at: u64 = value("--die-at").and_then(|v| v.parse().ok()).unwrap_or(4000);
     let Some(id) = value("--run-id").or_else(|| std::env::var("AMB_TESTBED_RUN_ID").ok()) else {
         eprintln!("rogue-controller: no run id");
         return ExitCode::from(2);
@@ -139,10 +142,23 @@ fn main() -> ExitCode {
         if mode == "every-other" && f.seq % 2 == 1 {
             continue;
         }
+        if mode == "die" && f.seq >= die_at {
+            die();
+        }
         let mut r = reply(&mut law, &f);
         if mode == "nan" && f.seq >= 100 {
             r.current_a[0] = f64::NAN;
         }
         frames.send(r).expect("reply");
     }
+}
+
+/// Ends the process by SIGKILL (no destructor, no STOPPING frame), as `kill -9` would.
+fn die() -> ! {
+    #[cfg(unix)]
+    // SAFETY: raise(2) has no memory-safety preconditions.
+    unsafe {
+        libc::raise(libc::SIGKILL);
+    }
+    std::process::abort()
 }

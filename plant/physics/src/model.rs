@@ -203,8 +203,40 @@ pub fn cage_angle(p: &Params, theta_b: f64) -> f64 {
 pub enum Control {
     /// PD evaluated inside the derivative on the exact Δ, Δ̇ (the study's setup).
     Continuous(PdGains),
+    /// The continuous PD reading its sensor signal plus a sine ([`SensorSine`]): the summing
+    /// point of a sensitivity measurement (ISO 14839-3) on the continuous loop.
+    ContinuousExcited(PdGains, SensorSine),
     /// A current held over the macro step (zero-order hold of a sampled law).
     Held([f64; 2]),
+}
+
+/// A sine added to the sensor signal the controller reads, per axis (V):
+/// `E(t) = a_k sin(ω t + φ)`, with its rate `Ė(t) = a_k ω cos(ω t + φ)`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct SensorSine {
+    /// Amplitude per axis, x then y (V); 0 on an axis not excited.
+    pub amplitude_v: [f64; 2],
+    /// Angular frequency ω (rad/s).
+    pub omega_rad_s: f64,
+    /// Phase φ at t = 0 (rad).
+    pub phase_rad: f64,
+}
+
+impl SensorSine {
+    /// `(E(t), Ė(t))` per axis (V, V/s).
+    ///
+    /// ```
+    /// use plant_physics::model::SensorSine;
+    /// let e = SensorSine { amplitude_v: [0.0, 2.0], omega_rad_s: 3.0, phase_rad: 0.0 };
+    /// let (v, rate) = e.at(0.0);
+    /// assert_eq!((v, rate), ([0.0, 0.0], [0.0, 6.0]));
+    /// ```
+    #[inline]
+    pub fn at(&self, t: f64) -> ([f64; 2], [f64; 2]) {
+        let (s, c) = (self.omega_rad_s * t + self.phase_rad).sin_cos();
+        let a = self.amplitude_v;
+        ([a[0] * s, a[1] * s], [a[0] * self.omega_rad_s * c, a[1] * self.omega_rad_s * c])
+    }
 }
 
 /// The model: parameters, base motion, and the control in force.
@@ -354,6 +386,13 @@ impl Model {
                 let a_s = p.loop_constants.sensor_gain_v_per_m;
                 let u = delta * a_s;
                 let u_dot = pair(y, VXR) * a_s;
+                saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
+            }
+            Control::ContinuousExcited(gains, sine) => {
+                let a_s = p.loop_constants.sensor_gain_v_per_m;
+                let (e, e_dot) = sine.at(t);
+                let u = delta * a_s + Vector2::from(e);
+                let u_dot = pair(y, VXR) * a_s + Vector2::from(e_dot);
                 saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
             }
             Control::Held(i) => i,

@@ -237,6 +237,15 @@ impl Model {
                     let (s, s_dot) = at_station(y, plane.sensor);
                     saturate(gains.current((s * a_s).into(), (s_dot * a_s).into()), bearing.current_limit)
                 }
+                Control::ContinuousExcited(gains, sine) => {
+                    // The excitation is added at the sensor, before the PD (its rate to the rate).
+                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
+                    let (s, s_dot) = at_station(y, plane.sensor);
+                    let (e, e_dot) = sine.at(t);
+                    let u = s * a_s + Vector2::from(e);
+                    let u_dot = s_dot * a_s + Vector2::from(e_dot);
+                    saturate(gains.current(u.into(), u_dot.into()), bearing.current_limit)
+                }
                 Control::Held(c) => c,
             };
             out.amb_force = bearing.amb.force(delta, out.current.into());
