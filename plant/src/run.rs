@@ -376,15 +376,12 @@ fn drive<const N: usize, M: Machine<N>>(
             ..Default::default()
         };
         sample.angle_rad = wrap_angle(model.spin(&y).0);
-        let read = |sensor: &mut Sensor, sample: &mut RotorSample| {
-            for i in 0..planes {
-                let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
-                let v = sensor.read_with_gain(model.sensed(&y, i), gain);
-                sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
-            }
-        };
-        if !matches!(source, Source::Continuous) {
-            read(&mut sensor, &mut sample);
+        // Every axis's sensor, in every mode: the continuous PD reads the exact state inside the
+        // derivative, but an excitation hook reads the sensor signal there too.
+        for i in 0..planes {
+            let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
+            let v = sensor.read_with_gain(model.sensed(&y, i), gain);
+            sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
         }
         // The summing point of a sensitivity measurement (plane A's axes): added to what a law
         // reads, handed to the continuous PD, which reads it inside the derivative.

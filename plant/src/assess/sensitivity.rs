@@ -447,8 +447,9 @@ impl<'a> Measure<'a> {
         let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz, p.s_db)).collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let Some(i) = (0..pts.len()).max_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1)) else { return };
-        for j in [i.wrapping_sub(1), i] {
-            if j + 1 >= pts.len() || j >= pts.len() {
+        // The intervals on either side of the peak (none below the first point).
+        for j in [i.checked_sub(1), Some(i)].into_iter().flatten() {
+            if j + 1 >= pts.len() {
                 continue;
             }
             let (a, b) = (pts[j].0, pts[j + 1].0);
