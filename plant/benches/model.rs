@@ -1,10 +1,10 @@
 //! Benchmarks: one derivative evaluation (all 19 ball contacts evaluated, rotor
-//! in contact with the race) and one macro step (one controller period) of
-//! each integrator, levitated and in contact.
+//! in contact with the race; the two-plane rotor with both planes so) and one macro
+//! step (one controller period) of each integrator, levitated and in contact.
 
 mod common;
 
-use common::{contact_state, model};
+use common::{contact_state, model, two_plane_contact_state, two_plane_model};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use plant::integrate::{Integrator, Method, Settings};
 use plant::run::integrator_settings;
@@ -17,6 +17,17 @@ fn derivative(c: &mut Criterion) {
     c.bench_function("derivative/contact_19_balls", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&y)).dy));
     let levitated = plant::initial::initial_state(&model_scene());
     c.bench_function("derivative/levitated", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&levitated)).dy));
+    let (two, scene) = two_plane_model();
+    let y = two_plane_contact_state();
+    let ev = two.evaluate(0.002, &y);
+    assert!(ev.planes.iter().all(|p| p.contact.normal > 0.0 && p.balls.loaded >= 3), "both planes in contact: {ev:?}");
+    c.bench_function("derivative/two_plane_contact_2x19_balls", |b| {
+        b.iter(|| two.evaluate(black_box(0.002), black_box(&y)).dy)
+    });
+    let levitated = plant::initial::two_plane_initial_state(&scene, scene.two_plane.as_ref().expect("two-plane"));
+    c.bench_function("derivative/two_plane_levitated", |b| {
+        b.iter(|| two.evaluate(black_box(0.002), black_box(&levitated)).dy)
+    });
 }
 
 fn model_scene() -> plant::config::Scene {

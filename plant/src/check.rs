@@ -48,7 +48,8 @@ use std::path::Path;
 /// Runs `scene` with `law` (built from the scene's design and `[controller.params]`) in this
 /// process, as sampled mode does, whatever the scene's `controller.mode`.
 pub fn run_law(scene: &Scene, law: &LawEntry, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
-    let built = (law.build)(&scene.design(), &scene.controller.params)?;
+    // One per bearing plane, side by side (the planar model's one plane: the law's own arithmetic).
+    let built = controller::AnyLaw::from(*law).build(&scene.rotor_design(), &scene.controller.params)?;
     let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
     let run = crate::run::run_law_into(scene, built, hooks, &mut trace)?;
     Ok(RunResult { trace, run })
@@ -130,6 +131,11 @@ pub fn replay(dir: &Path, law: &LawEntry) -> Result<Replay, ReplayError> {
 /// Replays `trace` (a `trace.csv` of a run of `scene`) through `law`, as it is (not reset).
 pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Result<Replay, ReplayError> {
     let c = &scene.controller;
+    if scene.two_plane.is_some() {
+        return Err(ReplayError::Layout(
+            "replay reads plane A's columns (dx_m, dy_m, ix_a, iy_a): a two-plane run cannot be replayed yet".into(),
+        ));
+    }
     if c.mode == ControlMode::Continuous {
         return Err(ReplayError::Layout(
             "a continuous run has no controller ticks (its PD acts inside the derivative): nothing to replay".into(),
@@ -159,6 +165,7 @@ pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Re
     let mut row: u64 = 0;
     let mut bad_time = None;
     crate::trace::read_rows(trace, |r| {
+        let r = &r.a;
         // Row `row` closes the step of tick `(row − 1) / per_tick`; the command of that tick was
         // pushed when its sample (the row at its start) was read.
         if row > 0 {

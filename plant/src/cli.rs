@@ -92,6 +92,28 @@ pub enum Command {
         #[arg(long, default_value_t = 1, requires = "realtime")]
         runs: usize,
     },
+    /// The whirl modes of a two-plane scene's rotor on its continuous PD against spin speed
+    /// (Campbell diagram, linearised) and the same frequencies from simulated free decays;
+    /// writes campbell.csv, campbell.png and decay.csv.
+    Campbell {
+        /// A two-plane scene file (TOML, `rotor.model = "two_plane"`).
+        scene: PathBuf,
+        /// Output folder (default: runs/campbell-<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene key (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Highest spin speed of the diagram (Hz).
+        #[arg(long, default_value_t = 500.0)]
+        max_speed_hz: f64,
+        /// Speeds of the diagram, from 0 to the highest.
+        #[arg(long, default_value_t = 51)]
+        points: usize,
+        /// Spin speeds of the free decays (Hz); empty: none.
+        #[arg(long, value_delimiter = ',', default_value = "0,250,500")]
+        decay_speeds_hz: Vec<f64>,
+    },
     /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
     /// classification; updates summary.json and writes the analysis plots.
     Analyze {
@@ -102,6 +124,10 @@ pub enum Command {
     /// (each point an ensemble with an `[ensemble]` table); writes points.csv, poincare.csv and
     /// bifurcation diagrams. Resumes an interrupted sweep.
     Sweep(plant::sweep::SweepArgs),
+    /// Judge controllers the way the field does: the stability margin of each axis (ISO 14839-3
+    /// sensitivity, measured through the loop), the vibration (ISO 14839-2), the shock ladder
+    /// and the touchdown bearing's duty; writes report.html, report.json and PNG charts.
+    Assess(plant::assess::AssessArgs),
     /// Run a scene's ensemble (`[ensemble]`): members drawn around the scene; writes
     /// ensemble.csv, members.csv, ensemble.json and members.png.
     Ensemble(plant::ensemble::EnsembleArgs),

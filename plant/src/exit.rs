@@ -6,6 +6,7 @@
 //!
 //! The table users read is `docs/guide/running.md`, "Exit codes".
 
+use crate::assess::{AssessError, Failure};
 use crate::claim::ClaimError;
 use crate::config::ConfigError;
 use crate::cosim::CosimError;
@@ -34,6 +35,9 @@ pub enum Code {
     /// The controller's commands were non-finite past `controller.max_invalid_burst` or
     /// `controller.max_invalid_fraction` (status `invalid_commands`).
     InvalidCommands = 8,
+    /// `plant assess`: a controller could not be graded (its rotor not levitated before the
+    /// shock, or the excitation drove it into the touchdown bearing); the report was written.
+    NotGradable = 9,
     /// Realtime: the plant-overrun budget was exceeded (status `overrun_budget`).
     OverrunBudget = 10,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
@@ -42,7 +46,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 10] = [
+    pub const ALL: [Code; 11] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -51,6 +55,7 @@ impl Code {
         Code::MissBudget,
         Code::Incomplete,
         Code::InvalidCommands,
+        Code::NotGradable,
         Code::OverrunBudget,
         Code::Interrupted,
     ];
@@ -67,6 +72,7 @@ const _: fn(Code) = |c| match c {
     | Code::MissBudget
     | Code::Incomplete
     | Code::InvalidCommands
+    | Code::NotGradable
     | Code::OverrunBudget
     | Code::Interrupted => {}
 };
@@ -109,6 +115,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         shock_table::ShockError,
         crate::bench::BadArgument,
         AnalyzeError,
+        AssessError,
     );
     None
 }
@@ -220,6 +227,19 @@ impl HasExitCode for AnalyzeError {
     }
 }
 
+impl HasExitCode for AssessError {
+    fn exit_code(&self) -> Code {
+        match self.kind {
+            Failure::NotGradable => Code::NotGradable,
+            Failure::PeerLost => Code::PeerLost,
+            Failure::InvalidCommands => Code::InvalidCommands,
+            Failure::Diverged => Code::Diverged,
+            Failure::Interrupted => Code::Interrupted,
+            Failure::Other => Code::Io,
+        }
+    }
+}
+
 /// Bad input, whatever the variant.
 macro_rules! bad_input {
     ($($t:ty),* $(,)?) => {
@@ -245,6 +265,10 @@ mod tests {
 
     fn exited(code: Option<i32>) -> CosimError {
         CosimError::ControllerExited { program: "c".into(), status: "x".into(), code, output: String::new() }
+    }
+
+    fn assessed(kind: Failure) -> anyhow::Error {
+        AssessError { kind, message: "m".into(), dir: "d".into() }.into()
     }
 
     #[test]
@@ -301,6 +325,12 @@ mod tests {
             ),
             (GridError::Interrupted.into(), 130),
             (ClaimError::InUse { path: "d".into(), holder: String::new() }.into(), 2),
+            (assessed(Failure::NotGradable), 9),
+            (assessed(Failure::PeerLost), 4),
+            (assessed(Failure::InvalidCommands), 8),
+            (assessed(Failure::Diverged), 3),
+            (assessed(Failure::Interrupted), 130),
+            (assessed(Failure::Other), 1),
             // An output that could not be written, whatever its message says.
             (anyhow::Error::from(std::io::Error::other("bad input")).context("writing summary.json"), 1),
         ];

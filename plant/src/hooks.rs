@@ -24,6 +24,15 @@ pub trait Hooks {
     fn time_ticks(&self) -> bool {
         false
     }
+    /// A sine to add to the sensor signal the controller reads over the macro step from tick
+    /// `k` at time `t` (s) (the summing point of a sensitivity measurement, ISO 14839-3);
+    /// `sensor_v` holds the values read at that tick, before the sine, one per axis. The loop
+    /// adds `E(t_k)` to the sample a sampled or co-simulated law gets, and hands the sine
+    /// itself to the continuous PD, which reads it inside the derivative. `None` (the
+    /// default): no excitation.
+    fn excitation(&mut self, _k: u64, _t: f64, _sensor_v: &[f64]) -> Option<crate::model::SensorSine> {
+        None
+    }
 }
 
 /// Hooks that do nothing.

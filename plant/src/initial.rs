@@ -17,6 +17,26 @@ pub fn initial_conditions(scene: &Scene) -> InitialConditions {
     }
 }
 
+/// The initial state of a two-plane scene whose rotor is `machine`.
+pub fn two_plane_initial_state(
+    scene: &Scene,
+    machine: &plant_physics::two_plane::Params,
+) -> plant_physics::two_plane::State {
+    let ic = initial_conditions(scene);
+    plant_physics::two_plane::initial::initial_state(
+        machine,
+        &plant_physics::two_plane::initial::InitialConditions {
+            unbalance_orbit: ic.unbalance_orbit,
+            unbalance_phase: ic.unbalance_phase,
+            stiffness: ic.stiffness,
+            damping_ratio: ic.damping_ratio,
+            gravity_bias: ic.gravity_bias,
+            rotor_offset: ic.rotor_offset,
+            slope_offset: scene.initial.slope_offset,
+        },
+    )
+}
+
 /// The initial state of a scene.
 pub fn initial_state(scene: &Scene) -> State {
     plant_physics::initial::initial_state(&scene.params, &initial_conditions(scene))

@@ -21,26 +21,44 @@
 //! assert!(e.contains("3 samples in a row") && e.contains("controller.max_invalid_burst = 2"), "{e}");
 //! ```
 
-use controller::Sample;
+use controller::{RotorSample, Sample};
+
+/// A sample's number and time, where a burst is said to begin and end.
+pub trait Stamped {
+    /// `(seq, t_s)`.
+    fn stamp(&self) -> (u64, f64);
+}
+
+impl Stamped for Sample {
+    fn stamp(&self) -> (u64, f64) {
+        (self.seq, self.t_s)
+    }
+}
+
+impl Stamped for RotorSample {
+    fn stamp(&self) -> (u64, f64) {
+        (self.seq, self.t_s)
+    }
+}
 
 /// Ticks with a command due before the share of non-finite ones is judged during the run.
 pub const MIN_TICKS: u64 = 1000;
 
 /// What to apply for a tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Checked {
+pub struct Checked<const N: usize = 2> {
     /// The law's command, or the last valid one held in place of a non-finite one.
-    pub command: [f64; 2],
+    pub command: [f64; N],
     /// This is the run's first non-finite command (say it).
     pub first: bool,
 }
 
 /// The non-finite commands of a run, against its budget.
 #[derive(Clone, Debug)]
-pub struct InvalidCommands {
+pub struct InvalidCommands<const N: usize = 2> {
     max_burst: u64,
     max_fraction: f64,
-    held: [f64; 2],
+    held: [f64; N],
     ticks: u64,
     count: u64,
     burst: u64,
@@ -48,10 +66,10 @@ pub struct InvalidCommands {
     burst_from: (u64, f64),
 }
 
-impl InvalidCommands {
+impl<const N: usize> InvalidCommands<N> {
     /// A run whose command before any law output is `initial` (the bias), with the budget
     /// `controller.max_invalid_burst` and `controller.max_invalid_fraction`.
-    pub fn new(initial: [f64; 2], max_burst: u64, max_fraction: f64) -> Self {
+    pub fn new(initial: [f64; N], max_burst: u64, max_fraction: f64) -> Self {
         Self { max_burst, max_fraction, held: initial, ticks: 0, count: 0, burst: 0, burst_from: (0, 0.0) }
     }
 
@@ -62,7 +80,8 @@ impl InvalidCommands {
 
     /// Takes the law's (saturated) command for `sample`: what to apply, or why the run must
     /// end (past the budget).
-    pub fn check(&mut self, command: [f64; 2], sample: &Sample) -> Result<Checked, String> {
+    pub fn check(&mut self, command: [f64; N], sample: &impl Stamped) -> Result<Checked<N>, String> {
+        let (seq, t_s) = sample.stamp();
         self.ticks += 1;
         if command.iter().all(|i| i.is_finite()) {
             self.held = command;
@@ -71,7 +90,7 @@ impl InvalidCommands {
         }
         self.count += 1;
         if self.burst == 0 {
-            self.burst_from = (sample.seq, sample.t_s);
+            self.burst_from = (seq, t_s);
         }
         self.burst += 1;
         if self.burst > self.max_burst {
@@ -79,12 +98,12 @@ impl InvalidCommands {
             return Err(format!(
                 "the controller's commands were non-finite for {} samples in a row, from sample {k} (t = {t} s) to \
                  sample {} (t = {} s, {command:?} A): more than controller.max_invalid_burst = {}",
-                self.burst, sample.seq, sample.t_s, self.max_burst
+                self.burst, seq, t_s, self.max_burst
             ));
         }
         if self.ticks >= MIN_TICKS {
             if let Some(why) = self.over_fraction() {
-                return Err(format!("{why} (by sample {}, t = {} s)", sample.seq, sample.t_s));
+                return Err(format!("{why} (by sample {seq}, t = {t_s} s)"));
             }
         }
         Ok(Checked { command: self.held, first: self.count == 1 })

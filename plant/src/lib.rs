@@ -16,9 +16,11 @@
 pub use plant_physics::{force, integrate, model, park};
 
 pub mod analysis;
+pub mod assess;
 pub mod atomic;
 pub mod bench;
 pub mod bounded;
+pub mod campbell;
 pub mod check;
 pub mod claim;
 pub mod compare;
@@ -26,11 +28,13 @@ pub mod config;
 pub mod cosim;
 pub mod ensemble;
 pub mod exit;
+pub mod figures;
 pub mod grid;
 pub mod hooks;
 pub mod initial;
 pub mod interrupt;
 pub mod invalid;
+pub mod machine;
 pub mod output;
 pub mod plot;
 pub mod record;

@@ -90,8 +90,28 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Analyze { dir } => analyze_cmd(&dir),
+        Command::Campbell { scene, out, set, max_speed_hz, points, decay_speeds_hz } => {
+            let req = plant::campbell::Request {
+                scene: &scene,
+                set: &set,
+                out: out.as_deref(),
+                max_speed_hz,
+                points,
+                decay_speeds_hz: &decay_speeds_hz,
+            };
+            let written = plant::campbell::command(&req, &mut |l| eprintln!("plant campbell: {l}"))?;
+            for f in written {
+                eprintln!("plant campbell: wrote {}", f.display());
+            }
+            Ok(())
+        }
         Command::Sweep(args) => plant::sweep::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),
+        Command::Assess(args) => {
+            let dir = plant::assess::command(&args, &plant::interrupt::stop_flag())?;
+            eprintln!("plant assess: report in {}", dir.join("report.html").display());
+            Ok(())
+        }
         Command::Bench { what } => match what {
             BenchCommand::Ensemble(args) => {
                 plant::ensemble::bench::bench(&args, &mut |l| eprintln!("plant bench: {l}")).map(|_| ())

@@ -9,16 +9,16 @@
 //! writes ([`RUN_FILES`]), and only those, so that no chart of another run
 //! survives next to this one's results.
 
-use crate::analysis::{Analysis, AnalysisData};
+use crate::analysis::Analysis;
+use crate::bounded::MinMaxBins;
 use crate::config::{ConfigError, Scene};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
-use crate::model::{Model, State};
 use crate::plot::{self, Scale, Series};
-use crate::record::{ChartData, Recorder};
+use crate::record::{ChartData, PlaneRecorded, Recorder};
 use crate::run::{run_into, Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
-use crate::trace::{TraceError, TraceWriter};
+use crate::trace::{Record, TraceError, TraceWriter};
 use anyhow::Context;
 use std::path::Path;
 
@@ -36,6 +36,18 @@ pub const RUN_FILES: &[&str] = &[
     "whirl_spectrum.png",
     "spectrogram.png",
     "poincare.png",
+    // A two-plane run's: an orbit and the analysis charts per plane, and the tilt.
+    "orbit_a.png",
+    "orbit_b.png",
+    "tilt.png",
+    "spectrum_a.png",
+    "whirl_spectrum_a.png",
+    "spectrogram_a.png",
+    "poincare_a.png",
+    "spectrum_b.png",
+    "whirl_spectrum_b.png",
+    "spectrogram_b.png",
+    "poincare_b.png",
     "controller.log",
     "tet.png",
 ];
@@ -126,12 +138,13 @@ impl RunFolder {
     /// Creates `dir/trace.csv` (header) for a run of `scene`.
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let path = dir.join("trace.csv");
-        let trace = TraceWriter::create(&path).with_context(|| format!("creating {}", path.display()))?;
+        let trace =
+            TraceWriter::create(&path, scene.planes()).with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })
     }
 
-    /// One row (also for a trace already in memory).
-    pub fn push(&mut self, r: &crate::trace::Row) {
+    /// One sample (also for a trace already in memory).
+    pub fn push(&mut self, r: &Record) {
         if self.error.is_none() {
             if let Err(e) = self.trace.write(r) {
                 self.error = Some(e);
@@ -164,32 +177,21 @@ impl RunFolder {
             None => self.trace.flush(),
         };
         let recorded = self.recorder.finish(run.outcome.failure_time());
+        let charts = scene.plots.then(|| (recorded.planes.clone(), recorded.tilt_chart.clone()));
         interrupt(&mut run);
-        let mut summary = Summary::from_parts(scene, &run, recorded.figures, recorded.analysis);
+        let mut summary = Summary::from_parts(scene, &run, recorded);
         write_json(&dir.join("summary.json"), &summary)?;
         flushed.with_context(|| format!("writing {}", trace_path.display()))?;
         let mut skipped = Vec::new();
-        if let Some(charts) = &recorded.charts {
-            skipped.extend(write_charts(dir, scene, charts).context("writing charts")?);
+        if let Some((planes, tilt)) = &charts {
+            skipped.extend(write_charts(dir, scene, planes, tilt.as_ref()).context("writing charts")?);
             if let Some(tet) = &run.ticks.tet {
                 match write_tet_chart(&dir.join("tet.png"), scene, tet) {
                     Err(plot::PlotError::NoData { .. }) => skipped.push("tet.png"),
                     other => other.context("writing tet.png")?,
                 }
             }
-            let written = crate::analysis::write_plots(
-                dir,
-                &scene.name,
-                &summary.analysis,
-                &recorded.analysis_data,
-                scene.params.contact.gap,
-            )
-            .context("writing analysis charts")?;
-            skipped.extend(
-                ["spectrum.png", "whirl_spectrum.png", "spectrogram.png", "poincare.png"]
-                    .into_iter()
-                    .filter(|f| !written.contains(f)),
-            );
+            skipped.extend(write_analysis_charts(dir, scene, planes).context("writing analysis charts")?);
         }
         if interrupt(&mut run) {
             summary.status = run.outcome.status();
@@ -200,9 +202,43 @@ impl RunFolder {
     }
 }
 
+/// Each plane's analysis charts (`spectrum.png`, `whirl_spectrum.png`, `spectrogram.png`,
+/// `poincare.png`; with `_a`, `_b` for a two-plane run); returns those not written.
+fn write_analysis_charts(
+    dir: &Path,
+    scene: &Scene,
+    planes: &[PlaneRecorded],
+) -> Result<Vec<&'static str>, plot::PlotError> {
+    let mut skipped = Vec::new();
+    for (i, p) in planes.iter().enumerate() {
+        let (tag, name) = plane_tag(scene, i);
+        let written =
+            crate::analysis::write_plots(dir, &name, tag, &p.analysis, &p.analysis_data, scene.plane(i).contact.gap)?;
+        skipped.extend(crate::analysis::PLOT_FILES[tag_index(tag)].iter().filter(|f| !written.contains(*f)));
+    }
+    Ok(skipped)
+}
+
+/// A plane's file tag (`""` planar, `"_a"`, `"_b"`) and the chart title's name.
+fn plane_tag(scene: &Scene, i: usize) -> (&'static str, String) {
+    match (scene.planes(), i) {
+        (1, _) => ("", scene.name.clone()),
+        (_, 0) => ("_a", format!("{} — plane A", scene.name)),
+        _ => ("_b", format!("{} — plane B", scene.name)),
+    }
+}
+
+fn tag_index(tag: &str) -> usize {
+    match tag {
+        "_a" => 1,
+        "_b" => 2,
+        _ => 0,
+    }
+}
+
 impl Sink for RunFolder {
-    fn sample(&mut self, model: &Model, t: f64, y: &State) {
-        self.push(&crate::trace::row(model, t, y));
+    fn sample(&mut self, record: &Record) {
+        self.push(record);
     }
 }
 
@@ -229,7 +265,7 @@ pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Ho
 pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Result<Summary> {
     prepare(dir, scene)?;
     let mut folder = RunFolder::create(dir, scene)?;
-    result.trace.rows().for_each(|r| folder.push(&r));
+    result.trace.records().for_each(|r| folder.push(&r));
     Ok(folder.finish(dir, scene, result.run.clone(), &|| false)?.summary)
 }
 
@@ -240,8 +276,14 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<
 }
 
 /// The run's own charts; a chart with nothing to draw is not written. Returns those not written.
-pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'static str>, plot::PlotError> {
-    let gap = scene.params.contact.gap;
+/// A two-plane run draws each plane's orbit (`orbit_a.png`, `orbit_b.png`), both planes in each
+/// time chart, and the tilt (`tilt.png`).
+pub fn write_charts(
+    dir: &Path,
+    scene: &Scene,
+    planes: &[PlaneRecorded],
+    tilt: Option<&MinMaxBins>,
+) -> Result<Vec<&'static str>, plot::PlotError> {
     let title = |what: &str| format!("{} — {what}", scene.name);
     let mut skipped = Vec::new();
     let mut draw = |file: &'static str, r: Result<(), plot::PlotError>| match r {
@@ -252,12 +294,41 @@ pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'st
         }
         Err(e) => Err(e),
     };
+    let charts: Vec<&ChartData> = planes.iter().filter_map(|p| p.charts.as_ref()).collect();
+    let two = charts.len() == 2;
+    let gap = |i: usize| scene.plane(i).contact.gap;
+    // Series labels: the planar chart's, or with the plane's letter.
+    let label = |what: &str, i: usize| if two { format!("{what} {}", ["A", "B"][i]) } else { what.to_string() };
 
-    let (ox, oy) = c.orbit();
-    draw("orbit.png", plot::orbit(&dir.join("orbit.png"), &title("rotor orbit relative to housing"), &ox, &oy, gap))?;
+    const ORBITS: [&str; 3] = ["orbit.png", "orbit_a.png", "orbit_b.png"];
+    for (i, c) in charts.iter().enumerate() {
+        let (ox, oy) = c.orbit();
+        let (file, what) = if two {
+            (ORBITS[1 + i], format!("rotor orbit at bearing {} relative to housing", ["A", "B"][i]))
+        } else {
+            (ORBITS[0], "rotor orbit relative to housing".to_string())
+        };
+        draw(file, plot::orbit(&dir.join(file), &title(&what), &ox, &oy, gap(i)))?;
+    }
 
-    let (ms, radius) = c.radius_um.points();
-    let gap_line = vec![gap * 1e6; ms.len()];
+    let radius: Vec<(Vec<f64>, Vec<f64>)> = charts.iter().map(|c| c.radius_um.points()).collect();
+    let gap_lines: Vec<Vec<f64>> = radius.iter().enumerate().map(|(i, (ms, _))| vec![gap(i) * 1e6; ms.len()]).collect();
+    let labels: Vec<(String, String)> =
+        (0..charts.len()).map(|i| (label("rotor radius", i), label("air gap r0", i))).collect();
+    let mut series = Vec::new();
+    for (i, (ms, r)) in radius.iter().enumerate() {
+        series.push(Series { label: &labels[i].0, x: ms, y: r });
+    }
+    for (i, (ms, _)) in radius.iter().enumerate() {
+        // One gap line when both planes have the same gap.
+        if i == 0 || gap(i) != gap(0) {
+            series.push(Series {
+                label: if two && gap(1) == gap(0) { "air gap r0" } else { &labels[i].1 },
+                x: ms,
+                y: &gap_lines[i],
+            });
+        }
+    }
     draw(
         "radius.png",
         plot::lines(
@@ -265,15 +336,14 @@ pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'st
             &title("rotor radius"),
             "time (ms)",
             "radius (µm)",
-            &[
-                Series { label: "rotor radius", x: &ms, y: &radius },
-                Series { label: "air gap r0", x: &ms, y: &gap_line },
-            ],
+            &series,
             Scale::Linear,
         ),
     )?;
 
-    let (ms, rpm) = c.race_rpm.points();
+    let rpm: Vec<(Vec<f64>, Vec<f64>)> = charts.iter().map(|c| c.race_rpm.points()).collect();
+    let labels: Vec<String> = (0..charts.len()).map(|i| label("race speed", i)).collect();
+    let series: Vec<Series> = rpm.iter().zip(&labels).map(|((x, y), l)| Series { label: l, x, y }).collect();
     draw(
         "race_speed.png",
         plot::lines(
@@ -281,12 +351,21 @@ pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'st
             &title("inner race speed"),
             "time (ms)",
             "speed (rpm)",
-            &[Series { label: "race speed", x: &ms, y: &rpm }],
+            &series,
             Scale::Linear,
         ),
     )?;
 
-    let ((mx, ix), (my, iy)) = (c.current_a[0].points(), c.current_a[1].points());
+    let currents: Vec<[(Vec<f64>, Vec<f64>); 2]> =
+        charts.iter().map(|c| [c.current_a[0].points(), c.current_a[1].points()]).collect();
+    let labels: Vec<[String; 2]> = (0..charts.len()).map(|i| [label("i_x", i), label("i_y", i)]).collect();
+    let series: Vec<Series> = currents
+        .iter()
+        .zip(&labels)
+        .flat_map(|(c, l)| {
+            [Series { label: &l[0], x: &c[0].0, y: &c[0].1 }, Series { label: &l[1], x: &c[1].0, y: &c[1].1 }]
+        })
+        .collect();
     draw(
         "currents.png",
         plot::lines(
@@ -294,12 +373,21 @@ pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'st
             &title("coil currents"),
             "time (ms)",
             "current (A)",
-            &[Series { label: "i_x", x: &mx, y: &ix }, Series { label: "i_y", x: &my, y: &iy }],
+            &series,
             Scale::Linear,
         ),
     )?;
 
-    let ((nx, normal), (fx, friction)) = (c.force_n[0].points(), c.force_n[1].points());
+    let forces: Vec<[(Vec<f64>, Vec<f64>); 2]> =
+        charts.iter().map(|c| [c.force_n[0].points(), c.force_n[1].points()]).collect();
+    let labels: Vec<[String; 2]> = (0..charts.len()).map(|i| [label("normal", i), label("friction", i)]).collect();
+    // The normal forces first, then the frictions.
+    let mut series: Vec<Series> = Vec::new();
+    for k in 0..2 {
+        for (f, l) in forces.iter().zip(&labels) {
+            series.push(Series { label: &l[k], x: &f[k].0, y: &f[k].1 });
+        }
+    }
     draw(
         "contact_force.png",
         plot::lines(
@@ -307,10 +395,25 @@ pub fn write_charts(dir: &Path, scene: &Scene, c: &ChartData) -> Result<Vec<&'st
             &title("rotor – race contact force"),
             "time (ms)",
             "force (N)",
-            &[Series { label: "normal", x: &nx, y: &normal }, Series { label: "friction", x: &fx, y: &friction }],
+            &series,
             Scale::Linear,
         ),
     )?;
+
+    if let Some(tilt) = tilt {
+        let (ms, urad) = tilt.points();
+        draw(
+            "tilt.png",
+            plot::lines(
+                &dir.join("tilt.png"),
+                &title("tilt of the rotor axis |(a, b)|"),
+                "time (ms)",
+                "tilt (µrad)",
+                &[Series { label: "tilt angle", x: &ms, y: &urad }],
+                Scale::Linear,
+            ),
+        )?;
+    }
     Ok(skipped)
 }
 
@@ -384,10 +487,11 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     const NOTHING: &str = "nothing was written";
     let scene = crate::config::load_scene(&dir.join("scene.toml"), &[])?;
     let trace_path = dir.join("trace.csv");
-    let mut recorder =
-        crate::analysis::Analyzer::new(crate::summary::analysis_spec(&scene), Some(scene.output_interval));
+    let mut recorder = Recorder::new(&scene, true);
     let mut rows = 0;
+    let mut planes = None;
     let whole = crate::trace::read_rows(&trace_path, |r| {
+        planes.get_or_insert(r.planes());
         recorder.push(r);
         rows += 1;
         !stopped()
@@ -398,10 +502,20 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     if rows < 2 {
         return Err(TraceError::TooShort { path: trace_path, rows }.into());
     }
-    let (analysis, data): (Analysis, AnalysisData) = recorder.finish();
+    if planes != Some(scene.planes()) {
+        let what = if scene.planes() == 2 {
+            "the scene is a two-plane rotor and the trace has no plane B columns (b_dx_m, …, slope_y_rate_rad_s)"
+        } else {
+            "the scene is planar and the trace has plane B columns"
+        };
+        return Err(TraceError::Malformed { path: trace_path, line: 1, column: None, what: what.to_string() }.into());
+    }
+    let recorded = recorder.finish(None);
     if stopped() {
         return Err(AnalyzeError::Interrupted(NOTHING));
     }
+    let governing = recorded.governing();
+    let analysis = recorded.planes[governing].analysis.clone();
 
     let summary_path = dir.join("summary.json");
     let bad_summary = |message: String| AnalyzeError::Summary { path: summary_path.display().to_string(), message };
@@ -415,22 +529,39 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
         }
     };
     let map = summary.as_object_mut().ok_or_else(|| bad_summary("not a JSON object".to_string()))?;
-    if let serde_json::Value::Object(new) =
-        serde_json::to_value(&analysis).map_err(|e| AnalyzeError::Output(anyhow::Error::new(e)))?
-    {
+    if let serde_json::Value::Object(new) = to_json(&analysis)? {
         map.extend(new);
+    }
+    if let (Some(tilt), [a, b]) = (&recorded.tilt, recorded.planes.as_slice()) {
+        // Each plane's analysis and the tilt, into `planes` (its figures kept where the run wrote them).
+        let planes = map.entry("planes").or_insert_with(|| serde_json::json!({}));
+        if let Some(planes) = planes.as_object_mut() {
+            planes.insert("governing".into(), serde_json::Value::from(["a", "b"][governing]));
+            for (key, p) in [("a", a), ("b", b)] {
+                let plane = planes.entry(key).or_insert_with(|| serde_json::json!({}));
+                if let (Some(plane), serde_json::Value::Object(new)) = (plane.as_object_mut(), to_json(&p.analysis)?) {
+                    plane.extend(new);
+                }
+            }
+            planes.insert("tilt".into(), to_json(tilt)?);
+        }
     }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
     if stopped() {
         return Err(AnalyzeError::Interrupted("summary.json was updated, the charts were not drawn"));
     }
-    crate::analysis::write_plots(dir, &scene.name, &analysis, &data, scene.params.contact.gap)
+    write_analysis_charts(dir, &scene, &recorded.planes)
         .context("writing analysis charts")
         .map_err(AnalyzeError::Output)?;
     if stopped() {
         return Err(AnalyzeError::Interrupted("summary.json and the charts were written"));
     }
     Ok(analysis)
+}
+
+/// A value as JSON, for `summary.json`.
+fn to_json<T: serde::Serialize>(v: &T) -> Result<serde_json::Value, AnalyzeError> {
+    serde_json::to_value(v).map_err(|e| AnalyzeError::Output(anyhow::Error::new(e)))
 }
 
 #[cfg(test)]
@@ -451,16 +582,17 @@ mod tests {
         let mut folder = RunFolder::create(&dir, &scene).unwrap();
         let mut row = [f64::NAN; crate::trace::WIDTH];
         row[crate::trace::col::T_S] = 0.0;
-        folder.push(&row);
+        folder.push(&Record::planar(row));
         let state = vec![f64::NAN; crate::model::N];
         let run = SinkRun {
             stats: Stats::default(),
             simulated: scene.controller.period,
             wall_time: 0.0,
             outcome: Outcome::Diverged(RunError::Integration(IntegrationError::NonFinite { t: 0.0, state })),
-            final_state: [0.0; crate::model::N],
+            final_state: vec![0.0; crate::model::N],
             cosim: None,
             parked_steps: 0,
+            planes: 1,
             invalid_commands: 0,
             ticks: Default::default(),
         };

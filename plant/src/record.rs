@@ -9,11 +9,12 @@
 //! keeps at most four per column); the orbit as every k-th row, at most
 //! [`ORBIT_POINTS`].
 
+use crate::analysis::tilt::{TiltAnalysis, TiltAnalyzer};
 use crate::analysis::{Analysis, AnalysisData, Analyzer};
 use crate::bounded::{MinMaxBins, Strided};
 use crate::config::Scene;
-use crate::summary::{analysis_spec, Figures, FiguresBuilder};
-use crate::trace::{col, Row};
+use crate::figures::{analysis_spec, plane_analysis_spec, Figures, FiguresBuilder};
+use crate::trace::{col, Record, Row};
 
 /// Bins of the time axis of a run's time charts.
 pub const CHART_BINS: usize = 4096;
@@ -21,8 +22,8 @@ pub const CHART_BINS: usize = 4096;
 /// Most orbit points kept for `orbit.png` (a 1.5 s run at 20 kHz keeps all its 30 000 rows).
 pub const ORBIT_POINTS: usize = 50_000;
 
-/// What a run's own charts draw (`orbit.png`, `radius.png`, `race_speed.png`,
-/// `currents.png`, `contact_force.png`), bounded.
+/// What a run's own charts draw of one bearing plane (`orbit.png`, `radius.png`,
+/// `race_speed.png`, `currents.png`, `contact_force.png`), bounded.
 #[derive(Clone, Debug)]
 pub struct ChartData {
     /// Rotor radius (µm) against time (ms).
@@ -84,17 +85,25 @@ impl ChartData {
     }
 }
 
-/// The rows' consumer.
+/// One bearing plane's consumer: its figures, analysis and charts.
 #[derive(Clone, Debug)]
-pub struct Recorder {
+struct PlaneRecorder {
     figures: FiguresBuilder,
     analyzer: Analyzer,
     charts: Option<ChartData>,
 }
 
-/// What a [`Recorder`] made of a run.
+/// The samples' consumer: one [`PlaneRecorder`] per bearing plane (fed the plane's own row,
+/// [`Record::plane`]) and, for a two-plane rotor, the tilt.
 #[derive(Clone, Debug)]
-pub struct Recorded {
+pub struct Recorder {
+    planes: Vec<PlaneRecorder>,
+    tilt: Option<(TiltAnalyzer, Option<MinMaxBins>)>,
+}
+
+/// What a [`Recorder`] made of one bearing plane.
+#[derive(Clone, Debug)]
+pub struct PlaneRecorded {
     /// The summary's figures.
     pub figures: Figures,
     /// The analysis.
@@ -105,29 +114,79 @@ pub struct Recorded {
     pub charts: Option<ChartData>,
 }
 
-impl Recorder {
-    /// A recorder for a run of `scene`; `charts` keeps what the charts draw (and
-    /// builds the spectrogram).
-    pub fn new(scene: &Scene, charts: bool) -> Self {
-        Self {
-            figures: FiguresBuilder::new(scene.first_shock_start()),
-            analyzer: Analyzer::new(analysis_spec(scene), charts.then_some(scene.output_interval)),
-            charts: charts.then(|| ChartData::new(scene.duration)),
+/// What a [`Recorder`] made of a run.
+#[derive(Clone, Debug)]
+pub struct Recorded {
+    /// Each bearing plane's (one for the planar model).
+    pub planes: Vec<PlaneRecorded>,
+    /// The tilt's figures (two-plane runs).
+    pub tilt: Option<TiltAnalysis>,
+    /// The tilt angle (µrad) against time (ms), for `tilt.png` (two-plane runs with charts).
+    pub tilt_chart: Option<MinMaxBins>,
+}
+
+impl Recorded {
+    /// The plane whose figures lead the summary: the larger steady contact fraction, then the
+    /// larger peak contact force, then plane A (0).
+    pub fn governing(&self) -> usize {
+        let key = |p: &PlaneRecorded| (p.analysis.steady_contact_fraction, p.figures.max_contact_force_n);
+        match self.planes.as_slice() {
+            [a, b] if key(b) > key(a) => 1,
+            _ => 0,
         }
     }
+}
 
-    /// The next row.
-    pub fn push(&mut self, r: &Row) {
-        self.figures.push(r);
-        self.analyzer.push(r);
-        if let Some(c) = &mut self.charts {
-            c.push(r);
+impl Recorder {
+    /// A recorder for a run of `scene`; `charts` keeps what the charts draw (and
+    /// builds the spectrograms).
+    pub fn new(scene: &Scene, charts: bool) -> Self {
+        let planes = (0..scene.planes())
+            .map(|i| PlaneRecorder {
+                figures: FiguresBuilder::new(scene.first_shock_start()),
+                analyzer: Analyzer::new(plane_analysis_spec(scene, i), charts.then_some(scene.output_interval)),
+                charts: charts.then(|| ChartData::new(scene.duration)),
+            })
+            .collect();
+        let tilt = scene.two_plane.as_ref().map(|_| {
+            let bins = charts.then(|| MinMaxBins::new(0.0, scene.duration * 1e3, CHART_BINS));
+            (TiltAnalyzer::new(analysis_spec(scene)), bins)
+        });
+        Self { planes, tilt }
+    }
+
+    /// The next sample.
+    pub fn push(&mut self, r: &Record) {
+        for (i, plane) in self.planes.iter_mut().enumerate() {
+            let row = r.plane(i);
+            plane.figures.push(&row);
+            plane.analyzer.push(&row);
+            if let Some(c) = &mut plane.charts {
+                c.push(&row);
+            }
+        }
+        if let Some((tilt, bins)) = &mut self.tilt {
+            tilt.push(r);
+            if let (Some(bins), Some([a, b])) = (bins, r.slopes()) {
+                bins.push(r.a[col::T_S] * 1e3, a.hypot(b) * 1e6);
+            }
         }
     }
 
     /// What was recorded; rows at or after `failure_time` (s) are left out of the maxima.
     pub fn finish(self, failure_time: Option<f64>) -> Recorded {
-        let (analysis, analysis_data) = self.analyzer.finish();
-        Recorded { figures: self.figures.finish(failure_time), analysis, analysis_data, charts: self.charts }
+        let planes = self
+            .planes
+            .into_iter()
+            .map(|p| {
+                let (analysis, analysis_data) = p.analyzer.finish();
+                PlaneRecorded { figures: p.figures.finish(failure_time), analysis, analysis_data, charts: p.charts }
+            })
+            .collect();
+        let (tilt, tilt_chart) = match self.tilt {
+            Some((t, bins)) => (Some(t.finish()), bins),
+            None => (None, None),
+        };
+        Recorded { planes, tilt, tilt_chart }
     }
 }

@@ -14,11 +14,13 @@ use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
-use crate::integrate::{IntegrationError, Integrator, Settings, Stats};
-use crate::model::{ix, Control, Model, RaceWhenClear, State};
+use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
+use crate::machine::Machine;
+use crate::model::{Control, Model, RaceWhenClear};
 use crate::sensor::Sensor;
-use crate::trace::Trace;
-use controller::{build_law, saturate, wrap_angle, ControlLaw, PdGains, Sample};
+use crate::trace::{Record, Trace};
+use controller::{build_rotor_law, saturate, saturate_axes, wrap_angle, PdGains, RotorLaw, RotorSample, ROTOR_AXES};
+use plant_physics::two_plane;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
@@ -110,13 +112,18 @@ pub enum SetupError {
 /// online monitor for `plant soak`. The loop itself keeps nothing per sample or
 /// per tick (co-simulation latencies go to fixed-size histograms).
 pub trait Sink {
-    /// The state `y` at time `t` (s); `model` holds the command applied then.
-    fn sample(&mut self, model: &Model, t: f64, y: &State);
+    /// The sample at one output time: the state's row(s) with the forces the model gives there.
+    fn sample(&mut self, record: &Record);
+
+    /// The same sample as the planar model's state, after [`Sink::sample`] (planar runs only):
+    /// for a sink that needs what a row does not hold (the race's angle and acceleration, each
+    /// ball's load: the assessment's touchdown-bearing duty). The default ignores it.
+    fn planar_state(&mut self, _model: &crate::model::Model, _t: f64, _y: &crate::model::State) {}
 }
 
 impl Sink for Trace {
-    fn sample(&mut self, model: &Model, t: f64, y: &State) {
-        self.push(model, t, y);
+    fn sample(&mut self, record: &Record) {
+        self.push(record);
     }
 }
 
@@ -129,19 +136,29 @@ pub struct RunResult {
     pub run: SinkRun,
 }
 
-/// Continuous PD gains for a scene's controller design.
+/// Continuous PD gains for a scene's controller design (plane A's, for a two-plane rotor).
 pub fn design_gains(scene: &Scene) -> Result<PdGains, controller::LawError> {
     PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants)
 }
 
+/// Continuous PD gains of each bearing plane's design (one for the planar model).
+pub fn plane_gains(scene: &Scene) -> Result<Vec<PdGains>, controller::LawError> {
+    scene.plane_designs().iter().map(|d| PdGains::from_design(&d.pd(), &d.constants)).collect()
+}
+
 /// Integrator settings for a scene, with the macro step as the largest step.
 pub fn integrator_settings(scene: &Scene) -> Settings<{ crate::model::N }> {
+    settings_with(scene, scene.integrator.atol)
+}
+
+/// Integrator settings for a scene's model of `N` state components, absolute tolerances `atol`.
+pub fn settings_with<const N: usize>(scene: &Scene, atol: [f64; N]) -> Settings<N> {
     let s = &scene.integrator;
     Settings {
         method: s.method,
         substeps: s.substeps,
         rtol: s.rtol,
-        atol: s.atol,
+        atol,
         h_max: scene.controller.period,
         max_steps: 1_000_000,
         ..Settings::new(s.method)
@@ -152,8 +169,8 @@ pub fn integrator_settings(scene: &Scene) -> Settings<{ crate::model::N }> {
 enum Source {
     /// The PD inside the derivative.
     Continuous,
-    /// The law in this process.
-    InProcess(Box<dyn ControlLaw>),
+    /// The law in this process: one per plane (decentralised) or one of the whole rotor.
+    InProcess(Box<dyn RotorLaw>),
     /// The law in the controller process.
     Cosim(Box<Session>),
 }
@@ -182,12 +199,16 @@ pub struct SinkRun {
     pub wall_time: f64,
     /// How it ended.
     pub outcome: Outcome,
-    /// Final state.
-    pub final_state: State,
+    /// Final state (ordered as the model's state: [`crate::model::ix`] or
+    /// [`plant_physics::two_plane::ix`]).
+    pub final_state: Vec<f64>,
     /// Co-simulation figures (`lockstep`, `realtime`).
     pub cosim: Option<CosimReport>,
-    /// Macro steps run with the race parked (`touchdown.race_when_clear = "parked"`).
+    /// Macro steps run with a race parked (`touchdown.race_when_clear = "parked"`), summed over
+    /// the bearing planes.
     pub parked_steps: u64,
+    /// Bearing planes of the model (1 or 2).
+    pub planes: usize,
     /// Ticks whose command was non-finite (the last valid one was held).
     pub invalid_commands: u64,
     /// The cost of the ticks: the most model evaluations in one, and the execution times.
@@ -211,23 +232,33 @@ pub fn run_into(
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
-    let gains = design_gains(scene)?;
-    let limit = scene.params.current_limit;
-    let bias = saturate(gains.bias_a, limit);
-    let (design, params) = (scene.design(), &scene.controller.params);
+    let params = &scene.controller.params;
     let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
-        ControlMode::Sampled => Source::InProcess(build_law(&scene.controller.law, &design, params)?),
+        ControlMode::Sampled => {
+            Source::InProcess(build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?)
+        }
         ControlMode::Lockstep | ControlMode::Realtime => {
             // A design the controller would refuse is bad input here, before any process starts
             // (a controller command checks the laws it serves itself, in the handshake).
             if scene.controller.cosim.command.is_none() {
-                build_law(&scene.controller.law, &design, params)?;
+                build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?;
             }
-            Source::Cosim(Box::new(Session::connect(scene, launch, bias, hooks)?))
+            Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene)?, hooks)?))
         }
     };
     run_from(scene, source, hooks, sink)
+}
+
+/// The bias currents per axis (A), each plane's within its limit (unused axes 0).
+fn bias_of(scene: &Scene) -> Result<[f64; ROTOR_AXES], SetupError> {
+    let gains = plane_gains(scene)?;
+    let mut bias = [0.0; ROTOR_AXES];
+    for (i, g) in gains.iter().enumerate() {
+        let b = saturate(g.bias_a, scene.plane(i).current_limit);
+        bias[2 * i..2 * i + 2].copy_from_slice(&b);
+    }
+    Ok(bias)
 }
 
 /// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
@@ -236,7 +267,7 @@ pub fn run_into(
 /// controller process writes the same trace, bit for bit. See [`crate::check`].
 pub fn run_law_into(
     scene: &Scene,
-    law: Box<dyn ControlLaw>,
+    law: Box<dyn RotorLaw>,
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
@@ -258,27 +289,65 @@ fn run_from(
         _ => None,
     };
     let scene = effective.as_ref().unwrap_or(scene);
-    let gains = design_gains(scene)?;
-    let limit = scene.params.current_limit;
-    let bias = saturate(gains.bias_a, limit);
+    let gains = plane_gains(scene)?;
+    let bias = bias_of(scene)?;
+    let limits = scene.rotor_design().current_limits();
     if let (Source::Cosim(session), Some(_)) = (&mut source, &effective) {
-        session.adopt(bias, limit);
+        session.adopt(bias, limits);
     }
-    let mut model = Model {
-        params: scene.params.clone(),
-        base: scene.base.clone(),
-        control: match source {
-            Source::Continuous => Control::Continuous(gains),
-            _ => Control::Held(bias),
-        },
-        race_parked: false,
+    let control = |i: usize| match source {
+        Source::Continuous => Control::Continuous(gains[i]),
+        _ => Control::Held([bias[2 * i], bias[2 * i + 1]]),
     };
-    let mut integrator = Integrator::new(integrator_settings(scene));
-    let mut y = initial_state(scene);
+    match &scene.two_plane {
+        None => {
+            let model = Model {
+                params: scene.params.clone(),
+                base: scene.base.clone(),
+                control: control(0),
+                race_parked: false,
+            };
+            let y = initial_state(scene);
+            drive(scene, model, y, integrator_settings(scene), source, (bias, limits), hooks, sink)
+        }
+        Some(params) => {
+            let model = two_plane::Model {
+                params: params.clone(),
+                base: scene.base.clone(),
+                control: [control(0), control(1)],
+                race_parked: [false; 2],
+            };
+            let y = crate::initial::two_plane_initial_state(scene, params);
+            let settings = settings_with(scene, scene.integrator.two_plane_atol());
+            drive(scene, model, y, settings, source, (bias, limits), hooks, sink)
+        }
+    }
+}
+
+/// The macro-step loop (module doc) for a model of `N` state components starting at `y`.
+#[allow(clippy::too_many_arguments)]
+fn drive<const N: usize, M: Machine<N>>(
+    scene: &Scene,
+    mut model: M,
+    mut y: [f64; N],
+    settings: Settings<N>,
+    mut source: Source,
+    (bias, limits): ([f64; ROTOR_AXES], [f64; ROTOR_AXES]),
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+) -> Result<SinkRun, SetupError> {
+    let planes = M::PLANES;
+    // Plane A's continuous PD, for an excitation hook (ISO 14839-3's summing point).
+    let continuous_gains = match source {
+        Source::Continuous => plane_gains(scene)?.first().copied(),
+        _ => None,
+    };
+    let mut excited = false;
+    let mut integrator = Integrator::new(settings);
     let period = scene.controller.period;
     let ticks = (scene.duration / period).ceil() as u64;
     let out_dt = scene.output_interval;
-    sink.sample(&model, 0.0, &y);
+    model.feed(sink, 0.0, &y);
     let mut next_out: u64 = 1;
     // Output samples per tick; a period longer than the run holds only the run's samples.
     let mut out_times: Vec<f64> = Vec::with_capacity((period.min(scene.duration) / out_dt).ceil() as usize + 2);
@@ -292,12 +361,12 @@ fn run_from(
         _ => 0,
     };
     let delay = scene.controller.delay_samples.saturating_sub(inherent) as usize;
-    let mut queue: VecDeque<[f64; 2]> = VecDeque::with_capacity(delay + 1);
+    let mut queue: VecDeque<[f64; ROTOR_AXES]> = VecDeque::with_capacity(delay + 1);
     queue.extend(std::iter::repeat_n(bias, delay));
     let mut sensor = Sensor::new(scene.sensor);
     let c = &scene.controller;
     let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
-    let guards = Guards::new(scene);
+    let guards = Guards::new(scene, &model);
     let breakpoints = scene.base.breakpoints();
     let mut next_breakpoint = 0;
     let mut parked_steps = 0u64;
@@ -317,17 +386,41 @@ fn run_from(
         let tick_start = Instant::now();
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        // The keyphasor: the rotor's speed and its angle wrapped to [0, 2π), from the state.
-        let sample = Sample {
+        // Every axis's sensor (the planes in order, one noise sequence) and the keyphasor: the
+        // rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let mut sample = RotorSample {
             seq: k,
             t_s: t0,
-            sensor_v: sensor.read([y[ix::XR], y[ix::YR]]),
-            speed_rad_s: y[ix::WR],
-            angle_rad: wrap_angle(y[ix::TR]),
+            axes: 2 * planes as u32,
+            speed_rad_s: model.spin(&y).1,
+            ..Default::default()
         };
+        sample.angle_rad = wrap_angle(model.spin(&y).0);
+        // Every axis's sensor, in every mode: the continuous PD reads the exact state inside the
+        // derivative, but an excitation hook reads the sensor signal there too.
+        for i in 0..planes {
+            let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
+            let v = sensor.read_with_gain(model.sensed(&y, i), gain);
+            sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
+        }
+        // The summing point of a sensitivity measurement (plane A's axes): added to what a law
+        // reads, handed to the continuous PD, which reads it inside the derivative.
+        let excitation = hooks.excitation(k, t0, &sample.sensor_v[..2 * planes]);
+        if let Some(sine) = excitation {
+            sample.sensor_v.iter_mut().zip(sine.at(t0).0).for_each(|(v, e)| *v += e);
+        }
+        if let (Source::Continuous, Some(gains)) = (&source, continuous_gains) {
+            if excitation.is_some() || excited {
+                model.set_control(
+                    0,
+                    excitation.map_or(Control::Continuous(gains), |e| Control::ContinuousExcited(gains, e)),
+                );
+            }
+            excited = excitation.is_some();
+        }
         let command = match &mut source {
             Source::Continuous => None,
-            Source::InProcess(law) => Some(saturate(law.update(&sample), limit)),
+            Source::InProcess(law) => Some(saturate_axes(law.update(&sample), limits)),
             Source::Cosim(session) => match session.command(&sample, hooks) {
                 Ok(cmd) => {
                     let pid = session.controller_pid();
@@ -355,10 +448,13 @@ fn run_from(
                 Ok(checked) => {
                     if checked.first {
                         hooks.note(&format!(
-                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {cmd:?} A: \
+                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {:?} A: \
                              the last valid command is held for it and for every later non-finite one, up to \
                              controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
-                            sample.seq, sample.t_s, c.max_invalid_burst
+                            sample.seq,
+                            sample.t_s,
+                            &cmd[..2 * planes],
+                            c.max_invalid_burst
                         ));
                     }
                     checked.command
@@ -370,7 +466,9 @@ fn run_from(
             };
             queue.push_back(cmd);
             if let Some(applied) = queue.pop_front() {
-                model.control = Control::Held(applied);
+                for i in 0..planes {
+                    model.set_control(i, Control::Held([applied[2 * i], applied[2 * i + 1]]));
+                }
             }
         }
         // A realtime tick starts when the plant wakes at its wall-clock time.
@@ -379,27 +477,39 @@ fn run_from(
             _ => tick_start,
         };
         let commanded = Instant::now();
-        if let RaceWhenClear::Parked(release) = scene.params.race_when_clear {
-            let clear = crate::park::clear(&model, t0, t1 - t0, &y);
-            if clear && !model.race_parked {
-                crate::park::park(&mut y);
-                model.race_parked = true;
-                integrator.set_substeps(scene.integrator.substeps);
-            } else if !clear && (model.race_parked || k == 0) {
-                if model.race_parked {
-                    crate::park::release(&model, t0, &mut y, release);
+        // Park or release each race; the fixed step is the contact one while any race is free.
+        let mut changed = false;
+        for i in 0..planes {
+            if let RaceWhenClear::Parked(release) = model.bearing(i).race_when_clear {
+                let clear = model.race_clear(t0, t1 - t0, &y, i);
+                if clear && !model.parked(i) {
+                    model.park_race(&mut y, i);
+                    model.set_parked(i, true);
+                    changed = true;
+                } else if !clear && (model.parked(i) || k == 0) {
+                    if model.parked(i) {
+                        model.release_race(t0, &mut y, i, release);
+                    }
+                    model.set_parked(i, false);
+                    changed = true;
                 }
-                model.race_parked = false;
-                integrator.set_substeps(scene.integrator.contact_substeps);
+                parked_steps += u64::from(model.parked(i));
             }
-            parked_steps += u64::from(model.race_parked);
+        }
+        if changed {
+            let all_parked = (0..planes).all(|i| model.parked(i));
+            integrator.set_substeps(if all_parked {
+                scene.integrator.substeps
+            } else {
+                scene.integrator.contact_substeps
+            });
         }
         out_times.clear();
         while (next_out as f64) * out_dt <= t1 + 1e-9 * out_dt {
             out_times.push(((next_out as f64) * out_dt).min(t1));
             next_out += 1;
         }
-        let (evals, touching) = (integrator.stats().rhs_evals, cost.tet.is_some() && touching(&model, &y));
+        let (evals, touching) = (integrator.stats().rhs_evals, cost.tet.is_some() && touching(&model, &y, planes));
         let mut rows = Duration::ZERO;
         let integrating = Instant::now();
         let step = advance_across_breakpoints(
@@ -413,10 +523,10 @@ fn run_from(
                 // The output rows' time is the sink's, not the integration's.
                 Some(_) => {
                     let row = Instant::now();
-                    sink.sample(&model, ts, ys);
+                    model.feed(sink, ts, ys);
                     rows += row.elapsed();
                 }
-                None => sink.sample(&model, ts, ys),
+                None => model.feed(sink, ts, ys),
             },
         );
         cost.max_rhs_evals = cost.max_rhs_evals.max(integrator.stats().rhs_evals - evals);
@@ -429,12 +539,12 @@ fn run_from(
                     command_ns: ns(commanded - tick_start),
                     integration_ns: ns((end - integrating).saturating_sub(rows)),
                     tick_ns: ns(end - tick_start),
-                    contact: touching || self::touching(&model, &y),
+                    contact: touching || self::touching(&model, &y, planes),
                 },
             );
         }
         t = t1;
-        if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(t1, &y)) {
+        if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(&model, t1, &y)) {
             // The run reached the failure, not the end of its macro step (an integration
             // error stops inside it).
             t = e.time();
@@ -476,30 +586,29 @@ fn run_from(
         simulated: t,
         wall_time,
         outcome,
-        final_state: y,
+        final_state: y.to_vec(),
         cosim,
         parked_steps,
+        planes,
         ticks: cost,
         invalid_commands,
     })
 }
 
-/// The rotor touches its race (the rotor – race contact force is not zero).
-fn touching(model: &Model, y: &State) -> bool {
-    let (dx, dy) = (y[ix::XR] - y[ix::XB], y[ix::YR] - y[ix::YB]);
-    let gap = model.params.contact.gap;
-    dx * dx + dy * dy > gap * gap
+/// The rotor touches one of its races (the rotor – race contact force is not zero).
+fn touching<const N: usize, M: Machine<N>>(model: &M, y: &[f64; N], planes: usize) -> bool {
+    (0..planes).any(|i| model.touching(y, i))
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it
 /// (where the housing acceleration or its slope jumps): a step across such a kink has an
 /// O(h²) local error whatever the method's order. `breakpoints` is sorted; `next` is the index
 /// of the first one not yet passed. Samples at `times` go to `sample`.
-fn advance_across_breakpoints<F: FnMut(f64, &State)>(
-    integrator: &mut Integrator<{ crate::model::N }>,
-    model: &Model,
+fn advance_across_breakpoints<const N: usize, S: System<N>, F: FnMut(f64, &[f64; N])>(
+    integrator: &mut Integrator<N>,
+    model: &S,
     (t0, t1): (f64, f64),
-    y: &mut State,
+    y: &mut [f64; N],
     times: &[f64],
     (breakpoints, next): (&[f64], &mut usize),
     mut sample: F,
@@ -521,28 +630,37 @@ fn advance_across_breakpoints<F: FnMut(f64, &State)>(
     integrator.advance_dense(model, from, t1, y, &times[done..], sample)
 }
 
-/// Radius limits beyond which the contact model has failed.
+/// Radius limits beyond which the contact model has failed, per bearing plane.
 struct Guards {
-    rotor: f64,
-    race: f64,
+    /// (rotor, race) limits of each plane (m).
+    limits: Vec<(f64, f64)>,
 }
 
 impl Guards {
-    fn new(scene: &Scene) -> Self {
-        let p = &scene.params;
+    fn new<const N: usize, M: Machine<N>>(scene: &Scene, model: &M) -> Self {
         let g = scene.integrator.radius_guard;
-        Self { rotor: p.contact.gap + p.balls.clearance + g, race: p.balls.clearance + g }
+        let limits = (0..M::PLANES)
+            .map(|i| {
+                let p = model.bearing(i);
+                (p.contact.gap + p.balls.clearance + g, p.balls.clearance + g)
+            })
+            .collect();
+        Self { limits }
     }
 
-    fn check(&self, t: f64, y: &State) -> Result<(), RunError> {
-        let rotor = y[ix::XR].hypot(y[ix::YR]);
-        let race = y[ix::XB].hypot(y[ix::YB]);
-        let fail = |what, value_m, limit_m| RunError::RadiusGuard { t, what, value_m, limit_m, state: y.to_vec() };
-        if rotor > self.rotor {
-            return Err(fail("rotor radius", rotor, self.rotor));
-        }
-        if race > self.race {
-            return Err(fail("race radius", race, self.race));
+    fn check<const N: usize, M: Machine<N>>(&self, model: &M, t: f64, y: &[f64; N]) -> Result<(), RunError> {
+        const NAMES: [[&str; 2]; 2] =
+            [["rotor radius at bearing A", "race A radius"], ["rotor radius at bearing B", "race B radius"]];
+        for (i, &(rotor_limit, race_limit)) in self.limits.iter().enumerate() {
+            let (rotor, race) = model.radii(y, i);
+            let [rotor_name, race_name] = if M::PLANES == 1 { ["rotor radius", "race radius"] } else { NAMES[i] };
+            let fail = |what, value_m, limit_m| RunError::RadiusGuard { t, what, value_m, limit_m, state: y.to_vec() };
+            if rotor > rotor_limit {
+                return Err(fail(rotor_name, rotor, rotor_limit));
+            }
+            if race > race_limit {
+                return Err(fail(race_name, race, race_limit));
+            }
         }
         Ok(())
     }

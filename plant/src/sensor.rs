@@ -40,8 +40,15 @@ impl Sensor {
 
     /// The voltages the controller reads for displacement `delta` (m), x then y.
     pub fn read(&mut self, delta: [f64; 2]) -> [f64; 2] {
+        self.read_with_gain(delta, self.settings.gain)
+    }
+
+    /// [`Sensor::read`] through a sensor of gain `gain` (V/m): a bearing plane's own, with the
+    /// noise and the ADC of the settings (one noise sequence for all the planes' sensors, read
+    /// in plane order).
+    pub fn read_with_gain(&mut self, delta: [f64; 2], gain: f64) -> [f64; 2] {
         let s = self.settings;
-        let mut u = [s.gain * delta[0], s.gain * delta[1]];
+        let mut u = [gain * delta[0], gain * delta[1]];
         if s.noise_v > 0.0 {
             let n = self.rng.normal_pair();
             u = [u[0] + s.noise_v * n[0], u[1] + s.noise_v * n[1]];

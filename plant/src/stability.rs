@@ -15,14 +15,20 @@ pub use plant_physics::stability::REFERENCE_CONTACT_FORCE;
 
 /// [`plant_physics::stability::estimate`] for a scene's parameters.
 pub fn estimate(scene: &Scene, method: Method, peak_contact_force: f64) -> f64 {
-    plant_physics::stability::estimate(&scene.params, method, peak_contact_force)
+    // The stiffer bearing plane of a two-plane rotor.
+    (0..scene.planes())
+        .map(|i| plant_physics::stability::estimate(scene.plane(i), method, peak_contact_force))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Substeps per controller period that keep `method` within the estimated limit under a
 /// [`REFERENCE_CONTACT_FORCE`] contact (1 for the adaptive methods and explicit Euler, which has no
 /// limit to meet).
 pub fn safe_contact_substeps(scene: &Scene, method: Method) -> u32 {
-    plant_physics::stability::safe_contact_substeps(&scene.params, method, scene.controller.period)
+    (0..scene.planes())
+        .map(|i| plant_physics::stability::safe_contact_substeps(scene.plane(i), method, scene.controller.period))
+        .max()
+        .unwrap_or(1)
 }
 
 /// What the plant says about a scene's integrator before running it.

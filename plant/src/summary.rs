@@ -6,11 +6,13 @@
 //! failure (the row at the failure holds the state that failed, which is
 //! reported on its own as `failure_state`).
 
-use crate::analysis::{Analysis, AnalysisSpec, Analyzer};
+use crate::analysis::tilt::TiltAnalysis;
+use crate::analysis::Analysis;
 use crate::config::{DragChoice, ForceLaw, RaceWhenClearChoice, ReleaseChoice, Scene, SpinChoice, SupportChoice};
+pub use crate::figures::{analysis_spec, plane_analysis_spec, recovery_time, Figures, FiguresBuilder};
+use crate::record::{PlaneRecorded, Recorded, Recorder};
 use crate::run::{RunError, RunResult, SinkRun};
 use crate::status::Status;
-use crate::trace::{col, Row, Trace};
 use serde::Serialize;
 
 /// The name a unit enum variant serialises to (`dry_whirl`, `rk4`, …), as written in the outputs.
@@ -24,6 +26,9 @@ pub use crate::analysis::STEADY_REVOLUTIONS;
 /// file writes them.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelInfo {
+    /// `two_plane` for the two-plane rotor (`rotor.model`; not written for the planar model).
+    #[serde(skip_serializing_if = "is_planar")]
+    pub rotor: crate::config::RotorModel,
     /// `held` or `free` (`rotor.spin`).
     pub spin: SpinChoice,
     /// `rotating` or `fixed`.
@@ -57,6 +62,11 @@ impl ModelInfo {
         let (p, c) = (&scene.params, &scene.controller);
         let (race_when_clear, race_release) = RaceWhenClearChoice::of(&p.race_when_clear);
         ModelInfo {
+            rotor: if scene.two_plane.is_some() {
+                crate::config::RotorModel::TwoPlane
+            } else {
+                crate::config::RotorModel::Planar
+            },
             spin: SpinChoice::of(&p.spin),
             cage: p.cage,
             race_drag: DragChoice::of(&p.drag),
@@ -71,6 +81,10 @@ impl ModelInfo {
             delay_samples: c.delay_samples,
         }
     }
+}
+
+fn is_planar(m: &crate::config::RotorModel) -> bool {
+    *m == crate::config::RotorModel::Planar
 }
 
 /// Integrator of a run, for the record.
@@ -154,6 +168,62 @@ pub struct Summary {
     /// Co-simulation figures (`lockstep`, `realtime` modes only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cosim: Option<crate::cosim::CosimReport>,
+    /// A two-plane run's figures per bearing plane and its tilt (the figures above are those of
+    /// the governing plane, `planes.governing`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planes: Option<PlanesSummary>,
+}
+
+/// One bearing plane's figures in a two-plane run's `summary.json` (the planar summary's, for
+/// this plane).
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneSummary {
+    /// Largest rotor radius at the bearing relative to the housing (m); `null` over no row.
+    pub max_radius_m: Option<f64>,
+    /// Fraction of samples with contact over the steady window.
+    pub contact_fraction: f64,
+    /// Largest rotor – race normal force (N); `null` over no row.
+    pub max_contact_force_n: Option<f64>,
+    /// Largest race speed (rpm); `null` over no row.
+    pub max_race_speed_rpm: Option<f64>,
+    /// From the first shock's start to the last sample in contact (s); `null` if still touching.
+    pub recovery_s: Option<f64>,
+    /// Time in contact over the run (s).
+    pub contact_time_s: f64,
+    /// Time of the first sample with rotor – race contact (s); `null` if the plane never touched.
+    pub first_contact_s: Option<f64>,
+    /// The plane's analysis (spectra, Poincaré section, classification).
+    #[serde(flatten)]
+    pub analysis: Analysis,
+}
+
+/// A two-plane run's per-plane figures and tilt.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanesSummary {
+    /// The plane whose figures the summary's top level holds: `a` or `b`, the one with the
+    /// larger steady contact fraction, then the larger peak contact force, then `a`.
+    pub governing: &'static str,
+    /// Bearing plane A.
+    pub a: PlaneSummary,
+    /// Bearing plane B.
+    pub b: PlaneSummary,
+    /// The rotor's tilt.
+    pub tilt: TiltAnalysis,
+}
+
+impl PlaneSummary {
+    fn new(p: &PlaneRecorded, simulated: f64) -> Self {
+        Self {
+            max_radius_m: p.figures.max_radius_m,
+            contact_fraction: p.analysis.steady_contact_fraction,
+            max_contact_force_n: p.figures.max_contact_force_n,
+            max_race_speed_rpm: p.figures.max_race_speed_rpm,
+            recovery_s: p.figures.recovery_s,
+            contact_time_s: p.figures.contact_share() * simulated,
+            first_contact_s: p.figures.first_contact_s,
+            analysis: p.analysis.clone(),
+        }
+    }
 }
 
 impl Summary {
@@ -176,18 +246,25 @@ impl Summary {
 
     /// Figures of a run whose trace is in memory.
     pub fn new(scene: &Scene, result: &RunResult) -> Self {
-        let mut figures = FiguresBuilder::new(scene.first_shock_start());
-        let mut analyzer = Analyzer::new(analysis_spec(scene), None);
-        for r in result.trace.rows() {
-            figures.push(&r);
-            analyzer.push(&r);
-        }
-        let (analysis, _) = analyzer.finish();
-        Self::from_parts(scene, &result.run, figures.finish(result.run.outcome.failure_time()), analysis)
+        let mut recorder = Recorder::new(scene, false);
+        result.trace.records().for_each(|r| recorder.push(&r));
+        Self::from_parts(scene, &result.run, recorder.finish(result.run.outcome.failure_time()))
     }
 
-    /// The summary of a run from its figures and analysis, taken as its rows came.
-    pub fn from_parts(scene: &Scene, run: &SinkRun, figures: Figures, analysis: Analysis) -> Self {
+    /// The summary of a run from what its [`Recorder`] made of it as its rows came.
+    pub fn from_parts(scene: &Scene, run: &SinkRun, recorded: Recorded) -> Self {
+        let governing = recorded.governing();
+        let planes = match (&recorded.tilt, recorded.planes.as_slice()) {
+            (Some(tilt), [a, b]) => Some(PlanesSummary {
+                governing: ["a", "b"][governing],
+                a: PlaneSummary::new(a, run.simulated),
+                b: PlaneSummary::new(b, run.simulated),
+                tilt: tilt.clone(),
+            }),
+            _ => None,
+        };
+        let lead = recorded.planes.into_iter().nth(governing).expect("a recorded run has a plane");
+        let (figures, analysis) = (lead.figures, lead.analysis);
         let c = &scene.controller;
         let failure = match &run.outcome {
             crate::run::Outcome::Diverged(e) => Some(e),
@@ -208,7 +285,7 @@ impl Summary {
             recovery_s: figures.recovery_s,
             contact_time_s: figures.contact_share() * run.simulated,
             parked_fraction: {
-                let ticks = (run.simulated / c.period).round();
+                let ticks = (run.simulated / c.period).round() * run.planes as f64;
                 if ticks > 0.0 {
                     run.parked_steps as f64 / ticks
                 } else {
@@ -225,7 +302,10 @@ impl Summary {
             integrator: IntegratorInfo {
                 method: scene.integrator.method,
                 rtol: scene.integrator.rtol,
-                atol: scene.integrator.atol.to_vec(),
+                atol: match scene.two_plane {
+                    None => scene.integrator.atol.to_vec(),
+                    Some(_) => scene.integrator.two_plane_atol().to_vec(),
+                },
                 substeps: scene.integrator.substeps,
                 contact_substeps: scene.integrator.contact_substeps,
                 macro_step_s: c.period,
@@ -234,6 +314,7 @@ impl Summary {
             },
             analysis,
             cosim: run.cosim.clone(),
+            planes,
         }
     }
 }
@@ -241,7 +322,17 @@ impl Summary {
 /// The state a diverged run failed in (`failure_state` in `summary.json`); non-finite
 /// values are written as `null`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FailureState {
+#[serde(untagged)]
+pub enum FailureState {
+    /// The planar model's.
+    Planar(PlanarFailure),
+    /// The two-plane rotor's.
+    TwoPlane(TwoPlaneFailure),
+}
+
+/// The planar model's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlanarFailure {
     /// Time of the failure (s).
     pub t_s: f64,
     /// Rotor radius relative to the housing (m).
@@ -262,200 +353,77 @@ pub struct FailureState {
     pub race_spin: [f64; 2],
 }
 
+/// One race of the two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RaceFailure {
+    /// Race radius relative to the housing (m).
+    pub race_radius_m: f64,
+    /// Race x, y relative to the housing (m).
+    pub race_m: [f64; 2],
+    /// Race velocity relative to the housing (m/s).
+    pub race_velocity_m_s: [f64; 2],
+    /// Race angle (rad) and speed (rad/s).
+    pub race_spin: [f64; 2],
+}
+
+/// The two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TwoPlaneFailure {
+    /// Time of the failure (s).
+    pub t_s: f64,
+    /// The rotor axis at the centre of mass's station, x, y relative to the housing (m).
+    pub rotor_m: [f64; 2],
+    /// Its velocity (m/s).
+    pub rotor_velocity_m_s: [f64; 2],
+    /// The slopes a, b of the axis (rad).
+    pub slopes_rad: [f64; 2],
+    /// Their rates (rad/s).
+    pub slope_rates_rad_s: [f64; 2],
+    /// Rotor spin angle (rad) and speed (rad/s).
+    pub rotor_spin: [f64; 2],
+    /// Race A.
+    pub race_a: RaceFailure,
+    /// Race B.
+    pub race_b: RaceFailure,
+}
+
 impl FailureState {
     /// The failing state of a divergence, if the error holds a whole state.
     pub fn of(e: &RunError) -> Option<Self> {
-        use crate::model::ix;
         let y = e.state();
-        if y.len() != crate::model::N {
-            return None;
+        if y.len() == crate::model::N {
+            use crate::model::ix;
+            return Some(Self::Planar(PlanarFailure {
+                t_s: e.time(),
+                rotor_radius_m: y[ix::XR].hypot(y[ix::YR]),
+                race_radius_m: y[ix::XB].hypot(y[ix::YB]),
+                rotor_m: [y[ix::XR], y[ix::YR]],
+                rotor_velocity_m_s: [y[ix::VXR], y[ix::VYR]],
+                race_m: [y[ix::XB], y[ix::YB]],
+                race_velocity_m_s: [y[ix::VXB], y[ix::VYB]],
+                rotor_spin: [y[ix::TR], y[ix::WR]],
+                race_spin: [y[ix::TB], y[ix::WB]],
+            }));
         }
-        Some(Self {
-            t_s: e.time(),
-            rotor_radius_m: y[ix::XR].hypot(y[ix::YR]),
-            race_radius_m: y[ix::XB].hypot(y[ix::YB]),
-            rotor_m: [y[ix::XR], y[ix::YR]],
-            rotor_velocity_m_s: [y[ix::VXR], y[ix::VYR]],
-            race_m: [y[ix::XB], y[ix::YB]],
-            race_velocity_m_s: [y[ix::VXB], y[ix::VYB]],
-            rotor_spin: [y[ix::TR], y[ix::WR]],
-            race_spin: [y[ix::TB], y[ix::WB]],
-        })
-    }
-}
-
-/// The analysis setting of a scene: Poincaré section at spin phase 0, periodicity tolerance 1e-3 r_0.
-pub fn analysis_spec(scene: &Scene) -> AnalysisSpec {
-    AnalysisSpec { gap: scene.params.contact.gap, speed: scene.params.speed, phase: 0.0, tolerance: 1e-3 }
-}
-
-/// The summary's figures of a whole run, taken row by row.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Figures {
-    /// Largest rotor radius (m); `None` when no row counts (a failure at the first row).
-    pub max_radius_m: Option<f64>,
-    /// Largest contact force (N); `None` when no row counts.
-    pub max_contact_force_n: Option<f64>,
-    /// Largest race speed (rpm); `None` when no row counts.
-    pub max_race_speed_rpm: Option<f64>,
-    /// See [`Summary::recovery_s`].
-    pub recovery_s: Option<f64>,
-    /// Rows.
-    pub rows: u64,
-    /// Rows with a positive contact force.
-    pub contact_rows: u64,
-}
-
-impl Figures {
-    /// Share of the rows in contact (0 without rows).
-    pub fn contact_share(&self) -> f64 {
-        if self.rows == 0 {
-            0.0
-        } else {
-            self.contact_rows as f64 / self.rows as f64
-        }
-    }
-}
-
-/// Takes [`Figures`] as the rows come. The maxima lag one row behind, so that
-/// the row of a failure can be left out at the end.
-#[derive(Clone, Debug)]
-pub struct FiguresBuilder {
-    shock_start: f64,
-    max_radius: f64,
-    max_force: f64,
-    max_rpm: f64,
-    /// The last row's time and its radius, force and race speed (rpm), not yet in the maxima.
-    pending: Option<[f64; 4]>,
-    last_contact: Option<f64>,
-    last_row_in_contact: bool,
-    rows: u64,
-    contact_rows: u64,
-    /// Rows taken into the maxima.
-    counted: u64,
-}
-
-impl FiguresBuilder {
-    /// Figures with recovery counted from `shock_start` (s).
-    pub fn new(shock_start: f64) -> Self {
-        Self {
-            shock_start,
-            max_radius: 0.0,
-            max_force: 0.0,
-            max_rpm: 0.0,
-            pending: None,
-            last_contact: None,
-            last_row_in_contact: false,
-            rows: 0,
-            contact_rows: 0,
-            counted: 0,
-        }
-    }
-
-    /// The next row.
-    pub fn push(&mut self, r: &Row) {
-        self.commit();
-        let (t, force) = (r[col::T_S], r[col::CONTACT_FORCE_N]);
-        let rpm = r[col::RACE_SPEED_RAD_S].abs() * 60.0 / std::f64::consts::TAU;
-        self.pending = Some([t, r[col::DX_M].hypot(r[col::DY_M]), force, rpm]);
-        self.rows += 1;
-        self.contact_rows += u64::from(force > 0.0);
-        self.last_row_in_contact = t >= self.shock_start && force > 0.0;
-        if self.last_row_in_contact {
-            self.last_contact = Some(t);
-        }
-    }
-
-    fn commit(&mut self) {
-        if let Some([_, radius, force, rpm]) = self.pending.take() {
-            let keep = |m: &mut f64, v: f64| {
-                if v.is_finite() {
-                    *m = m.max(v);
-                }
+        if y.len() == plant_physics::two_plane::N {
+            use plant_physics::two_plane::ix;
+            let race = |x: usize| RaceFailure {
+                race_radius_m: y[x].hypot(y[x + 1]),
+                race_m: [y[x], y[x + 1]],
+                race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
+                race_spin: [y[x + 2], y[x + 2 + ix::V]],
             };
-            keep(&mut self.max_radius, radius);
-            keep(&mut self.max_force, force);
-            keep(&mut self.max_rpm, rpm);
-            self.counted += 1;
+            return Some(Self::TwoPlane(TwoPlaneFailure {
+                t_s: e.time(),
+                rotor_m: [y[ix::X], y[ix::Y]],
+                rotor_velocity_m_s: [y[ix::VX], y[ix::VY]],
+                slopes_rad: [y[ix::SX], y[ix::SY]],
+                slope_rates_rad_s: [y[ix::VSX], y[ix::VSY]],
+                rotor_spin: [y[ix::TR], y[ix::WR]],
+                race_a: race(ix::RACE_A),
+                race_b: race(ix::RACE_B),
+            }));
         }
-    }
-
-    /// The figures; rows at or after `failure_time` (s) are left out of the maxima.
-    pub fn finish(mut self, failure_time: Option<f64>) -> Figures {
-        if self.pending.is_some_and(|p| failure_time.is_none_or(|tf| p[0] < tf)) {
-            self.commit();
-        }
-        let counted = |m: f64| (self.counted > 0).then_some(m);
-        Figures {
-            max_radius_m: counted(self.max_radius),
-            max_contact_force_n: counted(self.max_force),
-            max_race_speed_rpm: counted(self.max_rpm),
-            // From the shock's start to the last row in contact: 0 if none, `None` if the last
-            // row is in contact (the rotor never left).
-            recovery_s: match self.last_contact {
-                None => Some(0.0),
-                Some(_) if self.last_row_in_contact => None,
-                Some(t) => Some(t - self.shock_start),
-            },
-            rows: self.rows,
-            contact_rows: self.contact_rows,
-        }
-    }
-}
-
-/// Time from `start` (s) to the last trace sample with a positive contact force: 0 if there
-/// is none after `start`, `None` if the last sample is in contact (the rotor never left).
-pub fn recovery_time(trace: &Trace, start: f64) -> Option<f64> {
-    let mut f = FiguresBuilder::new(start);
-    trace.rows().for_each(|r| f.push(&r));
-    f.finish(None).recovery_s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn row(t: f64, dx: f64, force: f64) -> Row {
-        let mut r = [0.0; crate::trace::WIDTH];
-        r[col::T_S] = t;
-        r[col::DX_M] = dx;
-        r[col::CONTACT_FORCE_N] = force;
-        r
-    }
-
-    #[test]
-    fn maxima_leave_out_the_row_of_the_failure() {
-        let mut f = FiguresBuilder::new(0.0);
-        for r in [row(0.0, 1e-6, 0.0), row(1e-4, 628e-6, 10.0), row(2e-4, 793e-6, 2e5)] {
-            f.push(&r);
-        }
-        let diverged = f.clone().finish(Some(2e-4));
-        assert_eq!((diverged.max_radius_m, diverged.max_contact_force_n), (Some(628e-6), Some(10.0)));
-        let completed = f.finish(None);
-        assert_eq!((completed.max_radius_m, completed.max_contact_force_n), (Some(793e-6), Some(2e5)));
-    }
-
-    /// Issue 21 item 7: a run that failed at its first row reported `max_radius_m = 0.0`, a
-    /// radius it never had: without a row before the failure the maxima are `None` (null).
-    #[test]
-    fn maxima_over_no_row_are_none() {
-        let mut f = FiguresBuilder::new(0.0);
-        f.push(&row(0.0, f64::NAN, f64::NAN));
-        let failed = f.finish(Some(0.0));
-        assert_eq!((failed.max_radius_m, failed.max_contact_force_n, failed.max_race_speed_rpm), (None, None, None));
-        assert_eq!(FiguresBuilder::new(0.0).finish(None).max_radius_m, None);
-    }
-
-    #[test]
-    fn recovery_is_from_the_shock_to_the_last_contact() {
-        let mut tr = Trace::default();
-        for (t, force) in [(0.0, 1.0), (0.1, 0.0), (0.2, 5.0), (0.3, 0.0), (0.4, 0.0)] {
-            tr.push_row(&row(t, 0.0, force));
-        }
-        // Contact before the shock does not count.
-        assert_eq!(recovery_time(&tr, 0.05), Some(0.2 - 0.05));
-        assert_eq!(recovery_time(&tr, 0.25), Some(0.0));
-        tr.push_row(&row(0.5, 0.0, 1.0));
-        assert_eq!(recovery_time(&tr, 0.05), None);
+        None
     }
 }

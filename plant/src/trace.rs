@@ -9,32 +9,33 @@
 
 use crate::model::{ix, Model, State};
 use crate::row_file::RowFile;
+use plant_physics::two_plane;
 use std::path::{Path, PathBuf};
 
 macro_rules! columns {
-    ($($field:ident : $doc:literal),* $(,)?) => {
-        /// Trace columns; each is one CSV column named like the field.
+    ($(#[$meta:meta])* $name:ident: $row:ty; $($field:ident : $doc:literal),* $(,)?; $($extra:ident : $ety:ty : $edoc:literal),*) => {
+        $(#[$meta])*
         #[derive(Clone, Debug, Default)]
-        pub struct Trace { $(#[doc = $doc] pub $field: Vec<f64>,)* }
+        pub struct $name { $(#[doc = $doc] pub $field: Vec<f64>,)* $(#[doc = $edoc] pub $extra: $ety,)* }
 
-        impl Trace {
+        impl $name {
             /// CSV header names, in order.
             pub const COLUMNS: &'static [&'static str] = &[$(stringify!($field)),*];
 
             /// An empty trace with room for `n` rows.
             pub fn with_capacity(n: usize) -> Self {
-                Self { $($field: Vec::with_capacity(n),)* }
+                Self { $($field: Vec::with_capacity(n),)* $($extra: Default::default(),)* }
             }
 
-            /// Appends one row.
-            pub fn push_row(&mut self, row: &Row) {
+            /// Appends one row of these columns.
+            pub fn push_row(&mut self, row: &$row) {
                 let mut i = 0;
                 $(self.$field.push(row[i]); i += 1;)*
-                debug_assert_eq!(i, WIDTH);
+                debug_assert_eq!(i, row.len());
             }
 
-            /// Row `i`.
-            pub fn row(&self, i: usize) -> Row {
+            /// Row `i` of these columns.
+            pub fn row(&self, i: usize) -> $row {
                 [$(self.$field[i]),*]
             }
         }
@@ -42,32 +43,143 @@ macro_rules! columns {
 }
 
 columns! {
+    /// Trace columns (plane A's and the shared ones, the planar model's); each is one CSV
+    /// column named like the field. A two-plane run's trace also has plane B's and the tilt's
+    /// ([`TraceB`], in `b`).
+    Trace: Row;
     t_s: "Time (s).",
-    dx_m: "Rotor x relative to the housing (m).",
-    dy_m: "Rotor y relative to the housing (m).",
-    vx_m_s: "Rotor x velocity relative to the housing (m/s).",
-    vy_m_s: "Rotor y velocity relative to the housing (m/s).",
-    xb_m: "Race x relative to the housing (m).",
-    yb_m: "Race y relative to the housing (m).",
-    vxb_m_s: "Race x velocity relative to the housing (m/s).",
-    vyb_m_s: "Race y velocity relative to the housing (m/s).",
+    dx_m: "Rotor x relative to the housing (m); two-plane: at bearing A.",
+    dy_m: "Rotor y relative to the housing (m); two-plane: at bearing A.",
+    vx_m_s: "Rotor x velocity relative to the housing (m/s); two-plane: at bearing A.",
+    vy_m_s: "Rotor y velocity relative to the housing (m/s); two-plane: at bearing A.",
+    xb_m: "Race x relative to the housing (m); two-plane: race A.",
+    yb_m: "Race y relative to the housing (m); two-plane: race A.",
+    vxb_m_s: "Race x velocity relative to the housing (m/s); two-plane: race A.",
+    vyb_m_s: "Race y velocity relative to the housing (m/s); two-plane: race A.",
     rotor_angle_rad: "Rotor spin angle (rad).",
     rotor_speed_rad_s: "Rotor spin speed (rad/s).",
-    race_speed_rad_s: "Race spin speed (rad/s).",
-    contact_force_n: "Rotor – race normal force (N).",
-    friction_force_n: "Rotor – race friction force (N), signed like the slip.",
-    ball_force_n: "Resultant of the ball forces on the race (N).",
-    ix_a: "Coil current, x (A).",
-    iy_a: "Coil current, y (A).",
+    race_speed_rad_s: "Race spin speed (rad/s); two-plane: race A.",
+    contact_force_n: "Rotor – race normal force (N); two-plane: plane A.",
+    friction_force_n: "Rotor – race friction force (N), signed like the slip; two-plane: plane A.",
+    ball_force_n: "Resultant of the ball forces on the race (N); two-plane: race A.",
+    ix_a: "Coil current, x (A); two-plane: bearing A.",
+    iy_a: "Coil current, y (A); two-plane: bearing A.",
     housing_x_m: "Housing displacement, x (m).",
-    housing_y_m: "Housing displacement, y (m).",
+    housing_y_m: "Housing displacement, y (m).";
+    b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model)."
 }
 
-/// Number of columns of a trace.
+columns! {
+    /// A two-plane trace's plane B and tilt columns, after the planar ones in `trace.csv`:
+    /// plane B's columns are plane A's (the planar names) with the prefix `b_`.
+    TraceB: RowB;
+    b_dx_m: "Rotor x at bearing B relative to the housing (m).",
+    b_dy_m: "Rotor y at bearing B relative to the housing (m).",
+    b_vx_m_s: "Rotor x velocity at bearing B (m/s).",
+    b_vy_m_s: "Rotor y velocity at bearing B (m/s).",
+    b_xb_m: "Race B x relative to the housing (m).",
+    b_yb_m: "Race B y relative to the housing (m).",
+    b_vxb_m_s: "Race B x velocity (m/s).",
+    b_vyb_m_s: "Race B y velocity (m/s).",
+    b_race_speed_rad_s: "Race B spin speed (rad/s).",
+    b_contact_force_n: "Rotor – race B normal force (N).",
+    b_friction_force_n: "Rotor – race B friction force (N), signed like the slip.",
+    b_ball_force_n: "Resultant of race B's ball forces (N).",
+    b_ix_a: "Coil current of bearing B, x (A).",
+    b_iy_a: "Coil current of bearing B, y (A).",
+    slope_x_rad: "Slope a = dx/dz of the rotor axis (rad): the tilt about y.",
+    slope_y_rad: "Slope b = dy/dz of the rotor axis (rad): minus the tilt about x.",
+    slope_x_rate_rad_s: "Rate of the slope a (rad/s).",
+    slope_y_rate_rad_s: "Rate of the slope b (rad/s).";
+}
+
+/// Number of columns of a trace (the planar model's; plane A's and the shared ones).
 pub const WIDTH: usize = 19;
 
-/// One output sample: the values of [`Trace::COLUMNS`], in order.
+/// One output sample of one plane: the values of [`Trace::COLUMNS`], in order. A two-plane
+/// sample's plane B is seen as such a row too ([`Record::plane`]).
 pub type Row = [f64; WIDTH];
+
+/// Number of plane B and tilt columns of a two-plane trace.
+pub const WIDTH_B: usize = 18;
+
+/// A two-plane sample's plane B and tilt values: [`TraceB::COLUMNS`], in order.
+pub type RowB = [f64; WIDTH_B];
+
+/// One output sample: the planar columns (plane A's and the shared ones) and, for a two-plane
+/// rotor, plane B's and the tilt's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Record {
+    /// The planar columns.
+    pub a: Row,
+    /// Plane B and the tilt (two-plane runs).
+    pub b: Option<RowB>,
+}
+
+impl Record {
+    /// A planar sample.
+    pub fn planar(a: Row) -> Self {
+        Self { a, b: None }
+    }
+
+    /// Bearing planes in the sample: 1 (planar) or 2.
+    pub fn planes(&self) -> usize {
+        1 + usize::from(self.b.is_some())
+    }
+
+    /// Plane `i`'s sample as a planar row (0: plane A, the planar columns; 1: plane B's
+    /// columns with the shared ones: time, spin, housing).
+    pub fn plane(&self, i: usize) -> Row {
+        match (i, &self.b) {
+            (1, Some(b)) => {
+                let a = &self.a;
+                [
+                    a[col::T_S],
+                    b[colb::DX],
+                    b[colb::DX + 1],
+                    b[colb::DX + 2],
+                    b[colb::DX + 3],
+                    b[colb::RACE],
+                    b[colb::RACE + 1],
+                    b[colb::RACE + 2],
+                    b[colb::RACE + 3],
+                    a[col::ROTOR_ANGLE_RAD],
+                    a[col::ROTOR_SPEED_RAD_S],
+                    b[colb::RACE_SPEED],
+                    b[colb::CONTACT],
+                    b[colb::CONTACT + 1],
+                    b[colb::CONTACT + 2],
+                    b[colb::CURRENT],
+                    b[colb::CURRENT + 1],
+                    a[col::HOUSING_X_M],
+                    a[col::HOUSING_Y_M],
+                ]
+            }
+            _ => self.a,
+        }
+    }
+
+    /// The slopes (a, b) of the rotor axis (rad), two-plane samples.
+    pub fn slopes(&self) -> Option<[f64; 2]> {
+        self.b.map(|b| [b[colb::SLOPE], b[colb::SLOPE + 1]])
+    }
+}
+
+/// Column indices of a [`RowB`].
+pub mod colb {
+    /// `b_dx_m` (then `b_dy_m`, `b_vx_m_s`, `b_vy_m_s`).
+    pub const DX: usize = 0;
+    /// `b_xb_m` (then `b_yb_m`, `b_vxb_m_s`, `b_vyb_m_s`).
+    pub const RACE: usize = 4;
+    /// `b_race_speed_rad_s`.
+    pub const RACE_SPEED: usize = 8;
+    /// `b_contact_force_n` (then `b_friction_force_n`, `b_ball_force_n`).
+    pub const CONTACT: usize = 9;
+    /// `b_ix_a` (then `b_iy_a`).
+    pub const CURRENT: usize = 12;
+    /// `slope_x_rad` (then `slope_y_rad`, `slope_x_rate_rad_s`, `slope_y_rate_rad_s`).
+    pub const SLOPE: usize = 14;
+}
 
 /// Column indices of a [`Row`], in the order of [`Trace::COLUMNS`].
 pub mod col {
@@ -95,9 +207,13 @@ pub mod col {
     pub const IX_A: usize = 15;
     /// `iy_a`.
     pub const IY_A: usize = 16;
+    /// `housing_x_m`.
+    pub const HOUSING_X_M: usize = 17;
+    /// `housing_y_m`.
+    pub const HOUSING_Y_M: usize = 18;
 }
 
-/// The row of the state `y` at time `t`, with the forces the model gives there.
+/// The planar model's sample of the state `y` at time `t`, with the forces the model gives there.
 pub fn row(model: &Model, t: f64, y: &State) -> Row {
     let ev = model.evaluate(t, y);
     let housing = model.base.eval(t);
@@ -124,6 +240,62 @@ pub fn row(model: &Model, t: f64, y: &State) -> Row {
     ]
 }
 
+/// The two-plane model's sample of the state `y` at time `t`: plane A in the planar columns
+/// (the rotor at bearing A), plane B and the slopes in the others.
+pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) -> Record {
+    use two_plane::ix;
+    let ev = model.evaluate(t, y);
+    let housing = model.base.eval(t);
+    let plane = |i: usize| {
+        let (pos, vel) = two_plane::at_station(y, model.params.planes[i].station);
+        let race = ix::RACE[i];
+        let p = &ev.planes[i];
+        [
+            pos.x,
+            pos.y,
+            vel.x,
+            vel.y,
+            y[race],
+            y[race + 1],
+            y[race + ix::V],
+            y[race + 1 + ix::V],
+            y[race + 2 + ix::V],
+            p.contact.normal,
+            p.contact.tangential,
+            p.balls.on_race[0].hypot(p.balls.on_race[1]),
+            p.current[0],
+            p.current[1],
+        ]
+    };
+    let [dx, dy, vx, vy, xb, yb, vxb, vyb, race_speed, normal, tangential, balls, ix_a, iy_a] = plane(0);
+    let a = [
+        t,
+        dx,
+        dy,
+        vx,
+        vy,
+        xb,
+        yb,
+        vxb,
+        vyb,
+        y[ix::TR],
+        y[ix::WR],
+        race_speed,
+        normal,
+        tangential,
+        balls,
+        ix_a,
+        iy_a,
+        housing.disp[0],
+        housing.disp[1],
+    ];
+    let pb = plane(1);
+    let mut b = [0.0; WIDTH_B];
+    b[..14].copy_from_slice(&pb);
+    b[colb::SLOPE..].copy_from_slice(&[y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]]);
+    Record { a, b: Some(b) }
+}
+
 impl Trace {
     /// Number of rows.
     pub fn len(&self) -> usize {
@@ -135,25 +307,51 @@ impl Trace {
         self.t_s.is_empty()
     }
 
-    /// Records the state at time `t`, with the forces the model gives there.
-    pub fn push(&mut self, model: &Model, t: f64, y: &State) {
-        self.push_row(&row(model, t, y));
+    /// Appends one sample (plane B's and the tilt's columns only with a two-plane sample).
+    pub fn push(&mut self, r: &Record) {
+        self.push_row(&r.a);
+        if let Some(b) = &r.b {
+            self.b.get_or_insert_with(TraceB::default).push_row(b);
+        }
     }
 
-    /// The rows, in order.
+    /// Sample `i`.
+    pub fn record(&self, i: usize) -> Record {
+        Record { a: self.row(i), b: self.b.as_ref().map(|b| b.row(i)) }
+    }
+
+    /// The samples, in order.
+    pub fn records(&self) -> impl Iterator<Item = Record> + '_ {
+        (0..self.len()).map(|i| self.record(i))
+    }
+
+    /// Bearing planes in the trace: 1 (planar) or 2.
+    pub fn planes(&self) -> usize {
+        1 + usize::from(self.b.is_some())
+    }
+
+    /// Plane `i`'s trace in the planar columns ([`Record::plane`]): the planar columns for 0, a
+    /// copy of plane B's with the shared ones for 1.
+    pub fn plane(&self, i: usize) -> Trace {
+        let mut t = Trace::with_capacity(self.len());
+        self.records().for_each(|r| t.push_row(&r.plane(i)));
+        t
+    }
+
+    /// The planar columns' rows (plane A's, for a two-plane trace), in order.
     pub fn rows(&self) -> impl Iterator<Item = Row> + '_ {
         (0..self.len()).map(|i| self.row(i))
     }
 
-    /// Rotor radius relative to the housing at each row (m).
+    /// Rotor radius relative to the housing at each row (m) (at bearing A, two-plane).
     pub fn radius(&self) -> Vec<f64> {
         self.dx_m.iter().zip(&self.dy_m).map(|(x, y)| x.hypot(*y)).collect()
     }
 
     /// Writes the trace as `trace.csv` (see the module docs).
     pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        let mut w = TraceWriter::create(path)?;
-        for r in self.rows() {
+        let mut w = TraceWriter::create(path, self.planes())?;
+        for r in self.records() {
             w.write(&r)?;
         }
         w.flush()
@@ -163,34 +361,39 @@ impl Trace {
     pub fn read_csv(path: &Path) -> Result<Self, TraceError> {
         let mut trace = Trace::default();
         read_rows(path, |r| {
-            trace.push_row(r);
+            trace.push(r);
             true
         })?;
         Ok(trace)
     }
 }
 
-/// Streams rows to a `trace.csv` as they are made: the header at creation,
-/// then one record per row through the `csv` crate, in whole rows
+/// Streams samples to a `trace.csv` as they are made: the header at creation,
+/// then one record per sample through the `csv` crate, in whole rows
 /// ([`RowFile`]: a run killed by SIGKILL leaves a file that ends on a row, and
 /// `plant analyze` reads it). Each number is formatted here with `{:e}` (the
 /// csv crate's own float format differs).
 pub struct TraceWriter {
     rows: RowFile,
-    fields: [String; WIDTH],
+    fields: Vec<String>,
 }
 
 impl TraceWriter {
-    /// Creates (truncates) `path` and writes the header.
-    pub fn create(path: &Path) -> std::io::Result<Self> {
-        let rows = RowFile::create(path, Trace::COLUMNS)?;
-        Ok(Self { rows, fields: std::array::from_fn(|_| String::with_capacity(32)) })
+    /// Creates (truncates) `path` and writes the header of a trace of `planes` bearing planes
+    /// (1: the planar columns; 2: also plane B's and the tilt's).
+    pub fn create(path: &Path, planes: usize) -> std::io::Result<Self> {
+        let header: Vec<&str> =
+            Trace::COLUMNS.iter().chain(if planes == 2 { TraceB::COLUMNS } else { &[] }).copied().collect();
+        let rows = RowFile::create(path, &header)?;
+        Ok(Self { fields: vec![String::with_capacity(32); header.len()], rows })
     }
 
-    /// Appends one row (in memory until a chunk of whole rows is written out).
-    pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
+    /// Appends one sample (in memory until a chunk of whole rows is written out); a sample
+    /// without the trace's plane B columns fills them with `NaN`.
+    pub fn write(&mut self, r: &Record) -> std::io::Result<()> {
         use std::fmt::Write as _;
-        for (field, v) in self.fields.iter_mut().zip(row) {
+        let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
+        for (field, v) in self.fields.iter_mut().zip(r.a.iter().chain(&b)) {
             field.clear();
             let _ = write!(field, "{v:e}");
         }
@@ -236,10 +439,10 @@ pub enum TraceError {
     },
 }
 
-/// The longest line a `trace.csv` may have (bytes): a row of 19 numbers takes about 450.
+/// The longest line a `trace.csv` may have (bytes): a two-plane row of 40 numbers takes about 1000.
 pub const MAX_LINE_BYTES: usize = 64 << 10;
 
-/// Reads `trace.csv` at `path` strictly, passing each row to `row` in order, while `row`
+/// Reads `trace.csv` at `path` strictly, passing each sample to `row` in order, while `row`
 /// returns `true`; returns whether every row was read.
 ///
 /// The file must be a regular file (a device such as `/dev/zero`, a FIFO or a folder is
@@ -248,14 +451,15 @@ pub const MAX_LINE_BYTES: usize = 64 << 10;
 /// once in bounded memory.
 ///
 /// The header must hold every name of [`Trace::COLUMNS`] (other columns are
-/// ignored). Refused, naming the line and, where one is to blame, the
+/// ignored); a two-plane trace also every name of [`TraceB::COLUMNS`] (a header
+/// with some but not all of them is refused, naming the first missing). Refused, naming the line and, where one is to blame, the
 /// column: a row with more or fewer fields than the header (a ragged row), a
 /// field that is not a number (`NaN`, `inf` and `-inf`, which the plant
 /// writes for non-finite values, are numbers), a non-finite time, a time
 /// that does not increase (running backwards or repeating), and a last line
 /// without its line end (a file cut in the middle of a row, whose last field
 /// may read as a number it never was).
-pub fn read_rows(path: &Path, mut row: impl FnMut(&Row) -> bool) -> Result<bool, TraceError> {
+pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bool, TraceError> {
     let io = |source| TraceError::Io { path: path.to_path_buf(), source };
     let bad = |line: u64, column: Option<&str>, what: String| TraceError::Malformed {
         path: path.to_path_buf(),
@@ -279,13 +483,26 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row) -> bool) -> Result<bool,
         return Err(bad(1, None, "empty file: no header".to_string()));
     }
     let header: Vec<String> = record.iter().map(|h| String::from_utf8_lossy(h).trim().to_string()).collect();
+    let find = |name: &str| header.iter().position(|h| h == name);
     let mut index = [0usize; WIDTH];
     for (slot, name) in index.iter_mut().zip(Trace::COLUMNS) {
-        *slot = header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| bad(1, Some(name), format!("the header has no column `{name}`")))?;
+        *slot = find(name).ok_or_else(|| bad(1, Some(name), format!("the header has no column `{name}`")))?;
     }
+    let index_b = if TraceB::COLUMNS.iter().any(|name| find(name).is_some()) {
+        let mut index_b = [0usize; WIDTH_B];
+        for (slot, name) in index_b.iter_mut().zip(TraceB::COLUMNS) {
+            *slot = find(name).ok_or_else(|| {
+                bad(
+                    1,
+                    Some(name),
+                    format!("the header has plane B columns but not `{name}`: a two-plane trace has all of them"),
+                )
+            })?;
+        }
+        Some(index_b)
+    } else {
+        None
+    };
     let mut previous_t = f64::NEG_INFINITY;
     let mut last_line = 1;
     let mut values = [0.0; WIDTH];
@@ -299,10 +516,23 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row) -> bool) -> Result<bool,
                 format!("{} fields where the header has {}: a ragged or cut row", record.len(), header.len()),
             ));
         }
-        for ((v, &i), name) in values.iter_mut().zip(&index).zip(Trace::COLUMNS) {
+        let number = |i: usize, name: &str| {
             let field = std::str::from_utf8(&record[i]).unwrap_or("").trim();
-            *v = field.parse::<f64>().map_err(|_| bad(line, Some(name), format!("`{field}` is not a number")))?;
+            field.parse::<f64>().map_err(|_| bad(line, Some(name), format!("`{field}` is not a number")))
+        };
+        for ((v, &i), name) in values.iter_mut().zip(&index).zip(Trace::COLUMNS) {
+            *v = number(i, name)?;
         }
+        let b = match &index_b {
+            Some(index_b) => {
+                let mut b = [0.0; WIDTH_B];
+                for ((v, &i), name) in b.iter_mut().zip(index_b).zip(TraceB::COLUMNS) {
+                    *v = number(i, name)?;
+                }
+                Some(b)
+            }
+            None => None,
+        };
         let t = values[col::T_S];
         if !t.is_finite() {
             return Err(bad(line, Some("t_s"), format!("time {t} is not finite")));
@@ -312,7 +542,7 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Row) -> bool) -> Result<bool,
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        if !row(&values) {
+        if !row(&Record { a: values, b }) {
             return Ok(false);
         }
     }

@@ -7,10 +7,14 @@
 //! - `types`: opens the run's `ack` service with other message types, as a
 //!   controller of another protocol version would, and exits 2;
 //! - `version`: answers the hello with an ack of the next protocol version (5);
+//! - `two-axes`: a controller that can run two axes only (a planar one written against the
+//!   wire): refuses a four-axis hello with status 3 (`Refusal::Axes`), as the protocol says;
 //! - `other-session`: accepts the hello, then answers every sensor frame
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
 //! - `nan`: answers with the law's currents, but NaN on x from sample 100 on;
+//! - `die`: answers with the law's currents until sample `--die-at` (default 4000), then
+//!   kills itself with SIGKILL, as a controller killed in the middle of a run;
 //! - `no-wake`: answers every frame with the law's currents but never wakes
 //!   the plant: it polls every millisecond, asks for no wake-up and does not
 //!   serve `command/wake`.
@@ -28,6 +32,7 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().collect();
     let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1)).cloned();
     let mode = value("--mode").unwrap_or_default();
+    let die_at: u64 = value("--die-at").and_then(|v| v.parse().ok()).unwrap_or(4000);
     let Some(id) = value("--run-id").or_else(|| std::env::var("AMB_TESTBED_RUN_ID").ok()) else {
         eprintln!("rogue-controller: no run id");
         return ExitCode::from(2);
@@ -58,6 +63,13 @@ fn main() -> ExitCode {
         std::thread::sleep(Duration::from_millis(1));
     };
     let mut ack = Ack::new(hello.session, hello.token, 0, "pd", &format!("rogue controller, mode {mode}"));
+    if mode == "two-axes" && hello.axes != wire::AXES {
+        let why = format!("this controller runs {} axes, the plant asks for {}", wire::AXES, hello.axes);
+        let refusal = Ack::new(hello.session, hello.token, wire::Refusal::Axes.code(), "pd", &why);
+        handshake.send(refusal).expect("ack");
+        std::thread::sleep(Duration::from_secs(1));
+        return ExitCode::from(2);
+    }
     if mode == "version" {
         ack.protocol_version = wire::PROTOCOL_VERSION + 1;
         handshake.send(ack).expect("ack");
@@ -130,10 +142,23 @@ fn main() -> ExitCode {
         if mode == "every-other" && f.seq % 2 == 1 {
             continue;
         }
+        if mode == "die" && f.seq >= die_at {
+            die();
+        }
         let mut r = reply(&mut law, &f);
         if mode == "nan" && f.seq >= 100 {
             r.current_a[0] = f64::NAN;
         }
         frames.send(r).expect("reply");
     }
+}
+
+/// Ends the process by SIGKILL (no destructor, no STOPPING frame), as `kill -9` would.
+fn die() -> ! {
+    #[cfg(unix)]
+    // SAFETY: raise(2) has no memory-safety preconditions.
+    unsafe {
+        libc::raise(libc::SIGKILL);
+    }
+    std::process::abort()
 }

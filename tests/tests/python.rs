@@ -273,15 +273,27 @@ fn the_kits_pytest_suite_passes() {
 /// (the in-process `sampled` run of the same scene), byte for byte.
 #[test]
 fn python_pd_in_lockstep_writes_the_rust_pd_trace_byte_for_byte() {
-    let dir = TempDir::new("py-pd-identical");
-    let sets = ["scene.duration_s=0.05", "output.plots=false"];
+    python_pd_writes_the_rust_pd_trace("cosim-10g.toml", "pd");
+}
+
+/// Issue 17: the same on the two-plane rotor (four axes, `pd` once per bearing plane), on the
+/// asymmetric 10 G scene through its first impacts at both planes.
+#[test]
+fn python_pd_on_the_two_plane_scene_writes_the_rust_pd_trace_byte_for_byte() {
+    python_pd_writes_the_rust_pd_trace("two-plane-asymmetric-10g.toml", "pd-2p");
+}
+
+fn python_pd_writes_the_rust_pd_trace(scene_file: &str, name: &str) {
+    let dir = TempDir::new(&format!("py-{name}-identical"));
+    let sets = ["scene.duration_s=0.05", "output.plots=false", "controller.law=pd"];
     let sampled = dir.join("sampled");
     let sampled_sets: Vec<&str> = sets.iter().copied().chain(["controller.mode=sampled"]).collect();
-    assert_exit(&output_within(&mut plant_run(&scene("cosim-10g.toml"), &sampled, &sampled_sets), LIMIT), 0);
+    assert_exit(&output_within(&mut plant_run(&scene(scene_file), &sampled, &sampled_sets), LIMIT), 0);
 
-    let id = run_id("pd");
+    let id = run_id(name);
     let out = dir.join("python");
-    let mut plant_cmd = plant_run(&scene("cosim-10g.toml"), &out, &sets);
+    let lockstep_sets: Vec<&str> = sets.iter().copied().chain(["controller.mode=lockstep"]).collect();
+    let mut plant_cmd = plant_run(&scene(scene_file), &out, &lockstep_sets);
     plant_cmd.args(["--controller", "external", "--run-id", &id]);
     let plant = Proc::spawn(&mut plant_cmd);
     let ctl = Proc::spawn(&mut python_controller("pd.py", &["--run-id", &id]));

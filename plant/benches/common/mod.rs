@@ -1,6 +1,7 @@
-//! The model and states the derivative is measured on, shared by the criterion bench
+//! The models and states the derivative is measured on, shared by the criterion bench
 //! (`benches/model.rs`, time) and `examples/derivative_count.rs` (instruction counts), so
-//! that both measure the same thing.
+//! that both measure the same thing: the planar model, and the two-plane rotor (the default
+//! scene as its symmetric two-plane machine) with both planes in the planar contact state.
 
 use plant::config::{validate, RawScene};
 use plant::model::{ix, Control, Model, State};
@@ -39,5 +40,50 @@ pub fn contact_state() -> State {
     y[ix::WR] = std::f64::consts::TAU * 500.0;
     y[ix::WB] = 1000.0;
     y[ix::TB] = 0.3;
+    y
+}
+
+/// The default scene's symmetric two-plane machine under the same shock, the continuous PD at
+/// each plane.
+#[allow(dead_code)]
+pub fn two_plane_model() -> (plant_physics::two_plane::Model, plant::config::Scene) {
+    let mut raw = RawScene {
+        shock: vec![toml::from_str(
+            "kind = \"double_half_sine\"\npeak_g = 10.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = 0.0",
+        )
+        .expect("shock")],
+        ..Default::default()
+    };
+    raw.rotor.model = plant::config::RotorModel::TwoPlane;
+    raw.rotor.mass_kg = 23.0;
+    raw.rotor.polar_inertia_kg_m2 = 11.62e-3;
+    let scene = validate(raw, Path::new(".")).expect("scene");
+    let gains = plant::run::plane_gains(&scene).expect("gains");
+    let model = plant_physics::two_plane::Model {
+        params: scene.two_plane.clone().expect("two-plane"),
+        base: scene.base.clone(),
+        control: [Control::Continuous(gains[0]), Control::Continuous(gains[1])],
+        race_parked: [false; 2],
+    };
+    (model, scene)
+}
+
+/// [`contact_state`] at both planes of the two-plane rotor: the axis 165 µm down and moving, no
+/// tilt, each race pushed onto its lower balls.
+#[allow(dead_code)]
+pub fn two_plane_contact_state() -> plant_physics::two_plane::State {
+    use plant_physics::two_plane::ix as t;
+    let p = contact_state();
+    let mut y = [0.0; plant_physics::two_plane::N];
+    for (from, to) in [(ix::XR, t::X), (ix::YR, t::Y), (ix::TR, t::TR)] {
+        y[to] = p[from];
+        y[to + t::V] = p[from + 6];
+    }
+    for race in t::RACE {
+        for k in 0..3 {
+            y[race + k] = p[ix::XB + k];
+            y[race + k + t::V] = p[ix::XB + k + 6];
+        }
+    }
     y
 }

@@ -15,3 +15,4 @@ pub mod integrate;
 pub mod model;
 pub mod park;
 pub mod stability;
+pub mod two_plane;

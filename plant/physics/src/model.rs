@@ -203,8 +203,40 @@ pub fn cage_angle(p: &Params, theta_b: f64) -> f64 {
 pub enum Control {
     /// PD evaluated inside the derivative on the exact Δ, Δ̇ (the study's setup).
     Continuous(PdGains),
+    /// The continuous PD reading its sensor signal plus a sine ([`SensorSine`]): the summing
+    /// point of a sensitivity measurement (ISO 14839-3) on the continuous loop.
+    ContinuousExcited(PdGains, SensorSine),
     /// A current held over the macro step (zero-order hold of a sampled law).
     Held([f64; 2]),
+}
+
+/// A sine added to the sensor signal the controller reads, per axis (V):
+/// `E(t) = a_k sin(ω t + φ)`, with its rate `Ė(t) = a_k ω cos(ω t + φ)`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct SensorSine {
+    /// Amplitude per axis, x then y (V); 0 on an axis not excited.
+    pub amplitude_v: [f64; 2],
+    /// Angular frequency ω (rad/s).
+    pub omega_rad_s: f64,
+    /// Phase φ at t = 0 (rad).
+    pub phase_rad: f64,
+}
+
+impl SensorSine {
+    /// `(E(t), Ė(t))` per axis (V, V/s).
+    ///
+    /// ```
+    /// use plant_physics::model::SensorSine;
+    /// let e = SensorSine { amplitude_v: [0.0, 2.0], omega_rad_s: 3.0, phase_rad: 0.0 };
+    /// let (v, rate) = e.at(0.0);
+    /// assert_eq!((v, rate), ([0.0, 0.0], [0.0, 6.0]));
+    /// ```
+    #[inline]
+    pub fn at(&self, t: f64) -> ([f64; 2], [f64; 2]) {
+        let (s, c) = (self.omega_rad_s * t + self.phase_rad).sin_cos();
+        let a = self.amplitude_v;
+        ([a[0] * s, a[1] * s], [a[0] * self.omega_rad_s * c, a[1] * self.omega_rad_s * c])
+    }
 }
 
 /// The model: parameters, base motion, and the control in force.
@@ -261,6 +293,86 @@ fn frame_force(g: f64, a_h: Vector2<f64>) -> Vector2<f64> {
     Vector2::new(a_h.x, a_h.y + g)
 }
 
+/// A touchdown race's state, relative to the housing: centre (m), velocity (m/s), angle (rad)
+/// and spin speed (rad/s).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RaceInput {
+    pub(crate) position: Vector2<f64>,
+    pub(crate) velocity: Vector2<f64>,
+    pub(crate) angle: f64,
+    pub(crate) speed: f64,
+}
+
+impl RaceInput {
+    /// The race of a state whose race position pair starts at `x` (its angle at `x + 2`, its
+    /// velocities `n/2` further on: the `[positions; velocities]` layout of a state of size `n`).
+    #[inline]
+    pub(crate) fn of<const M: usize>(y: &[f64; M], x: usize) -> Self {
+        let v = x + M / 2;
+        Self {
+            position: Vector2::new(y[x], y[x + 1]),
+            velocity: Vector2::new(y[v], y[v + 1]),
+            angle: y[x + 2],
+            speed: y[v + 2],
+        }
+    }
+}
+
+/// What one touchdown bearing does at an instant: the rotor – race contact, the support's force
+/// on the race, and the race's accelerations relative to the housing.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RaceDynamics {
+    pub(crate) contact: RotorRaceForce,
+    pub(crate) balls: BallForce,
+    /// The race centre's acceleration relative to the housing (m/s²).
+    pub(crate) accel: Vector2<f64>,
+    /// The race's angular acceleration (rad/s²).
+    pub(crate) spin_accel: f64,
+}
+
+/// One bearing plane's touchdown bearing (MODEL.md §4, §5), the kernel both rotor models call
+/// per plane: the rotor's centre in that plane at `rotor` (m) moving at `rotor_v` (m/s) and
+/// spinning at `w` (rad/s), the race `race`, the housing accelerated by `a_h` (m/s²). The race
+/// obeys `m_b r̈_b = F_balls − F_contact − m_b (g ŷ + a_h)`, `J_b θ̈_b = r_inner F_t + M_drag`.
+///
+/// Always inlined: called from two models, it would otherwise become a function of its own,
+/// which the compiler optimises worse than the code inlined in each derivative (the planar
+/// derivative took 7 % more instructions that way, `examples/derivative_count.rs`).
+#[inline(always)]
+pub(crate) fn race_dynamics(
+    p: &Params,
+    race: RaceInput,
+    rotor: Vector2<f64>,
+    rotor_v: Vector2<f64>,
+    w: f64,
+    a_h: Vector2<f64>,
+) -> RaceDynamics {
+    let contact = p.contact.force(rotor - race.position, rotor_v - race.velocity, w, race.speed);
+    let (cage, cage_rate) = match p.cage {
+        Cage::Rotating => (p.cage_phase + p.cage_ratio * race.angle, p.cage_ratio * race.speed),
+        Cage::Fixed => (p.cage_phase, 0.0),
+    };
+    let balls = p.race_support(race.position, race.velocity, cage, cage_rate);
+    let race_load = balls.on_race.norm();
+    let race_torque = contact.torque_race + p.drag.torque(race.speed, race_load);
+    RaceDynamics {
+        contact,
+        balls,
+        accel: (balls.on_race - contact.on_rotor) / p.race_mass - Vector2::new(0.0, p.gravity) - a_h,
+        spin_accel: race_torque / p.race_inertia,
+    }
+}
+
+/// The spin deceleration of a parked race (rad/s²): the drag at speed `speed` (rad/s) under
+/// the race's weight in the housing frame, `m_b |g ŷ + a_h|`.
+#[inline]
+pub(crate) fn parked_race_spin_accel(p: &Params, speed: f64, a_h: Vector2<f64>) -> f64 {
+    let frame = frame_force(p.gravity, a_h);
+    // hypot, not a norm, as before (kept for bit-identical traces).
+    let load = p.race_mass * frame.x.hypot(frame.y);
+    p.drag.torque(speed, load) / p.race_inertia
+}
+
 impl Model {
     /// Evaluates all forces and the state derivative at time `t`.
     #[inline]
@@ -276,6 +388,13 @@ impl Model {
                 let u_dot = pair(y, VXR) * a_s;
                 saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
             }
+            Control::ContinuousExcited(gains, sine) => {
+                let a_s = p.loop_constants.sensor_gain_v_per_m;
+                let (e, e_dot) = sine.at(t);
+                let u = delta * a_s + Vector2::from(e);
+                let u_dot = pair(y, VXR) * a_s + Vector2::from(e_dot);
+                saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
+            }
             Control::Held(i) => i,
         };
         let amb_force = p.amb.force(delta, current.into());
@@ -283,12 +402,8 @@ impl Model {
             return self.evaluate_parked(t, y, a_h, current, amb_force);
         }
 
-        let contact = p.contact.force(delta - pair(y, XB), pair(y, VXR) - pair(y, VXB), y[WR], y[WB]);
-        let (cage, cage_rate) = match p.cage {
-            Cage::Rotating => (p.cage_phase + p.cage_ratio * y[TB], p.cage_ratio * y[WB]),
-            Cage::Fixed => (p.cage_phase, 0.0),
-        };
-        let balls = p.race_support(pair(y, XB), pair(y, VXB), cage, cage_rate);
+        let race = race_dynamics(p, RaceInput::of(y, XB), delta, pair(y, VXR), y[WR], a_h);
+        let contact = race.contact;
 
         // Rotor.
         let (m, e, g) = (p.rotor_mass, p.eccentricity, p.gravity);
@@ -305,18 +420,14 @@ impl Model {
                 (r3 + e * r.perp(&unbalance)) / p.rotor_inertia
             }
         };
-        // Race.
-        let mb = p.race_mass;
-        let race_load = balls.on_race.norm();
-        let race_torque = contact.torque_race + p.drag.torque(y[WB], race_load);
 
         let mut dy = [0.0; N];
         dy[..6].copy_from_slice(&y[6..]);
         set_pair(&mut dy, VXR, (r - Vector2::new(-s, c) * (m * e) * spin_accel) / m);
         dy[WR] = spin_accel;
-        set_pair(&mut dy, VXB, (balls.on_race - contact.on_rotor) / mb - Vector2::new(0.0, g) - a_h);
-        dy[WB] = race_torque / p.race_inertia;
-        Evaluation { dy, contact, balls, current, amb_force, housing_accel: a_h }
+        set_pair(&mut dy, VXB, race.accel);
+        dy[WB] = race.spin_accel;
+        Evaluation { dy, contact, balls: race.balls, current, amb_force, housing_accel: a_h }
     }
 }
 
@@ -348,9 +459,6 @@ impl Model {
                 (r3 + e * r.perp(&unbalance)) / p.rotor_inertia
             }
         };
-        // The race's load is its weight in the housing frame; hypot, not a norm, as before
-        // (kept for bit-identical traces).
-        let load = p.race_mass * frame.x.hypot(frame.y);
         let mut dy = [0.0; N];
         dy[XR] = y[VXR];
         dy[YR] = y[VYR];
@@ -358,7 +466,7 @@ impl Model {
         dy[TB] = y[WB];
         set_pair(&mut dy, VXR, (r - Vector2::new(-s, c) * (m * e) * spin_accel) / m);
         dy[WR] = spin_accel;
-        dy[WB] = p.drag.torque(y[WB], load) / p.race_inertia;
+        dy[WB] = parked_race_spin_accel(p, y[WB], a_h);
         Evaluation {
             dy,
             contact: RotorRaceForce::default(),

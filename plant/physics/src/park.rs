@@ -34,6 +34,7 @@
 
 use crate::model::{ix, Model, Params, Release, State};
 use nalgebra::Vector2;
+use shock_table::Programme;
 
 /// Safety margin of the gap test (m): `2 r_cl + r₀/20` (see the module doc).
 pub fn margin(p: &Params) -> f64 {
@@ -54,39 +55,73 @@ fn length(v: Vector2<f64>) -> f64 {
 /// from the state `y` at `t0` (see the module doc).
 pub fn clear(model: &Model, t0: f64, h: f64, y: &State) -> bool {
     use ix::*;
-    let p = &model.params;
-    let d = length(pair(y, XR) - pair(y, XB));
-    let w = length(pair(y, VXR) - pair(y, VXB));
     let dy = model.evaluate(t0, y).dy;
-    let a = length(pair(&dy, VXR));
-    let a0 = Vector2::from(model.base.accel(t0));
-    let change = |t: f64| length(Vector2::from(model.base.accel(t)) - a0);
+    let motion = GapMotion {
+        distance: length(pair(y, XR) - pair(y, XB)),
+        speed: length(pair(y, VXR) - pair(y, VXB)),
+        accel: length(pair(&dy, VXR)),
+    };
+    stays_open(&model.params, &model.base, t0, h, motion)
+}
+
+/// The rotor's motion relative to one race at the start of a macro step, in that bearing plane.
+#[derive(Clone, Copy, Debug)]
+pub struct GapMotion {
+    /// `|d|`, the distance between the rotor's and the race's centres (m).
+    pub distance: f64,
+    /// `|w|`, their relative speed (m/s).
+    pub speed: f64,
+    /// `|a|`, the rotor's acceleration relative to the housing (m/s²).
+    pub accel: f64,
+}
+
+/// The test of the module doc for one bearing plane of parameters `p`, the housing moved by
+/// `base`: whether the gap stays open by the margin over `[t0, t0 + h]`.
+pub fn stays_open(p: &Params, base: &Programme, t0: f64, h: f64, m: GapMotion) -> bool {
+    let a0 = Vector2::from(base.accel(t0));
+    let change = |t: f64| length(Vector2::from(base.accel(t)) - a0);
     let da = change(t0 + 0.5 * h).max(change(t0 + h));
-    let travel = 2.0 * (w * h + 0.5 * (a + da) * h * h);
-    d + travel + margin(p) <= p.contact.gap
+    let travel = 2.0 * (m.speed * h + 0.5 * (m.accel + da) * h * h);
+    m.distance + travel + margin(p) <= p.contact.gap
 }
 
 /// Parks the race: its translational velocity relative to the housing is set to zero.
 pub fn park(y: &mut State) {
-    y[ix::VXB] = 0.0;
-    y[ix::VYB] = 0.0;
+    park_race(y, ix::XB);
+}
+
+/// Parks the race whose position pair starts at `x` in a `[positions; velocities]` state.
+pub fn park_race<const M: usize>(y: &mut [f64; M], x: usize) {
+    y[x + M / 2] = 0.0;
+    y[x + 1 + M / 2] = 0.0;
 }
 
 /// Releases the race at time `t` with the state `release` says (see the module doc).
 pub fn release(model: &Model, t: f64, y: &mut State, release: Release) {
-    y[ix::VXB] = 0.0;
-    y[ix::VYB] = 0.0;
+    release_race(&model.params, &model.base, t, y, ix::XB, release);
+}
+
+/// Releases the race of parameters `p` whose position pair starts at `x` (its angle at `x + 2`)
+/// in a `[positions; velocities]` state, at time `t`, as `release` says.
+pub fn release_race<const M: usize>(
+    p: &Params,
+    base: &Programme,
+    t: f64,
+    y: &mut [f64; M],
+    x: usize,
+    release: Release,
+) {
+    park_race(y, x);
     if release == Release::Held {
         return;
     }
-    let p = &model.params;
-    let a_h = Vector2::from(model.base.accel(t));
+    let a_h = Vector2::from(base.accel(t));
     // The race feels −m_b (g ŷ + a_h) in the housing frame: it rests along that direction.
     let push = -a_h - Vector2::new(0.0, p.gravity);
-    let cage = crate::model::cage_angle(p, y[ix::TB]);
+    let cage = crate::model::cage_angle(p, y[x + 2]);
     let eps = rest_position(p, push, cage);
-    y[ix::XB] = eps.x;
-    y[ix::YB] = eps.y;
+    y[x] = eps.x;
+    y[x + 1] = eps.y;
 }
 
 /// Where the race rests on its supports (m, relative to the housing) under the specific force

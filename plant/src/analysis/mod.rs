@@ -14,6 +14,7 @@
 pub mod classify;
 pub mod poincare;
 pub mod spectrum;
+pub mod tilt;
 
 use crate::bounded::Strided;
 use crate::plot::{self, PointGroup, Scale, Series};
@@ -219,23 +220,37 @@ impl Analyzer {
     }
 }
 
-/// Analyses a trace in memory (no spectrogram).
+/// Analyses a trace in memory (no spectrogram; plane A of a two-plane trace).
 pub fn analyze(trace: &Trace, spec: &AnalysisSpec) -> Analysis {
     let mut a = Analyzer::new(*spec, None);
     trace.rows().for_each(|r| a.push(&r));
     a.finish().0
 }
 
-/// Writes `spectrum.png`, `whirl_spectrum.png`, `spectrogram.png` and `poincare.png`;
-/// a chart with nothing to draw (a run stopped within a few samples) is not written.
-/// Returns the charts written.
+/// The analysis charts' files, without a tag (the planar model) and with the tags `_a`, `_b`
+/// (a two-plane run's planes).
+pub const PLOT_FILES: [[&str; 4]; 3] = [
+    ["spectrum.png", "whirl_spectrum.png", "spectrogram.png", "poincare.png"],
+    ["spectrum_a.png", "whirl_spectrum_a.png", "spectrogram_a.png", "poincare_a.png"],
+    ["spectrum_b.png", "whirl_spectrum_b.png", "spectrogram_b.png", "poincare_b.png"],
+];
+
+/// Writes `spectrum.png`, `whirl_spectrum.png`, `spectrogram.png` and `poincare.png`, with
+/// `tag` (`""`, `"_a"` or `"_b"`) before the extension ([`PLOT_FILES`]); a chart with nothing
+/// to draw (a run stopped within a few samples) is not written. Returns the charts written.
 pub fn write_plots(
     dir: &Path,
     name: &str,
+    tag: &str,
     a: &Analysis,
     data: &AnalysisData,
     gap: f64,
 ) -> Result<Vec<&'static str>, plot::PlotError> {
+    let [f_spectrum, f_whirl, f_spectrogram, f_poincare] = PLOT_FILES[match tag {
+        "_a" => 1,
+        "_b" => 2,
+        _ => 0,
+    }];
     let mut written = Vec::new();
     let (t, x, y) = (&data.t_s[..], &data.x_m[..], &data.y_m[..]);
     if t.len() < 8 {
@@ -258,7 +273,7 @@ pub fn write_plots(
     let keep = sx.freq_hz.partition_point(|f| *f <= f_max);
     let (ax, ay) = (um(&sx.amplitude[..keep]), um(&sy.amplitude[..keep]));
     let r = plot::lines(
-        &dir.join("spectrum.png"),
+        &dir.join(f_spectrum),
         &title(&format!("amplitude spectrum, steady window {:.2}–{:.2} s", a.steady_window_s[0], a.steady_window_s[1])),
         "frequency (Hz)",
         "amplitude (µm)",
@@ -268,20 +283,20 @@ pub fn write_plots(
         ],
         Scale::Log10,
     );
-    skip_empty(r, "spectrum.png", &mut written)?;
+    skip_empty(r, f_spectrum, &mut written)?;
 
     let w = spectrum::whirl_spectrum(x, y, dt);
     let (lo, hi) = (w.freq_hz.partition_point(|f| *f < -f_max), w.freq_hz.partition_point(|f| *f <= f_max));
     let aw = um(&w.amplitude[lo..hi]);
     let r = plot::lines(
-        &dir.join("whirl_spectrum.png"),
+        &dir.join(f_whirl),
         &title("spectrum of dx + j·dy (f > 0 forward, f < 0 backward whirl)"),
         "frequency (Hz)",
         "amplitude (µm)",
         &[Series { label: "dx + j·dy", x: &w.freq_hz[lo..hi], y: &aw }],
         Scale::Log10,
     );
-    skip_empty(r, "whirl_spectrum.png", &mut written)?;
+    skip_empty(r, f_whirl, &mut written)?;
 
     if let Some(sg) = data.spectrogram.as_ref().filter(|sg| !sg.time_s.is_empty()) {
         // 100 dB of dynamic range below the loudest cell.
@@ -289,7 +304,7 @@ pub fn write_plots(
         let top = db.iter().flatten().copied().fold(f64::NEG_INFINITY, f64::max);
         db.iter_mut().flatten().for_each(|v| *v = v.max(top - 100.0));
         let r = plot::heatmap(
-            &dir.join("spectrogram.png"),
+            &dir.join(f_spectrogram),
             &title("spectrogram of dx + j·dy (f < 0: backward whirl)"),
             "time (s)",
             "frequency (Hz)",
@@ -298,7 +313,7 @@ pub fn write_plots(
             &db,
             "amplitude (dB re 1 m)",
         );
-        skip_empty(r, "spectrogram.png", &mut written)?;
+        skip_empty(r, f_spectrogram, &mut written)?;
     }
 
     let (mut tx, mut ty, mut sx_, mut sy_) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -315,7 +330,7 @@ pub fn write_plots(
         (0..=360).map(|d| (d as f64).to_radians()).map(|a| [gap * 1e6 * a.cos(), gap * 1e6 * a.sin()]).collect();
     let (cx, cy): (Vec<f64>, Vec<f64>) = circle.iter().map(|p| (p[0], p[1])).unzip();
     let r = plot::scatter(
-        &dir.join("poincare.png"),
+        &dir.join(f_poincare),
         &title(&format!(
             "Poincaré map: {}{}",
             a.steady_class.name(),
@@ -330,6 +345,6 @@ pub fn write_plots(
         ],
         true,
     );
-    skip_empty(r, "poincare.png", &mut written)?;
+    skip_empty(r, f_poincare, &mut written)?;
     Ok(written)
 }

@@ -5,6 +5,10 @@
 //! both run accurately (DP5 at rtol 1e-10) so that it measures the model,
 //! not the integration. Cost: wall time per simulated second with the
 //! scene's own integrator. Writes `models.csv` and `models_<scene>.png`.
+//!
+//! Then what the second bearing plane changes ([`TWO_PLANE_VARIANTS`]): the study's planar model
+//! against the symmetric two-plane machine and each asymmetry on its own, the error the larger
+//! of the two planes' against the planar trace, the cost against the planar model's.
 
 use super::rows::{self, ModelRow};
 use super::{measure, window_error, with_integrator, BenchScene, IntegratorSetting, WINDOW};
@@ -53,6 +57,36 @@ pub const VARIANTS: &[Variant] = &[
             "amb.force_law=\"linear\"",
         ],
     },
+];
+
+/// The study's model choices (speed held, linear bearing): the planar reference of the
+/// two-plane rows.
+pub const STUDY: &[&str] = &["rotor.spin=\"held\"", "amb.force_law=\"linear\""];
+
+/// The study's planar scene as its symmetric two-plane machine (docs/MODEL.md §10.1).
+pub const SYMMETRIC_TWO_PLANE: &[&str] =
+    &["rotor.model=\"two_plane\"", "rotor.mass_kg=23.0", "rotor.polar_inertia_kg_m2=0.01162"];
+
+/// What the second plane changes: the symmetric two-plane machine, then one asymmetry at a
+/// time. Their rows compare each plane's motion with the planar study model's (the larger of
+/// the two planes' errors) and their cost with its cost.
+pub const TWO_PLANE_VARIANTS: &[Variant] = &[
+    Variant { name: "two-plane: symmetric", sets: &[] },
+    Variant {
+        name: "two-plane: centre of mass 60 mm off mid-span",
+        sets: &[
+            "rotor.bearing_a_mm=-120.0",
+            "rotor.bearing_b_mm=240.0",
+            "rotor.end_a_mm=-170.0",
+            "rotor.end_b_mm=290.0",
+        ],
+    },
+    Variant { name: "two-plane: couple unbalance 50 µrad", sets: &["rotor.couple_unbalance_urad=50.0"] },
+    Variant {
+        name: "two-plane: sensors 30 mm outboard",
+        sets: &["rotor.sensor_a_mm=-210.0", "rotor.sensor_b_mm=210.0"],
+    },
+    Variant { name: "two-plane: gap of plane B 0.25 mm", sets: &["touchdown.b.air_gap_mm=0.25"] },
 ];
 
 fn overridden(b: &BenchScene, sets: &[&str]) -> anyhow::Result<Scene> {
@@ -107,9 +141,17 @@ pub fn models(
             });
         }
     }
+    for b in super::scenes(config_dir)? {
+        rows.extend(second_plane(&b, repeats, log)?);
+    }
     crate::table::write_with_header(&out.join("models.csv"), rows::MODELS_HEADER, &rows)?;
     for scene in ["levitation", "impact", "rub"] {
-        let here: Vec<&ModelRow> = rows.iter().filter(|r| r.scene == scene && r.variant != "full").collect();
+        let here: Vec<&ModelRow> = rows
+            .iter()
+            // The simplifications against the full model; the two-plane rows have another reference.
+            .filter(|r| r.scene == scene && r.variant != "full" && r.variant != "planar study model")
+            .filter(|r| !r.variant.starts_with("two-plane"))
+            .collect();
         let xs: Vec<Vec<f64>> = here.iter().map(|r| vec![r.speedup]).collect();
         let ys: Vec<Vec<f64>> = here.iter().map(|r| vec![r.err_rms.max(1e-12)]).collect();
         let groups: Vec<PointGroup> =
@@ -122,6 +164,45 @@ pub fn models(
             &[],
             &groups,
         )?;
+    }
+    Ok(rows)
+}
+
+/// The rows of [`TWO_PLANE_VARIANTS`] on one bench scene: each against the planar study model
+/// (`planar study model`, speed-up 1), both run accurately for the error; the error is the
+/// larger of the two planes'.
+fn second_plane(b: &BenchScene, repeats: usize, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<ModelRow>> {
+    let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.params.contact.gap);
+    let accurate = |s: &Scene| run(&with_integrator(s, Method::Dp5, IntegratorSetting::Rtol(1e-10)), &mut Quiet);
+    let planar = overridden(b, STUDY)?;
+    let reference = accurate(&planar)?.trace;
+    let planar_cost = measure(&planar, repeats)?.best_wall / planar.duration;
+    let mut rows = vec![ModelRow {
+        scene: b.name.into(),
+        variant: "planar study model".into(),
+        err_rms: 0.0,
+        err_max: 0.0,
+        wall_s_per_sim_s: planar_cost,
+        speedup: 1.0,
+    }];
+    for v in TWO_PLANE_VARIANTS {
+        let sets: Vec<&str> = STUDY.iter().chain(SYMMETRIC_TWO_PLANE).chain(v.sets).copied().collect();
+        let scene = overridden(b, &sets)?;
+        let trace = accurate(&scene)?.trace;
+        let (rms, max) = (0..2).fold((0.0f64, 0.0f64), |(rms, max), i| {
+            let (r, m) = window_error(&trace.plane(i), &reference, t0, t1, gap);
+            (rms.max(r), max.max(m))
+        });
+        let cost = measure(&scene, repeats)?.best_wall / scene.duration;
+        log(&format!("{}: {}: error rms {rms:.2e} max {max:.2e}, speed-up {:.2}", b.name, v.name, planar_cost / cost));
+        rows.push(ModelRow {
+            scene: b.name.into(),
+            variant: v.name.into(),
+            err_rms: rms,
+            err_max: max,
+            wall_s_per_sim_s: cost,
+            speedup: planar_cost / cost,
+        });
     }
     Ok(rows)
 }

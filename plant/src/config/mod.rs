@@ -18,7 +18,7 @@ pub mod validate;
 pub use overrides::apply_override;
 pub use raw::{
     ControlMode, DragChoice, Fallback, ForceLaw, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
-    ReleaseChoice, SpinChoice, SupportChoice,
+    ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
 pub use validate::{finite, non_negative, positive, range, validate};
 
@@ -147,8 +147,11 @@ pub struct IntegratorSettings {
     pub method: Method,
     /// Relative tolerance.
     pub rtol: f64,
-    /// Absolute tolerance per state component.
+    /// Absolute tolerance per state component of the planar model.
     pub atol: [f64; crate::model::N],
+    /// Absolute tolerances of positions (m), velocities (m/s), angles (rad) and angular speeds
+    /// (rad/s), from which each model's per-component tolerances are laid out.
+    pub atol_groups: [f64; 4],
     /// Substeps per macro step (fixed-step methods).
     pub substeps: u32,
     /// Substeps per macro step while the race is free (fixed-step methods, parked race); ≥ 1.
@@ -160,6 +163,16 @@ pub struct IntegratorSettings {
     pub realtime: RealtimeSetting,
 }
 
+impl IntegratorSettings {
+    /// Absolute tolerances per state component of the two-plane rotor
+    /// ([`plant_physics::two_plane::ix`]): the slopes and their rates count as angles and
+    /// angular speeds.
+    pub fn two_plane_atol(&self) -> [f64; plant_physics::two_plane::N] {
+        let [p, v, a, w] = self.atol_groups;
+        [p, p, a, a, a, p, p, a, p, p, a, v, v, w, w, w, v, v, w, v, v, w]
+    }
+}
+
 /// Initial-state settings.
 #[derive(Clone, Debug, Serialize)]
 pub struct InitialSettings {
@@ -169,6 +182,8 @@ pub struct InitialSettings {
     pub unbalance_phase: f64,
     /// Rotor offset (m).
     pub rotor_offset: [f64; 2],
+    /// Two-plane: offset of the slopes a, b (rad).
+    pub slope_offset: [f64; 2],
 }
 
 /// A validated scene, SI.
@@ -180,8 +195,11 @@ pub struct Scene {
     pub description: String,
     /// Simulated time (s).
     pub duration: f64,
-    /// Physics.
+    /// Physics: the planar model's parameters, or, for a two-plane rotor, bearing plane A's
+    /// (its share of the rotor; the whole machine is in `two_plane`).
     pub params: Params,
+    /// The two-plane rotor (`rotor.model = "two_plane"`), or `None` for the planar model.
+    pub two_plane: Option<plant_physics::two_plane::Params>,
     /// Base motion.
     pub base: Programme,
     /// Controller.
@@ -227,17 +245,70 @@ impl Scene {
     }
 
     /// The common loop design the scene's law is built from: one conversion, scene to
-    /// [`controller::Design`].
+    /// [`controller::Design`] (plane A's, for a two-plane rotor).
     pub fn design(&self) -> controller::Design {
+        self.design_of(&self.params)
+    }
+
+    /// The design of each bearing plane (one for the planar model): the scene's closed loop
+    /// with the plane's own loop constants, its load share as the mass (the damping design and
+    /// the gravity bias act on it) and its own air gap.
+    pub fn plane_designs(&self) -> Vec<controller::Design> {
+        match &self.two_plane {
+            None => vec![self.design()],
+            Some(machine) => machine.planes.iter().map(|p| self.design_of(&p.params)).collect(),
+        }
+    }
+
+    /// The whole rotor's design a law is built from (`controller::build_rotor_law`) and the
+    /// hello carries: the planar design, or each plane's with the rotor's geometry.
+    pub fn rotor_design(&self) -> controller::RotorDesign {
+        match &self.two_plane {
+            None => controller::RotorDesign::Planar(self.design()),
+            Some(m) => {
+                let [a, b] = &m.planes;
+                controller::RotorDesign::TwoPlane {
+                    planes: [self.design_of(&a.params), self.design_of(&b.params)],
+                    geometry: controller::Geometry {
+                        mass_kg: m.rotor.mass,
+                        transverse_inertia_kg_m2: m.rotor.transverse_inertia,
+                        polar_inertia_kg_m2: m.rotor.polar_inertia,
+                        rated_speed_rad_s: m.rotor.speed,
+                        bearing_z_m: [a.station, b.station],
+                        sensor_z_m: [a.sensor, b.sensor],
+                    },
+                }
+            }
+        }
+    }
+
+    /// Bearing planes: 1 (planar) or 2.
+    pub fn planes(&self) -> usize {
+        if self.two_plane.is_some() {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// Plane `i`'s parameters (the planar model's for `i = 0` without a second plane).
+    pub fn plane(&self, i: usize) -> &Params {
+        match &self.two_plane {
+            Some(machine) => &machine.planes[i].params,
+            None => &self.params,
+        }
+    }
+
+    fn design_of(&self, params: &Params) -> controller::Design {
         let c = &self.controller;
         controller::Design {
             stiffness_n_per_m: c.stiffness,
             damping_ratio: c.damping_ratio,
             period_s: c.period,
             gravity_bias: c.gravity_bias,
-            current_limit_a: self.params.current_limit,
+            current_limit_a: params.current_limit,
             delay_samples: c.delay_samples,
-            constants: self.params.loop_constants,
+            constants: params.loop_constants,
         }
     }
 

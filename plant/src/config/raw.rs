@@ -67,12 +67,20 @@ pub struct RawMeta {
 
 scene_table! {
 /// `[rotor]`.
+///
+/// `model` chooses the planar model (one bearing plane, the study's: `mass_kg` and
+/// `polar_inertia_kg_m2` are the share one bearing carries) or the two-plane rotor (the whole
+/// rotor on two bearings with its tilt: they are the whole rotor's; the study's symmetric
+/// machine has 23 kg and 11.62e-3 kg·m², docs/MODEL.md §10.1). The keys after `drive_*` are the
+/// two-plane rotor's, `None` unless given, and refused in a planar scene.
 pub struct RawRotor {
-    /// m_r (kg).
+    /// `planar` or `two_plane`.
+    pub model: RotorModel = RotorModel::Planar,
+    /// m_r (kg); two-plane: the whole rotor's mass M.
     pub mass_kg: f64 = 11.5,
-    /// e (µm).
+    /// e (µm): the centre of mass's offset from the geometric axis (static unbalance).
     pub eccentricity_um: f64 = 2.0,
-    /// J_r (kg·m²).
+    /// J_r (kg·m²); two-plane: the whole rotor's I_p.
     pub polar_inertia_kg_m2: f64 = 5.81e-3,
     /// r_r (mm).
     pub radius_mm: f64 = 19.85,
@@ -82,11 +90,53 @@ pub struct RawRotor {
     pub unbalance_phase_deg: f64 = 0.0,
     /// `held` or `free`.
     pub spin: SpinChoice = SpinChoice::Held,
-    /// Speed-loop gain for `free` spin (N·m·s/rad).
+    /// Speed-loop gain for `free` spin (N·m·s/rad); two-plane: on the whole rotor.
     pub drive_gain_n_m_s: f64 = 0.05,
-    /// Drive torque limit for `free` spin (N·m).
+    /// Drive torque limit for `free` spin (N·m); two-plane: on the whole rotor.
     pub drive_torque_limit_n_m: f64 = 2.0,
+    /// Two-plane: transverse moment of inertia I_t about the centre of mass (kg·m²); none: 0.414.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transverse_inertia_kg_m2: Option<f64> = None,
+    /// Two-plane: couple unbalance, the tilt χ of the principal axis of inertia from the
+    /// geometric axis (µrad); none: 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub couple_unbalance_urad: Option<f64> = None,
+    /// Two-plane: the rotor-fixed direction of that tilt, from the static unbalance's (deg);
+    /// none: 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub couple_unbalance_phase_deg: Option<f64> = None,
+    /// Two-plane: axial position of bearing A (AMB and touchdown bearing) from the centre of
+    /// mass (mm), < 0; none: −180.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_a_mm: Option<f64> = None,
+    /// Two-plane: axial position of bearing B (mm), > 0; none: 180.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing_b_mm: Option<f64> = None,
+    /// Two-plane: axial position of plane A's displacement sensor (mm); none: `bearing_a_mm`
+    /// (collocated).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_a_mm: Option<f64> = None,
+    /// Two-plane: axial position of plane B's displacement sensor (mm); none: `bearing_b_mm`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_b_mm: Option<f64> = None,
+    /// Two-plane: axial position of the rotor's end on plane A's side (mm); none: −230.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_a_mm: Option<f64> = None,
+    /// Two-plane: axial position of the rotor's end on plane B's side (mm); none: 230.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_b_mm: Option<f64> = None,
 }
+}
+
+/// `rotor.model`: the rotor model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RotorModel {
+    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
+    #[default]
+    Planar,
+    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
+    TwoPlane,
 }
 
 scene_table! {
@@ -138,6 +188,12 @@ pub struct RawTouchdown {
     /// close: `equilibrium` (at rest on its supports under gravity and the current
     /// housing acceleration) or `held` (where it was parked, at rest).
     pub race_release: ReleaseChoice = ReleaseChoice::Equilibrium,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table> = None,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table> = None,
 }
 }
 
@@ -170,6 +226,12 @@ pub struct RawContact {
     pub stribeck_static_m_s: f64 = 0.1,
     /// v_d (m/s).
     pub stribeck_dynamic_m_s: f64 = 0.1,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table> = None,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table> = None,
 }
 }
 
@@ -190,6 +252,12 @@ pub struct RawAmb {
     pub nominal_gap_mm: f64 = 1.0,
     /// Largest pull of one magnet, from flux saturation (N).
     pub magnet_force_limit_n: f64 = 1000.0,
+    /// Two-plane: plane A's own values of this table's keys (the others are shared).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a: Option<toml::Table> = None,
+    /// Two-plane: plane B's own values of this table's keys.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<toml::Table> = None,
 }
 }
 
@@ -482,6 +550,12 @@ pub struct RawInitial {
     pub rotor_x_um: f64 = 0.0,
     /// Offset added to the rotor's initial y (µm).
     pub rotor_y_um: f64 = 0.0,
+    /// Two-plane: offset added to the initial slope a = dx/dz of the rotor axis (µrad); none: 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slope_x_urad: Option<f64> = None,
+    /// Two-plane: offset added to the initial slope b = dy/dz (µrad); none: 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slope_y_urad: Option<f64> = None,
 }
 }
 

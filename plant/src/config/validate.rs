@@ -28,6 +28,7 @@ use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
 use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
+use plant_physics::two_plane;
 use std::path::Path;
 
 /// Longest simulated time (s): about 11.6 days.
@@ -222,6 +223,200 @@ fn resolve_command(ctl: &mut RawController, base_dir: &Path) -> Result<(), Confi
     Ok(())
 }
 
+/// The rotor's values a bearing plane's planar parameters take: for the planar model the
+/// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
+struct Share {
+    gravity: f64,
+    mass: f64,
+    eccentricity: f64,
+    inertia: f64,
+    radius: f64,
+    speed: f64,
+    spin: Spin,
+}
+
+/// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`
+/// where plane B's table sets it.
+struct Keys<'a> {
+    /// The plane's letter and its own tables of `[touchdown]`, `[contact]`, `[amb]`.
+    plane: Option<(&'static str, [Option<&'a toml::Table>; 3])>,
+}
+
+impl Keys<'_> {
+    fn key(&self, table: usize, field: &str) -> String {
+        const TABLES: [&str; 3] = ["touchdown", "contact", "amb"];
+        match self.plane {
+            Some((plane, own)) if own[table].is_some_and(|t| t.contains_key(field)) => {
+                format!("{}.{plane}.{field}", TABLES[table])
+            }
+            _ => format!("{}.{field}", TABLES[table]),
+        }
+    }
+
+    fn td(&self, field: &str) -> String {
+        self.key(0, field)
+    }
+
+    fn ct(&self, field: &str) -> String {
+        self.key(1, field)
+    }
+
+    fn amb(&self, field: &str) -> String {
+        self.key(2, field)
+    }
+}
+
+/// One bearing plane's parameters, validated: its touchdown bearing (`[touchdown]`), contact
+/// laws (`[contact]`) and AMB (`[amb]`, `controller.current_limit_a`), with the rotor's `share`.
+fn bearing(
+    td: &RawTouchdown,
+    ct: &RawContact,
+    amb: &RawAmb,
+    ctl: &RawController,
+    k: &Keys,
+    share: &Share,
+) -> Result<Params, ConfigError> {
+    let gap = positive(&k.td("air_gap_mm"), td.air_gap_mm, "mm")? * 1e-3;
+    let race_mass = positive(&k.td("race_mass_kg"), td.race_mass_kg, "kg")?;
+    let race_inertia = positive(&k.td("race_polar_inertia_kg_m2"), td.race_polar_inertia_kg_m2, "kg·m²")?;
+    let ball_d = positive(&k.td("ball_diameter_mm"), td.ball_diameter_mm, "mm")?;
+    let dm = positive(&k.td("pitch_diameter_mm"), td.pitch_diameter_mm, "mm")?;
+    if ball_d >= dm {
+        return Err(range(
+            &k.td("ball_diameter_mm"),
+            ball_d,
+            "mm",
+            &format!("must be smaller than {}", k.td("pitch_diameter_mm")),
+        ));
+    }
+    positive(&k.td("outer_diameter_mm"), td.outer_diameter_mm, "mm")?;
+    positive(&k.td("width_mm"), td.width_mm, "mm")?;
+    if !(3..=64).contains(&td.ball_count) {
+        return Err(range(&k.td("ball_count"), td.ball_count, "", "must be between 3 and 64"));
+    }
+    let clearance = non_negative(&k.td("ball_clearance_mm"), td.ball_clearance_mm, "mm")? * 1e-3;
+    let cage_phase = finite(&k.td("cage_phase_deg"), td.cage_phase_deg, "deg")?.to_radians();
+    let (r_in, r_out) = (dm / 2.0 - ball_d / 2.0, dm / 2.0 + ball_d / 2.0);
+    let reg_speed = positive(&k.td("drag_smoothing_rad_s"), td.drag_smoothing_rad_s, "rad/s")?;
+    let torque = non_negative(&k.td("drag_torque_n_m"), td.drag_torque_n_m, "N·m")?;
+    let f0 = non_negative(&k.td("palmgren_f0"), td.palmgren_f0, "")?;
+    let nu0_cst = positive(&k.td("palmgren_viscosity_cst"), td.palmgren_viscosity_cst, "cSt")?;
+    let f1 = non_negative(&k.td("palmgren_f1"), td.palmgren_f1, "")?;
+    let drag = match td.drag {
+        DragChoice::Constant => RaceDrag::Constant { torque, reg_speed },
+        DragChoice::Palmgren => RaceDrag::Palmgren { f0, nu0_cst, f1, pitch_diameter_mm: dm, reg_speed },
+    };
+
+    let damping_depth = positive(&k.ct("damping_depth_mm"), ct.damping_depth_mm, "mm")? * 1e-3;
+    let v_static = positive(&k.ct("stribeck_static_m_s"), ct.stribeck_static_m_s, "m/s")?;
+    let v_dynamic = positive(&k.ct("stribeck_dynamic_m_s"), ct.stribeck_dynamic_m_s, "m/s")?;
+    if v_dynamic < v_static {
+        return Err(range(
+            &k.ct("stribeck_dynamic_m_s"),
+            v_dynamic,
+            "m/s",
+            &format!("must be >= {}", k.ct("stribeck_static_m_s")),
+        ));
+    }
+    let friction = Friction {
+        mu_static: non_negative(&k.ct("friction_static"), ct.friction_static, "")?,
+        mu_dynamic: non_negative(&k.ct("friction_dynamic"), ct.friction_dynamic, "")?,
+        v_static,
+        v_dynamic,
+    };
+    let contact = RotorRace {
+        gap,
+        rotor_radius: share.radius,
+        bore_radius: share.radius + gap,
+        stiffness: positive(
+            &k.ct("rotor_race_stiffness_n_per_m10_9"),
+            ct.rotor_race_stiffness_n_per_m10_9,
+            "N/m^(10/9)",
+        )?,
+        damping_max: non_negative(&k.ct("rotor_race_damping_n_s_per_m"), ct.rotor_race_damping_n_s_per_m, "N·s/m")?,
+        damping_depth,
+        friction,
+    };
+    let balls = BallSet::new(
+        td.ball_count as usize,
+        clearance,
+        positive(&k.ct("ball_stiffness_n_per_m1_5"), ct.ball_stiffness_n_per_m1_5, "N/m^(3/2)")?,
+        non_negative(&k.ct("ball_damping_n_s_per_m"), ct.ball_damping_n_s_per_m, "N·s/m")?,
+        damping_depth,
+    );
+
+    let lumped_reference = positive(&k.td("lumped_reference_mm"), td.lumped_reference_mm, "mm")? * 1e-3;
+    let support = match td.support {
+        SupportChoice::Balls => Support::Balls,
+        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(&balls, lumped_reference)),
+    };
+    let release = match td.race_release {
+        ReleaseChoice::Equilibrium => Release::Equilibrium,
+        ReleaseChoice::Held => Release::Held,
+    };
+    let race_when_clear = match td.race_when_clear {
+        RaceWhenClearChoice::Free => RaceWhenClear::Free,
+        RaceWhenClearChoice::Parked => RaceWhenClear::Parked(release),
+    };
+    let ki = positive(&k.amb("ki_n_per_a"), amb.ki_n_per_a, "N/A")?;
+    let ks = non_negative(&k.amb("ks_n_per_m"), amb.ks_n_per_m, "N/m")?;
+    let s0 = positive(&k.amb("nominal_gap_mm"), amb.nominal_gap_mm, "mm")? * 1e-3;
+    let magnet_force_limit = positive(&k.amb("magnet_force_limit_n"), amb.magnet_force_limit_n, "N")?;
+    let amb_law = match amb.force_law {
+        ForceLaw::Linear => AmbLaw::Linear { ki, ks },
+        ForceLaw::Nonlinear => {
+            if ks == 0.0 {
+                return Err(range(
+                    &k.amb("ks_n_per_m"),
+                    ks,
+                    "N/m",
+                    "must be > 0 for the nonlinear law (it sets the bias current)",
+                ));
+            }
+            if s0 <= gap + clearance {
+                return Err(range(
+                    &k.amb("nominal_gap_mm"),
+                    amb.nominal_gap_mm,
+                    "mm",
+                    "must exceed the touchdown gap plus ball clearance",
+                ));
+            }
+            AmbLaw::nonlinear_matching(ki, ks, s0, magnet_force_limit)
+        }
+    };
+    let loop_constants = LoopConstants {
+        ki_n_per_a: ki,
+        ks_n_per_m: ks,
+        amp_gain_a_per_v: positive(&k.amb("amp_gain_a_per_v"), amb.amp_gain_a_per_v, "A/V")?,
+        sensor_gain_v_per_m: positive(&k.amb("sensor_gain_v_per_m"), amb.sensor_gain_v_per_m, "V/m")?,
+        rotor_mass_kg: share.mass,
+        gravity_m_s2: share.gravity,
+        air_gap_m: gap,
+    };
+    let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    Ok(Params {
+        gravity: share.gravity,
+        rotor_mass: share.mass,
+        eccentricity: share.eccentricity,
+        rotor_inertia: share.inertia,
+        speed: share.speed,
+        spin: share.spin,
+        race_mass,
+        race_inertia,
+        cage: td.cage,
+        cage_phase,
+        cage_ratio: r_in / (r_in + r_out),
+        contact,
+        balls,
+        support,
+        race_when_clear,
+        drag,
+        amb: amb_law,
+        loop_constants,
+        current_limit,
+    })
+}
+
 /// Validates a raw scene into SI parameter types. `base_dir` resolves relative file paths.
 ///
 /// The deprecated `controller.relev_*` keys become `controller.params` keys
@@ -272,6 +467,10 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     }
     positive("housing.mass_kg", raw.housing.mass_kg, "kg")?;
     let unbalance_phase = finite("rotor.unbalance_phase_deg", r.unbalance_phase_deg, "deg")?.to_radians();
+    let two = r.model == RotorModel::TwoPlane;
+    if !two {
+        refuse_two_plane_keys(&raw)?;
+    }
     let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
     let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
     let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
@@ -283,120 +482,15 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         SpinChoice::Held => Spin::Held,
         SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
     };
-
-    let gap = positive("touchdown.air_gap_mm", td.air_gap_mm, "mm")? * 1e-3;
-    let race_mass = positive("touchdown.race_mass_kg", td.race_mass_kg, "kg")?;
-    let race_inertia = positive("touchdown.race_polar_inertia_kg_m2", td.race_polar_inertia_kg_m2, "kg·m²")?;
-    let ball_d = positive("touchdown.ball_diameter_mm", td.ball_diameter_mm, "mm")?;
-    let dm = positive("touchdown.pitch_diameter_mm", td.pitch_diameter_mm, "mm")?;
-    if ball_d >= dm {
-        return Err(range(
-            "touchdown.ball_diameter_mm",
-            ball_d,
-            "mm",
-            "must be smaller than touchdown.pitch_diameter_mm",
-        ));
-    }
-    positive("touchdown.outer_diameter_mm", td.outer_diameter_mm, "mm")?;
-    positive("touchdown.width_mm", td.width_mm, "mm")?;
-    if !(3..=64).contains(&td.ball_count) {
-        return Err(range("touchdown.ball_count", td.ball_count, "", "must be between 3 and 64"));
-    }
-    let clearance = non_negative("touchdown.ball_clearance_mm", td.ball_clearance_mm, "mm")? * 1e-3;
-    let cage_phase = finite("touchdown.cage_phase_deg", td.cage_phase_deg, "deg")?.to_radians();
-    let (r_in, r_out) = (dm / 2.0 - ball_d / 2.0, dm / 2.0 + ball_d / 2.0);
-    let reg_speed = positive("touchdown.drag_smoothing_rad_s", td.drag_smoothing_rad_s, "rad/s")?;
-    let torque = non_negative("touchdown.drag_torque_n_m", td.drag_torque_n_m, "N·m")?;
-    let f0 = non_negative("touchdown.palmgren_f0", td.palmgren_f0, "")?;
-    let nu0_cst = positive("touchdown.palmgren_viscosity_cst", td.palmgren_viscosity_cst, "cSt")?;
-    let f1 = non_negative("touchdown.palmgren_f1", td.palmgren_f1, "")?;
-    let drag = match td.drag {
-        DragChoice::Constant => RaceDrag::Constant { torque, reg_speed },
-        DragChoice::Palmgren => RaceDrag::Palmgren { f0, nu0_cst, f1, pitch_diameter_mm: dm, reg_speed },
+    let whole =
+        Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
+    let (physics, two_plane) = if two {
+        let machine = two_plane_params(&raw, &whole)?;
+        (machine.planes[0].params.clone(), Some(machine))
+    } else {
+        (bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?, None)
     };
-
-    let damping_depth = positive("contact.damping_depth_mm", ct.damping_depth_mm, "mm")? * 1e-3;
-    let v_static = positive("contact.stribeck_static_m_s", ct.stribeck_static_m_s, "m/s")?;
-    let v_dynamic = positive("contact.stribeck_dynamic_m_s", ct.stribeck_dynamic_m_s, "m/s")?;
-    if v_dynamic < v_static {
-        return Err(range("contact.stribeck_dynamic_m_s", v_dynamic, "m/s", "must be >= contact.stribeck_static_m_s"));
-    }
-    let friction = Friction {
-        mu_static: non_negative("contact.friction_static", ct.friction_static, "")?,
-        mu_dynamic: non_negative("contact.friction_dynamic", ct.friction_dynamic, "")?,
-        v_static,
-        v_dynamic,
-    };
-    let contact = RotorRace {
-        gap,
-        rotor_radius,
-        bore_radius: rotor_radius + gap,
-        stiffness: positive(
-            "contact.rotor_race_stiffness_n_per_m10_9",
-            ct.rotor_race_stiffness_n_per_m10_9,
-            "N/m^(10/9)",
-        )?,
-        damping_max: non_negative("contact.rotor_race_damping_n_s_per_m", ct.rotor_race_damping_n_s_per_m, "N·s/m")?,
-        damping_depth,
-        friction,
-    };
-    let balls = BallSet::new(
-        td.ball_count as usize,
-        clearance,
-        positive("contact.ball_stiffness_n_per_m1_5", ct.ball_stiffness_n_per_m1_5, "N/m^(3/2)")?,
-        non_negative("contact.ball_damping_n_s_per_m", ct.ball_damping_n_s_per_m, "N·s/m")?,
-        damping_depth,
-    );
-
-    let lumped_reference = positive("touchdown.lumped_reference_mm", td.lumped_reference_mm, "mm")? * 1e-3;
-    let support = match td.support {
-        SupportChoice::Balls => Support::Balls,
-        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(&balls, lumped_reference)),
-    };
-    let release = match td.race_release {
-        ReleaseChoice::Equilibrium => Release::Equilibrium,
-        ReleaseChoice::Held => Release::Held,
-    };
-    let race_when_clear = match td.race_when_clear {
-        RaceWhenClearChoice::Free => RaceWhenClear::Free,
-        RaceWhenClearChoice::Parked => RaceWhenClear::Parked(release),
-    };
-    let ki = positive("amb.ki_n_per_a", amb.ki_n_per_a, "N/A")?;
-    let ks = non_negative("amb.ks_n_per_m", amb.ks_n_per_m, "N/m")?;
-    let s0 = positive("amb.nominal_gap_mm", amb.nominal_gap_mm, "mm")? * 1e-3;
-    let magnet_force_limit = positive("amb.magnet_force_limit_n", amb.magnet_force_limit_n, "N")?;
-    let amb_law = match amb.force_law {
-        ForceLaw::Linear => AmbLaw::Linear { ki, ks },
-        ForceLaw::Nonlinear => {
-            if ks == 0.0 {
-                return Err(range(
-                    "amb.ks_n_per_m",
-                    ks,
-                    "N/m",
-                    "must be > 0 for the nonlinear law (it sets the bias current)",
-                ));
-            }
-            if s0 <= gap + clearance {
-                return Err(range(
-                    "amb.nominal_gap_mm",
-                    amb.nominal_gap_mm,
-                    "mm",
-                    "must exceed the touchdown gap plus ball clearance",
-                ));
-            }
-            AmbLaw::nonlinear_matching(ki, ks, s0, magnet_force_limit)
-        }
-    };
-    let loop_constants = LoopConstants {
-        ki_n_per_a: ki,
-        ks_n_per_m: ks,
-        amp_gain_a_per_v: positive("amb.amp_gain_a_per_v", amb.amp_gain_a_per_v, "A/V")?,
-        sensor_gain_v_per_m: positive("amb.sensor_gain_v_per_m", amb.sensor_gain_v_per_m, "V/m")?,
-        rotor_mass_kg: rotor_mass,
-        gravity_m_s2: gravity,
-        air_gap_m: gap,
-    };
-    let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    let loop_constants = physics.loop_constants;
 
     let rate = positive("controller.rate_hz", ctl.rate_hz, "Hz")?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
@@ -485,6 +579,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         method: int.method,
         rtol,
         atol: [ap, ap, aa, ap, ap, aa, av, av, aw, av, av, aw],
+        atol_groups: [ap, av, aa, aw],
         substeps: int.substeps,
         contact_substeps: if int.contact_substeps == 0 { int.substeps } else { int.contact_substeps },
         radius_guard: positive("integrator.radius_guard_mm", int.radius_guard_mm, "mm")? * 1e-3,
@@ -514,6 +609,10 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
             finite("initial.rotor_x_um", raw.initial.rotor_x_um, "µm")? * 1e-6,
             finite("initial.rotor_y_um", raw.initial.rotor_y_um, "µm")? * 1e-6,
         ],
+        slope_offset: [
+            finite("initial.slope_x_urad", raw.initial.slope_x_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+            finite("initial.slope_y_urad", raw.initial.slope_y_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+        ],
     };
     if raw.sensor.adc_bits > 24 {
         return Err(range("sensor.adc_bits", raw.sensor.adc_bits, "bits", "must be between 0 (ideal) and 24"));
@@ -526,32 +625,16 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
     };
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
-    let params = Params {
-        gravity,
-        rotor_mass,
-        eccentricity,
-        rotor_inertia,
-        speed,
-        spin,
-        race_mass,
-        race_inertia,
-        cage: td.cage,
-        cage_phase,
-        cage_ratio: r_in / (r_in + r_out),
-        contact,
-        balls,
-        support,
-        race_when_clear,
-        drag,
-        amb: amb_law,
-        loop_constants,
-        current_limit,
-    };
+    // The resolved scene states the two-plane rotor's defaults.
+    if two_plane.is_some() {
+        record_two_plane(&mut raw);
+    }
     let scene = Scene {
         name: raw.scene.name.clone(),
         description: raw.scene.description.clone(),
         duration,
-        params,
+        params: physics,
+        two_plane,
         base,
         controller,
         integrator,
@@ -565,9 +648,184 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // The law validates its own parameters: a scene it refuses is bad input, before any run.
     // A controller command serves laws of its own: it checks them, in the handshake.
     if scene.controller.cosim.command.is_none() {
-        controller::build_law(&scene.controller.law, &scene.design(), &scene.controller.params)?;
+        controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
     }
     Ok(scene)
+}
+
+/// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
+/// silently ignored otherwise.
+fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
+    let r = &raw.rotor;
+    let given = [
+        ("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2, "kg·m²"),
+        ("rotor.couple_unbalance_urad", r.couple_unbalance_urad, "µrad"),
+        ("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg, "deg"),
+        ("rotor.bearing_a_mm", r.bearing_a_mm, "mm"),
+        ("rotor.bearing_b_mm", r.bearing_b_mm, "mm"),
+        ("rotor.sensor_a_mm", r.sensor_a_mm, "mm"),
+        ("rotor.sensor_b_mm", r.sensor_b_mm, "mm"),
+        ("rotor.end_a_mm", r.end_a_mm, "mm"),
+        ("rotor.end_b_mm", r.end_b_mm, "mm"),
+        ("initial.slope_x_urad", raw.initial.slope_x_urad, "µrad"),
+        ("initial.slope_y_urad", raw.initial.slope_y_urad, "µrad"),
+    ];
+    const WHY: &str = "is a key of the two-plane rotor and this scene is planar (rotor.model = \"planar\"): set \
+                       rotor.model = \"two_plane\" or remove the key";
+    if let Some((key, value, unit)) = given.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
+        return Err(range(key, value, unit, WHY));
+    }
+    let tables = [
+        ("touchdown", &raw.touchdown.a, &raw.touchdown.b),
+        ("contact", &raw.contact.a, &raw.contact.b),
+        ("amb", &raw.amb.a, &raw.amb.b),
+    ];
+    for (table, a, b) in tables {
+        for (plane, own) in [("a", a), ("b", b)] {
+            if let Some(own) = own {
+                return Err(ConfigError::Range {
+                    key: format!("{table}.{plane}"),
+                    value: format!("a table of {} key(s)", own.len()),
+                    unit: String::new(),
+                    why: format!(
+                        "per-plane tables ([{table}.a], [{table}.b]) are for the two-plane rotor and this scene is \
+                         planar (rotor.model = \"planar\"): set rotor.model = \"two_plane\" or write the keys in [{table}]"
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A per-plane table: the shared table `shared` (`[touchdown]`) with plane `plane`'s own keys
+/// (`[touchdown.b]`) set over it, read as the same table.
+fn plane_table<T: serde::Serialize + serde::de::DeserializeOwned>(
+    shared: &T,
+    own: Option<&toml::Table>,
+    name: &str,
+) -> Result<T, ConfigError> {
+    let parse = |message: String| ConfigError::Parse { path: name.to_string(), message };
+    let mut table = toml::Table::try_from(shared).map_err(|e| parse(e.to_string()))?;
+    table.remove("a");
+    table.remove("b");
+    if let Some(own) = own {
+        if let Some(nested) = ["a", "b"].into_iter().find(|k| own.contains_key(*k)) {
+            return Err(parse(format!("a plane's table holds keys, not another plane's table (`{nested}`)")));
+        }
+        for (key, value) in own {
+            table.insert(key.clone(), value.clone());
+        }
+    }
+    toml::Value::Table(table).try_into::<T>().map_err(|e| parse(e.to_string()))
+}
+
+/// The two-plane rotor of a scene (`rotor.model = "two_plane"`), validated: its geometry and
+/// inertia from `[rotor]`, each plane's bearing from the shared tables and its own.
+fn two_plane_params(raw: &RawScene, whole: &Share) -> Result<two_plane::Params, ConfigError> {
+    let r = &raw.rotor;
+    let mm = |key: &str, value: f64| finite(key, value, "mm");
+    let za = mm("rotor.bearing_a_mm", r.bearing_a_mm.unwrap_or(-180.0))?;
+    let zb = mm("rotor.bearing_b_mm", r.bearing_b_mm.unwrap_or(180.0))?;
+    const SIDES: &str = "bearing A lies on the −z side of the centre of mass (the origin of z) and bearing B on \
+                         the +z side: the centre of mass is between the bearings";
+    if za >= 0.0 {
+        return Err(range("rotor.bearing_a_mm", za, "mm", &format!("must be < 0: {SIDES}")));
+    }
+    if zb <= 0.0 {
+        return Err(range("rotor.bearing_b_mm", zb, "mm", &format!("must be > 0: {SIDES}")));
+    }
+    let ea = mm("rotor.end_a_mm", r.end_a_mm.unwrap_or(-230.0))?;
+    let eb = mm("rotor.end_b_mm", r.end_b_mm.unwrap_or(230.0))?;
+    if ea > za {
+        return Err(range(
+            "rotor.end_a_mm",
+            ea,
+            "mm",
+            &format!("must be <= rotor.bearing_a_mm = {za} mm: the bearing sits on the rotor"),
+        ));
+    }
+    if eb < zb {
+        return Err(range(
+            "rotor.end_b_mm",
+            eb,
+            "mm",
+            &format!("must be >= rotor.bearing_b_mm = {zb} mm: the bearing sits on the rotor"),
+        ));
+    }
+    let sensor = |key: &str, value: f64| -> Result<f64, ConfigError> {
+        let v = mm(key, value)?;
+        if !(ea..=eb).contains(&v) {
+            return Err(range(
+                key,
+                v,
+                "mm",
+                &format!("must lie on the rotor, between rotor.end_a_mm = {ea} mm and rotor.end_b_mm = {eb} mm"),
+            ));
+        }
+        Ok(v)
+    };
+    let sa = sensor("rotor.sensor_a_mm", r.sensor_a_mm.unwrap_or(za))?;
+    let sb = sensor("rotor.sensor_b_mm", r.sensor_b_mm.unwrap_or(zb))?;
+    let transverse = positive("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2.unwrap_or(0.414), "kg·m²")?;
+    let couple = non_negative("rotor.couple_unbalance_urad", r.couple_unbalance_urad.unwrap_or(0.0), "µrad")? * 1e-6;
+    let couple_phase =
+        finite("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg.unwrap_or(0.0), "deg")?.to_radians();
+    let stations = [za * 1e-3, zb * 1e-3];
+    let sensors = [sa * 1e-3, sb * 1e-3];
+    let plane = |i: usize| -> Result<two_plane::Plane, ConfigError> {
+        let letter = ["a", "b"][i];
+        let pick = |a: &Option<toml::Table>, b: &Option<toml::Table>| if i == 0 { a.clone() } else { b.clone() };
+        let own = [
+            pick(&raw.touchdown.a, &raw.touchdown.b),
+            pick(&raw.contact.a, &raw.contact.b),
+            pick(&raw.amb.a, &raw.amb.b),
+        ];
+        let td = plane_table(&raw.touchdown, own[0].as_ref(), &format!("touchdown.{letter}"))?;
+        let ct = plane_table(&raw.contact, own[1].as_ref(), &format!("contact.{letter}"))?;
+        let amb = plane_table(&raw.amb, own[2].as_ref(), &format!("amb.{letter}"))?;
+        let mass = two_plane::load_share(whole.mass, stations, i);
+        let fraction = mass / whole.mass;
+        let spin = match whole.spin {
+            Spin::Held => Spin::Held,
+            Spin::Free { drive_gain, torque_limit } => {
+                Spin::Free { drive_gain: drive_gain * fraction, torque_limit: torque_limit * fraction }
+            }
+        };
+        let share = Share { mass, inertia: whole.inertia * fraction, spin, ..*whole };
+        let keys = Keys { plane: Some((letter, [own[0].as_ref(), own[1].as_ref(), own[2].as_ref()])) };
+        let params = bearing(&td, &ct, &amb, &raw.controller, &keys, &share)?;
+        Ok(two_plane::Plane { station: stations[i], sensor: sensors[i], params })
+    };
+    Ok(two_plane::Params {
+        gravity: whole.gravity,
+        rotor: two_plane::Rotor {
+            mass: whole.mass,
+            transverse_inertia: transverse,
+            polar_inertia: whole.inertia,
+            eccentricity: whole.eccentricity,
+            couple,
+            couple_phase,
+            speed: whole.speed,
+            spin: whole.spin,
+        },
+        planes: [plane(0)?, plane(1)?],
+    })
+}
+
+/// Writes the two-plane rotor's defaults into the raw scene (as the user would have written
+/// them, in the file's units), so that the resolved `scene.toml` states them.
+fn record_two_plane(raw: &mut RawScene) {
+    let r = &mut raw.rotor;
+    r.transverse_inertia_kg_m2.get_or_insert(0.414);
+    r.couple_unbalance_urad.get_or_insert(0.0);
+    r.couple_unbalance_phase_deg.get_or_insert(0.0);
+    let a = *r.bearing_a_mm.get_or_insert(-180.0);
+    let b = *r.bearing_b_mm.get_or_insert(180.0);
+    r.sensor_a_mm.get_or_insert(a);
+    r.sensor_b_mm.get_or_insert(b);
+    r.end_a_mm.get_or_insert(-230.0);
+    r.end_b_mm.get_or_insert(230.0);
 }
 
 /// Moves the deprecated `relev_*` keys into `params` (law `relev`) or drops them (another

@@ -6,7 +6,7 @@ use super::{CosimError, Launch, Percentiles};
 use crate::config::{ControlMode, CosimSettings, Fallback};
 use crate::hooks::Hooks;
 use controller::wire::{self, mode, Hello};
-use controller::Sample;
+use controller::{RotorSample, ROTOR_AXES};
 
 /// `plant bench ipc`: `n` round trips with a controller process (lockstep,
 /// zero sensor values), after `warmup` unrecorded ones. Returns the round trips,
@@ -41,13 +41,13 @@ pub fn bench_round_trips(
         max_miss_fraction: 1.0,
         max_overrun_fraction: 1.0,
     };
-    let bias = [0.0; 2];
+    let bias = [0.0; ROTOR_AXES];
     let mut s = Session::open(ControlMode::Lockstep, settings, hello, launch, bias, hello.period_s, hooks)?;
     for k in 0..(warmup + n) {
         if k == warmup {
             s.reset_figures();
         }
-        let sample = Sample { seq: k, t_s: k as f64 * hello.period_s, sensor_v: [0.0; 2], ..Default::default() };
+        let sample = RotorSample { seq: k, t_s: k as f64 * hello.period_s, axes: hello.axes, ..Default::default() };
         if let Err(halt) = s.lockstep(&sample, hooks) {
             let why = match halt {
                 Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) | Halt::OverrunBudget(w) => w,

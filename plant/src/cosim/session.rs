@@ -16,7 +16,7 @@ use crate::hooks::Hooks;
 use controller::link::{self, Endpoint, Ipc, Mailbox, Peer};
 use controller::lock::RunLock;
 use controller::wire::{self, Ack, CommandFrame, Hello, SensorFrame};
-use controller::{saturate, Sample};
+use controller::{saturate_axes, RotorSample, ROTOR_AXES};
 use iceoryx2::node::Node;
 use std::time::{Duration, Instant};
 
@@ -101,8 +101,8 @@ pub struct Session {
     log: OutputLog,
     _lock: RunLock,
     hello: Hello,
-    limit: f64,
-    bias: [f64; 2],
+    limits: [f64; ROTOR_AXES],
+    bias: [f64; ROTOR_AXES],
     period: f64,
     /// False while the controller is lost.
     connected: bool,
@@ -110,7 +110,7 @@ pub struct Session {
     pending: Option<Pending>,
     /// First sample sent in the current session.
     first_seq: u64,
-    last_cmd: [f64; 2],
+    last_cmd: [f64; ROTOR_AXES],
     controller: String,
     /// Process id of the connected controller (from its handshake ack).
     controller_pid: Option<u32>,
@@ -142,12 +142,12 @@ impl Session {
         self.overrides.as_ref()
     }
 
-    /// Takes the bias command and the current limit (A) of the design the controller runs
-    /// (its overrides), before the loop.
-    pub fn adopt(&mut self, bias: [f64; 2], limit: f64) {
+    /// Takes the bias command and the current limits (A, per axis) of the design the
+    /// controller runs (its overrides), before the loop.
+    pub fn adopt(&mut self, bias: [f64; ROTOR_AXES], limits: [f64; ROTOR_AXES]) {
         self.bias = bias;
         self.last_cmd = bias;
-        self.limit = limit;
+        self.limits = limits;
     }
 
     /// Process id of the controller now connected, as its handshake ack gave it
@@ -213,7 +213,7 @@ impl Session {
         self.figures.events.push(PeerEvent { kind, t_s, seq, wall_s, detail });
     }
 
-    fn frame(&self, sample: &Sample) -> SensorFrame {
+    fn frame(&self, sample: &RotorSample) -> SensorFrame {
         SensorFrame {
             seq: sample.seq,
             t_s: sample.t_s,
@@ -221,19 +221,22 @@ impl Session {
             sent_ns: wire::monotonic_ns(),
             status: 0,
             session: self.hello.session,
-            axes: wire::AXES,
+            axes: self.hello.axes,
             reserved: 0,
-            sensor_v: wire::axes_of(sample.sensor_v),
+            sensor_v: wire::rotor_axes_of(sample.sensor_v, self.hello.axes),
             speed_rad_s: sample.speed_rad_s,
             angle_rad: sample.angle_rad,
         }
     }
 
-    /// A reply's currents, saturated. A non-finite one is passed on as it is (the run loop
-    /// holds, counts and judges them, [`crate::invalid`]) and is not kept as the last current
-    /// (held on a miss or a loss).
-    fn accept(&mut self, reply: &CommandFrame) -> [f64; 2] {
-        let current = saturate(reply.current_xy(), self.limit);
+    /// A reply's currents on the axes in use (the others are 0 on the wire and unused),
+    /// saturated. A non-finite one is passed on as it is (the run loop holds, counts and
+    /// judges them, [`crate::invalid`]) and is not kept as the last current (held on a miss
+    /// or a loss).
+    fn accept(&mut self, reply: &CommandFrame) -> [f64; ROTOR_AXES] {
+        let mut current = reply.current_axes();
+        current[self.hello.axes as usize..].iter_mut().for_each(|i| *i = 0.0);
+        let current = saturate_axes(current, self.limits);
         if current.iter().all(|i| i.is_finite()) {
             self.last_cmd = current;
         }
@@ -242,14 +245,14 @@ impl Session {
 
     /// The command for sample `k` to push into the delay line: the reply to
     /// `k` (lockstep) or to `k − 1` (realtime), or a fallback.
-    pub fn command(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+    pub fn command(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
         match self.mode {
             ControlMode::Realtime => self.realtime(sample, hooks),
             _ => self.lockstep(sample, hooks),
         }
     }
 
-    pub(super) fn lockstep(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+    pub(super) fn lockstep(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
         let k = sample.seq;
         let frame = self.frame(sample);
         let t0 = Instant::now();
@@ -340,7 +343,12 @@ impl Session {
     }
 
     /// A live controller that did not answer within `controller.lockstep_timeout_ms`.
-    fn on_silent(&mut self, sample: &Sample, seen: &Seen, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+    fn on_silent(
+        &mut self,
+        sample: &RotorSample,
+        seen: &Seen,
+        hooks: &mut dyn Hooks,
+    ) -> Result<[f64; ROTOR_AXES], Halt> {
         let pid = self.controller_pid.map(|p| format!(" (pid {p})")).unwrap_or_default();
         let why = format!(
             "no reply to sample {} within controller.lockstep_timeout_ms = {} ms although the controller{pid} is alive: {}",
@@ -353,7 +361,7 @@ impl Session {
 
     /// A lost controller at sample `k`: record it, then the fallback, then
     /// (lockstep) a blocking reconnection or the end of the run.
-    fn on_lost(&mut self, sample: &Sample, why: String, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+    fn on_lost(&mut self, sample: &RotorSample, why: String, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
         self.connected = false;
         self.lost_since = Some(Instant::now());
         let (cmd, applied) = match self.settings.fallback {
@@ -400,7 +408,7 @@ impl Session {
         }
     }
 
-    fn realtime(&mut self, sample: &Sample, hooks: &mut dyn Hooks) -> Result<[f64; 2], Halt> {
+    fn realtime(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
         let k = sample.seq;
         let start = *self.start.get_or_insert_with(Instant::now);
         let deadline = start + Duration::from_secs_f64(k as f64 * self.period);
@@ -517,7 +525,7 @@ impl Session {
                 status: SensorFrame::STOP,
                 session: self.hello.session,
                 token: self.hello.token,
-                axes: wire::AXES,
+                axes: self.hello.axes,
                 ..Default::default()
             };
             let _ = self.frames.send_and_wake(stop);

@@ -97,7 +97,7 @@ impl MemberResult {
 }
 
 /// The figures of a run: the one place that reads [`Summary`] for ensembles.
-fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
+pub fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
     let s = Summary::new(scene, result);
     let a = &s.analysis;
     let f = Figures {
@@ -166,7 +166,7 @@ pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
 }
 
 /// The field of a shock that sets its size, and its value.
-fn shock_size(s: &ShockSpec) -> Option<(&'static str, f64)> {
+pub fn shock_size(s: &ShockSpec) -> Option<(&'static str, f64)> {
     match s {
         ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => Some(("peak_g", *p)),
         ShockSpec::DoubleHalfSine { design_accel_g: Some(a), .. } => Some(("design_accel_g", *a)),

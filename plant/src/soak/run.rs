@@ -168,6 +168,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         ),
         envelope: monitor::Envelope::new(ENVELOPE_BIN_S),
         planned: &prog.shocks,
+        gap_ratio: if scene.planes() == 2 { scene.plane(0).contact.gap / scene.plane(1).contact.gap } else { 1.0 },
         figures: Vec::with_capacity(prog.shocks.len()),
         soak_csv,
         envelope_csv,

@@ -4,9 +4,9 @@
 
 use super::monitor::{Envelope, EnvelopeRow, ShockFigures, ShockTracker};
 use super::programme::PlannedShock;
-use crate::model::{ix, Model, State};
 use crate::row_file::RowFile;
 use crate::run::Sink;
+use crate::trace::{col, Record};
 
 /// The sink: per-shock figures and the envelope, each written as it closes;
 /// both files are written out at each shock's end.
@@ -14,6 +14,8 @@ pub struct SoakSink<'a> {
     pub(crate) tracker: ShockTracker,
     pub(crate) envelope: Envelope,
     pub(crate) planned: &'a [PlannedShock],
+    /// Two-plane: plane A's gap over plane B's (plane B's radius is scaled by it).
+    pub(crate) gap_ratio: f64,
     pub(crate) figures: Vec<ShockFigures>,
     pub(crate) soak_csv: RowFile,
     pub(crate) envelope_csv: RowFile,
@@ -69,9 +71,17 @@ impl SoakSink<'_> {
 }
 
 impl Sink for SoakSink<'_> {
-    fn sample(&mut self, model: &Model, t: f64, y: &State) {
-        let radius = y[ix::XR].hypot(y[ix::YR]);
-        let force = model.evaluate(t, y).contact.normal;
+    fn sample(&mut self, record: &Record) {
+        // Of a two-plane rotor, the plane nearer its gap: the larger of r_A and r_B·r0_A/r0_B
+        // (plane B's radius on plane A's gap, so that the clear test holds each plane to its
+        // own gap), and the larger contact force.
+        let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
+        let (mut radius, mut force) = of(&record.a);
+        if record.planes() == 2 {
+            let (rb, fb) = of(&record.plane(1));
+            (radius, force) = (radius.max(rb * self.gap_ratio), force.max(fb));
+        }
+        let t = record.a[col::T_S];
         if let Some(r) = self.envelope.sample(t, radius, force) {
             self.write_bin(r);
         }

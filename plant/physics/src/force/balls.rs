@@ -85,22 +85,12 @@ impl BallSet {
         if eps.norm_squared() <= self.clearance * self.clearance {
             return BallForce::default();
         }
-        // In the cage frame ball i sits at the fixed direction u_i, and ε' = R(θ_c)⁻¹ ε = (A, B),
-        // so δ_i = ε'·u_i − r_cl and, with the frame turning, δ̇_i = ε̇'·u_i,
-        // ε̇' = R(θ_c)⁻¹ ε̇ − θ̇_c J ε' = (… + θ̇_c B, … − θ̇_c A).
         let cage = UnitComplex::new(cage);
-        let ab = cage.inverse_transform_vector(&eps);
-        let ab_dot = cage.inverse_transform_vector(&eps_dot) + Vector2::new(ab.y, -ab.x) * cage_rate;
+        let (ab, ab_dot) = self.cage_frame(eps, eps_dot, &cage, cage_rate);
         let mut sum = Vector2::zeros();
         let mut out = BallForce::default();
         for u in &self.pitch[..self.count] {
-            let delta = ab.dot(u) - self.clearance;
-            if delta <= 0.0 {
-                continue;
-            }
-            let delta_dot = ab_dot.dot(u);
-            let damping = step(delta, 0.0, 0.0, self.damping_depth, self.damping_max);
-            let load = (self.stiffness * delta * delta.sqrt() + damping * delta_dot).max(0.0);
+            let Some(load) = self.load(ab, ab_dot, u) else { continue };
             sum += u * load;
             out.max_load = out.max_load.max(load);
             out.loaded += u32::from(load > 0.0);
@@ -108,6 +98,47 @@ impl BallSet {
         // Back to the housing frame: −Σ F_i (cos ψ_i, sin ψ_i).
         out.on_race = -cage.transform_vector(&sum);
         out
+    }
+
+    /// Each ball's load (N), ball 0 first, for the same arguments as [`BallSet::force`]: the
+    /// loads it sums (for the touchdown bearing's duty: the most loaded ball, load cycles).
+    pub fn loads(&self, eps: Vector2<f64>, eps_dot: Vector2<f64>, cage: f64, cage_rate: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|l| *l = 0.0);
+        if eps.norm_squared() <= self.clearance * self.clearance {
+            return;
+        }
+        let (ab, ab_dot) = self.cage_frame(eps, eps_dot, &UnitComplex::new(cage), cage_rate);
+        for (u, l) in self.pitch[..self.count].iter().zip(out) {
+            *l = self.load(ab, ab_dot, u).unwrap_or(0.0);
+        }
+    }
+
+    /// The race's position and velocity in the cage frame, `(ε', ε̇')` (see the module doc).
+    #[inline]
+    fn cage_frame(
+        &self,
+        eps: Vector2<f64>,
+        eps_dot: Vector2<f64>,
+        cage: &UnitComplex<f64>,
+        cage_rate: f64,
+    ) -> (Vector2<f64>, Vector2<f64>) {
+        // In the cage frame ball i sits at the fixed direction u_i, and ε' = R(θ_c)⁻¹ ε = (A, B),
+        // so δ_i = ε'·u_i − r_cl and, with the frame turning, δ̇_i = ε̇'·u_i,
+        // ε̇' = R(θ_c)⁻¹ ε̇ − θ̇_c J ε' = (… + θ̇_c B, … − θ̇_c A).
+        let ab = cage.inverse_transform_vector(&eps);
+        (ab, cage.inverse_transform_vector(&eps_dot) + Vector2::new(ab.y, -ab.x) * cage_rate)
+    }
+
+    /// The load of the ball at direction `u` of the cage frame (N); `None` when it does not touch.
+    #[inline]
+    fn load(&self, ab: Vector2<f64>, ab_dot: Vector2<f64>, u: &Vector2<f64>) -> Option<f64> {
+        let delta = ab.dot(u) - self.clearance;
+        if delta <= 0.0 {
+            return None;
+        }
+        let delta_dot = ab_dot.dot(u);
+        let damping = step(delta, 0.0, 0.0, self.damping_depth, self.damping_max);
+        Some((self.stiffness * delta * delta.sqrt() + damping * delta_dot).max(0.0))
     }
 
     /// Elastic energy stored in the ball contacts (J): `Σ (2/5) K_b δ_i^(5/2)`.
@@ -136,6 +167,26 @@ mod tests {
 
     fn balls() -> BallSet {
         BallSet::new(19, 1e-5, 7.81e9, 750.0, 1e-5)
+    }
+
+    #[test]
+    fn loads_are_the_ones_the_resultant_sums() {
+        let b = balls();
+        let (eps, eps_dot, cage, rate) = (v(3e-6, -1.4e-5), v(0.01, -0.02), 0.3, 50.0);
+        let f = b.force(eps, eps_dot, cage, rate);
+        let mut loads = [0.0; 19];
+        b.loads(eps, eps_dot, cage, rate, &mut loads);
+        let sum: Vector2<f64> = loads
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let psi = cage + std::f64::consts::TAU * i as f64 / 19.0;
+                -Vector2::new(psi.cos(), psi.sin()) * *l
+            })
+            .sum();
+        assert!((sum - f.on_race).norm() < 1e-9 * f.on_race.norm(), "{sum:?} {:?}", f.on_race);
+        assert_eq!(loads.iter().copied().fold(0.0, f64::max), f.max_load);
+        assert_eq!(loads.iter().filter(|l| **l > 0.0).count() as u32, f.loaded);
     }
 
     #[test]

@@ -65,3 +65,32 @@ pub fn study_params() -> Params {
 pub fn model(params: Params) -> Model {
     Model { params, base: Programme::default(), control: Control::Held([0.0; 2]), race_parked: false }
 }
+
+/// The symmetric two-plane machine equivalent to `planar` (docs/MODEL.md §10.1): a whole rotor
+/// of twice the mass and polar inertia, the centre of mass mid-span between bearings at
+/// ±0.18 m, sensors collocated, each plane the planar scene's bearing; I_t = 0.414 kg·m².
+#[allow(dead_code)]
+pub fn symmetric_two_plane(planar: &Params) -> plant_physics::two_plane::Params {
+    use plant_physics::two_plane::{Params as TwoPlane, Plane, Rotor};
+    let spin = match planar.spin {
+        Spin::Held => Spin::Held,
+        Spin::Free { drive_gain, torque_limit } => {
+            Spin::Free { drive_gain: 2.0 * drive_gain, torque_limit: 2.0 * torque_limit }
+        }
+    };
+    let plane = |z: f64| Plane { station: z, sensor: z, params: planar.clone() };
+    TwoPlane {
+        gravity: planar.gravity,
+        rotor: Rotor {
+            mass: 2.0 * planar.rotor_mass,
+            transverse_inertia: 0.414,
+            polar_inertia: 2.0 * planar.rotor_inertia,
+            eccentricity: planar.eccentricity,
+            couple: 0.0,
+            couple_phase: 0.0,
+            speed: planar.speed,
+            spin,
+        },
+        planes: [plane(-0.18), plane(0.18)],
+    }
+}

@@ -12,6 +12,7 @@ use crate::cosim::{ControllerProcess, CosimError, Launch};
 use crate::hooks::Hooks;
 use controller::link::{self, Endpoint, Mailbox};
 use controller::wire::{self, mode, Ack, Hello, Refusal};
+use controller::ROTOR_AXES;
 use std::time::{Duration, Instant};
 
 /// The hello is published again this often until it is answered.
@@ -23,12 +24,13 @@ pub(super) struct Pending {
     last_hello: Option<Instant>,
 }
 
-/// The hello a scene sends: the scene's [`controller::Design`], law and parameter document,
-/// with the run's token.
+/// The hello a scene sends: the scene's [`controller::RotorDesign`] (2 axes for the planar
+/// model, 4 with plane B's design and the geometry for a two-plane rotor), law and parameter
+/// document, with the run's token.
 pub fn hello_for(scene: &Scene, run_id: &str, token: u64) -> Result<Hello, CosimError> {
     let c = &scene.controller;
     let params = c.params.to_document()?;
-    let mut hello = Hello::new(run_id, &c.law, &scene.design(), c.rate_hz, &params)?;
+    let mut hello = Hello::for_rotor(run_id, &c.law, &scene.rotor_design(), c.rate_hz, &params)?;
     hello.token = token;
     hello.spin_ns = (controller_spin(c.mode, c.cosim.spin, c.period) * 1e9) as u64;
     hello.mode = if c.mode == ControlMode::Realtime { mode::REALTIME } else { mode::LOCKSTEP };
@@ -53,11 +55,11 @@ fn controller_spin(mode: ControlMode, spin: f64, period: f64) -> f64 {
 
 impl Session {
     /// Opens the services of a run, starts (or waits for) the controller and
-    /// completes the handshake. `bias` is the saturated bias command (A).
+    /// completes the handshake. `bias` is the saturated bias command (A, per axis).
     pub fn connect(
         scene: &Scene,
         launch: &Launch,
-        bias: [f64; 2],
+        bias: [f64; ROTOR_AXES],
         hooks: &mut dyn Hooks,
     ) -> Result<Session, CosimError> {
         let run_id = match &launch.run_id {
@@ -81,7 +83,7 @@ impl Session {
         settings: CosimSettings,
         hello: Hello,
         launch: &Launch,
-        bias: [f64; 2],
+        bias: [f64; ROTOR_AXES],
         period: f64,
         hooks: &mut dyn Hooks,
     ) -> Result<Session, CosimError> {
@@ -131,7 +133,7 @@ impl Session {
             log,
             _lock: lock,
             hello,
-            limit: hello.current_limit_a,
+            limits: hello.rotor_design().map_or([hello.current_limit_a; ROTOR_AXES], |d| d.current_limits()),
             bias,
             period,
             connected: false,

@@ -1,0 +1,185 @@
+//! The touchdown bearing's duty in one run, accumulated as the run goes (a [`Sink`] around
+//! another): what one shock event costs the bearing. Every figure is taken at the run's output
+//! samples (the scene's `output.rate_hz`): a peak between two samples is not seen.
+//!
+//! | figure | basis |
+//! |---|---|
+//! | time in contact | output samples with a rotor – race normal force > 0, each counted for one sample interval |
+//! | peak rotor – race force | the contact law's normal force (MODEL.md §4) |
+//! | peak rotor – race pressure | Hertz line contact at that force ([`super::hertz::rotor_race`]) |
+//! | peak ball load, its pressure | the most loaded ball (MODEL.md §5) and Hertz's point contact at its inner raceway ([`super::hertz::ball_inner`]) |
+//! | friction energy | `∫ |F_t v_slip| dt` at the rotor – race contact (trapezoid over the samples): the heat the contact's friction dissipates |
+//! | race peak speed, acceleration | the inner race's spin `|ω_b|` and its angular acceleration `|ω̇_b|` from the model |
+//! | ball-load cycles | rainflow count of each ball's load history ([`super::rainflow`]), cycles whose range is at least `capacity_fraction` of one ball's static capacity `Q₀` ([`super::hertz::ball_static_load`]), summed over the balls |
+//!
+//! None of these is a life: they are the loads a life model would take.
+
+use super::hertz::{self, Materials};
+use super::rainflow::Rainflow;
+use crate::model::{cage_angle, ix, Cage, Model, State, Support};
+use crate::run::Sink;
+use nalgebra::Vector2;
+use serde::Serialize;
+
+/// The bearing's geometry and materials the duty needs beyond the model's parameters (SI).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Bearing {
+    /// Materials and groove conformity.
+    pub materials: Materials,
+    /// Ball diameter D (m).
+    pub ball_diameter_m: f64,
+    /// Pitch diameter d_m (m).
+    pub pitch_diameter_m: f64,
+    /// Race width B, the rotor – race contact length (m).
+    pub width_m: f64,
+    /// One ball's static capacity Q₀ (N).
+    pub ball_static_load_n: f64,
+    /// Counted load cycles have a range of at least this share of Q₀.
+    pub capacity_fraction: f64,
+}
+
+impl Bearing {
+    /// The bearing of a scene's `[touchdown]` with these materials.
+    pub fn new(materials: Materials, ball: f64, pitch: f64, width: f64, capacity_fraction: f64) -> Self {
+        Self {
+            materials,
+            ball_diameter_m: ball,
+            pitch_diameter_m: pitch,
+            width_m: width,
+            ball_static_load_n: hertz::ball_static_load(&materials, ball, pitch),
+            capacity_fraction,
+        }
+    }
+}
+
+/// The duty of one run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct Duty {
+    /// Time in contact (s).
+    pub contact_time_s: f64,
+    /// Peak rotor – race normal force (N).
+    pub peak_contact_force_n: f64,
+    /// Peak rotor – race Hertz pressure (MPa).
+    pub peak_race_pressure_mpa: f64,
+    /// The line contact's half-width at that force (mm).
+    pub race_contact_half_width_mm: f64,
+    /// Peak load of the most loaded ball (N); `None` with the lumped support (no balls).
+    pub peak_ball_load_n: Option<f64>,
+    /// Its Hertz pressure at the inner raceway (MPa).
+    pub peak_ball_pressure_mpa: Option<f64>,
+    /// Friction energy dissipated at the rotor – race contact (J).
+    pub friction_energy_j: f64,
+    /// Peak race spin speed (rpm).
+    pub race_peak_speed_rpm: f64,
+    /// Peak race angular acceleration (rad/s²).
+    pub race_peak_accel_rad_s2: f64,
+    /// Ball-load cycles with a range of at least the stated share of Q₀, all balls.
+    pub ball_cycles: Option<f64>,
+}
+
+/// Accumulates [`Duty`] from a run's samples and passes them on to `inner`.
+pub struct DutySink<'a> {
+    inner: &'a mut dyn Sink,
+    bearing: Bearing,
+    duty: Duty,
+    last: Option<(f64, f64)>,
+    loads: Vec<f64>,
+    counters: Vec<Rainflow>,
+    lumped: bool,
+}
+
+impl<'a> DutySink<'a> {
+    /// A duty accumulator for `balls` balls in front of `inner`.
+    pub fn new(inner: &'a mut dyn Sink, bearing: Bearing, balls: usize) -> Self {
+        let q0 = bearing.ball_static_load_n;
+        Self {
+            inner,
+            bearing,
+            duty: Duty::default(),
+            last: None,
+            loads: vec![0.0; balls],
+            counters: (0..balls).map(|_| Rainflow::new(0.01 * q0, bearing.capacity_fraction * q0)).collect(),
+            lumped: false,
+        }
+    }
+
+    /// The duty of the samples seen.
+    pub fn finish(self) -> Duty {
+        let mut d = self.duty;
+        let m = &self.bearing.materials;
+        if self.lumped {
+            d.peak_ball_load_n = None;
+            d.peak_ball_pressure_mpa = None;
+            d.ball_cycles = None;
+        } else {
+            let q = d.peak_ball_load_n.unwrap_or(0.0);
+            let p = hertz::ball_inner(m, q, self.bearing.ball_diameter_m, self.bearing.pitch_diameter_m);
+            d.peak_ball_pressure_mpa = Some(p.p_max_pa * 1e-6);
+            d.ball_cycles = Some(self.counters.into_iter().map(|c| c.finish().0).sum());
+        }
+        d
+    }
+}
+
+impl Sink for DutySink<'_> {
+    fn sample(&mut self, record: &crate::trace::Record) {
+        self.inner.sample(record);
+    }
+
+    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
+        self.inner.planar_state(model, t, y);
+        let p = &model.params;
+        let ev = model.evaluate(t, y);
+        let d = &mut self.duty;
+        let normal = ev.contact.normal;
+        // Slip at the contact point (MODEL.md §4), for the friction power |F_t v_t|.
+        let gap = Vector2::new(y[ix::XR] - y[ix::XB], y[ix::YR] - y[ix::YB]);
+        let power = if normal > 0.0 && gap.norm() > 0.0 {
+            let n = gap / gap.norm();
+            let tangent = Vector2::new(-n.y, n.x);
+            let dv = Vector2::new(y[ix::VXR] - y[ix::VXB], y[ix::VYR] - y[ix::VYB]);
+            let slip = dv.dot(&tangent) + y[ix::WR] * p.contact.rotor_radius - y[ix::WB] * p.contact.bore_radius;
+            (ev.contact.tangential * slip).abs()
+        } else {
+            0.0
+        };
+        if let Some((t0, p0)) = self.last {
+            let dt = t - t0;
+            d.friction_energy_j += 0.5 * (p0 + power) * dt;
+            if normal > 0.0 {
+                d.contact_time_s += dt;
+            }
+        }
+        self.last = Some((t, power));
+        if normal > d.peak_contact_force_n {
+            d.peak_contact_force_n = normal;
+            let r = hertz::rotor_race(
+                &self.bearing.materials,
+                normal,
+                p.contact.rotor_radius,
+                p.contact.bore_radius,
+                self.bearing.width_m,
+            );
+            d.peak_race_pressure_mpa = r.p_max_pa * 1e-6;
+            d.race_contact_half_width_mm = r.half_width_m * 1e3;
+        }
+        d.race_peak_speed_rpm = d.race_peak_speed_rpm.max(y[ix::WB].abs() * 60.0 / std::f64::consts::TAU);
+        d.race_peak_accel_rad_s2 = d.race_peak_accel_rad_s2.max(ev.dy[ix::WB].abs());
+        self.lumped = !matches!(p.support, Support::Balls);
+        if let Support::Balls = p.support {
+            let (cage, rate) = match p.cage {
+                Cage::Rotating => (cage_angle(p, y[ix::TB]), p.cage_ratio * y[ix::WB]),
+                Cage::Fixed => (cage_angle(p, y[ix::TB]), 0.0),
+            };
+            let eps = Vector2::new(y[ix::XB], y[ix::YB]);
+            let eps_dot = Vector2::new(y[ix::VXB], y[ix::VYB]);
+            p.balls.loads(eps, eps_dot, cage, rate, &mut self.loads);
+            let mut most = d.peak_ball_load_n.unwrap_or(0.0);
+            for (l, c) in self.loads.iter().zip(&mut self.counters) {
+                c.push(*l);
+                most = most.max(*l);
+            }
+            d.peak_ball_load_n = Some(most);
+        }
+    }
+}

@@ -1,0 +1,367 @@
+//! The shock ladder: the probability of recovery against the shock's peak, each rung an
+//! ensemble over the rotor's angle at the shock's arrival (the ensemble machinery's draws,
+//! members' setting, verification and Wilson intervals: [`crate::ensemble`]), with the
+//! touchdown bearing's duty of every counted member ([`super::duty`]).
+//!
+//! A rung's shock is the scene's programme scaled so that its first shock peaks at the rung's
+//! value (every shock's size field times the same factor). Members run in batches of `batch`;
+//! a rung is decided once its Wilson 95 % interval lies wholly above or wholly below `min_p`
+//! (0.9), or at `members`: the question each rung answers is whether recovery is at least
+//! 90 % likely there. The ladder's answer is the highest peak up to which every rung's lower
+//! bound is ≥ `min_p`.
+
+use super::duty::{Bearing, Duty, DutySink};
+use crate::config::{load_scene, Scene};
+use crate::ensemble::member::{
+    close_to_decision, figures, member_overrides, shock_size, verify_overrides, MemberResult,
+};
+use crate::ensemble::spec::EnsembleSpec;
+use crate::ensemble::stats::{quantile, wilson};
+use crate::grid::Point;
+use crate::hooks::Cancel;
+use crate::run::{run_into, Outcome, RunResult};
+use crate::trace::Trace;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Settings of the ladder (`[ladder]` of an assessment).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Settings {
+    /// The rungs: peaks of the first shock (G), ascending.
+    pub peaks_g: Vec<f64>,
+    /// Most members per rung.
+    pub members: usize,
+    /// Members per round.
+    pub batch: usize,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Verify members close to a decision at the reference setting.
+    pub verify: bool,
+    /// The probability a rung's lower bound must reach.
+    pub min_p: f64,
+    /// The rung whose duty goes into the verdict (G).
+    pub duty_g: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            peaks_g: vec![1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 15.0, 20.0],
+            members: 64,
+            batch: 16,
+            seed: 1,
+            verify: true,
+            min_p: 0.9,
+            duty_g: 10.0,
+        }
+    }
+}
+
+/// The spread of one duty figure over a rung's counted members.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Spread {
+    /// Median.
+    pub median: Option<f64>,
+    /// 90th percentile.
+    pub p90: Option<f64>,
+    /// Largest.
+    pub max: Option<f64>,
+}
+
+fn spread(values: &[f64]) -> Spread {
+    Spread {
+        median: quantile(values, 0.5),
+        p90: quantile(values, 0.9),
+        max: values.iter().copied().filter(|v| v.is_finite()).reduce(f64::max),
+    }
+}
+
+/// The duty of a rung: each figure's spread over the counted members.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RungDuty {
+    /// Time in contact (s).
+    pub contact_time_s: Spread,
+    /// Peak rotor – race force (N).
+    pub peak_contact_force_n: Spread,
+    /// Peak rotor – race pressure (MPa).
+    pub peak_race_pressure_mpa: Spread,
+    /// Peak load of the most loaded ball (N).
+    pub peak_ball_load_n: Spread,
+    /// Its pressure (MPa).
+    pub peak_ball_pressure_mpa: Spread,
+    /// Friction energy (J).
+    pub friction_energy_j: Spread,
+    /// Race peak speed (rpm).
+    pub race_peak_speed_rpm: Spread,
+    /// Race peak angular acceleration (rad/s²).
+    pub race_peak_accel_rad_s2: Spread,
+    /// Ball-load cycles over the threshold.
+    pub ball_cycles: Spread,
+}
+
+fn rung_duty(d: &[&Duty]) -> RungDuty {
+    let v = |f: fn(&Duty) -> Option<f64>| spread(&d.iter().filter_map(|x| f(x)).collect::<Vec<_>>());
+    RungDuty {
+        contact_time_s: v(|d| Some(d.contact_time_s)),
+        peak_contact_force_n: v(|d| Some(d.peak_contact_force_n)),
+        peak_race_pressure_mpa: v(|d| Some(d.peak_race_pressure_mpa)),
+        peak_ball_load_n: v(|d| d.peak_ball_load_n),
+        peak_ball_pressure_mpa: v(|d| d.peak_ball_pressure_mpa),
+        friction_energy_j: v(|d| Some(d.friction_energy_j)),
+        race_peak_speed_rpm: v(|d| Some(d.race_peak_speed_rpm)),
+        race_peak_accel_rad_s2: v(|d| Some(d.race_peak_accel_rad_s2)),
+        ball_cycles: v(|d| d.ball_cycles),
+    }
+}
+
+/// One rung.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Rung {
+    /// Peak of the first shock (G).
+    pub peak_g: f64,
+    /// Members counted.
+    pub members: usize,
+    /// Members recovered.
+    pub recovered: usize,
+    /// Members in dry whirl, rebounding, diverged.
+    pub dry_whirl: usize,
+    /// Rebounding.
+    pub rebound: usize,
+    /// Diverged (also at the reference setting).
+    pub diverged: usize,
+    /// Recovered share and its Wilson 95 % interval.
+    pub p_recovered: f64,
+    /// Lower end.
+    pub p_lo: f64,
+    /// Upper end.
+    pub p_hi: f64,
+    /// Median recovery time of the recovered members (s).
+    pub recovery_median_s: Option<f64>,
+    /// Their 90th percentile (s).
+    pub recovery_p90_s: Option<f64>,
+    /// Members re-run at the reference setting, and of those, members whose mode changed.
+    pub verified: usize,
+    /// Numerically sensitive members.
+    pub numerically_sensitive: usize,
+    /// The rung was decided (false: the ladder was interrupted).
+    pub complete: bool,
+    /// The duty over the counted members.
+    pub duty: RungDuty,
+}
+
+/// The ladder's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LadderResult {
+    /// The rungs, ascending.
+    pub rungs: Vec<Rung>,
+    /// The highest peak up to which every rung's lower bound reaches `min_p` (G); `None` when
+    /// the first rung does not.
+    pub safe_up_to_g: Option<f64>,
+    /// The members' setting, in words.
+    pub member_setting: String,
+    /// Members run in all (verification re-runs not counted).
+    pub members_run: usize,
+    /// Members re-run at the reference setting.
+    pub verified: usize,
+    /// True when interrupted before every rung was decided.
+    pub interrupted: bool,
+}
+
+/// A member's controller process was lost (or missed its realtime budget): the ladder stops
+/// there, keeping the rungs it has.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ControllerLost(pub String);
+
+/// A member's controller sent non-finite commands past the scene's budget: the ladder stops
+/// there, keeping the rungs it has (such a member says nothing of the controller's recovery).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct NotControlling(pub String);
+
+/// A member's outcome with the duty of its counted run.
+struct Counted {
+    result: MemberResult,
+    duty: Duty,
+}
+
+/// The overrides that give rung peak `g` (G) to the scene's programme.
+pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
+    let raw = scene.resolved()?;
+    let first = raw.shock.first().and_then(shock_size).map(|(_, v)| v);
+    let Some(first) = first.filter(|v| *v > 0.0) else {
+        anyhow::bail!("the shock ladder needs a scene whose first [[shock]] has a size (peak_g, amplitude_g or scale)");
+    };
+    let factor = g / first;
+    Ok(raw
+        .shock
+        .iter()
+        .enumerate()
+        .filter_map(|(k, s)| shock_size(s).map(|(field, v)| format!("shock[{k}].{field}={:?}", v * factor)))
+        .collect())
+}
+
+/// Runs a member with its duty; `None` when interrupted.
+fn run_counted(
+    point: &Point,
+    spec: &EnsembleSpec,
+    j: usize,
+    bearing: Bearing,
+    stop: &AtomicBool,
+) -> anyhow::Result<Option<Counted>> {
+    let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty)>> {
+        let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
+        let balls = scene.params.balls.count();
+        let mut sink = DutySink::new(&mut trace, bearing, balls);
+        let run = run_into(scene, &crate::cosim::Launch::default(), &mut Cancel(stop), &mut sink)?;
+        let duty = sink.finish();
+        match &run.outcome {
+            Outcome::Interrupted => return Ok(None),
+            // Ctrl-C in a terminal stops the controller process too: interrupted, not lost.
+            _ if stop.load(Ordering::Relaxed) && run.outcome != Outcome::Completed => return Ok(None),
+            // A member whose controller was lost says nothing of the controller's recovery: it
+            // must not be counted (as a run that did not complete, it would count as diverged).
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => {
+                return Err(ControllerLost(why.clone()).into());
+            }
+            Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),
+            Outcome::Completed | Outcome::Diverged(_) => {}
+        }
+        Ok(Some((RunResult { trace, run }, duty)))
+    };
+    let (sets, draw, drawn) = member_overrides(point, spec, j);
+    let scene = load_scene(point.path, &sets)?;
+    let Some((result, mut duty)) = run(&scene)? else { return Ok(None) };
+    let (first, _) = figures(&scene, &result);
+    drop(result);
+    let mut verified = None;
+    if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
+        let mut sets = point.sets.to_vec();
+        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
+        sets.extend(drawn.iter().cloned());
+        let reference = load_scene(point.path, &sets)?;
+        let Some((result, d)) = run(&reference)? else { return Ok(None) };
+        verified = Some(figures(&reference, &result).0);
+        duty = d;
+    }
+    Ok(Some(Counted {
+        result: MemberResult {
+            point: point.index,
+            member: j,
+            angle_deg: draw.angle_deg,
+            drawn,
+            run: first,
+            verified,
+            poincare: Vec::new(),
+        },
+        duty,
+    }))
+}
+
+/// Runs the ladder for the controller whose scene is `path` with `sets`. A member that fails
+/// (its controller lost, a run that cannot start) stops the ladder after its round: the result
+/// then holds the rungs so far, the undecided ones marked incomplete, with the error beside it.
+pub fn ladder(
+    path: &Path,
+    sets: &[String],
+    settings: &Settings,
+    bearing: Bearing,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> anyhow::Result<(LadderResult, Option<anyhow::Error>)> {
+    let base = load_scene(path, sets)?;
+    let spec = EnsembleSpec {
+        members: settings.members,
+        batch: settings.batch,
+        seed: settings.seed,
+        verify: settings.verify,
+        ..EnsembleSpec::default()
+    };
+    let mut points = Vec::new();
+    for (i, g) in settings.peaks_g.iter().enumerate() {
+        let mut s = sets.to_vec();
+        s.extend(rung_overrides(&base, *g)?);
+        s.push("output.plots=false".into());
+        let scene = load_scene(path, &s)?;
+        points.push(Point { path, sets: s, scene, index: i, values: vec![*g] });
+    }
+    let member_setting = crate::ensemble::member::setting_description(&base, &spec);
+    let mut counted: Vec<Vec<Counted>> = points.iter().map(|_| Vec::new()).collect();
+    let mut decided = vec![false; points.len()];
+    let mut members_run = 0;
+    let mut interrupted = false;
+    let mut failed: Option<anyhow::Error> = None;
+    for round in 0..spec.rounds() {
+        let work: Vec<(usize, usize)> = (0..points.len())
+            .filter(|&i| !decided[i])
+            .flat_map(|i| spec.batch_members(round).map(move |j| (i, j)))
+            .collect();
+        if work.is_empty() {
+            break;
+        }
+        log(&format!(
+            "ladder round {}: {} members on {} rungs",
+            round + 1,
+            work.len(),
+            work.iter().map(|w| w.0).collect::<std::collections::BTreeSet<_>>().len()
+        ));
+        let done: Vec<anyhow::Result<Option<Counted>>> =
+            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, stop)).collect();
+        for r in done {
+            match r {
+                Ok(Some(c)) => {
+                    members_run += 1;
+                    counted[c.result.point].push(c);
+                }
+                Ok(None) => interrupted = true,
+                Err(e) => {
+                    failed.get_or_insert(e);
+                }
+            }
+        }
+        if failed.is_some() {
+            break;
+        }
+        if interrupted || stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+        for (i, c) in counted.iter().enumerate() {
+            let n = c.len();
+            let k = c.iter().filter(|m| m.result.counted().mode == crate::grid::Mode::Recovered).count();
+            let [lo, hi] = wilson(k, n);
+            decided[i] = decided[i] || lo >= settings.min_p || hi < settings.min_p || n >= spec.members;
+        }
+    }
+    let mut rungs = Vec::new();
+    for (i, c) in counted.iter_mut().enumerate() {
+        c.sort_by_key(|m| m.result.member);
+        let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
+        // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
+        // is not read.
+        let stats = crate::ensemble::point::point_stats(i, &refs, crate::ensemble::point::StoppedBy::Members);
+        let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
+        rungs.push(Rung {
+            peak_g: settings.peaks_g[i],
+            members: stats.members,
+            recovered: stats.recovered,
+            dry_whirl: stats.dry_whirl,
+            rebound: stats.rebound,
+            diverged: stats.diverged,
+            p_recovered: stats.p_recovered,
+            p_lo: stats.p_lo,
+            p_hi: stats.p_hi,
+            recovery_median_s: stats.recovery_median_s,
+            recovery_p90_s: stats.recovery_p90_s,
+            verified: stats.verified,
+            numerically_sensitive: stats.numerically_sensitive,
+            complete: decided[i],
+            duty: rung_duty(&duties),
+        });
+    }
+    let safe_up_to_g = rungs.iter().take_while(|r| r.complete && r.p_lo >= settings.min_p).last().map(|r| r.peak_g);
+    let verified = rungs.iter().map(|r| r.verified).sum();
+    Ok((LadderResult { rungs, safe_up_to_g, member_setting, members_run, verified, interrupted }, failed))
+}

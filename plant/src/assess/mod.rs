@@ -1,0 +1,790 @@
+//! `plant assess`: a controller judged the way the field judges one, side by side with
+//! others: the stability margin of each control axis (ISO 14839-3, measured through the
+//! loop: [`sensitivity`], checked against [`closed_form`]), the vibration of the levitated
+//! rotor (ISO 14839-2: [`vibration`]), the probability of recovery against the shock's peak
+//! ([`ladder`], on the ensemble machinery) and what each shock costs the touchdown bearing
+//! ([`duty`]: [`hertz`] pressures, [`rainflow`] load cycles). [`report`] writes `report.json`,
+//! `report.html` (self-contained) and the PNG charts.
+//!
+//! A controller is the scene with `--set` overrides (a law by name with its
+//! `[controller.params]`, or a controller process by `controller.command`): the plant treats it
+//! as a black box through the same run loop every other command uses.
+
+pub mod closed_form;
+pub mod duty;
+pub mod hertz;
+pub mod ladder;
+pub mod rainflow;
+pub mod report;
+pub mod sensitivity;
+pub mod spec;
+pub mod vibration;
+
+use crate::config::{load_scene, ConfigError, ControlMode, Scene};
+use crate::cosim::Launch;
+use crate::ensemble::member::setting_overrides;
+use crate::ensemble::spec::MemberSetting;
+use crate::run::{run_into, Outcome};
+use anyhow::Context;
+use rayon::prelude::*;
+use serde::Serialize;
+use spec::{Assessment, ControllerSpec, Part};
+use std::cell::Cell;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// `plant assess` arguments.
+#[derive(clap::Args, Debug, Clone)]
+pub struct AssessArgs {
+    /// An assessment file (TOML: `scene = "…"`, `[[controller]]` tables, `[sensitivity]`,
+    /// `[ladder]`, `[duty]`) or a scene file (its own controller, or `--laws`).
+    pub file: PathBuf,
+    /// Assess these laws (each in the scene's controller mode) instead of the file's controllers.
+    #[arg(long, value_delimiter = ',')]
+    pub laws: Vec<String>,
+    /// Override a scene key for every controller (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Output folder (default: runs/assess-<file stem>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// No progress lines.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// How a part of an assessment failed; each has its exit code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Failure {
+    /// The rotor is not levitated before the shock, or the excitation drove it into the
+    /// touchdown bearing: nothing to grade (exit 9).
+    NotGradable,
+    /// The controller process was lost (exit 4).
+    PeerLost,
+    /// The controller's commands were non-finite past the scene's budget (exit 8).
+    InvalidCommands,
+    /// A run diverged (exit 3).
+    Diverged,
+    /// Interrupted by SIGINT/SIGTERM (exit 130).
+    Interrupted,
+    /// Anything else (exit 1).
+    Other,
+}
+
+impl Failure {
+    fn rank(self) -> u8 {
+        match self {
+            Failure::Interrupted => 6,
+            Failure::PeerLost => 5,
+            Failure::InvalidCommands => 4,
+            Failure::Diverged => 3,
+            Failure::NotGradable => 2,
+            Failure::Other => 1,
+        }
+    }
+}
+
+/// An assessment that wrote its report but could not measure everything.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}; the report in {dir} holds what was measured and says what was not")]
+pub struct AssessError {
+    /// The gravest failure.
+    pub kind: Failure,
+    /// What failed, for each part.
+    pub message: String,
+    /// The report's folder.
+    pub dir: String,
+}
+
+/// A part's outcome.
+#[derive(Clone, Debug, Serialize)]
+pub struct PartOutcome<T> {
+    /// `measured`, `skipped`, `failed`, or `interrupted`.
+    pub status: &'static str,
+    /// Why it was not measured.
+    pub why: Option<String>,
+    /// How it failed.
+    pub failure: Option<Failure>,
+    /// The result.
+    pub result: Option<T>,
+    /// Wall time (s).
+    pub wall_s: f64,
+}
+
+impl<T> PartOutcome<T> {
+    fn measured(result: T, wall_s: f64) -> Self {
+        Self { status: "measured", why: None, failure: None, result: Some(result), wall_s }
+    }
+    fn skipped(why: &str) -> Self {
+        Self { status: "skipped", why: Some(why.to_string()), failure: None, result: None, wall_s: 0.0 }
+    }
+    fn failed(kind: Failure, why: String, wall_s: f64) -> Self {
+        let status = if kind == Failure::Interrupted { "interrupted" } else { "failed" };
+        Self { status, why: Some(why), failure: Some(kind), result: None, wall_s }
+    }
+}
+
+/// The sensitivity part: one result per axis and speed.
+#[derive(Clone, Debug, Serialize)]
+pub struct SensitivityPart {
+    /// Per axis and speed.
+    pub axes: Vec<sensitivity::AxisResult>,
+    /// The closed form of the law, where it has one (`pd`, `pd_delay` and the continuous PD on
+    /// the linear bearing): per speed-independent axis, its peak and zone.
+    pub closed_form: Option<ClosedFormPeak>,
+    /// Simulated time of all the measurement's runs (s).
+    pub simulated_s: f64,
+    /// The settings.
+    pub settings: sensitivity::Settings,
+}
+
+/// The closed form's peak for comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClosedFormPeak {
+    /// The closed loop is stable.
+    pub stable: bool,
+    /// Peak frequency (Hz).
+    pub f_hz: Option<f64>,
+    /// Peak `|S|`.
+    pub s_abs: Option<f64>,
+    /// In dB.
+    pub s_db: Option<f64>,
+    /// Zone.
+    pub zone: String,
+    /// `|S|` in dB at each measured frequency of the first axis, for the chart.
+    pub curve: Vec<(f64, f64)>,
+}
+
+/// One controller's assessment.
+#[derive(Clone, Debug, Serialize)]
+pub struct ControllerReport {
+    /// Label.
+    pub label: String,
+    /// Its overrides of the scene.
+    pub set: Vec<String>,
+    /// Law, mode, rate.
+    pub law: String,
+    /// Controller mode.
+    pub mode: String,
+    /// Rate (Hz).
+    pub rate_hz: f64,
+    /// Stability margin.
+    pub sensitivity: PartOutcome<SensitivityPart>,
+    /// Vibration.
+    pub vibration: PartOutcome<vibration::Vibration>,
+    /// Shock ladder with the duty.
+    pub ladder: PartOutcome<ladder::LadderResult>,
+    /// The verdict line.
+    pub verdict: String,
+    /// Wall time of the whole (s).
+    pub wall_s: f64,
+}
+
+/// The axes a scene's loop has, by name (x then y; the two-plane rotor will have four).
+pub fn axis_names(_scene: &Scene) -> Vec<&'static str> {
+    vec!["x", "y"]
+}
+
+fn initial_offset_key(axis: usize) -> &'static str {
+    ["initial.rotor_x_um", "initial.rotor_y_um"][axis.min(1)]
+}
+
+/// Overrides of a measurement run without shocks: the shocks moved past `duration`, the fast
+/// setting, the output at `output_hz`, no plots.
+fn quiet_run_overrides(scene: &Scene, duration: f64, output_hz: f64, substeps: u32) -> Vec<String> {
+    let mut s: Vec<String> = setting_overrides(scene, MemberSetting::Fast);
+    s.retain(|o| !o.starts_with("integrator.substeps"));
+    s.push(format!("integrator.substeps={substeps}"));
+    s.extend((0..scene.shock_count()).map(|i| format!("shock[{i}].start_s={:?}", duration + 10.0)));
+    s.push(format!("scene.duration_s={duration:?}"));
+    s.push(format!("output.rate_hz={output_hz:?}"));
+    s.push("output.plots=false".into());
+    s
+}
+
+fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)> {
+    match outcome {
+        Outcome::Completed => None,
+        // Ctrl-C in a terminal also reaches a controller process of the same process group,
+        // which then stops: the run was interrupted, not its controller lost.
+        _ if stop.load(Ordering::Relaxed) => Some((Failure::Interrupted, "interrupted".into())),
+        Outcome::Interrupted => None,
+        Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
+        Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
+        Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => Some((Failure::PeerLost, why.clone())),
+        Outcome::InvalidCommands(why) => Some((Failure::InvalidCommands, why.clone())),
+    }
+}
+
+/// Measures the sensitivity of axis `axis` at rotor speed `speed_hz` (0: standstill).
+pub fn measure_axis(
+    scene: &Scene,
+    axis: usize,
+    speed_hz: f64,
+    settings: &sensitivity::Settings,
+    stop: &AtomicBool,
+) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
+    measure_axis_or_abandon(scene, axis, speed_hz, settings, stop, None)
+}
+
+/// [`measure_axis`], stopping early (`MeasureError::Abandoned`) once `abandon` is set.
+fn measure_axis_or_abandon(
+    scene: &Scene,
+    axis: usize,
+    speed_hz: f64,
+    settings: &sensitivity::Settings,
+    stop: &AtomicBool,
+    abandon: Option<&AtomicBool>,
+) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
+    use sensitivity::MeasureError;
+    let continuous = scene.controller.mode == ControlMode::Continuous;
+    let period = scene.controller.period;
+    // The continuous PD reads the sine inside the derivative: steps of at most 1/20 of its period.
+    let substeps = if continuous { ((20.0 * settings.f_max_hz * period).ceil() as u32).max(1) } else { 1 };
+    let cap = sensitivity::RUN_CAP_S;
+    let mut sets = quiet_run_overrides(scene, cap, 1000.0, substeps);
+    sets.push(format!("rotor.speed_hz={speed_hz:?}"));
+    sets.push(format!("{}={:?}", initial_offset_key(axis), settings.probe_um));
+    let run_scene = scene.reload(&sets).map_err(|e| MeasureError::Run { kind: Failure::Other, why: e.to_string() })?;
+    let touched = Rc::new(Cell::new(None));
+    let names = axis_names(scene);
+    let mut m = sensitivity::Measure::new(
+        settings.clone(),
+        axis,
+        names.get(axis).copied().unwrap_or("?"),
+        period,
+        !continuous,
+        scene.params.loop_constants.sensor_gain_v_per_m,
+        scene.params.contact.gap,
+        speed_hz,
+        stop,
+        touched.clone(),
+    );
+    if let Some(flag) = abandon {
+        m = m.abandon_on(flag);
+    }
+    let mut watch = sensitivity::ContactWatch { touched };
+    let run = run_into(&run_scene, &Launch::default(), &mut m, &mut watch);
+    // Stopped by another axis' failure (while running or still connecting), not by Ctrl-C.
+    let abandoned = || abandon.is_some_and(|a| a.load(Ordering::Relaxed)) && !stop.load(Ordering::Relaxed);
+    let run = match run {
+        Ok(run) => run,
+        Err(crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted)) if abandoned() => {
+            return Err(MeasureError::Abandoned)
+        }
+        Err(e) => return Err(MeasureError::Run { kind: setup_failure(&e, stop), why: e.to_string() }),
+    };
+    if run.outcome == Outcome::Interrupted && abandoned() {
+        return Err(MeasureError::Abandoned);
+    }
+    if let Some((kind, why)) = run_failure(&run.outcome, stop) {
+        return Err(MeasureError::Run { kind, why });
+    }
+    m.result(run.simulated)
+}
+
+fn setup_failure(e: &crate::run::SetupError, stop: &AtomicBool) -> Failure {
+    if stop.load(Ordering::Relaxed) {
+        return Failure::Interrupted;
+    }
+    match e {
+        crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted) => Failure::Interrupted,
+        crate::run::SetupError::Cosim(_) => Failure::PeerLost,
+        _ => Failure::Other,
+    }
+}
+
+fn measure_kind(e: &sensitivity::MeasureError) -> Failure {
+    match e {
+        sensitivity::MeasureError::Touched { .. } | sensitivity::MeasureError::Level { .. } => Failure::NotGradable,
+        sensitivity::MeasureError::Run { kind, .. } => *kind,
+        sensitivity::MeasureError::Abandoned => Failure::Other,
+    }
+}
+
+/// The closed form of the scene's law, where it has one.
+pub fn closed_form_of(scene: &Scene) -> Option<closed_form::PdLoop> {
+    use crate::model::Params;
+    let p: &Params = &scene.params;
+    if !matches!(p.amb, crate::force::amb::AmbLaw::Linear { .. }) {
+        return None;
+    }
+    let design = scene.design();
+    let c = &scene.controller;
+    // A sampled law runs in the plant whatever `controller.command` says; co-simulated, the
+    // built-in controller runs the registry's law, a command is a black box.
+    let registry = c.mode == ControlMode::Sampled || c.cosim.command.is_none();
+    match (c.mode, c.law.as_str()) {
+        (ControlMode::Continuous, _) => {
+            let g = crate::run::design_gains(scene).ok()?;
+            Some(closed_form::PdLoop::Continuous { kp: g.kp, kd: g.kd })
+        }
+        (_, "pd") if registry => {
+            let g = crate::run::design_gains(scene).ok()?;
+            Some(closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples })
+        }
+        (_, "pd_delay" | "relev") if registry => {
+            let g = controller::discrete_pd::DelayPdGains::from_design(
+                &design.pd(),
+                &design.constants,
+                c.period,
+                c.delay_samples,
+            )
+            .ok()?
+            .pd;
+            Some(closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples })
+        }
+        _ => None,
+    }
+}
+
+fn closed_form_peak(scene: &Scene, pd: &closed_form::PdLoop, settings: &sensitivity::Settings) -> ClosedFormPeak {
+    let plant = closed_form::AxisPlant::of(&scene.params.loop_constants);
+    let stable = closed_form::stable(&plant, pd);
+    let f_hi = match pd {
+        closed_form::PdLoop::Sampled { period, .. } => settings.f_max_hz.min(0.45 / period),
+        _ => settings.f_max_hz,
+    };
+    let curve: Vec<(f64, f64)> = sensitivity::log_grid(settings.f_min_hz, f_hi, 400)
+        .into_iter()
+        .map(|f| (f, 20.0 * closed_form::sensitivity(&plant, pd, f).norm().log10()))
+        .collect();
+    if !stable {
+        return ClosedFormPeak { stable, f_hz: None, s_abs: None, s_db: None, zone: "unstable".into(), curve };
+    }
+    let (f, s) = closed_form::peak(&plant, pd, settings.f_min_hz, f_hi);
+    ClosedFormPeak {
+        stable,
+        f_hz: Some(f),
+        s_abs: Some(s),
+        s_db: Some(20.0 * s.log10()),
+        zone: sensitivity::zone(s).into(),
+        curve,
+    }
+}
+
+/// A sensitivity part that failed or was interrupted: how, why, and the part with the axes
+/// measured before it (none: `None`).
+type PartialSensitivity = (Failure, String, Option<Box<SensitivityPart>>);
+
+/// The sensitivity part of one controller: every axis at each speed, in parallel.
+fn sensitivity_part(
+    scene: &Scene,
+    a: &Assessment,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> Result<SensitivityPart, PartialSensitivity> {
+    let speed = scene.params.speed / std::f64::consts::TAU;
+    let speeds: Vec<f64> = a.speeds.iter().map(|s| if *s == spec::Speed::Rated { speed } else { 0.0 }).collect();
+    let jobs: Vec<(usize, f64)> =
+        speeds.iter().flat_map(|s| (0..axis_names(scene).len()).map(move |k| (k, *s))).collect();
+    // One axis failing fails the part: the others stop there instead of running on for nothing.
+    let abandon = AtomicBool::new(false);
+    let results: Vec<_> = jobs
+        .par_iter()
+        .map(|&(k, s)| {
+            let r = measure_axis_or_abandon(scene, k, s, &a.sensitivity, stop, Some(&abandon));
+            match &r {
+                Ok(x) => {
+                    let peak =
+                        x.peak.as_ref().map_or(String::new(), |p| format!(", {:.2} dB at {:.2} Hz", p.s_db, p.f_hz));
+                    log(&format!("  axis {} at {:.0} Hz: zone {}{peak}", x.axis, x.speed_hz, x.zone));
+                }
+                Err(_) => abandon.store(true, Ordering::Relaxed),
+            }
+            r
+        })
+        .collect();
+    let mut axes = Vec::new();
+    let mut errors = Vec::new();
+    for r in results {
+        match r {
+            Ok(x) => axes.push(x),
+            Err(sensitivity::MeasureError::Abandoned) => {}
+            Err(e) => errors.push((measure_kind(&e), e.to_string())),
+        }
+    }
+    let simulated_s = axes.iter().map(|x| x.simulated_s).sum();
+    let closed_form = closed_form_of(scene).map(|pd| closed_form_peak(scene, &pd, &a.sensitivity));
+    let part = SensitivityPart { axes, closed_form, simulated_s, settings: a.sensitivity.clone() };
+    if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
+        // The axes often fail alike (one controller command, one interruption): each reason once.
+        let mut reasons: Vec<&str> = Vec::new();
+        for (_, why) in &errors {
+            if !reasons.contains(&why.as_str()) {
+                reasons.push(why);
+            }
+        }
+        let mut why = reasons.join("; ");
+        // The axes measured before the failure are kept, and said to be all there is.
+        let kept = (!part.axes.is_empty()).then(|| Box::new(part));
+        if let Some(p) = &kept {
+            let names: Vec<String> = p.axes.iter().map(|x| format!("{} at {:.0} Hz", x.axis, x.speed_hz)).collect();
+            why.push_str(&format!(
+                "; measured before it: {} of {} axes ({})",
+                names.len(),
+                jobs.len(),
+                names.join(", ")
+            ));
+        }
+        return Err((worst.0, why, kept));
+    }
+    Ok(part)
+}
+
+/// The vibration part: the levitated rotor at its speed without shock.
+fn vibration_part(
+    scene: &Scene,
+    decay_per_s: Option<f64>,
+    stop: &AtomicBool,
+) -> Result<vibration::Vibration, (Failure, String)> {
+    let speed_hz = scene.params.speed / std::f64::consts::TAU;
+    let settle = decay_per_s.filter(|s| *s > 0.0).map_or(1.0, |s| (1000f64.ln() / s).clamp(0.1, 5.0));
+    let window = if speed_hz > 0.0 { (50.0 / speed_hz).max(0.2) } else { 0.2 };
+    let sets = quiet_run_overrides(scene, settle + window, scene.controller.rate_hz.min(20_000.0), 1);
+    let run_scene = scene.reload(&sets).map_err(|e| (Failure::Other, e.to_string()))?;
+    let mut sink = vibration::VibrationSink::new(settle);
+    let run = run_into(&run_scene, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut sink)
+        .map_err(|e| (setup_failure(&e, stop), e.to_string()))?;
+    if let Some(t) = sink.touched {
+        return Err((
+            Failure::NotGradable,
+            format!("not levitated: without a shock the rotor touches the touchdown bearing at t = {t:.4} s"),
+        ));
+    }
+    if let Some(f) = run_failure(&run.outcome, stop) {
+        return Err(f);
+    }
+    if run.outcome == Outcome::Interrupted {
+        return Err((Failure::Interrupted, "interrupted".into()));
+    }
+    Ok(sink.figures(scene.params.contact.gap, scene.params.current_limit, speed_hz, settle, window))
+}
+
+/// A co-simulated controller started once, for one tick, before anything is measured: a
+/// command that cannot run, a controller that refuses the run or speaks another protocol is
+/// found here, with the exit code `plant run` gives it (bad input: 2), instead of failing every
+/// part of the assessment. A controller lost in that tick is left to the parts to report.
+fn controller_starts(scene: &Scene, stop: &AtomicBool) -> anyhow::Result<()> {
+    let sets = [format!("scene.duration_s={:?}", scene.controller.period), "output.plots=false".to_string()];
+    let one_tick = scene.reload(&sets)?;
+    let mut trace = crate::trace::Trace::with_capacity(4);
+    run_into(&one_tick, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut trace)?;
+    Ok(())
+}
+
+/// The bearing of a scene with the assessment's materials.
+fn bearing(scene: &Scene, a: &Assessment) -> anyhow::Result<duty::Bearing> {
+    let raw = scene.resolved()?;
+    let t = &raw.touchdown;
+    Ok(duty::Bearing::new(
+        a.materials,
+        t.ball_diameter_mm * 1e-3,
+        t.pitch_diameter_mm * 1e-3,
+        t.width_mm * 1e-3,
+        a.capacity_fraction,
+    ))
+}
+
+/// Assesses one controller.
+fn assess_controller(
+    a: &Assessment,
+    c: &ControllerSpec,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> anyhow::Result<ControllerReport> {
+    let started = Instant::now();
+    let scene = load_scene(&a.scene, &c.sets)?;
+    let mut report = ControllerReport {
+        label: c.label.clone(),
+        set: c.own.clone(),
+        law: if scene.controller.mode == ControlMode::Continuous {
+            "continuous PD".into()
+        } else {
+            scene.controller.law.clone()
+        },
+        mode: crate::summary::snake_name(&scene.controller.mode),
+        rate_hz: scene.controller.rate_hz,
+        sensitivity: PartOutcome::skipped("not asked for"),
+        vibration: PartOutcome::skipped("not asked for"),
+        ladder: PartOutcome::skipped("not asked for"),
+        verdict: String::new(),
+        wall_s: 0.0,
+    };
+    let interrupted = || stop.load(Ordering::Relaxed);
+    let mut decay_at_speed = None;
+    if a.parts.contains(&Part::Sensitivity) && !interrupted() {
+        log(&format!("{}: sensitivity (ISO 14839-3)", c.label));
+        let t = Instant::now();
+        report.sensitivity = match sensitivity_part(&scene, a, stop, log) {
+            Ok(p) => {
+                decay_at_speed = p
+                    .axes
+                    .iter()
+                    .filter(|x| x.speed_hz > 0.0 || p.axes.iter().all(|y| y.speed_hz == 0.0))
+                    .map(|x| x.decay_per_s)
+                    .reduce(f64::min);
+                PartOutcome::measured(p, t.elapsed().as_secs_f64())
+            }
+            Err((kind, why, kept)) => {
+                PartOutcome { result: kept.map(|p| *p), ..PartOutcome::failed(kind, why, t.elapsed().as_secs_f64()) }
+            }
+        };
+    }
+    let mut levitated = true;
+    if a.parts.contains(&Part::Vibration) && !interrupted() {
+        log(&format!("{}: vibration (ISO 14839-2)", c.label));
+        let t = Instant::now();
+        report.vibration = match vibration_part(&scene, decay_at_speed, stop) {
+            Ok(v) => PartOutcome::measured(v, t.elapsed().as_secs_f64()),
+            Err((kind, why)) => {
+                levitated = kind != Failure::NotGradable;
+                PartOutcome::failed(kind, why, t.elapsed().as_secs_f64())
+            }
+        };
+    }
+    if a.parts.contains(&Part::Ladder) && !interrupted() {
+        if !levitated {
+            let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
+            report.ladder = PartOutcome::failed(Failure::NotGradable, why, 0.0);
+        } else {
+            log(&format!("{}: shock ladder", c.label));
+            let t = Instant::now();
+            let b = bearing(&scene, a)?;
+            let kind = |e: &anyhow::Error| {
+                if interrupted() {
+                    Failure::Interrupted
+                } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
+                    Failure::InvalidCommands
+                } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
+                    Failure::PeerLost
+                } else {
+                    Failure::Other
+                }
+            };
+            report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stop, log) {
+                Ok((l, Some(e))) => {
+                    let kind = kind(&e);
+                    PartOutcome {
+                        status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
+                        why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
+                        failure: Some(kind),
+                        result: Some(l),
+                        wall_s: t.elapsed().as_secs_f64(),
+                    }
+                }
+                Ok((l, None)) if l.interrupted => PartOutcome {
+                    status: "interrupted",
+                    why: Some("interrupted: the rungs marked incomplete were not decided".into()),
+                    failure: Some(Failure::Interrupted),
+                    result: Some(l),
+                    wall_s: t.elapsed().as_secs_f64(),
+                },
+                Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
+                Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
+            };
+        }
+    }
+    for (status, part) in [
+        (report.sensitivity.status, "sensitivity"),
+        (report.vibration.status, "vibration"),
+        (report.ladder.status, "ladder"),
+    ] {
+        if status == "skipped" && interrupted() && a.parts.iter().any(|p| p.name() == part) {
+            match part {
+                "sensitivity" => {
+                    report.sensitivity =
+                        PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
+                }
+                "vibration" => {
+                    report.vibration =
+                        PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0)
+                }
+                _ => report.ladder = PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            }
+        }
+    }
+    report.verdict = report::verdict(&report, a.ladder.duty_g);
+    report.wall_s = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// The whole report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Program and version.
+    pub program: String,
+    /// The assessment file or scene.
+    pub file: String,
+    /// The scene every controller runs.
+    pub scene: String,
+    /// The parts asked for.
+    pub parts: Vec<String>,
+    /// The bearing's basis (materials, static capacity, cycle threshold).
+    pub bearing: Option<duty::Bearing>,
+    /// The ladder's settings.
+    pub ladder_settings: ladder::Settings,
+    /// One per controller.
+    pub controllers: Vec<ControllerReport>,
+    /// True when interrupted: the parts not measured say so.
+    pub interrupted: bool,
+    /// Wall time (s).
+    pub wall_s: f64,
+}
+
+/// `plant assess`: loads everything first (bad input: exit 2 before anything runs), assesses
+/// each controller, writes the report (also when a part failed or the run was interrupted).
+pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> {
+    let started = Instant::now();
+    let a = spec::load(&args.file, &args.set, &args.laws)?;
+    // Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2).
+    let mut first = None;
+    for c in &a.controllers {
+        let scene = load_scene(&a.scene, &c.sets)?;
+        if scene.two_plane.is_some() {
+            // Not yet: the excitation and the grades are plane A's two axes.
+            return Err(ConfigError::Range {
+                key: "rotor.model".into(),
+                value: "two_plane".into(),
+                unit: String::new(),
+                why: "plant assess measures the planar model's two axes; a two-plane rotor's four axes are not assessed yet"
+                    .into(),
+            }
+            .into());
+        }
+        if a.parts.contains(&Part::Ladder) {
+            ladder::rung_overrides(&scene, 1.0).map_err(|e| ConfigError::Range {
+                key: "ladder".into(),
+                value: a.scene.display().to_string(),
+                unit: String::new(),
+                why: e.to_string(),
+            })?;
+            for g in &a.ladder.peaks_g {
+                let mut s = c.sets.clone();
+                s.extend(ladder::rung_overrides(&scene, *g)?);
+                load_scene(&a.scene, &s)?;
+            }
+        }
+        if matches!(scene.controller.mode, ControlMode::Lockstep | ControlMode::Realtime) {
+            controller_starts(&scene, stop).with_context(|| format!("{}: starting its controller", c.label))?;
+        }
+        first.get_or_insert(scene);
+    }
+    let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
+    let _claim = crate::claim::claim(&dir, true)?;
+    let quiet = args.quiet;
+    let log = move |l: &str| {
+        if !quiet {
+            eprintln!("plant assess: {l}");
+        }
+    };
+    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
+    let mut report = Report {
+        program: format!("plant {}", env!("CARGO_PKG_VERSION")),
+        file: args.file.display().to_string(),
+        scene: shown(&a.scene),
+        parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
+        bearing,
+        ladder_settings: a.ladder.clone(),
+        controllers: Vec::new(),
+        interrupted: false,
+        wall_s: 0.0,
+    };
+    for c in &a.controllers {
+        let r = assess_controller(&a, c, stop, &log)?;
+        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
+        report.controllers.push(r);
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+    }
+    for c in a.controllers.iter().skip(report.controllers.len()) {
+        let mut r = ControllerReport {
+            label: c.label.clone(),
+            set: c.own.clone(),
+            law: String::new(),
+            mode: String::new(),
+            rate_hz: 0.0,
+            sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+            verdict: String::new(),
+            wall_s: 0.0,
+        };
+        r.verdict = "not assessed: interrupted".into();
+        report.controllers.push(r);
+    }
+    report.interrupted = stop.load(Ordering::Relaxed);
+    report.wall_s = started.elapsed().as_secs_f64();
+    report::write(&dir, &report)?;
+    log(&format!("wrote {}", dir.join("report.html").display()));
+    let failures: Vec<(Failure, String)> = report
+        .controllers
+        .iter()
+        .flat_map(|c| {
+            [
+                ("sensitivity", &c.sensitivity.failure, &c.sensitivity.why),
+                ("vibration", &c.vibration.failure, &c.vibration.why),
+                ("ladder", &c.ladder.failure, &c.ladder.why),
+            ]
+            .into_iter()
+            .filter_map(move |(part, f, why)| {
+                f.map(|f| (f, format!("{}: {part}: {}", c.label, why.clone().unwrap_or_default())))
+            })
+        })
+        .collect();
+    if let Some(worst) = failures.iter().map(|f| f.0).max_by_key(|f| f.rank()) {
+        let message = if worst == Failure::Interrupted {
+            "interrupted".to_string()
+        } else {
+            failures.iter().map(|f| f.1.as_str()).collect::<Vec<_>>().join("; ")
+        };
+        return Err(AssessError { kind: worst, message, dir: dir.display().to_string() }.into());
+    }
+    Ok(dir)
+}
+
+/// Where a relative path of an assessment file points.
+pub fn relative_to(file: &Path, path: &str) -> PathBuf {
+    file.parent().unwrap_or(Path::new(".")).join(path)
+}
+
+/// A path as the report shows it: `.` and each `dir/..` pair dropped, lexically
+/// (`config/assess/../paper-10g.toml` is shown `config/paper-10g.toml`); the scene is still
+/// loaded by the path as written, which a symbolic link could make differ.
+pub fn shown(path: &Path) -> String {
+    use std::path::Component;
+    let mut kept: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(kept.last(), Some(Component::Normal(_))) => {
+                kept.pop();
+            }
+            c => kept.push(c),
+        }
+    }
+    if kept.is_empty() {
+        return ".".into();
+    }
+    kept.iter().collect::<PathBuf>().display().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+    use std::path::Path;
+
+    #[test]
+    fn a_scene_path_is_shown_without_dot_dot() {
+        assert_eq!(shown(Path::new("config/assess/../paper-10g.toml")), "config/paper-10g.toml");
+        assert_eq!(shown(Path::new("./a/./b/../../c.toml")), "c.toml");
+        assert_eq!(shown(Path::new("../x/../../y.toml")), "../../y.toml");
+        assert_eq!(shown(Path::new("/etc/../a.toml")), "/a.toml");
+        assert_eq!(shown(Path::new("a/..")), ".");
+    }
+}

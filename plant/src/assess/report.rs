@@ -1,0 +1,557 @@
+//! The assessment's outputs: `report.json` (every figure), the charts as PNG, and
+//! `report.html`, one self-contained page (the charts embedded as data URIs, no script, no
+//! network) with the verdict line of each controller at the top, one column each.
+
+use super::{ControllerReport, Report};
+use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, finish, titled_root, PlotError, WIDE_SIZE};
+use anyhow::Context;
+use base64::Engine;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The ISO 14839-3 zone boundaries of the peak sensitivity, in dB (3, 4, 5).
+const ZONE_DB: [(f64, &str); 3] = [(9.542, "A/B"), (12.041, "B/C"), (13.979, "C/D")];
+
+/// The verdict line of a controller: its worst zone, the vibration zone, the highest safe
+/// shock and the duty at the duty rung.
+pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
+    let mut parts = Vec::new();
+    match (&r.sensitivity.result, r.sensitivity.status) {
+        (Some(s), _) => {
+            let worst = s
+                .axes
+                .iter()
+                .max_by_key(|a| match a.zone.as_str() {
+                    "A" => 0,
+                    "B" => 1,
+                    "C" => 2,
+                    "D" => 3,
+                    _ => 4,
+                })
+                .map(|a| {
+                    a.peak.as_ref().map_or(format!("{} ({} at {:.0} Hz)", a.zone, a.axis, a.speed_hz), |p| {
+                        format!(
+                            "zone {} (|S| {:.1} dB at {:.1} Hz, {} at {:.0} Hz)",
+                            a.zone, p.s_db, p.f_hz, a.axis, a.speed_hz
+                        )
+                    })
+                })
+                .unwrap_or_default();
+            // A part that failed or was interrupted: the axes measured before it, said so.
+            let so_far = match r.sensitivity.status {
+                "measured" => String::new(),
+                status => format!("sensitivity {status}, on the {} axes measured: ", s.axes.len()),
+            };
+            if s.axes.iter().any(|a| !a.stable) {
+                parts.push(format!("{so_far}UNSTABLE loop: no stability margin"));
+            } else {
+                parts.push(format!("{so_far}{worst}"));
+            }
+        }
+        (None, status) => parts.push(format!("sensitivity {status}")),
+    }
+    if let Some(v) = &r.vibration.result {
+        parts.push(format!("vibration zone {} ({:.1} µm, {:.2} C_min)", v.zone, v.peak_um, v.ratio));
+    } else if r.vibration.status != "skipped" {
+        parts.push(format!("vibration {}", r.vibration.status));
+    }
+    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.members > 0)) {
+        // An interrupted or failed ladder: its figures are those of the rungs decided so far.
+        let so_far = match r.ladder.status {
+            "measured" => String::new(),
+            status => format!("ladder {status}, on the members run so far: "),
+        };
+        parts.push(match l.safe_up_to_g {
+            Some(g) => format!("{so_far}P(recovered) ≥ 0.9 up to {g} G"),
+            None => format!("{so_far}P(recovered) ≥ 0.9 at no rung"),
+        });
+        if let Some(rung) = l.rungs.iter().find(|x| (x.peak_g - duty_g).abs() < 1e-9) {
+            let d = &rung.duty;
+            parts.push(format!(
+                "at {duty_g} G{}: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
+                if rung.complete { "" } else { " (incomplete)" },
+                rung.p_recovered,
+                rung.p_lo,
+                rung.p_hi,
+                d.contact_time_s.median.unwrap_or(f64::NAN),
+                d.friction_energy_j.median.unwrap_or(f64::NAN),
+                d.peak_ball_pressure_mpa.median.unwrap_or(f64::NAN)
+            ));
+        }
+    } else if r.ladder.status != "skipped" {
+        parts.push(format!("ladder {}", r.ladder.status));
+    }
+    parts.join("; ")
+}
+
+/// A line of a chart.
+struct Line {
+    label: String,
+    points: Vec<(f64, f64)>,
+    colour: RGBColor,
+    dashed: bool,
+    width: u32,
+}
+
+/// Error bars of one series: its colour and `(x, low, high)` per bar.
+type ErrorBars = (RGBColor, Vec<(f64, f64, f64)>);
+
+/// An x–y chart with a log or linear x axis, horizontal reference lines, optional error bars.
+fn chart(
+    path: &Path,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    x_log: bool,
+    lines: &[Line],
+    hlines: &[(f64, &str)],
+    bars: &[ErrorBars],
+) -> Result<(), PlotError> {
+    let pts = lines.iter().flat_map(|l| l.points.iter().copied()).filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for (x, y) in pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    for (_, b) in bars {
+        for (_, lo, hi) in b {
+            y0 = y0.min(*lo);
+            y1 = y1.max(*hi);
+        }
+    }
+    for (y, _) in hlines {
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(PlotError::NoData { path: path.into(), what: "no finite point".into() });
+    }
+    if x1 <= x0 {
+        x1 = x0 * 1.1 + 1.0;
+    }
+    let pad = ((y1 - y0) * 0.06).max(1e-9);
+    let (y0, y1) = (y0 - pad, y1 + pad);
+    ensure_font(path)?;
+    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
+    let area = titled_root(&root, path, title)?;
+    let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
+    macro_rules! body {
+        ($chart:expr) => {{
+            let mut c = $chart;
+            for (y, label) in hlines {
+                c.draw_series(std::iter::once(PathElement::new(
+                    vec![(x0, *y), (x1, *y)],
+                    RGBColor(120, 120, 120).stroke_width(1),
+                )))
+                .map_err(draw_err(path))?;
+                c.draw_series(std::iter::once(Text::new(label.to_string(), (x0, *y), crate::plot::font(16))))
+                    .map_err(draw_err(path))?;
+            }
+            for (col, b) in bars {
+                for (x, lo, hi) in b {
+                    c.draw_series(std::iter::once(PathElement::new(vec![(*x, *lo), (*x, *hi)], col.stroke_width(2))))
+                        .map_err(draw_err(path))?;
+                }
+            }
+            for l in lines {
+                let style = l.colour.stroke_width(l.width);
+                let pts: Vec<(f64, f64)> =
+                    l.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+                if l.dashed {
+                    c.draw_series(DashedLineSeries::new(pts.clone(), 8, 6, style)).map_err(draw_err(path))?
+                } else {
+                    c.draw_series(LineSeries::new(pts.clone(), style)).map_err(draw_err(path))?
+                }
+                .label(l.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+                if !l.dashed && pts.len() < 40 {
+                    c.draw_series(pts.iter().map(|p| Circle::new(*p, 3, l.colour.filled()))).map_err(draw_err(path))?;
+                }
+            }
+            c.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(crate::plot::font(16))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(draw_err(path))?;
+        }};
+    }
+    if x_log {
+        let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
+        let mut c = builder(&area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
+        let fmt_x = |v: &f64| format!("{v}");
+        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+        body!(c);
+    } else {
+        let mut c = builder(&area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
+        let fmt_x = |v: &f64| format!("{v}");
+        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+        body!(c);
+    }
+    finish(&root, path)
+}
+
+/// The Bode magnitude chart of one controller: `|S|` and `|T|` of each axis and speed, the
+/// closed form where there is one, the zone boundaries.
+fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
+    let Some(s) = &c.sensitivity.result else { return Ok(false) };
+    let mut lines = Vec::new();
+    for (i, a) in s.axes.iter().filter(|a| !a.points.is_empty()).enumerate() {
+        let name = format!("{} at {:.0} Hz", a.axis, a.speed_hz);
+        lines.push(Line {
+            label: format!("|S| {name}"),
+            points: a.points.iter().map(|p| (p.f_hz, p.s_db)).collect(),
+            colour: colour(i),
+            dashed: false,
+            width: 2,
+        });
+        lines.push(Line {
+            label: format!("|T| {name}"),
+            points: a.points.iter().map(|p| (p.f_hz, p.t_db)).collect(),
+            colour: {
+                let RGBColor(r, g, b) = colour(i);
+                RGBColor(r / 2 + 110, g / 2 + 110, b / 2 + 110)
+            },
+            dashed: true,
+            width: 1,
+        });
+    }
+    if let Some(cf) = &s.closed_form {
+        lines.push(Line {
+            label: "|S| closed form".into(),
+            points: cf.curve.clone(),
+            colour: BLACK,
+            dashed: true,
+            width: 2,
+        });
+    }
+    if lines.iter().all(|l| l.points.is_empty()) {
+        return Ok(false);
+    }
+    let zones: Vec<(f64, &str)> = ZONE_DB.to_vec();
+    chart(
+        path,
+        &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label),
+        ("frequency (Hz)", "magnitude (dB)"),
+        true,
+        &lines,
+        &zones,
+        &[],
+    )?;
+    Ok(true)
+}
+
+/// The ladder's charts over all controllers: probability with its interval, recovery times,
+/// friction energy and the most loaded ball's pressure.
+fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotError> {
+    let with: Vec<(usize, &ControllerReport, &super::ladder::LadderResult)> =
+        r.controllers.iter().enumerate().filter_map(|(i, c)| c.ladder.result.as_ref().map(|l| (i, c, l))).collect();
+    if with.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut out = Vec::new();
+    let series = |f: &dyn Fn(&super::ladder::Rung) -> Option<f64>, dashed: bool, suffix: &str| -> Vec<Line> {
+        with.iter()
+            .map(|(i, c, l)| Line {
+                label: format!("{}{suffix}", c.label),
+                points: l.rungs.iter().filter(|x| x.members > 0).filter_map(|x| f(x).map(|v| (x.peak_g, v))).collect(),
+                colour: colour(*i),
+                dashed,
+                width: 2,
+            })
+            .collect()
+    };
+    let bars: Vec<ErrorBars> = with
+        .iter()
+        .map(|(i, _, l)| {
+            (colour(*i), l.rungs.iter().filter(|x| x.members > 0).map(|x| (x.peak_g, x.p_lo, x.p_hi)).collect())
+        })
+        .collect();
+    // A ladder interrupted or stopped before any member was counted has nothing to draw.
+    let lines = series(&|x| Some(x.p_recovered), false, "");
+    if lines.iter().any(|l| !l.points.is_empty()) {
+        let p = dir.join("ladder_probability.png");
+        let min_p = format!("{}", r.ladder_settings.min_p);
+        chart(
+            &p,
+            "Probability of recovery against the shock's peak (Wilson 95 % intervals)",
+            ("peak of the shock (G)", "P(recovered)"),
+            false,
+            &lines,
+            &[(r.ladder_settings.min_p, min_p.as_str())],
+            &bars,
+        )?;
+        out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
+    }
+    let mut lines = series(&|x| x.recovery_median_s.map(|v| v * 1e3), false, " median");
+    lines.extend(series(&|x| x.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
+    if lines.iter().any(|l| !l.points.is_empty()) {
+        let p = dir.join("ladder_recovery.png");
+        chart(
+            &p,
+            "Recovery time of the recovered members",
+            ("peak of the shock (G)", "recovery time (ms)"),
+            false,
+            &lines,
+            &[],
+            &[],
+        )?;
+        out.push(("ladder_recovery.png".into(), "Recovery time, median and 90th percentile".into()));
+    }
+    let mut lines = series(&|x| x.duty.friction_energy_j.median, false, " median");
+    lines.extend(series(&|x| x.duty.friction_energy_j.p90, true, " p90"));
+    if lines.iter().any(|l| !l.points.is_empty()) {
+        let p = dir.join("duty_friction.png");
+        chart(
+            &p,
+            "Friction energy dissipated at the rotor – race contact per shock",
+            ("peak of the shock (G)", "energy (J)"),
+            false,
+            &lines,
+            &[],
+            &[],
+        )?;
+        out.push(("duty_friction.png".into(), "Friction energy per shock".into()));
+    }
+    let lines = series(&|x| x.duty.peak_ball_pressure_mpa.median, false, " median");
+    if lines.iter().any(|l| !l.points.is_empty()) {
+        let p = dir.join("duty_ball_pressure.png");
+        let limit = r.bearing.map(|b| b.materials.static_pressure_pa * 1e-6);
+        let hl: Vec<(f64, &str)> = limit.map(|l| vec![(l, "static capacity")]).unwrap_or_default();
+        chart(
+            &p,
+            "Peak Hertz pressure of the most loaded ball (inner raceway)",
+            ("peak of the shock (G)", "pressure (MPa)"),
+            false,
+            &lines,
+            &hl,
+            &[],
+        )?;
+        out.push(("duty_ball_pressure.png".into(), "Most loaded ball's peak pressure".into()));
+    }
+    Ok(out)
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn num(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.digits$}"),
+        _ => "–".into(),
+    }
+}
+
+fn image(dir: &Path, name: &str, alt: &str) -> anyhow::Result<String> {
+    let bytes = std::fs::read(dir.join(name)).with_context(|| format!("reading {name}"))?;
+    let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+    Ok(format!("<figure><img alt=\"{}\" src=\"data:image/png;base64,{data}\"><figcaption>{} (<code>{name}</code>)</figcaption></figure>\n", esc(alt), esc(alt)))
+}
+
+/// Writes `report.json`, the charts and `report.html` into `dir`.
+pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let json = serde_json::to_vec_pretty(r)?;
+    crate::atomic::write(&dir.join("report.json"), &json)?;
+    let mut charts: Vec<(usize, String)> = Vec::new();
+    for (i, c) in r.controllers.iter().enumerate() {
+        let name = format!("sensitivity_{}.png", i + 1);
+        if sensitivity_chart(&dir.join(&name), c)? {
+            charts.push((i, name));
+        }
+    }
+    let ladder = ladder_charts(dir, r)?;
+    let mut h = String::new();
+    let title = format!("Controller assessment: {}", r.scene);
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title>\n<style>\
+body{{font-family:sans-serif;max-width:1250px;margin:1.5em auto;padding:0 1em;color:#222;line-height:1.4}}\
+table{{border-collapse:collapse;margin:.8em 0;font-size:.92em}}td,th{{border:1px solid #bbb;padding:.3em .55em;text-align:left;vertical-align:top}}\
+th{{background:#f1f1f1}}.verdict td{{font-weight:600}}.bad{{color:#b00020}}.ok{{color:#126b12}}\
+figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{font-size:.9em;color:#555}}code{{font-size:.92em}}\
+.note{{font-size:.9em;color:#444}}</style></head><body>\n<h1>{}</h1>\n",
+        esc(&title),
+        esc(&title)
+    );
+    let _ = writeln!(
+        h,
+        "<p class=\"note\">{} · file <code>{}</code> · parts: {} · {:.0} s{}</p>",
+        esc(&r.program),
+        esc(&r.file),
+        r.parts.join(", "),
+        r.wall_s,
+        if r.interrupted {
+            " · <span class=\"bad\">INTERRUPTED: the parts marked so were not measured</span>"
+        } else {
+            ""
+        }
+    );
+    // The verdict table: one column per controller.
+    let _ = writeln!(h, "<h2>Verdict</h2>\n<table><tr><th></th>");
+    for c in &r.controllers {
+        let _ = write!(h, "<th>{}</th>", esc(&c.label));
+    }
+    let row = |h: &mut String, name: &str, f: &dyn Fn(&ControllerReport) -> String| {
+        let _ = write!(h, "<tr><th>{name}</th>");
+        for c in &r.controllers {
+            let _ = write!(h, "<td>{}</td>", f(c));
+        }
+        let _ = writeln!(h, "</tr>");
+    };
+    row(&mut h, "verdict", &|c| format!("<b>{}</b>", esc(&c.verdict)));
+    row(&mut h, "law, mode, rate", &|c| format!("{} · {} · {:.0} Hz", esc(&c.law), esc(&c.mode), c.rate_hz));
+    row(&mut h, "overrides", &|c| {
+        c.set.iter().map(|s| format!("<code>{}</code>", esc(s))).collect::<Vec<_>>().join("<br>")
+    });
+    row(&mut h, "stability margin (ISO 14839-3)", &|c| match &c.sensitivity.result {
+        Some(s) => {
+            let not_all = match c.sensitivity.status {
+                "measured" => String::new(),
+                status => format!(
+                    "<span class=\"bad\">{status}</span>: {}<br>",
+                    esc(c.sensitivity.why.as_deref().unwrap_or(""))
+                ),
+            };
+            not_all
+                + &s.axes
+                    .iter()
+                    .map(|a| match &a.peak {
+                        Some(p) if a.stable => format!(
+                            "{} at {:.0} Hz: zone <b>{}</b>, |S| {:.2} ({:.2} dB) at {:.2} Hz",
+                            a.axis, a.speed_hz, a.zone, p.s_abs, p.s_db, p.f_hz
+                        ),
+                        _ => format!(
+                            "{} at {:.0} Hz: <b class=\"bad\">unstable</b> ({})",
+                            a.axis,
+                            a.speed_hz,
+                            esc(a.note.as_deref().unwrap_or(""))
+                        ),
+                    })
+                    .collect::<Vec<_>>()
+                    .join("<br>")
+        }
+        None => format!(
+            "<span class=\"bad\">{}</span>: {}",
+            c.sensitivity.status,
+            esc(c.sensitivity.why.as_deref().unwrap_or(""))
+        ),
+    });
+    row(&mut h, "closed form (where the law has one)", &|c| match c
+        .sensitivity
+        .result
+        .as_ref()
+        .and_then(|s| s.closed_form.as_ref())
+    {
+        Some(cf) if cf.stable => {
+            format!("zone {}, |S| {} ({} dB) at {} Hz", cf.zone, num(cf.s_abs, 2), num(cf.s_db, 2), num(cf.f_hz, 2))
+        }
+        Some(_) => "unstable".into(),
+        None => "–".into(),
+    });
+    row(&mut h, "vibration (ISO 14839-2)", &|c| {
+        match &c.vibration.result {
+        Some(v) => format!(
+            "zone <b>{}</b>: {:.2} µm = {:.3} C_min (C_min = {:.0} µm) at {:.0} Hz; coil current swing {} A (RMS {} A) of {:.1} A",
+            v.zone,
+            v.peak_um,
+            v.ratio,
+            v.clearance_um,
+            v.speed_hz,
+            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_limit_a
+        ),
+        None => format!("<span class=\"bad\">{}</span>: {}", c.vibration.status, esc(c.vibration.why.as_deref().unwrap_or(""))),
+    }
+    });
+    row(&mut h, "highest safe shock", &|c| match &c.ladder.result {
+        Some(l) if c.ladder.status != "measured" => format!(
+            "<span class=\"bad\">{}</span>: {}; the complete rungs: {}",
+            c.ladder.status,
+            esc(c.ladder.why.as_deref().unwrap_or("")),
+            l.safe_up_to_g.map_or("none safe".into(), |g| format!("safe up to {g} G"))
+        ),
+        Some(l) => match l.safe_up_to_g {
+            Some(g) => {
+                format!("<b class=\"ok\">{g} G</b> (every rung up to it: lower bound ≥ {})", r.ladder_settings.min_p)
+            }
+            None => {
+                format!("<b class=\"bad\">none</b> (the first rung's lower bound is below {})", r.ladder_settings.min_p)
+            }
+        },
+        None => {
+            format!("<span class=\"bad\">{}</span>: {}", c.ladder.status, esc(c.ladder.why.as_deref().unwrap_or("")))
+        }
+    });
+    row(&mut h, "wall time", &|c| {
+        format!(
+            "{:.1} s (sensitivity {:.1} s, vibration {:.1} s, ladder {:.1} s)",
+            c.wall_s, c.sensitivity.wall_s, c.vibration.wall_s, c.ladder.wall_s
+        )
+    });
+    let _ = writeln!(h, "</table>");
+    // The ladder table.
+    if r.controllers.iter().any(|c| c.ladder.result.is_some()) {
+        let _ = writeln!(h, "<h2>Shock ladder and the touchdown bearing's duty</h2>");
+        let _ = writeln!(h, "<p class=\"note\">Each rung is an ensemble over the rotor's angle at the shock's arrival; P(recovered) with its Wilson 95 % interval; recovery time from the shock's start to the last contact (median, p90); the duty per shock, median [p90] over the counted members. Members' setting: {}.</p>",
+            esc(&r.controllers.iter().find_map(|c| c.ladder.result.as_ref().map(|l| l.member_setting.clone())).unwrap_or_default()));
+        for c in r.controllers.iter() {
+            let Some(l) = &c.ladder.result else { continue };
+            let _ = writeln!(h, "<h3>{}</h3><table><tr><th>peak (G)</th><th>members</th><th>P(recovered) [95 %]</th><th>modes R/W/B/D</th><th>recovery median / p90 (ms)</th><th>contact (ms)</th><th>peak force (N)</th><th>rotor–race pressure (MPa)</th><th>most loaded ball (N / MPa)</th><th>friction energy (J)</th><th>race peak speed (rpm)</th><th>race peak accel. (krad/s²)</th><th>ball-load cycles ≥ {:.0} % Q₀</th></tr>",
+                esc(&c.label), r.bearing.map_or(50.0, |b| b.capacity_fraction * 100.0));
+            for x in &l.rungs {
+                let d = &x.duty;
+                let mp = |s: &super::ladder::Spread, k: f64, dig: usize| {
+                    format!("{} [{}]", num(s.median.map(|v| v * k), dig), num(s.p90.map(|v| v * k), dig))
+                };
+                let _ = writeln!(
+                    h,
+                    "<tr><td>{}</td><td>{}{}</td><td>{:.2} [{:.2}, {:.2}]</td><td>{}/{}/{}/{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    x.peak_g,
+                    x.members,
+                    if x.complete { "" } else { " (incomplete)" },
+                    x.p_recovered,
+                    x.p_lo,
+                    x.p_hi,
+                    x.recovered,
+                    x.dry_whirl,
+                    x.rebound,
+                    x.diverged,
+                    num(x.recovery_median_s.map(|v| v * 1e3), 1),
+                    num(x.recovery_p90_s.map(|v| v * 1e3), 1),
+                    mp(&d.contact_time_s, 1e3, 1),
+                    mp(&d.peak_contact_force_n, 1.0, 0),
+                    mp(&d.peak_race_pressure_mpa, 1.0, 0),
+                    num(d.peak_ball_load_n.median, 0),
+                    num(d.peak_ball_pressure_mpa.median, 0),
+                    mp(&d.friction_energy_j, 1.0, 2),
+                    mp(&d.race_peak_speed_rpm, 1.0, 0),
+                    mp(&d.race_peak_accel_rad_s2, 1e-3, 0),
+                    mp(&d.ball_cycles, 1.0, 1),
+                );
+            }
+            let _ = writeln!(h, "</table>");
+        }
+        for (name, alt) in &ladder {
+            h.push_str(&image(dir, name, alt)?);
+        }
+    }
+    if !charts.is_empty() {
+        let _ = writeln!(h, "<h2>Sensitivity functions</h2><p class=\"note\">Measured by adding a sine to the sensor signal the controller reads, one axis at a time (stepped sine, settled, fitted by least squares over whole periods; docs/guide/assess.md). Horizontal lines: the zone boundaries at |S| = 3, 4, 5 (9.5, 12, 14 dB). Dashed black: the closed form of the law where it has one.</p>");
+        for (i, name) in &charts {
+            h.push_str(&image(dir, name, &format!("{}: |S| and |T|", r.controllers[*i].label))?);
+        }
+    }
+    if let Some(b) = &r.bearing {
+        let _ = writeln!(h, "<h2>Basis of the duty figures</h2><p class=\"note\">Taken at the output samples of each member's run. Rotor–race pressure: Hertz line contact of the shaft in the bore over the race width ({:.1} mm), steel E = {:.0} GPa, ν = {}; with a very conformal contact the half-width is not small against the radius, so it is Hertz's estimate outside its strict validity. Ball pressure: Hertz point contact of the most loaded ball on the inner raceway (ball {:.2} mm, pitch diameter {:.1} mm, groove conformity {}). Static capacity of one ball Q₀ = {:.0} N (the load giving {:.0} MPa, ISO 76's basis; C₀ = Z Q₀/5). Ball-load cycles: rainflow count of each ball's load, cycles with a range ≥ {:.0} % of Q₀, summed over the balls. Friction energy: ∫ |μ N v_slip| dt at the rotor–race contact. None of these figures is a life.</p>",
+            b.width_m * 1e3, b.materials.youngs_modulus_pa * 1e-9, b.materials.poisson, b.ball_diameter_m * 1e3, b.pitch_diameter_m * 1e3, b.materials.groove_conformity, b.ball_static_load_n, b.materials.static_pressure_pa * 1e-6, b.capacity_fraction * 100.0);
+    }
+    let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
+    crate::atomic::write(&dir.join("report.html"), h.as_bytes())?;
+    Ok(())
+}

@@ -1,0 +1,769 @@
+//! The sensitivity function of each control axis measured through the loop (ISO 14839-3):
+//! the plant adds an excitation `E` to the sensor signal it hands the controller (the summing
+//! point, [`crate::hooks::Hooks::excitation`]), one axis at a time, and correlates what the
+//! controller read, `v = u + E`, with `E`: `S = v / E`, `T = u / E = S − 1`. The controller is
+//! a black box: a law in the plant, the continuous PD, or a controller process over the wire.
+//!
+//! **One run per axis and speed.** The run starts levitated with the rotor offset by
+//! `probe_um` on the axis and no shock. *Probe*: for `probe_s` the loop decays freely; the
+//! envelope of the axis' signal (the rotation's unbalance response fitted and removed) gives
+//! the slowest decay rate `σ` (a straight line through the logarithm of the envelope, block by
+//! block). A loop whose envelope does not decay (`σ ≤ 0`), or whose rotor reaches the
+//! touchdown bearing, is **unstable**: it has no margin to grade and gets no peak.
+//! *Stepped sine*: then the excitation `E = a sin θ` steps through the frequencies, phase
+//! continuous. At each frequency it settles for `ln(1/settle)/σ` (between two periods and
+//! `max_settle_s`), then fits `v` over whole windows (at least `min_cycles` periods) by least
+//! squares on `[1, cos θ, sin θ]`, plus `cos Ωt, sin Ωt` at speed (the unbalance response at the
+//! rotation frequency Ω, which would otherwise leak into the estimate); frequencies within 2 %
+//! of Ω are not measured at speed. Windows follow one another until two consecutive estimates
+//! agree within `tolerance` (at most 6 windows; a point that never agrees is marked
+//! `settled = false`).
+//!
+//! **Level.** The amplitude `a` is at most `excitation_um` (as a displacement at the sensor,
+//! `A_s · excitation_um` volts) and is lowered so that the expected response `|T| a` stays near
+//! `response_um` (`|T|` from the previous point). If the rotor's displacement still passes
+//! `limit` × the air gap, the amplitude is cut fourfold and the frequency starts again. With
+//! `auto_level = false` the amplitude is fixed; a rotor that then reaches the touchdown bearing
+//! ends the measurement with an error naming the frequency and the amplitude.
+//!
+//! **Frequencies and resolution near a peak.** A log grid of `points` frequencies from `f_min`
+//! to `f_max` (below the Nyquist frequency of a sampled loop), then around the largest `|S|`
+//! the two intervals beside it are halved (in log f) until the points around the peak are at
+//! most `resolution` apart (relative; 0.2 % by default); the peak is the vertex of the parabola
+//! through the three points around it in (log f, dB). For a resonance of damping ratio ζ the
+//! half-power width is `2ζ f`: at 0.2 % spacing the nearest point of a peak with ζ = 0.004 is
+//! within 0.1 % of it, 0.3 dB below it, and the parabola's vertex closer.
+
+use crate::hooks::Hooks;
+use crate::model::{ix, Model, SensorSine, State};
+use crate::run::Sink;
+use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
+use serde::Serialize;
+use std::cell::Cell;
+use std::collections::VecDeque;
+use std::f64::consts::TAU;
+use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Settings of the measurement (`[sensitivity]` of an assessment).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Settings {
+    /// Lowest frequency (Hz).
+    pub f_min_hz: f64,
+    /// Highest frequency (Hz); capped below the Nyquist frequency of a sampled loop.
+    pub f_max_hz: f64,
+    /// Frequencies of the log grid.
+    pub points: usize,
+    /// Largest excitation amplitude, as a displacement at the sensor (µm).
+    pub excitation_um: f64,
+    /// Response amplitude the level aims at (µm).
+    pub response_um: f64,
+    /// Lower the level to keep the response near `response_um`.
+    pub auto_level: bool,
+    /// Response limit as a share of the air gap: past it the amplitude is cut.
+    pub limit: f64,
+    /// Share of a transient left when a window starts.
+    pub settle: f64,
+    /// Agreement of two consecutive windows (relative).
+    pub tolerance: f64,
+    /// Longest settling at one frequency (s).
+    pub max_settle_s: f64,
+    /// Spacing of the points around the peak (relative).
+    pub resolution: f64,
+    /// Initial offset of the probe (µm).
+    pub probe_um: f64,
+    /// Length of the probe (s).
+    pub probe_s: f64,
+    /// Periods per window, at least.
+    pub min_cycles: f64,
+}
+
+impl Settings {
+    /// The defaults for an air gap `gap_m` (m).
+    pub fn for_gap(gap_m: f64) -> Self {
+        Self {
+            f_min_hz: 5.0,
+            f_max_hz: 2000.0,
+            points: 40,
+            excitation_um: 1.0,
+            response_um: 0.05 * gap_m * 1e6,
+            auto_level: true,
+            limit: 0.4,
+            settle: 0.01,
+            tolerance: 0.01,
+            max_settle_s: 10.0,
+            resolution: 0.002,
+            probe_um: 0.1 * gap_m * 1e6,
+            probe_s: 1.0,
+            min_cycles: 8.0,
+        }
+    }
+}
+
+/// One measured frequency.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Point {
+    /// Frequency (Hz).
+    pub f_hz: f64,
+    /// `S` real and imaginary parts.
+    pub s: [f64; 2],
+    /// `|S|` (dB).
+    pub s_db: f64,
+    /// `|T|` (dB).
+    pub t_db: f64,
+    /// Excitation amplitude (V).
+    pub amplitude_v: f64,
+    /// Windows fitted.
+    pub windows: u32,
+    /// Two consecutive windows agreed within the tolerance.
+    pub settled: bool,
+}
+
+/// A peak of `|S|`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Peak {
+    /// Frequency (Hz).
+    pub f_hz: f64,
+    /// `|S|` at the peak.
+    pub s_abs: f64,
+    /// The same in dB.
+    pub s_db: f64,
+    /// Relative spacing of the points around it.
+    pub spacing: f64,
+}
+
+/// The ISO 14839-3 zone of a peak sensitivity (boundaries 3, 4, 5: 9.5, 12, 14 dB).
+pub fn zone(s_abs: f64) -> &'static str {
+    match s_abs {
+        s if s < 3.0 => "A",
+        s if s < 4.0 => "B",
+        s if s < 5.0 => "C",
+        _ => "D",
+    }
+}
+
+/// The measurement of one axis at one speed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AxisResult {
+    /// Axis name.
+    pub axis: String,
+    /// Rotor speed (Hz).
+    pub speed_hz: f64,
+    /// The loop decays after the probe.
+    pub stable: bool,
+    /// The probe's decay rate σ (1/s; negative: growing).
+    pub decay_per_s: f64,
+    /// The probe's dominant frequency (Hz).
+    pub probe_hz: f64,
+    /// Why it is unstable, in words.
+    pub note: Option<String>,
+    /// Measured frequencies, ascending.
+    pub points: Vec<Point>,
+    /// The peak of `|S|` (stable loops only).
+    pub peak: Option<Peak>,
+    /// `A`, `B`, `C`, `D`, or `unstable`.
+    pub zone: String,
+    /// Simulated time of the measurement (s).
+    pub simulated_s: f64,
+}
+
+/// Why a measurement stopped without a result.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum MeasureError {
+    /// The excitation drove the rotor into the touchdown bearing.
+    #[error("axis {axis} at {speed_hz} Hz rotor speed: the excitation of {amplitude_um:.3} µm at {f_hz:.2} Hz drove the rotor into the touchdown bearing (t = {t_s:.3} s); lower sensitivity.excitation_um or keep sensitivity.auto_level = true")]
+    Touched {
+        /// Axis.
+        axis: String,
+        /// Speed (Hz).
+        speed_hz: f64,
+        /// Amplitude as displacement (µm).
+        amplitude_um: f64,
+        /// Frequency (Hz).
+        f_hz: f64,
+        /// Time (s).
+        t_s: f64,
+    },
+    /// The level could not keep the response below the limit.
+    #[error("axis {axis}: at {f_hz:.2} Hz the response to an excitation of {amplitude_um:.3} µm passed the limit of {limit_um:.1} µm (sensitivity.limit of the air gap) on its way to the touchdown bearing; lower sensitivity.excitation_um or keep sensitivity.auto_level = true")]
+    Level {
+        /// Axis.
+        axis: String,
+        /// Frequency (Hz).
+        f_hz: f64,
+        /// The limit (µm).
+        limit_um: f64,
+        /// Last amplitude (µm).
+        amplitude_um: f64,
+    },
+    /// Stopped because another axis of the same part failed.
+    #[error("not finished: another axis failed")]
+    Abandoned,
+    /// The run ended otherwise (controller lost, divergence, interruption, time cap).
+    #[error("{why}")]
+    Run {
+        /// How.
+        kind: super::Failure,
+        /// What happened.
+        why: String,
+    },
+}
+
+/// Where the measurement stands.
+enum Phase {
+    Probe,
+    Step(Box<Step>),
+    Done,
+}
+
+/// One frequency being measured.
+struct Step {
+    f_hz: f64,
+    omega: f64,
+    amplitude: f64,
+    /// θ at the step's start and that start's time.
+    theta0: f64,
+    t0: f64,
+    /// Ticks left to settle, then ticks of the current window.
+    settle_left: u64,
+    window_ticks: u64,
+    in_window: u64,
+    /// The normal equations of the fit on `[1, cos θ, sin θ, cos Ωt, sin Ωt]` (the last two
+    /// zero at standstill), fixed-size: no allocation per tick.
+    normal: SMatrix<f64, 5, 5>,
+    rhs: SVector<f64, 5>,
+    estimates: Vec<Complex<f64>>,
+}
+
+/// The measurement as run-loop hooks: drives the excitation and reads the axis' sensor.
+pub struct Measure<'a> {
+    settings: Settings,
+    axis: usize,
+    axis_name: String,
+    period: f64,
+    sensor_gain: f64,
+    gap: f64,
+    speed_hz: f64,
+    f_max: f64,
+    stop: &'a AtomicBool,
+    /// Set when another axis of the same part has failed: this one stops too.
+    abandon: Option<&'a AtomicBool>,
+    touched: Rc<Cell<Option<f64>>>,
+    phase: Phase,
+    probe: Vec<(f64, f64)>,
+    sigma: f64,
+    probe_hz: f64,
+    queue: VecDeque<f64>,
+    coarse_left: bool,
+    points: Vec<Point>,
+    error: Option<MeasureError>,
+    stable: Option<bool>,
+    note: Option<String>,
+    theta_now: f64,
+    t_now: f64,
+    /// After a level cut, the response is let come down until this time before it is judged again.
+    grace_until: f64,
+}
+
+impl<'a> Measure<'a> {
+    /// A measurement on axis `axis` (its name `axis_name`) of a loop with controller period
+    /// `period` (s; the continuous PD: the plant's macro step), sensor gain (V/m), air gap (m),
+    /// rotor speed (Hz); `sampled`: cap `f_max` below the Nyquist frequency.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        settings: Settings,
+        axis: usize,
+        axis_name: &str,
+        period: f64,
+        sampled: bool,
+        sensor_gain: f64,
+        gap: f64,
+        speed_hz: f64,
+        stop: &'a AtomicBool,
+        touched: Rc<Cell<Option<f64>>>,
+    ) -> Self {
+        let f_max = if sampled { settings.f_max_hz.min(0.45 / period) } else { settings.f_max_hz };
+        let grid = log_grid(settings.f_min_hz, f_max, settings.points)
+            .into_iter()
+            .filter(|f| !near_rotation(*f, speed_hz))
+            .collect();
+        Self {
+            settings,
+            axis,
+            axis_name: axis_name.to_string(),
+            period,
+            sensor_gain,
+            gap,
+            speed_hz,
+            f_max,
+            stop,
+            abandon: None,
+            touched,
+            phase: Phase::Probe,
+            probe: Vec::new(),
+            sigma: f64::NAN,
+            probe_hz: f64::NAN,
+            queue: grid,
+            coarse_left: true,
+            points: Vec::new(),
+            error: None,
+            stable: None,
+            note: None,
+            theta_now: 0.0,
+            t_now: 0.0,
+            grace_until: 0.0,
+        }
+    }
+
+    /// Stops the measurement, too, once `flag` is set (another axis of the part has failed).
+    pub fn abandon_on(mut self, flag: &'a AtomicBool) -> Self {
+        self.abandon = Some(flag);
+        self
+    }
+
+    /// The result, once the run has ended (`simulated_s`: how far it ran).
+    pub fn result(mut self, simulated_s: f64) -> Result<AxisResult, MeasureError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.stable.is_none() {
+            if let Some(t) = self.touched.get() {
+                self.stable = Some(false);
+                self.sigma = decay(&self.probe, self.speed_hz).0;
+                self.note = Some(format!(
+                    "the rotor reached the touchdown bearing {t:.3} s into the free decay from {:.1} µm",
+                    self.settings.probe_um
+                ));
+            }
+        }
+        let Some(stable) = self.stable else {
+            let why = "the measurement did not get past its probe".into();
+            return Err(MeasureError::Run { kind: super::Failure::Other, why });
+        };
+        if stable && !matches!(self.phase, Phase::Done) {
+            let why = format!("the measurement stopped at t = {simulated_s:.3} s before its last frequency");
+            return Err(MeasureError::Run { kind: super::Failure::Other, why });
+        }
+        self.points.sort_by(|a, b| a.f_hz.total_cmp(&b.f_hz));
+        let peak = if stable { peak_of(&self.points) } else { None };
+        let zone = match (&peak, stable) {
+            (Some(p), true) => zone(p.s_abs).to_string(),
+            (None, true) => "none".to_string(),
+            _ => "unstable".to_string(),
+        };
+        Ok(AxisResult {
+            axis: self.axis_name,
+            speed_hz: self.speed_hz,
+            stable,
+            decay_per_s: self.sigma,
+            probe_hz: self.probe_hz,
+            note: self.note,
+            points: self.points,
+            peak,
+            zone,
+            simulated_s,
+        })
+    }
+
+    fn finish_probe(&mut self, t: f64) {
+        let (sigma, f_d) = decay(&self.probe, self.speed_hz);
+        self.sigma = sigma;
+        self.probe_hz = f_d;
+        if sigma.is_nan() || sigma <= 0.0 {
+            self.stable = Some(false);
+            self.note = Some(format!(
+                "the free decay from {:.1} µm does not decay: its envelope grows at {:.3} 1/s (about {:.1} Hz)",
+                self.settings.probe_um, -sigma, f_d
+            ));
+            self.phase = Phase::Done;
+            return;
+        }
+        self.stable = Some(true);
+        self.t_now = t;
+        self.next_step(t);
+    }
+
+    /// The amplitude (V) for frequency `f` from the points measured so far.
+    fn level(&self, f: f64) -> f64 {
+        let max = self.settings.excitation_um * 1e-6 * self.sensor_gain;
+        if !self.settings.auto_level {
+            return max;
+        }
+        let near =
+            self.points.iter().min_by(|a, b| (a.f_hz.ln() - f.ln()).abs().total_cmp(&(b.f_hz.ln() - f.ln()).abs()));
+        let t = near.map_or(1.0, |p| 10f64.powf(p.t_db / 20.0)).max(1.0);
+        max.min(self.settings.response_um * 1e-6 * self.sensor_gain / t)
+    }
+
+    fn next_step(&mut self, t: f64) {
+        if self.queue.is_empty() && self.coarse_left {
+            self.coarse_left = false;
+        }
+        if self.queue.is_empty() {
+            self.refine();
+        }
+        match self.queue.pop_front() {
+            Some(f) => {
+                let a = self.level(f);
+                self.start(f, a, t);
+            }
+            None => self.phase = Phase::Done,
+        }
+    }
+
+    /// The settling time at frequency `f_hz` (s).
+    fn settle_time(&self, f_hz: f64) -> f64 {
+        let s = &self.settings;
+        (s.settle.recip().ln() / self.sigma).clamp(2.0 / f_hz, s.max_settle_s.max(2.0 / f_hz))
+    }
+
+    fn start(&mut self, f_hz: f64, amplitude: f64, t: f64) {
+        let omega = TAU * f_hz;
+        let s = &self.settings;
+        let settle = self.settle_time(f_hz);
+        let mut window = s.min_cycles / f_hz;
+        if self.speed_hz > 0.0 {
+            window = window.max(4.0 / (f_hz - self.speed_hz).abs());
+        }
+        // A whole number of excitation periods, and whole ticks.
+        let window = (window * f_hz).ceil() / f_hz;
+        self.phase = Phase::Step(Box::new(Step {
+            f_hz,
+            omega,
+            amplitude,
+            theta0: self.theta_now,
+            t0: t,
+            settle_left: (settle / self.period).ceil() as u64,
+            window_ticks: ((window / self.period).round() as u64).max(4),
+            in_window: 0,
+            normal: SMatrix::zeros(),
+            rhs: SVector::zeros(),
+            estimates: Vec::with_capacity(6),
+        }));
+    }
+
+    /// Adds the midpoints around the largest `|S|` until its neighbours are within the resolution.
+    fn refine(&mut self) {
+        let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz, p.s_db)).collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let Some(i) = (0..pts.len()).max_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1)) else { return };
+        // The intervals on either side of the peak (none below the first point).
+        for j in [i.checked_sub(1), Some(i)].into_iter().flatten() {
+            if j + 1 >= pts.len() {
+                continue;
+            }
+            let (a, b) = (pts[j].0, pts[j + 1].0);
+            if (b / a).ln() > self.settings.resolution {
+                let mid = (a * b).sqrt();
+                if !near_rotation(mid, self.speed_hz) && mid <= self.f_max {
+                    self.queue.push_back(mid);
+                }
+            }
+        }
+    }
+
+    fn tick(&mut self, t: f64, u: f64) -> Option<SensorSine> {
+        if let Phase::Probe = self.phase {
+            self.probe.push((t, u));
+            if t + 0.5 * self.period >= self.settings.probe_s {
+                self.finish_probe(t);
+            } else {
+                return None;
+            }
+        }
+        let speed = self.speed_hz;
+        let limit_v = self.settings.limit * self.gap * self.sensor_gain;
+        let tolerance = self.settings.tolerance;
+        let Phase::Step(step) = &mut self.phase else { return None };
+        let theta = step.theta0 + step.omega * (t - step.t0);
+        self.theta_now = theta;
+        self.t_now = t;
+        let e = step.amplitude * theta.sin();
+        if u.abs() > limit_v && t >= self.grace_until {
+            // Too strong a response: a quarter of the level, and this frequency again.
+            let (f, a, was) = (step.f_hz, step.amplitude / 4.0, step.amplitude);
+            let floor = 1e-6 * self.settings.excitation_um * 1e-6 * self.sensor_gain;
+            if !self.settings.auto_level || a < floor {
+                self.error = Some(MeasureError::Level {
+                    axis: self.axis_name.clone(),
+                    f_hz: f,
+                    limit_um: limit_v / self.sensor_gain * 1e6,
+                    amplitude_um: was / self.sensor_gain * 1e6,
+                });
+                self.phase = Phase::Done;
+                return None;
+            }
+            self.start(f, a, t);
+            // The response decays at σ: judge it again once it has had time to come down.
+            self.grace_until = t + (self.settle_time(f) * 0.5).min(2.0);
+            return self.sine();
+        }
+        let mut done = None;
+        if step.settle_left > 0 {
+            step.settle_left -= 1;
+        } else {
+            let (w_sin, w_cos) = if speed > 0.0 { (TAU * speed * t).sin_cos() } else { (0.0, 0.0) };
+            let phi = SVector::<f64, 5>::new(1.0, theta.cos(), theta.sin(), w_cos, w_sin);
+            step.normal += phi * phi.transpose();
+            step.rhs += phi * (u + e);
+            step.in_window += 1;
+            if step.in_window >= step.window_ticks {
+                let mut normal = step.normal;
+                if speed <= 0.0 {
+                    normal[(3, 3)] = 1.0;
+                    normal[(4, 4)] = 1.0;
+                }
+                let fit = normal.lu().solve(&step.rhs);
+                let v = fit.map_or(Complex::new(f64::NAN, f64::NAN), |c| Complex::new(c[1], -c[2]));
+                let s_est = v / Complex::new(0.0, -step.amplitude);
+                step.estimates.push(s_est);
+                step.normal.fill(0.0);
+                step.rhs.fill(0.0);
+                step.in_window = 0;
+                let n = step.estimates.len();
+                let agreed =
+                    n >= 2 && (step.estimates[n - 1] - step.estimates[n - 2]).norm() <= tolerance * s_est.norm();
+                if agreed || n >= 6 {
+                    let tt = s_est - 1.0;
+                    done = Some(Point {
+                        f_hz: step.f_hz,
+                        s: [s_est.re, s_est.im],
+                        s_db: 20.0 * s_est.norm().log10(),
+                        t_db: 20.0 * tt.norm().log10(),
+                        amplitude_v: step.amplitude,
+                        windows: n as u32,
+                        settled: agreed,
+                    });
+                }
+            }
+        }
+        if let Some(point) = done {
+            self.points.push(point);
+            self.next_step(t);
+        }
+        self.sine()
+    }
+
+    /// The sine in force now.
+    fn sine(&self) -> Option<SensorSine> {
+        let Phase::Step(step) = &self.phase else { return None };
+        let mut amplitude_v = [0.0; 2];
+        if let Some(a) = amplitude_v.get_mut(self.axis) {
+            *a = step.amplitude;
+        }
+        Some(SensorSine { amplitude_v, omega_rad_s: step.omega, phase_rad: step.theta0 - step.omega * step.t0 })
+    }
+}
+
+impl Hooks for Measure<'_> {
+    fn cancelled(&self) -> bool {
+        matches!(self.phase, Phase::Done)
+            || self.touched.get().is_some()
+            || self.stop.load(Ordering::Relaxed)
+            || self.abandon.is_some_and(|a| a.load(Ordering::Relaxed))
+    }
+
+    fn excitation(&mut self, _k: u64, t: f64, sensor_v: &[f64]) -> Option<SensorSine> {
+        if let Some(t_touch) = self.touched.get() {
+            if self.error.is_none() {
+                match &self.phase {
+                    Phase::Step(step) => {
+                        self.error = Some(MeasureError::Touched {
+                            axis: self.axis_name.clone(),
+                            speed_hz: self.speed_hz,
+                            amplitude_um: step.amplitude / self.sensor_gain * 1e6,
+                            f_hz: step.f_hz,
+                            t_s: t_touch,
+                        });
+                    }
+                    Phase::Probe => {
+                        self.stable = Some(false);
+                        self.note = Some(format!(
+                            "the rotor reached the touchdown bearing {t_touch:.3} s into the free decay from {:.1} µm",
+                            self.settings.probe_um
+                        ));
+                    }
+                    Phase::Done => {}
+                }
+                self.phase = Phase::Done;
+            }
+            return None;
+        }
+        let u = sensor_v.get(self.axis).copied().unwrap_or(0.0);
+        self.tick(t, u)
+    }
+}
+
+/// A sink that notes the first rotor – race contact (the rotor and the race's centres farther
+/// apart than the air gap).
+pub struct ContactWatch {
+    /// When the rotor first touched (s).
+    pub touched: Rc<Cell<Option<f64>>>,
+}
+
+impl Sink for ContactWatch {
+    fn sample(&mut self, _record: &crate::trace::Record) {}
+
+    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
+        let d = (y[ix::XR] - y[ix::XB]).hypot(y[ix::YR] - y[ix::YB]);
+        if d > model.params.contact.gap && self.touched.get().is_none() {
+            self.touched.set(Some(t));
+        }
+    }
+}
+
+/// The longest a measurement run may simulate (s): one that has not reached its last frequency
+/// by then fails.
+pub const RUN_CAP_S: f64 = 3000.0;
+
+/// The least simulated time a measurement of `settings` takes (s): the probe, then at each
+/// frequency of the grid two periods of settling and two windows of `min_cycles` periods. Above
+/// [`RUN_CAP_S`] it cannot finish, and is refused before anything runs.
+pub fn least_simulated_s(settings: &Settings) -> f64 {
+    let per_frequency = 2.0 + 2.0 * settings.min_cycles;
+    settings.probe_s
+        + log_grid(settings.f_min_hz, settings.f_max_hz, settings.points).iter().map(|f| per_frequency / f).sum::<f64>()
+}
+
+/// `n` frequencies log-spaced from `lo` to `hi` (Hz).
+pub fn log_grid(lo: f64, hi: f64, n: usize) -> VecDeque<f64> {
+    let n = n.max(2);
+    (0..n).map(|i| (lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (n - 1) as f64).exp()).collect()
+}
+
+fn near_rotation(f: f64, speed_hz: f64) -> bool {
+    speed_hz > 0.0 && (f / speed_hz - 1.0).abs() < 0.02
+}
+
+/// The peak of `|S|` over the points (sorted by frequency): the vertex of the parabola through
+/// the largest and its neighbours in (ln f, dB), or the largest point itself at an end.
+pub fn peak_of(points: &[Point]) -> Option<Peak> {
+    let i = (0..points.len()).max_by(|&a, &b| points[a].s_db.total_cmp(&points[b].s_db))?;
+    let p = &points[i];
+    let at = |f: f64, db: f64, spacing: f64| Peak { f_hz: f, s_abs: 10f64.powf(db / 20.0), s_db: db, spacing };
+    if i == 0 || i + 1 == points.len() {
+        let spacing = if points.len() > 1 {
+            let j = if i == 0 { 1 } else { i - 1 };
+            (points[j].f_hz / p.f_hz).ln().abs()
+        } else {
+            f64::NAN
+        };
+        return Some(at(p.f_hz, p.s_db, spacing));
+    }
+    let (a, c) = (&points[i - 1], &points[i + 1]);
+    let (x0, x1, x2) = (a.f_hz.ln(), p.f_hz.ln(), c.f_hz.ln());
+    let (y0, y1, y2) = (a.s_db, p.s_db, c.s_db);
+    let spacing = (x1 - x0).max(x2 - x1);
+    // The parabola through three points: its vertex.
+    let d0 = (y1 - y0) / (x1 - x0);
+    let d1 = (y2 - y1) / (x2 - x1);
+    let curv = (d1 - d0) / (x2 - x0);
+    if curv >= 0.0 {
+        return Some(at(p.f_hz, p.s_db, spacing));
+    }
+    let xv = 0.5 * (x0 + x1) - d0 / (2.0 * curv);
+    let xv = xv.clamp(x0, x2);
+    let yv = y0 + d0 * (xv - x0) + curv * (xv - x0) * (xv - x1);
+    Some(at(xv.exp(), yv.max(y1), spacing))
+}
+
+/// The decay rate σ (1/s) and the dominant frequency (Hz) of a free response `(t, u)`, after
+/// removing its mean and, at speed, its component at the rotation frequency: a straight line
+/// through the logarithm of the block envelopes (blocks of two periods of the dominant
+/// frequency), over the blocks above 1e-4 of the first one.
+pub fn decay(samples: &[(f64, f64)], speed_hz: f64) -> (f64, f64) {
+    if samples.len() < 16 {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = if speed_hz > 0.0 { 3 } else { 1 };
+    let mut normal = DMatrix::<f64>::zeros(n, n);
+    let mut rhs = DVector::<f64>::zeros(n);
+    let basis = |t: f64| {
+        let mut v = vec![1.0];
+        if speed_hz > 0.0 {
+            let w = TAU * speed_hz * t;
+            v.extend([w.cos(), w.sin()]);
+        }
+        DVector::from_vec(v)
+    };
+    // The fit of the steady part over the second half (where the decay has mostly gone).
+    for (t, u) in &samples[samples.len() / 2..] {
+        let b = basis(*t);
+        normal += &b * b.transpose();
+        rhs += &b * *u;
+    }
+    let fit = normal.lu().solve(&rhs).unwrap_or_else(|| DVector::zeros(n));
+    let r: Vec<(f64, f64)> = samples.iter().map(|(t, u)| (*t, u - basis(*t).dot(&fit))).collect();
+    // Dominant frequency from the zero crossings of the first half.
+    let half = &r[..r.len() / 2];
+    let crossings: Vec<f64> = half.windows(2).filter(|w| w[0].1 * w[1].1 < 0.0).map(|w| w[0].0).collect();
+    let span = r.last().map_or(0.0, |x| x.0) - r[0].0;
+    let f_d = if crossings.len() >= 3 {
+        (crossings.len() - 1) as f64 / (2.0 * (crossings[crossings.len() - 1] - crossings[0]))
+    } else {
+        1.0 / span.max(1e-9)
+    };
+    let block = (2.0 / f_d).max(span / 200.0).min(span / 8.0);
+    let mut env: Vec<(f64, f64)> = Vec::new();
+    let mut start = r[0].0;
+    let mut peak: f64 = 0.0;
+    for (t, u) in &r {
+        if *t >= start + block {
+            env.push((start + 0.5 * block, peak));
+            start += block;
+            peak = 0.0;
+        }
+        peak = peak.max(u.abs());
+    }
+    let Some(first) = env.first().map(|e| e.1) else { return (f64::NAN, f_d) };
+    let used: Vec<(f64, f64)> = env.iter().skip(1).filter(|e| e.1 > 1e-4 * first && e.1 > 0.0).copied().collect();
+    if used.len() < 3 {
+        // Gone within a few blocks: a fast decay; its rate from the first block down to 1e-4.
+        return ((1e4f64).ln() / (block * 3.0), f_d);
+    }
+    let m = used.len() as f64;
+    let (sx, sy) = used.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y.ln()));
+    let (mx, my) = (sx / m, sy / m);
+    let (sxy, sxx) =
+        used.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + (x - mx) * (y.ln() - my), b + (x - mx).powi(2)));
+    (-sxy / sxx, f_d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_decay_of_a_damped_sine_with_an_unbalance_line() {
+        let (sigma, f) = (2.95, 47.0);
+        let s: Vec<(f64, f64)> = (0..20_000)
+            .map(|k| {
+                let t = k as f64 * 5e-5;
+                (t, 1.0 + (-sigma * t).exp() * (TAU * f * t).cos() + 0.05 * (TAU * 500.0 * t + 0.3).sin())
+            })
+            .collect();
+        let (got, fd) = decay(&s, 500.0);
+        assert!((got / sigma - 1.0).abs() < 0.05, "σ = {got}");
+        assert!((fd / f - 1.0).abs() < 0.02, "f = {fd}");
+        let grow: Vec<(f64, f64)> = s.iter().map(|(t, _)| (*t, (0.5 * t).exp() * (TAU * f * t).sin())).collect();
+        assert!(decay(&grow, 0.0).0 < 0.0);
+    }
+
+    #[test]
+    fn the_parabola_finds_a_peak_between_points() {
+        let f0 = 50.0;
+        let pts: Vec<Point> = [49.0, 50.3, 51.6]
+            .iter()
+            .map(|f: &f64| {
+                let db = 30.0 - 400.0 * (f / f0).ln().powi(2);
+                Point { f_hz: *f, s: [0.0; 2], s_db: db, t_db: db, amplitude_v: 0.0, windows: 2, settled: true }
+            })
+            .collect();
+        let p = peak_of(&pts).expect("peak");
+        assert!((p.f_hz / f0 - 1.0).abs() < 1e-9 && (p.s_db - 30.0).abs() < 1e-9, "{p:?}");
+        assert_eq!(zone(2.9), "A");
+        assert_eq!(zone(3.5), "B");
+        assert_eq!(zone(4.5), "C");
+        assert_eq!(zone(5.0), "D");
+    }
+}

@@ -1,0 +1,259 @@
+//! End-to-end tests of `plant assess`: a small report card of two controllers (one stable, one
+//! the study's PD sampled at 20 kHz, unstable), bad input refused before anything runs, an
+//! excitation that drives the rotor into the touchdown bearing and a rotor not levitated
+//! before the shock (exit 9, the report kept), an external controller killed during the
+//! measurement (exit 4), and Ctrl-C midway (exit 130, the parts measured so far kept).
+
+mod common;
+
+use common::*;
+use std::path::Path;
+use std::process::Command;
+
+/// A few short runs and a small ladder in a debug build on a loaded machine: a hang fails.
+const LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// Writes the assessment file `path` around the 10 G scene, shortened, with `extra` appended.
+fn file(path: &Path, controllers: &str, extra: &str) -> std::path::PathBuf {
+    let scene = scene("paper-10g.toml");
+    let text = format!(
+        "scene = {scene:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\n{controllers}\n\
+         [sensitivity]\nf_min_hz = 20.0\nf_max_hz = 200.0\npoints = 4\nprobe_s = 0.3\nresolution = 0.05\nspeeds = [\"standstill\"]\n\
+         [ladder]\npeaks_g = [3.0, 20.0]\nmembers = 2\nbatch = 2\nverify = false\n{extra}",
+        scene = scene.display().to_string()
+    );
+    std::fs::write(path, text).expect("write");
+    path.to_path_buf()
+}
+
+fn assess(path: &Path, out: &Path) -> std::process::Output {
+    output_within(Command::new(plant_bin()).arg("assess").arg(path).arg("--out").arg(out).arg("--quiet"), LIMIT)
+}
+
+#[test]
+fn a_report_card_of_a_stable_and_an_unstable_controller() {
+    let dir = TempDir::new("assess-card");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
+                       [[controller]]\nlabel = \"study pd\"\nset = [\"controller.law=\\\"pd\\\"\"]\n";
+    let out = dir.join("out");
+    let o = assess(&file(&dir.join("assess.toml"), controllers, ""), &out);
+    assert_exit(&o, 0);
+    let r = read_json(&out.join("report.json"));
+    let c = r["controllers"].as_array().expect("controllers");
+    assert_eq!(c.len(), 2);
+    // The damped loop: stable on both axes, a peak, a zone, the closed form's peak near it.
+    let s = &c[0]["sensitivity"]["result"];
+    for axis in s["axes"].as_array().expect("axes") {
+        assert_eq!(axis["stable"], true, "{axis}");
+        let measured = num(&axis["peak"], "s_db");
+        let closed = num(&s["closed_form"], "s_db");
+        assert!((measured - closed).abs() < 0.5, "measured {measured} dB, closed form {closed} dB");
+        assert!(["A", "B", "C", "D"].contains(&axis["zone"].as_str().expect("zone")));
+    }
+    // The study's PD at 20 kHz: unstable, no peak, and its closed form agrees.
+    let s = &c[1]["sensitivity"]["result"];
+    for axis in s["axes"].as_array().expect("axes") {
+        assert_eq!(axis["zone"], "unstable", "{axis}");
+        assert!(axis["peak"].is_null());
+    }
+    assert_eq!(s["closed_form"]["stable"], false);
+    assert!(c[1]["verdict"].as_str().expect("verdict").contains("UNSTABLE"));
+    // Vibration and ladder with the duty, for both.
+    for k in c {
+        assert_eq!(k["vibration"]["status"], "measured", "{}", k["vibration"]);
+        let v = &k["vibration"]["result"];
+        assert!(num(v, "peak_um") > 0.0 && num(v, "peak_um") < 150.0);
+        let rungs = k["ladder"]["result"]["rungs"].as_array().expect("rungs");
+        assert_eq!(rungs.len(), 2);
+        let top = &rungs[1];
+        assert_eq!(top["members"], 2);
+        // 20 G: the rotor hits the race; the duty has a force, a pressure and friction.
+        let d = &top["duty"];
+        assert!(num(&d["peak_contact_force_n"], "max") > 100.0, "{d}");
+        assert!(num(&d["peak_race_pressure_mpa"], "max") > 0.0);
+        assert!(num(&d["peak_ball_pressure_mpa"], "max") > 0.0);
+        assert!(num(&d["friction_energy_j"], "max") > 0.0);
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(html.contains("data:image/png;base64,") && html.contains("damped") && html.contains("study pd"));
+    assert!(!html.contains("http://") && !html.contains("https://") && !html.contains("<script"), "self-contained");
+    for png in ["sensitivity_1.png", "ladder_probability.png", "duty_friction.png"] {
+        Png::read(&out.join(png));
+    }
+}
+
+#[test]
+fn bad_input_is_refused_before_anything_runs() {
+    let dir = TempDir::new("assess-bad");
+    let cases = [
+        ("[[controller]]\nlabel = \"x\"\nset = [\"controller.law=\\\"nope\\\"\"]\n", "", "nope"),
+        ("", "[duty]\npoisson = 0.7\n", "duty.poisson = 0.7"),
+        ("", "[sensitivity2]\n", "sensitivity2"),
+        // Appended inside [ladder]: the verdict's duty rung must be a rung.
+        ("", "duty_g = 4.0\n", "ladder.duty_g = 4 G"),
+        // An external controller that cannot be started: found by starting it once, for one tick.
+        (
+            "[[controller]]\nlabel = \"x\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.command=[\\\"/nonexistent/ctl\\\"]\"]\n",
+            "",
+            "cannot run \"/nonexistent/ctl\"",
+        ),
+    ];
+    for (i, (controllers, extra, says)) in cases.iter().enumerate() {
+        let sub = dir.join(&format!("case{i}"));
+        std::fs::create_dir_all(&sub).expect("dir");
+        let out = sub.join("out");
+        let o = assess(&file(&sub.join("assess.toml"), controllers, extra), &out);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(says), "{}", stderr(&o));
+        assert!(!out.join("report.json").exists());
+    }
+    // A lowest frequency whose periods alone outlast the measurement's run (it ran 3000 s
+    // simulated, then failed with exit 1).
+    let sub = dir.join("slow");
+    std::fs::create_dir_all(&sub).expect("dir");
+    let path = file(&sub.join("assess.toml"), "", "");
+    std::fs::write(&path, read_text(&path).replace("f_min_hz = 20.0", "f_min_hz = 0.001")).expect("write");
+    let out = sub.join("out");
+    let o = assess(&path, &out);
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("sensitivity.f_min_hz = 0.001 Hz"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+#[test]
+fn an_excitation_into_the_touchdown_bearing_is_not_graded() {
+    let dir = TempDir::new("assess-touch");
+    // `parts` is a top-level key: before the first table.
+    let controllers = "parts = [\"sensitivity\"]\n[[controller]]\nlabel = \"light\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.05\"]\n";
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), controllers, "");
+    let text = std::fs::read_to_string(&path)
+        .expect("read")
+        .replace("speeds =", "auto_level = false\nexcitation_um = 10.0\nspeeds =");
+    std::fs::write(&path, text).expect("write");
+    let o = assess(&path, &out);
+    assert_exit(&o, 9);
+    assert!(stderr(&o).contains("excitation"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    assert_eq!(r["controllers"][0]["sensitivity"]["failure"], "not_gradable");
+}
+
+#[test]
+fn a_rotor_not_levitated_before_the_shock_is_not_graded() {
+    // A coil current limit of 0.1 A cannot carry the rotor's weight: it sinks onto the race.
+    let dir = TempDir::new("assess-drop");
+    let controllers = "parts = [\"vibration\", \"ladder\"]\n[[controller]]\nlabel = \"weak\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.current_limit_a=0.1\"]\n";
+    let out = dir.join("out");
+    let o = assess(&file(&dir.join("assess.toml"), controllers, ""), &out);
+    assert_exit(&o, 9);
+    assert!(stderr(&o).contains("not levitated"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    assert_eq!(c["vibration"]["failure"], "not_gradable", "{}", c["vibration"]);
+    // No ladder for a rotor that is down before the shock (no member was run).
+    assert_eq!(c["ladder"]["failure"], "not_gradable", "{}", c["ladder"]);
+    assert!(c["ladder"]["result"].is_null());
+}
+
+/// A controller process killed (SIGKILL, by itself) 0.2 s into each run, co-simulated in
+/// lockstep: every part fails as "controller lost" (exit 4), none is graded, the report is
+/// written and says why.
+#[cfg(unix)]
+#[test]
+fn a_controller_killed_during_the_measurement_is_reported_lost() {
+    let dir = TempDir::new("assess-killed");
+    let command = format!(
+        "controller.command=[{:?}, \"--mode\", \"die\", \"--die-at\", \"4000\"]",
+        rogue_bin().display().to_string()
+    );
+    let controllers =
+        format!("[[controller]]\nlabel = \"dies\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\", {:?}]\n", command);
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), &controllers, "");
+    // The probe over by 0.1 s: the controller dies in the stepped sine.
+    let text = read_text(&path).replace("probe_s = 0.3", "probe_s = 0.1");
+    std::fs::write(&path, text).expect("write");
+    let o = assess(&path, &out);
+    assert_exit(&o, 4);
+    assert!(stderr(&o).contains("controller lost"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    for part in ["sensitivity", "vibration", "ladder"] {
+        assert_eq!(c[part]["status"], "failed", "{part}: {}", c[part]);
+        assert_eq!(c[part]["failure"], "peer_lost", "{part}: {}", c[part]);
+    }
+    // No member whose controller died is counted (as diverged or otherwise).
+    for rung in c["ladder"]["result"]["rungs"].as_array().expect("rungs") {
+        assert_eq!(rung["members"], 0, "{rung}");
+    }
+    assert!(c["sensitivity"]["result"].is_null());
+}
+
+/// SIGINT once the ladder has started: the sensitivity and the vibration measured before it
+/// are in the report, the ladder is marked interrupted, exit 130.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_midway_keeps_the_parts_measured_and_says_so() {
+    let dir = TempDir::new("assess-sigint");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
+                       [[controller]]\nlabel = \"second\"\nset = [\"controller.law=\\\"pd_delay\\\"\"]\n";
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), controllers, "");
+    // A ladder long enough to be interrupted in: up to 64 members per rung, two per round.
+    let text = read_text(&path).replace("members = 2", "members = 64");
+    std::fs::write(&path, text).expect("write");
+    let mut p = Proc::spawn(Command::new(plant_bin()).arg("assess").arg(&path).arg("--out").arg(&out));
+    p.wait_line("damped: shock ladder");
+    p.signal(libc::SIGINT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    assert!(log.contains("interrupted"), "{log}");
+    let r = read_json(&out.join("report.json"));
+    assert_eq!(r["interrupted"], true);
+    let c = &r["controllers"][0];
+    assert_eq!(c["sensitivity"]["status"], "measured", "{}", c["sensitivity"]);
+    assert_eq!(c["vibration"]["status"], "measured", "{}", c["vibration"]);
+    assert_eq!(c["ladder"]["status"], "interrupted", "{}", c["ladder"]);
+    assert!(c["verdict"].as_str().expect("verdict").contains("ladder interrupted"), "{}", c["verdict"]);
+    // The second controller was never started.
+    let second = &r["controllers"][1];
+    for part in ["sensitivity", "vibration", "ladder"] {
+        assert_eq!(second[part]["status"], "interrupted", "{part}: {}", second[part]);
+    }
+    assert!(std::fs::read_to_string(out.join("report.html")).expect("report.html").contains("INTERRUPTED"));
+}
+
+/// SIGINT during the sensitivity measurement, once one axis is measured: that axis is kept in
+/// the report (the part marked interrupted, its reason naming what was measured), nothing after
+/// it runs, exit 130.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_during_the_sensitivity_keeps_the_axes_measured() {
+    let dir = TempDir::new("assess-sigint-sens");
+    let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n";
+    let out = dir.join("out");
+    let path = file(&dir.join("assess.toml"), controllers, "");
+    // Four axis runs (x and y, at standstill and at speed) on a pool of at most two threads.
+    let text = read_text(&path).replace("speeds = [\"standstill\"]", "speeds = [\"standstill\", \"rated\"]");
+    std::fs::write(&path, text).expect("write");
+    let mut p = Proc::spawn(Command::new(plant_bin()).arg("assess").arg(&path).arg("--out").arg(&out));
+    p.wait_line("  axis ");
+    p.signal(libc::SIGINT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(130), "{log}");
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    let s = &c["sensitivity"];
+    assert_eq!(s["status"], "interrupted", "{s}");
+    let axes = s["result"]["axes"].as_array().expect("the axes measured are kept");
+    assert!(!axes.is_empty() && axes.len() < 4, "{s}");
+    for axis in axes {
+        assert_eq!(axis["stable"], true, "{axis}");
+        assert!(num(&axis["peak"], "s_db").is_finite(), "{axis}");
+    }
+    assert!(s["why"].as_str().expect("why").contains("measured before it"), "{s}");
+    for part in ["vibration", "ladder"] {
+        assert_eq!(c[part]["status"], "interrupted", "{part}: {}", c[part]);
+    }
+    assert!(c["verdict"].as_str().expect("verdict").starts_with("sensitivity interrupted, on the"), "{}", c["verdict"]);
+}
