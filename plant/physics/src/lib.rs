@@ -9,6 +9,7 @@
 //! crate's; this crate builds and tests without them.
 #![warn(missing_docs)]
 
+pub mod amplifier;
 pub mod force;
 pub mod initial;
 pub mod integrate;
