@@ -27,6 +27,7 @@ pub mod cosim;
 pub mod ensemble;
 pub mod exit;
 pub mod grid;
+pub mod hardware;
 pub mod hooks;
 pub mod initial;
 pub mod interrupt;

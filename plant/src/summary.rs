@@ -138,6 +138,10 @@ pub struct Summary {
     pub contact_time_s: f64,
     /// Fraction of macro steps run with the race parked (0 unless `race_when_clear = "parked"`).
     pub parked_fraction: f64,
+    /// Time with an amplifier at its voltage limit (s), in runs with amplifiers
+    /// (`amb.amplifier`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub voltage_saturation_s: Option<f64>,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -278,6 +282,7 @@ impl Summary {
                     0.0
                 }
             },
+            voltage_saturation_s: run.voltage_saturation_s,
             steps: run.stats.steps,
             rejected_steps: run.stats.rejected,
             rhs_evals: run.stats.rhs_evals,
