@@ -308,3 +308,68 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         self.hw.amplified().then(|| y[N + ex::SATURATED])
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::load_scene;
+    use crate::model::{ix, Model};
+    use crate::sensor::Sensor;
+
+    fn realistic(sets: &[&str]) -> crate::config::Scene {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/realistic-10g.toml");
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load_scene(&file, &sets).expect("the realistic scene")
+    }
+
+    fn wired(scene: &crate::config::Scene) -> Wired<Model, { crate::model::N }, { crate::model::N + EXTRA }> {
+        let model =
+            Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Held([0.0; 2]), race_parked: false };
+        Wired::new(model, [Control::Held([0.0; 2]); 2], scene.hardware.clone())
+    }
+
+    /// With the rotor held still at the centre, what the sensor reads is the runout's harmonics
+    /// exactly (the ideal low-pass: the sum itself; through the gain, the gain times it).
+    #[test]
+    fn runout_with_the_rotor_held_at_the_centre_is_the_harmonics() {
+        let scene = realistic(&["sensor.bandwidth_hz=0"]);
+        let w = wired(&scene);
+        let harmonics = &scene.hardware.front_end.runout;
+        assert_eq!(harmonics.len(), 4);
+        let gain = scene.params.loop_constants.sensor_gain_v_per_m;
+        let mut sensor = Sensor::new(scene.sensor);
+        for k in 0..100 {
+            let theta = 0.37 * k as f64;
+            let mut y = [0.0; crate::model::N + EXTRA];
+            y[ix::TR] = theta;
+            let sensed = Machine::sensed(&w, &y, 0);
+            let expect: [f64; 2] = std::array::from_fn(|axis| {
+                harmonics
+                    .iter()
+                    .filter(|h| h.axis == axis)
+                    .map(|h| h.amplitude * (f64::from(h.order) * theta + h.phase).cos())
+                    .sum::<f64>()
+            });
+            assert_eq!(sensed, expect, "θ = {theta}");
+            // The scene's 1× and 2× harmonics, written out.
+            let x = 1.5e-6 * theta.cos() + 0.75e-6 * (2.0 * theta + 30f64.to_radians()).cos();
+            assert!((sensed[0] - x).abs() < 1e-18, "θ = {theta}: {} against {x}", sensed[0]);
+            assert_eq!(sensor.read_with_gain(sensed, gain), [gain * expect[0], gain * expect[1]]);
+        }
+    }
+
+    /// The range clips what the sensor reads; the filter's output is what is read when the
+    /// sensor has a bandwidth.
+    #[test]
+    fn the_range_clips_and_the_filter_is_read() {
+        let scene = realistic(&["sensor.runout=[]"]);
+        let w = wired(&scene);
+        let mut y = [0.0; crate::model::N + EXTRA];
+        y[ix::XR] = 1e-4;
+        y[crate::model::N + ex::FILTER] = 3e-4;
+        y[crate::model::N + ex::FILTER + 1] = -1e-5;
+        assert_eq!(Machine::sensed(&w, &y, 0), [2.5e-4, -1e-5]);
+        let ideal = realistic(&["sensor.runout=[]", "sensor.bandwidth_hz=0"]);
+        assert_eq!(Machine::sensed(&wired(&ideal), &y, 0), [1e-4, 0.0]);
+    }
+}
