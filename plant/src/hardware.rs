@@ -113,13 +113,14 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
         y[..N].copy_from_slice(y0);
         for i in 0..M::PLANES {
             let reference = self.reference_current(y0, i);
-            for j in 0..2 {
+            let signal = self.raw_signal(y0, i);
+            for (j, (&current, &measured)) in reference.iter().zip(&signal).enumerate() {
                 let ax = 2 * i + j;
                 if let Some(a) = &self.hw.amplifiers[i] {
-                    y[N + ex::CURRENT + ax] = reference[j];
-                    y[N + ex::INTEGRAL + ax] = a.steady_integral(reference[j]);
+                    y[N + ex::CURRENT + ax] = current;
+                    y[N + ex::INTEGRAL + ax] = a.steady_integral(current);
                 }
-                y[N + ex::FILTER + ax] = self.raw_signal(y0, i)[j];
+                y[N + ex::FILTER + ax] = measured;
             }
         }
         y
@@ -323,8 +324,12 @@ mod tests {
     }
 
     fn wired(scene: &crate::config::Scene) -> Wired<Model, { crate::model::N }, { crate::model::N + EXTRA }> {
-        let model =
-            Model { params: scene.params.clone(), base: scene.base.clone(), control: Control::Held([0.0; 2]), race_parked: false };
+        let model = Model {
+            params: scene.params.clone(),
+            base: scene.base.clone(),
+            control: Control::Held([0.0; 2]),
+            race_parked: false,
+        };
         Wired::new(model, [Control::Held([0.0; 2]); 2], scene.hardware.clone())
     }
 

@@ -194,14 +194,24 @@ fn a_two_plane_amplifier_run_has_both_planes_coils() {
     let dir = TempDir::new("hw-two-plane");
     let out = dir.join("run");
     let sets = ["scene.duration_s=0.01", "output.plots=false", "amb.amplifier=true", "amb.b.bus_voltage_v=100"];
-    let o = output_within(&mut plant_run(&scene("two-plane-asymmetric-10g.toml"), &out, &sets), Duration::from_secs(120));
+    let o =
+        output_within(&mut plant_run(&scene("two-plane-asymmetric-10g.toml"), &out, &sets), Duration::from_secs(120));
     assert_exit(&o, 0);
     let text = std::fs::read_to_string(out.join("trace.csv")).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     assert_eq!(header.len(), 37 + 8);
     assert_eq!(
         header[37..],
-        ["ix_coil_a", "iy_coil_a", "vx_coil_v", "vy_coil_v", "b_ix_coil_a", "b_iy_coil_a", "b_vx_coil_v", "b_vy_coil_v"]
+        [
+            "ix_coil_a",
+            "iy_coil_a",
+            "vx_coil_v",
+            "vy_coil_v",
+            "b_ix_coil_a",
+            "b_iy_coil_a",
+            "b_vx_coil_v",
+            "b_vy_coil_v"
+        ]
     );
 }
 
@@ -214,13 +224,22 @@ fn bad_amplifier_and_sensor_values_are_refused_naming_key_value_and_unit() {
         (&["amb.coil_inductance_mh=0"], "amb.coil_inductance_mh = 0 mH"),
         (&["amb.bus_voltage_v=-5"], "amb.bus_voltage_v = -5 V"),
         (&["amb.coil_resistance_ohm=-1"], "amb.coil_resistance_ohm = -1 Ω"),
-        (&["integrator.method=rk4", "integrator.substeps=1", "amb.current_loop_hz=20000"], "amb.current_loop_hz = 20000 Hz"),
-        (&["integrator.method=rk4", "integrator.substeps=1", "sensor.bandwidth_hz=50000"], "sensor.bandwidth_hz = 50000 Hz"),
+        (
+            &["integrator.method=rk4", "integrator.substeps=1", "amb.current_loop_hz=20000"],
+            "amb.current_loop_hz = 20000 Hz",
+        ),
+        (
+            &["integrator.method=rk4", "integrator.substeps=1", "sensor.bandwidth_hz=50000"],
+            "sensor.bandwidth_hz = 50000 Hz",
+        ),
         (&["integrator.method=symplectic_euler"], "symplectic_euler"),
         (&["sensor.filter_order=3"], "sensor.filter_order = 3"),
         (&["sensor.range_um=-1"], "sensor.range_um = -1 µm"),
         (&["sensor.runout=[{axis = \"x\", order = 0, amplitude_um = 1.0}]"], "sensor.runout[0].order = 0"),
-        (&["sensor.runout=[{axis = \"y\", order = 1, amplitude_um = 200.0}]"], "sensor.runout[0].amplitude_um = 200 µm"),
+        (
+            &["sensor.runout=[{axis = \"y\", order = 1, amplitude_um = 200.0}]"],
+            "sensor.runout[0].amplitude_um = 200 µm",
+        ),
         (&["sensor.runout=[{axis = \"x_b\", order = 1, amplitude_um = 1.0}]"], "sensor.runout[0].axis"),
         (&["amb.a.coil_inductance_mh=1"], "amb.a"),
     ];
