@@ -30,6 +30,7 @@ pub mod ensemble;
 pub mod exit;
 pub mod figures;
 pub mod grid;
+pub mod hardware;
 pub mod hooks;
 pub mod initial;
 pub mod interrupt;

@@ -7,6 +7,7 @@ use crate::model::{Control, Model, Params, Release};
 use crate::park::{self, GapMotion};
 use crate::run::Sink;
 use crate::trace::{self, Record};
+use controller::{saturate, PdGains};
 use plant_physics::integrate::System;
 use plant_physics::two_plane;
 
@@ -56,6 +57,19 @@ pub trait Machine<const N: usize>: System<N> {
     /// Hands the output sample of state `y` at time `t` to `sink`.
     fn feed(&self, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
         sink.sample(&self.record(t, y));
+    }
+
+    /// Plane `i`'s continuous PD current in state `y` (A): what the model's
+    /// `Control::Continuous(gains)` applies, saturated at the plane's limit.
+    fn pd_current(&self, gains: &PdGains, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// The rotor's velocity at plane `i`'s bearing, relative to the housing (m/s).
+    fn bearing_velocity(&self, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// Time spent with an amplifier at its voltage limit (s), for a model with amplifiers
+    /// ([`crate::hardware`]).
+    fn voltage_saturation(&self, _y: &[f64; N]) -> Option<f64> {
+        None
     }
 }
 
@@ -117,6 +131,18 @@ impl Machine<{ crate::model::N }> for Model {
 
     fn record(&self, t: f64, y: &crate::model::State) -> Record {
         Record::planar(trace::row(self, t, y))
+    }
+
+    fn pd_current(&self, gains: &PdGains, y: &crate::model::State, _i: usize) -> [f64; 2] {
+        use crate::model::ix::*;
+        let p = &self.params;
+        let a_s = p.loop_constants.sensor_gain_v_per_m;
+        let (u, u_dot) = ([y[XR] * a_s, y[YR] * a_s], [y[VXR] * a_s, y[VYR] * a_s]);
+        saturate(gains.current(u, u_dot), p.current_limit)
+    }
+
+    fn bearing_velocity(&self, y: &crate::model::State, _i: usize) -> [f64; 2] {
+        [y[crate::model::ix::VXR], y[crate::model::ix::VYR]]
     }
 }
 
@@ -185,5 +211,16 @@ impl Machine<{ two_plane::N }> for two_plane::Model {
 
     fn record(&self, t: f64, y: &two_plane::State) -> Record {
         trace::two_plane_record(self, t, y)
+    }
+
+    fn pd_current(&self, gains: &PdGains, y: &two_plane::State, i: usize) -> [f64; 2] {
+        let plane = &self.params.planes[i];
+        let a_s = plane.params.loop_constants.sensor_gain_v_per_m;
+        let (s, s_dot) = two_plane::at_station(y, plane.sensor);
+        saturate(gains.current((s * a_s).into(), (s_dot * a_s).into()), plane.params.current_limit)
+    }
+
+    fn bearing_velocity(&self, y: &two_plane::State, i: usize) -> [f64; 2] {
+        two_plane::at_station(y, self.params.planes[i].station).1.into()
     }
 }

@@ -138,8 +138,8 @@ impl RunFolder {
     /// Creates `dir/trace.csv` (header) for a run of `scene`.
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let path = dir.join("trace.csv");
-        let trace =
-            TraceWriter::create(&path, scene.planes()).with_context(|| format!("creating {}", path.display()))?;
+        let trace = TraceWriter::create(&path, scene.planes(), scene.hardware.amplified())
+            .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })
     }
 
@@ -592,6 +592,7 @@ mod tests {
             final_state: vec![0.0; crate::model::N],
             cosim: None,
             parked_steps: 0,
+            voltage_saturation_s: None,
             planes: 1,
             invalid_commands: 0,
             ticks: Default::default(),

@@ -12,6 +12,7 @@
 use crate::config::{ControlMode, Scene};
 use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
+use crate::hardware::{Hardware, Wired, EXTRA};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
@@ -211,6 +212,8 @@ pub struct SinkRun {
     pub planes: usize,
     /// Ticks whose command was non-finite (the last valid one was held).
     pub invalid_commands: u64,
+    /// Time with an amplifier at its voltage limit (s); `None` without amplifiers.
+    pub voltage_saturation_s: Option<f64>,
     /// The cost of the ticks: the most model evaluations in one, and the execution times.
     pub ticks: TickCost,
 }
@@ -299,6 +302,9 @@ fn run_from(
         Source::Continuous => Control::Continuous(gains[i]),
         _ => Control::Held([bias[2 * i], bias[2 * i + 1]]),
     };
+    let hw = &scene.hardware;
+    let controls = if scene.two_plane.is_some() { [control(0), control(1)] } else { [control(0); 2] };
+    let [p, v, ..] = scene.integrator.atol_groups;
     match &scene.two_plane {
         None => {
             let model = Model {
@@ -308,6 +314,13 @@ fn run_from(
                 race_parked: false,
             };
             let y = initial_state(scene);
+            if hw.is_on() {
+                const NA: usize = crate::model::N + EXTRA;
+                let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
+                let y = wired.initial(&y);
+                let settings = settings_with(scene, extended::<{ crate::model::N }, NA>(scene.integrator.atol, p, v));
+                return drive(scene, wired, y, settings, source, (bias, limits), hooks, sink);
+            }
             drive(scene, model, y, integrator_settings(scene), source, (bias, limits), hooks, sink)
         }
         Some(params) => {
@@ -318,10 +331,25 @@ fn run_from(
                 race_parked: [false; 2],
             };
             let y = crate::initial::two_plane_initial_state(scene, params);
+            if hw.is_on() {
+                const NA: usize = two_plane::N + EXTRA;
+                let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
+                let y = wired.initial(&y);
+                let atol = extended::<{ two_plane::N }, NA>(scene.integrator.two_plane_atol(), p, v);
+                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), hooks, sink);
+            }
             let settings = settings_with(scene, scene.integrator.two_plane_atol());
             drive(scene, model, y, settings, source, (bias, limits), hooks, sink)
         }
     }
+}
+
+/// The model's tolerances `atol` with the hardware's after them ([`Hardware::atol`]).
+fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
+    let mut a = [0.0; NA];
+    a[..N].copy_from_slice(&atol);
+    a[N..].copy_from_slice(&Hardware::atol(p, v));
+    a
 }
 
 /// The macro-step loop (module doc) for a model of `N` state components starting at `y`.
@@ -592,6 +620,7 @@ fn drive<const N: usize, M: Machine<N>>(
         planes,
         ticks: cost,
         invalid_commands,
+        voltage_saturation_s: model.voltage_saturation(&y),
     })
 }
 

@@ -10,6 +10,124 @@
 
 use crate::rng::SplitMix64;
 
+/// One runout harmonic of one sensor axis (MODEL.md §12.2): a signal locked to the rotor's
+/// angle θ that the sensor reads as displacement, `a cos(k θ + φ)`. Mechanical runout (the
+/// target surface's out-of-roundness) and electrical runout (the target's varying conductivity
+/// and permeability) add the same way; `kind` only labels it.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Harmonic {
+    /// The axis: 0 = x, 1 = y (plane A's for a two-plane rotor), 2 = x_B, 3 = y_B.
+    pub axis: usize,
+    /// The order k ≥ 1 (1 = once per revolution).
+    pub order: u32,
+    /// Amplitude a (m).
+    pub amplitude: f64,
+    /// Phase φ (rad), from the keyphasor's angle 0.
+    pub phase: f64,
+    /// Mechanical or electrical.
+    pub kind: RunoutKind,
+}
+
+/// What causes a runout harmonic (both add to the signal alike).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunoutKind {
+    /// The target surface's out-of-roundness.
+    Mechanical,
+    /// The target material's non-uniformity (eddy-current and inductive sensors).
+    Electrical,
+}
+
+/// The runout of `axis` at rotor angle `angle` (rad): the sum of its harmonics (m).
+#[inline]
+pub fn runout(harmonics: &[Harmonic], axis: usize, angle: f64) -> f64 {
+    harmonics
+        .iter()
+        .filter(|h| h.axis == axis)
+        .map(|h| h.amplitude * (f64::from(h.order) * angle + h.phase).cos())
+        .sum()
+}
+
+/// The sensor's low-pass (its bandwidth), on the displacement it measures.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "order", rename_all = "snake_case")]
+pub enum LowPass {
+    /// First order, `H(s) = ω / (s + ω)`.
+    First {
+        /// Corner ω (rad/s).
+        corner: f64,
+    },
+    /// Second order Butterworth, `H(s) = ω² / (s² + √2 ω s + ω²)`.
+    Second {
+        /// Corner ω (rad/s).
+        corner: f64,
+    },
+}
+
+impl LowPass {
+    /// The states' rates for input `u` and states `z` (the output `z[0]`, and its rate for the
+    /// second order): `ż₀ = ω (u − z₀)`, or `ż₀ = z₁`, `ż₁ = ω² (u − z₀) − √2 ω z₁`.
+    #[inline]
+    pub fn rates(&self, u: f64, z: [f64; 2]) -> [f64; 2] {
+        match *self {
+            LowPass::First { corner } => [corner * (u - z[0]), 0.0],
+            LowPass::Second { corner } => {
+                [z[1], corner * corner * (u - z[0]) - std::f64::consts::SQRT_2 * corner * z[1]]
+            }
+        }
+    }
+
+    /// The frequency response `H(jω)` at `omega` (rad/s): (magnitude, phase in rad).
+    pub fn response(&self, omega: f64) -> (f64, f64) {
+        match *self {
+            LowPass::First { corner } => {
+                let r = omega / corner;
+                (1.0 / (1.0 + r * r).sqrt(), -r.atan())
+            }
+            LowPass::Second { corner } => {
+                let r = omega / corner;
+                let (re, im) = (1.0 - r * r, std::f64::consts::SQRT_2 * r);
+                (1.0 / re.hypot(im), -im.atan2(re))
+            }
+        }
+    }
+
+    /// The corner ω (rad/s).
+    pub fn corner(&self) -> f64 {
+        match *self {
+            LowPass::First { corner } | LowPass::Second { corner } => corner,
+        }
+    }
+}
+
+/// What lies between the rotor and the sensor's voltage besides the gain, noise and ADC: its
+/// bandwidth, runout, and measurement range (the scene's `[sensor]`; all off by default).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct FrontEnd {
+    /// The low-pass; `None`: ideal.
+    pub low_pass: Option<LowPass>,
+    /// The runout harmonics.
+    pub runout: Vec<Harmonic>,
+    /// The measurement range ±r (m); `None`: unlimited.
+    pub range: Option<f64>,
+}
+
+impl FrontEnd {
+    /// Whether any part is on.
+    pub fn is_on(&self) -> bool {
+        self.low_pass.is_some() || !self.runout.is_empty() || self.range.is_some()
+    }
+
+    /// The measured displacement `d` (m) clipped to the range.
+    #[inline]
+    pub fn clip(&self, d: f64) -> f64 {
+        match self.range {
+            Some(r) => d.clamp(-r, r),
+            None => d,
+        }
+    }
+}
+
 /// Sensor settings (the scene's `[sensor]` table).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SensorSettings {
@@ -69,6 +187,75 @@ mod tests {
 
     fn ideal() -> SensorSettings {
         SensorSettings { gain: 25_000.0, noise_v: 0.0, seed: 1, adc_bits: 0, adc_range_v: 10.0 }
+    }
+
+    /// A sine of `omega` (rad/s) through `lp` (RK4, fine step), after the transient: the
+    /// amplitude and phase of the output's fundamental against the input's.
+    fn measured_response(lp: LowPass, omega: f64) -> (f64, f64) {
+        let period = std::f64::consts::TAU / omega;
+        let h = period / 2000.0;
+        let mut z = [0.0; 2];
+        let mut t = 0.0;
+        let settle = 40.0 * period;
+        let (mut c, mut s) = (0.0, 0.0);
+        let step = |t: f64, z: [f64; 2]| {
+            let f = |t: f64, z: [f64; 2]| lp.rates((omega * t).sin(), z);
+            let k1 = f(t, z);
+            let k2 = f(t + h / 2.0, [z[0] + h / 2.0 * k1[0], z[1] + h / 2.0 * k1[1]]);
+            let k3 = f(t + h / 2.0, [z[0] + h / 2.0 * k2[0], z[1] + h / 2.0 * k2[1]]);
+            let k4 = f(t + h, [z[0] + h * k3[0], z[1] + h * k3[1]]);
+            [
+                z[0] + h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+                z[1] + h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+            ]
+        };
+        let n = (settle / h).round() as usize;
+        for _ in 0..n {
+            z = step(t, z);
+            t += h;
+        }
+        // One whole period more: the output's Fourier coefficients at omega (rectangle rule).
+        for _ in 0..2000 {
+            z = step(t, z);
+            t += h;
+            c += z[0] * (omega * t).cos() * h;
+            s += z[0] * (omega * t).sin() * h;
+        }
+        let (c, s) = (2.0 * c / period, 2.0 * s / period);
+        // z = A sin(ω t + φ) = A (sin cos φ + cos sin φ): s = A cos φ, c = A sin φ.
+        (c.hypot(s), c.atan2(s))
+    }
+
+    #[test]
+    fn a_low_pass_lags_as_its_transfer_function() {
+        for lp in [
+            LowPass::First { corner: 2.0 * std::f64::consts::PI * 5000.0 },
+            LowPass::Second { corner: 2.0 * std::f64::consts::PI * 5000.0 },
+        ] {
+            for f in [500.0, 3000.0, 5000.0] {
+                let omega = std::f64::consts::TAU * f;
+                let (mag, phase) = measured_response(lp, omega);
+                let (emag, ephase) = lp.response(omega);
+                assert!((mag - emag).abs() < 1e-4, "{lp:?} at {f} Hz: |H| {mag} against {emag}");
+                assert!((phase - ephase).abs() < 1e-3, "{lp:?} at {f} Hz: phase {phase} against {ephase}");
+            }
+        }
+        // The first order's lag at its corner is 45°, the second's 90°.
+        let w = 1000.0;
+        assert!((LowPass::First { corner: w }.response(w).1 + std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+        assert!((LowPass::Second { corner: w }.response(w).1 + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn runout_sums_its_harmonics_per_axis() {
+        let h =
+            |axis, order, amplitude, phase| Harmonic { axis, order, amplitude, phase, kind: RunoutKind::Mechanical };
+        let list = [h(0, 1, 2e-6, 0.3), h(0, 2, 1e-6, -1.0), h(1, 1, 3e-6, 0.0)];
+        let theta = 0.7;
+        let x = 2e-6 * (theta + 0.3f64).cos() + 1e-6 * (2.0 * theta - 1.0f64).cos();
+        assert_eq!(runout(&list, 0, theta), x);
+        assert_eq!(runout(&list, 1, theta), 3e-6 * theta.cos());
+        assert_eq!(runout(&list, 2, theta), 0.0);
     }
 
     #[test]

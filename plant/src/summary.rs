@@ -148,6 +148,10 @@ pub struct Summary {
     /// Controller ticks whose command was non-finite (the last valid one was held; see
     /// `controller.max_invalid_burst`, `controller.max_invalid_fraction`).
     pub invalid_commands: u64,
+    /// Time with an amplifier at its voltage limit (s), in runs with amplifiers
+    /// (`amb.amplifier`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub voltage_saturation_s: Option<f64>,
     /// Accepted integrator steps.
     pub steps: u64,
     /// Rejected steps (adaptive methods).
@@ -293,6 +297,7 @@ impl Summary {
                 }
             },
             invalid_commands: run.invalid_commands,
+            voltage_saturation_s: run.voltage_saturation_s,
             steps: run.stats.steps,
             rejected_steps: run.stats.rejected,
             rhs_evals: run.stats.rhs_evals,

@@ -66,8 +66,31 @@ columns! {
     iy_a: "Coil current, y (A); two-plane: bearing A.",
     housing_x_m: "Housing displacement, x (m).",
     housing_y_m: "Housing displacement, y (m).";
-    b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model)."
+    b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model).",
+    hw: Option<TraceHw>: "A run with amplifiers: the coils' currents and voltages (`None` without)."
 }
+
+columns! {
+    /// The coils' real currents and voltages of a run with amplifiers (`amb.amplifier`), after
+    /// all other columns in `trace.csv` (plane B's four only in a two-plane run). The current
+    /// columns `ix_a`, `iy_a` (`b_ix_a`, `b_iy_a`) are then the commanded currents, the
+    /// references of the current loops.
+    TraceHw: RowHw;
+    ix_coil_a: "Coil current, x (A): the real current the force follows; two-plane: bearing A.",
+    iy_coil_a: "Coil current, y (A); two-plane: bearing A.",
+    vx_coil_v: "Coil voltage, x (V): the amplifier's output; two-plane: bearing A.",
+    vy_coil_v: "Coil voltage, y (V); two-plane: bearing A.",
+    b_ix_coil_a: "Coil current of bearing B, x (A).",
+    b_iy_coil_a: "Coil current of bearing B, y (A).",
+    b_vx_coil_v: "Coil voltage of bearing B, x (V).",
+    b_vy_coil_v: "Coil voltage of bearing B, y (V).";
+}
+
+/// Number of coil columns (both planes').
+pub const WIDTH_HW: usize = 8;
+
+/// A sample's coil currents and voltages: [`TraceHw::COLUMNS`], in order.
+pub type RowHw = [f64; WIDTH_HW];
 
 columns! {
     /// A two-plane trace's plane B and tilt columns, after the planar ones in `trace.csv`:
@@ -114,12 +137,14 @@ pub struct Record {
     pub a: Row,
     /// Plane B and the tilt (two-plane runs).
     pub b: Option<RowB>,
+    /// The coils' currents and voltages (runs with amplifiers).
+    pub hw: Option<RowHw>,
 }
 
 impl Record {
     /// A planar sample.
     pub fn planar(a: Row) -> Self {
-        Self { a, b: None }
+        Self { a, b: None, hw: None }
     }
 
     /// Bearing planes in the sample: 1 (planar) or 2.
@@ -293,7 +318,7 @@ pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) 
     let mut b = [0.0; WIDTH_B];
     b[..14].copy_from_slice(&pb);
     b[colb::SLOPE..].copy_from_slice(&[y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]]);
-    Record { a, b: Some(b) }
+    Record { a, b: Some(b), hw: None }
 }
 
 impl Trace {
@@ -313,11 +338,14 @@ impl Trace {
         if let Some(b) = &r.b {
             self.b.get_or_insert_with(TraceB::default).push_row(b);
         }
+        if let Some(hw) = &r.hw {
+            self.hw.get_or_insert_with(TraceHw::default).push_row(hw);
+        }
     }
 
     /// Sample `i`.
     pub fn record(&self, i: usize) -> Record {
-        Record { a: self.row(i), b: self.b.as_ref().map(|b| b.row(i)) }
+        Record { a: self.row(i), b: self.b.as_ref().map(|b| b.row(i)), hw: self.hw.as_ref().map(|h| h.row(i)) }
     }
 
     /// The samples, in order.
@@ -350,7 +378,7 @@ impl Trace {
 
     /// Writes the trace as `trace.csv` (see the module docs).
     pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        let mut w = TraceWriter::create(path, self.planes())?;
+        let mut w = TraceWriter::create(path, self.planes(), self.hw.is_some())?;
         for r in self.records() {
             w.write(&r)?;
         }
@@ -376,16 +404,31 @@ impl Trace {
 pub struct TraceWriter {
     rows: RowFile,
     fields: Vec<String>,
+    /// Plane B columns written (0 or [`WIDTH_B`]).
+    b_cols: usize,
+    /// Coil columns written (0, or 4 per plane).
+    coils: usize,
 }
 
 impl TraceWriter {
     /// Creates (truncates) `path` and writes the header of a trace of `planes` bearing planes
-    /// (1: the planar columns; 2: also plane B's and the tilt's).
-    pub fn create(path: &Path, planes: usize) -> std::io::Result<Self> {
-        let header: Vec<&str> =
-            Trace::COLUMNS.iter().chain(if planes == 2 { TraceB::COLUMNS } else { &[] }).copied().collect();
+    /// (1: the planar columns; 2: also plane B's and the tilt's), with the coils' columns after
+    /// them when `amplified`.
+    pub fn create(path: &Path, planes: usize, amplified: bool) -> std::io::Result<Self> {
+        let coils = if amplified { 4 * planes } else { 0 };
+        let header: Vec<&str> = Trace::COLUMNS
+            .iter()
+            .chain(if planes == 2 { TraceB::COLUMNS } else { &[] })
+            .chain(&TraceHw::COLUMNS[..coils])
+            .copied()
+            .collect();
         let rows = RowFile::create(path, &header)?;
-        Ok(Self { fields: vec![String::with_capacity(32); header.len()], rows })
+        Ok(Self {
+            fields: vec![String::with_capacity(32); header.len()],
+            rows,
+            b_cols: if planes == 2 { WIDTH_B } else { 0 },
+            coils,
+        })
     }
 
     /// Appends one sample (in memory until a chunk of whole rows is written out); a sample
@@ -393,7 +436,8 @@ impl TraceWriter {
     pub fn write(&mut self, r: &Record) -> std::io::Result<()> {
         use std::fmt::Write as _;
         let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
-        for (field, v) in self.fields.iter_mut().zip(r.a.iter().chain(&b)) {
+        let hw = r.hw.unwrap_or([f64::NAN; WIDTH_HW]);
+        for (field, v) in self.fields.iter_mut().zip(r.a.iter().chain(&b[..self.b_cols]).chain(&hw[..self.coils])) {
             field.clear();
             let _ = write!(field, "{v:e}");
         }
@@ -542,7 +586,7 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        if !row(&Record { a: values, b }) {
+        if !row(&Record { a: values, b, hw: None }) {
             return Ok(false);
         }
     }

@@ -655,6 +655,17 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
             }
             .into());
         }
+        if scene.hardware.is_on() {
+            return Err(ConfigError::Range {
+                key: "amb.amplifier".into(),
+                value: "true".into(),
+                unit: String::new(),
+                why: "plant assess measures the ideal loop; a scene with an amplifier or a sensor front end \
+                      (amb.amplifier, sensor.bandwidth_hz, sensor.range_um, sensor.runout) is not assessed yet"
+                    .into(),
+            }
+            .into());
+        }
         if a.parts.contains(&Part::Ladder) {
             ladder::rung_overrides(&scene, 1.0).map_err(|e| ConfigError::Range {
                 key: "ladder".into(),

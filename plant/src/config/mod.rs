@@ -210,6 +210,8 @@ pub struct Scene {
     pub initial: InitialSettings,
     /// The sensor as the digital controller reads it.
     pub sensor: crate::sensor::SensorSettings,
+    /// The amplifiers and the sensor's front end (all off by default).
+    pub hardware: crate::hardware::Hardware,
     /// Trace interval (s).
     pub output_interval: f64,
     /// Write plots.

@@ -252,6 +252,21 @@ pub struct RawAmb {
     pub nominal_gap_mm: f64 = 1.0,
     /// Largest pull of one magnet, from flux saturation (N).
     pub magnet_force_limit_n: f64 = 1000.0,
+    /// Model the amplifier and coil of each axis (docs/MODEL.md §12): the command becomes the
+    /// current loop's reference and the force follows the coil's real current.
+    pub amplifier: bool = false,
+    /// The amplifier's bus voltage V_dc (V): the coil voltage is limited to ±V_dc.
+    pub bus_voltage_v: f64 = 150.0,
+    /// Coil inductance L (mH); the default is one magnet's at the nominal gap,
+    /// 2 k / (s_0 cos η) with k from k_i, k_s and s_0 = 1 mm.
+    pub coil_inductance_mh: f64 = 58.0,
+    /// Coil resistance R (Ω).
+    pub coil_resistance_ohm: f64 = 1.0,
+    /// Closed current-loop bandwidth (Hz); the PI is designed for it from L and R.
+    pub current_loop_hz: f64 = 1500.0,
+    /// Back-EMF constant k_b (V·s/m) in L di/dt = v − R i − k_b ẋ; 0: none (k_i is the
+    /// energy-consistent value).
+    pub back_emf_v_s_per_m: f64 = 0.0,
     /// Two-plane: plane A's own values of this table's keys (the others are shared).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub a: Option<toml::Table> = None,
@@ -571,7 +586,55 @@ pub struct RawSensor {
     pub adc_bits: u32 = 0,
     /// ADC input range ±V (V).
     pub adc_range_v: f64 = 10.0,
+    /// The sensor's bandwidth, its low-pass corner (Hz); 0: ideal.
+    pub bandwidth_hz: f64 = 0.0,
+    /// Order of the low-pass: 1 (first order) or 2 (Butterworth).
+    pub filter_order: u32 = 2,
+    /// Measurement range ±r (µm): the measured displacement clips there; 0: unlimited.
+    pub range_um: f64 = 0.0,
+    /// Runout harmonics, `[[sensor.runout]]` tables of `axis`, `order`, `amplitude_um`,
+    /// `phase_deg`, `kind`.
+    pub runout: Vec<RawRunout> = Vec::new(),
 }
+}
+
+/// One `[[sensor.runout]]` harmonic: `amplitude_um · cos(order · θ + phase_deg)` added to the
+/// displacement `axis`'s sensor reads, θ the rotor's angle (the keyphasor's).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRunout {
+    /// `x`, `y` (plane A's in a two-plane scene), `x_b`, `y_b`; `x_a`, `y_a` are `x`, `y`.
+    pub axis: RunoutAxis,
+    /// Order ≥ 1 (1 = once per revolution).
+    pub order: u32,
+    /// Amplitude (µm).
+    pub amplitude_um: f64,
+    /// Phase (deg).
+    #[serde(default)]
+    pub phase_deg: f64,
+    /// `mechanical` or `electrical` (a label: both add alike).
+    #[serde(default = "mechanical")]
+    pub kind: crate::sensor::RunoutKind,
+}
+
+fn mechanical() -> crate::sensor::RunoutKind {
+    crate::sensor::RunoutKind::Mechanical
+}
+
+/// `sensor.runout.axis`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunoutAxis {
+    /// x (plane A's).
+    #[serde(alias = "x_a")]
+    X,
+    /// y (plane A's).
+    #[serde(alias = "y_a")]
+    Y,
+    /// Plane B's x.
+    XB,
+    /// Plane B's y.
+    YB,
 }
 
 scene_table! {

@@ -26,6 +26,7 @@ use super::raw::*;
 use super::{ConfigError, ControllerSettings, CosimSettings, InitialSettings, IntegratorSettings, Scene, Source};
 use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
+use crate::integrate::Method;
 use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
 use plant_physics::two_plane;
@@ -624,6 +625,12 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         adc_bits: raw.sensor.adc_bits,
         adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
     };
+    let planes = if two { 2 } else { 1 };
+    let gaps: Vec<f64> = match &two_plane {
+        Some(m) => m.planes.iter().map(|p| p.params.contact.gap).collect(),
+        None => vec![physics.contact.gap],
+    };
+    let hardware = hardware(&raw, planes, &gaps, &integrator, 1.0 / rate)?;
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
     // The resolved scene states the two-plane rotor's defaults.
     if two_plane.is_some() {
@@ -640,6 +647,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         integrator,
         initial,
         sensor,
+        hardware,
         output_interval: 1.0 / output_rate,
         plots: raw.output.plots,
         warnings,
@@ -652,6 +660,144 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     }
     Ok(scene)
 }
+
+/// The hardware between the wire and the physics (`amb.amplifier` and its keys, per plane;
+/// `[sensor]`'s bandwidth, range and runout), validated against the planes' air gaps `gaps` (m)
+/// and the integrator's step (a fixed-step method must resolve the fastest of them).
+fn hardware(
+    raw: &RawScene,
+    planes: usize,
+    gaps: &[f64],
+    integrator: &IntegratorSettings,
+    period: f64,
+) -> Result<crate::hardware::Hardware, ConfigError> {
+    use crate::sensor::{Harmonic, LowPass};
+    // The largest fixed step: an explicit method is stable on a real pole −ω for ω h ≤ 2
+    // (Euler; RK4: 2.79), which also keeps the pole below the step's Nyquist rate 1/(2h).
+    let resolve = |key: &str, value: f64, unit: &str, omega: f64, what: &str| -> Result<(), ConfigError> {
+        if integrator.method == Method::SymplecticEuler {
+            return Err(range(
+                key,
+                value,
+                unit,
+                "needs an integrator that steps any state: integrator.method = \"symplectic_euler\" needs the \
+                 [positions; velocities] layout and the hardware's states are neither (use rk4, dp5 or dop853)",
+            ));
+        }
+        if integrator.method.is_adaptive() {
+            return Ok(());
+        }
+        let h = period / f64::from(integrator.substeps.min(integrator.contact_substeps));
+        if omega * h > 2.0 {
+            return Err(range(
+                key,
+                value,
+                unit,
+                &format!(
+                    "{what} (pole at {omega:.4e} rad/s) is too fast for the fixed step h = {h:e} s \
+                     (controller period / integrator.substeps): 2π f h must be ≤ 2, below the step's Nyquist \
+                     rate 1/(2h); raise integrator.substeps or use an adaptive method"
+                ),
+            ));
+        }
+        Ok(())
+    };
+    let mut amplifiers = [None; 2];
+    for (i, slot) in amplifiers.iter_mut().enumerate().take(planes) {
+        let (amb, own, name) = if planes == 2 {
+            let own = if i == 0 { &raw.amb.a } else { &raw.amb.b };
+            let letter = ["a", "b"][i];
+            (plane_table(&raw.amb, own.as_ref(), &format!("amb.{letter}"))?, own.clone(), Some(letter))
+        } else {
+            (raw.amb.clone(), None, None)
+        };
+        let key = |field: &str| match (name, &own) {
+            (Some(letter), Some(t)) if t.contains_key(field) => format!("amb.{letter}.{field}"),
+            _ => format!("amb.{field}"),
+        };
+        let v = positive(&key("bus_voltage_v"), amb.bus_voltage_v, "V")?;
+        let l = positive(&key("coil_inductance_mh"), amb.coil_inductance_mh, "mH")? * 1e-3;
+        let r = non_negative(&key("coil_resistance_ohm"), amb.coil_resistance_ohm, "Ω")?;
+        let f = positive(&key("current_loop_hz"), amb.current_loop_hz, "Hz")?;
+        let kb = non_negative(&key("back_emf_v_s_per_m"), amb.back_emf_v_s_per_m, "V·s/m")?;
+        if amb.amplifier {
+            let omega = std::f64::consts::TAU * f;
+            resolve(&key("current_loop_hz"), f, "Hz", omega.max(r / l), "the current loop")?;
+            *slot = Some(plant_physics::amplifier::Amplifier::design(v, l, r, f, kb));
+        }
+    }
+    let s = &raw.sensor;
+    let bandwidth = non_negative("sensor.bandwidth_hz", s.bandwidth_hz, "Hz")?;
+    let low_pass = if bandwidth > 0.0 {
+        let corner = std::f64::consts::TAU * bandwidth;
+        let lp = match s.filter_order {
+            1 => LowPass::First { corner },
+            2 => LowPass::Second { corner },
+            n => return Err(range("sensor.filter_order", n, "", "must be 1 (first order) or 2 (Butterworth)")),
+        };
+        resolve("sensor.bandwidth_hz", bandwidth, "Hz", corner, "the sensor's low-pass")?;
+        Some(lp)
+    } else {
+        if !(1..=2).contains(&s.filter_order) {
+            return Err(range("sensor.filter_order", s.filter_order, "", "must be 1 (first order) or 2 (Butterworth)"));
+        }
+        None
+    };
+    let range_um = non_negative("sensor.range_um", s.range_um, "µm")?;
+    if s.runout.len() > MAX_RUNOUT {
+        return Err(range("sensor.runout", s.runout.len(), "harmonics", &format!("must be at most {MAX_RUNOUT}")));
+    }
+    let mut runout = Vec::with_capacity(s.runout.len());
+    for (n, h) in s.runout.iter().enumerate() {
+        let key = |field: &str| format!("sensor.runout[{n}].{field}");
+        let axis = match h.axis {
+            RunoutAxis::X => 0,
+            RunoutAxis::Y => 1,
+            RunoutAxis::XB => 2,
+            RunoutAxis::YB => 3,
+        };
+        if axis >= 2 * planes {
+            return Err(range(
+                &key("axis"),
+                format!("{:?}", h.axis).to_lowercase(),
+                "",
+                "is plane B's: this scene is planar",
+            ));
+        }
+        if !(1..=MAX_RUNOUT_ORDER).contains(&h.order) {
+            return Err(range(
+                &key("order"),
+                h.order,
+                "",
+                &format!("must be between 1 (once per revolution) and {MAX_RUNOUT_ORDER}"),
+            ));
+        }
+        let amplitude = non_negative(&key("amplitude_um"), h.amplitude_um, "µm")? * 1e-6;
+        let gap = gaps[axis / 2];
+        if amplitude > gap {
+            return Err(range(
+                &key("amplitude_um"),
+                h.amplitude_um,
+                "µm",
+                &format!(
+                    "must be at most the air gap ({} µm): the sensor would read the rotor beyond the touchdown bearing",
+                    gap * 1e6
+                ),
+            ));
+        }
+        let phase = finite(&key("phase_deg"), h.phase_deg, "deg")?.to_radians();
+        runout.push(Harmonic { axis, order: h.order, amplitude, phase, kind: h.kind });
+    }
+    Ok(crate::hardware::Hardware {
+        amplifiers,
+        front_end: crate::sensor::FrontEnd { low_pass, runout, range: (range_um > 0.0).then_some(range_um * 1e-6) },
+    })
+}
+
+/// Most runout harmonics in a scene.
+const MAX_RUNOUT: usize = 64;
+/// Highest runout order.
+const MAX_RUNOUT_ORDER: u32 = 64;
 
 /// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
 /// silently ignored otherwise.

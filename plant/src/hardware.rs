@@ -1,0 +1,387 @@
+//! The parts of the loop between the wire and the physics (docs/MODEL.md §12): each axis's
+//! amplifier and coil ([`plant_physics::amplifier`]) and the sensor's front end (bandwidth,
+//! runout, range: [`crate::sensor::FrontEnd`]). All off by default: a scene without them runs
+//! the bare model, its arithmetic untouched.
+//!
+//! When one is on, [`Wired`] wraps the rotor model (planar or two-plane) and appends the
+//! hardware's states to the model's, `EXTRA` numbers after the model's `N`:
+//!
+//! ```text
+//! [ model (N) | coil currents i (4) | PI integrals q (4) | sensor filter z₀ (4) | ż₀ (4) | t_sat ]
+//! ```
+//!
+//! one per axis in the order x_A, y_A, x_B, y_B (a planar model uses the first two), and the
+//! time spent with any amplifier at its voltage limit. The controller's command (held over the
+//! macro step, or the continuous PD on the exact state) is the current reference; the model is
+//! evaluated with the coils' real currents. The sensor reads the filter's output (with the runout
+//! in its input), or the displacement plus the runout when the sensor is ideal, clipped to the
+//! range.
+
+use crate::machine::Machine;
+use crate::model::{Control, Params, Release};
+use crate::sensor::{runout, FrontEnd};
+use crate::trace::{col, colb, Record};
+use controller::PdGains;
+use plant_physics::amplifier::Amplifier;
+use plant_physics::integrate::System;
+use std::cell::RefCell;
+
+/// Hardware states appended to the model's.
+pub const EXTRA: usize = 17;
+
+/// Offsets of the hardware states after the model's.
+mod ex {
+    /// Coil currents (A), 4 axes.
+    pub const CURRENT: usize = 0;
+    /// PI integrals (V), 4 axes.
+    pub const INTEGRAL: usize = 4;
+    /// Sensor filter outputs (m), 4 axes.
+    pub const FILTER: usize = 8;
+    /// Sensor filter output rates (m/s), 4 axes (second order).
+    pub const FILTER_RATE: usize = 12;
+    /// Time with any amplifier at its voltage limit (s).
+    pub const SATURATED: usize = 16;
+}
+
+/// The scene's hardware between wire and physics.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Hardware {
+    /// Each bearing plane's amplifiers (both axes alike); `None`: an ideal current source.
+    pub amplifiers: [Option<Amplifier>; 2],
+    /// The sensor's front end (shared by all axes).
+    pub front_end: FrontEnd,
+}
+
+impl Hardware {
+    /// Whether any part is on (the model is then [`Wired`]).
+    pub fn is_on(&self) -> bool {
+        self.amplified() || self.front_end.is_on()
+    }
+
+    /// Whether a plane has an amplifier (the trace then has the coil columns).
+    pub fn amplified(&self) -> bool {
+        self.amplifiers.iter().any(Option::is_some)
+    }
+
+    /// Absolute tolerances of the hardware states: currents `1e-6` A, integrals `1e-4` V, the
+    /// filter like the positions `p` (m) and velocities `v` (m/s), the saturation time 1 s (it
+    /// never limits the step).
+    pub fn atol(p: f64, v: f64) -> [f64; EXTRA] {
+        let mut a = [0.0; EXTRA];
+        a[ex::CURRENT..ex::CURRENT + 4].fill(1e-6);
+        a[ex::INTEGRAL..ex::INTEGRAL + 4].fill(1e-4);
+        a[ex::FILTER..ex::FILTER + 4].fill(p);
+        a[ex::FILTER_RATE..ex::FILTER_RATE + 4].fill(v);
+        a[ex::SATURATED] = 1.0;
+        a
+    }
+}
+
+/// A rotor model `M` on `N` states with the hardware's states appended: a model on `NA = N +
+/// EXTRA` states (module doc).
+pub struct Wired<M, const N: usize, const NA: usize> {
+    /// The model as the loop configures it (parameters, parked races).
+    inner: M,
+    /// A copy evaluated with the coils' currents (the evaluation sets its control).
+    work: RefCell<M>,
+    /// Each plane's command: the current reference.
+    reference: [Control; 2],
+    hw: Hardware,
+}
+
+/// The model's part and the hardware's part of an extended state.
+#[inline]
+fn split<const N: usize, const NA: usize>(y: &[f64; NA]) -> ([f64; N], [f64; EXTRA]) {
+    let mut a = [0.0; N];
+    let mut b = [0.0; EXTRA];
+    a.copy_from_slice(&y[..N]);
+    b.copy_from_slice(&y[N..]);
+    (a, b)
+}
+
+impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
+    /// Wraps `model` whose controls are `controls` (one per plane, as the loop set them).
+    pub fn new(model: M, controls: [Control; 2], hw: Hardware) -> Self {
+        assert_eq!(NA, N + EXTRA, "a wired model has the model's states and EXTRA more");
+        Self { work: RefCell::new(model.clone()), inner: model, reference: controls, hw }
+    }
+
+    /// The extended initial state of the model's `y0`: each coil at rest at its reference, the
+    /// sensor filter at rest at its input.
+    pub fn initial(&self, y0: &[f64; N]) -> [f64; NA] {
+        let mut y = [0.0; NA];
+        y[..N].copy_from_slice(y0);
+        for i in 0..M::PLANES {
+            let reference = self.reference_current(y0, i);
+            let signal = self.raw_signal(y0, i);
+            for (j, (&current, &measured)) in reference.iter().zip(&signal).enumerate() {
+                let ax = 2 * i + j;
+                if let Some(a) = &self.hw.amplifiers[i] {
+                    y[N + ex::CURRENT + ax] = current;
+                    y[N + ex::INTEGRAL + ax] = a.steady_integral(current);
+                }
+                y[N + ex::FILTER + ax] = measured;
+            }
+        }
+        y
+    }
+
+    /// Plane `i`'s current reference in the model's state `y`.
+    #[inline]
+    fn reference_current(&self, y: &[f64; N], i: usize) -> [f64; 2] {
+        match self.reference[i] {
+            Control::Held(c) => c,
+            Control::Continuous(gains) => self.inner.pd_current(&gains, y, i),
+            // The sensitivity measurement's excitation is not added behind an amplifier or a
+            // sensor front end: `plant assess` refuses a scene with them (not assessed yet).
+            Control::ContinuousExcited(gains, _) => self.inner.pd_current(&gains, y, i),
+        }
+    }
+
+    /// Plane `i`'s sensed displacement with the runout, before the filter and the range (m).
+    #[inline]
+    fn raw_signal(&self, y: &[f64; N], i: usize) -> [f64; 2] {
+        let d = self.inner.sensed(y, i);
+        if self.hw.front_end.runout.is_empty() {
+            return d;
+        }
+        let theta = self.inner.spin(y).0;
+        [
+            d[0] + runout(&self.hw.front_end.runout, 2 * i, theta),
+            d[1] + runout(&self.hw.front_end.runout, 2 * i + 1, theta),
+        ]
+    }
+
+    /// Sets the working copy's controls to the coils' currents of state `(y, x)` (the
+    /// references where a plane has no amplifier), writing the hardware's rates into `dx` and
+    /// each axis's coil voltage into `volts`.
+    #[inline]
+    fn apply(&self, m: &mut M, y: &[f64; N], x: &[f64; EXTRA], dx: &mut [f64; EXTRA], volts: &mut [f64; 4]) {
+        let mut saturated = false;
+        for i in 0..M::PLANES {
+            let reference = self.reference_current(y, i);
+            let applied = match &self.hw.amplifiers[i] {
+                None => reference,
+                Some(a) => {
+                    let velocity = m.bearing_velocity(y, i);
+                    for j in 0..2 {
+                        let ax = 2 * i + j;
+                        let r = a.rates(reference[j], x[ex::CURRENT + ax], x[ex::INTEGRAL + ax], velocity[j]);
+                        dx[ex::CURRENT + ax] = r.current_rate;
+                        dx[ex::INTEGRAL + ax] = r.integral_rate;
+                        volts[ax] = r.voltage;
+                        saturated |= r.saturated;
+                    }
+                    [x[ex::CURRENT + 2 * i], x[ex::CURRENT + 2 * i + 1]]
+                }
+            };
+            m.set_control(i, Control::Held(applied));
+            if let Some(lp) = self.hw.front_end.low_pass {
+                let u = self.raw_signal(y, i);
+                for (j, &u) in u.iter().enumerate() {
+                    let ax = 2 * i + j;
+                    let r = lp.rates(u, [x[ex::FILTER + ax], x[ex::FILTER_RATE + ax]]);
+                    dx[ex::FILTER + ax] = r[0];
+                    dx[ex::FILTER_RATE + ax] = r[1];
+                }
+            }
+        }
+        dx[ex::SATURATED] = if saturated { 1.0 } else { 0.0 };
+    }
+
+    /// The working copy with its controls set for the extended state `y`.
+    fn synced(&self, y: &[f64; NA]) -> (std::cell::RefMut<'_, M>, [f64; N], [f64; 4]) {
+        let (iy, x) = split::<N, NA>(y);
+        let mut m = self.work.borrow_mut();
+        let (mut dx, mut volts) = ([0.0; EXTRA], [0.0; 4]);
+        self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
+        (m, iy, volts)
+    }
+}
+
+impl<M: Machine<N> + Clone, const N: usize, const NA: usize> System<NA> for Wired<M, N, NA> {
+    #[inline]
+    fn rhs(&self, t: f64, y: &[f64; NA], dy: &mut [f64; NA]) {
+        let (iy, x) = split::<N, NA>(y);
+        let mut m = self.work.borrow_mut();
+        let (mut dx, mut volts) = ([0.0; EXTRA], [0.0; 4]);
+        self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
+        let mut idy = [0.0; N];
+        m.rhs(t, &iy, &mut idy);
+        dy[..N].copy_from_slice(&idy);
+        dy[N..].copy_from_slice(&dx);
+    }
+}
+
+impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wired<M, N, NA> {
+    const PLANES: usize = M::PLANES;
+
+    fn bearing(&self, i: usize) -> &Params {
+        self.inner.bearing(i)
+    }
+
+    fn set_control(&mut self, i: usize, control: Control) {
+        self.reference[i] = control;
+    }
+
+    fn sensed(&self, y: &[f64; NA], i: usize) -> [f64; 2] {
+        let fe = &self.hw.front_end;
+        let d = if fe.low_pass.is_some() {
+            [y[N + ex::FILTER + 2 * i], y[N + ex::FILTER + 2 * i + 1]]
+        } else {
+            self.raw_signal(&split::<N, NA>(y).0, i)
+        };
+        [fe.clip(d[0]), fe.clip(d[1])]
+    }
+
+    fn parked(&self, i: usize) -> bool {
+        self.inner.parked(i)
+    }
+
+    fn set_parked(&mut self, i: usize, parked: bool) {
+        self.inner.set_parked(i, parked);
+        self.work.get_mut().set_parked(i, parked);
+    }
+
+    fn race_clear(&self, t0: f64, h: f64, y: &[f64; NA], i: usize) -> bool {
+        let (m, iy, _) = self.synced(y);
+        m.race_clear(t0, h, &iy, i)
+    }
+
+    fn park_race(&self, y: &mut [f64; NA], i: usize) {
+        let (mut iy, _) = split::<N, NA>(y);
+        self.inner.park_race(&mut iy, i);
+        y[..N].copy_from_slice(&iy);
+    }
+
+    fn release_race(&self, t: f64, y: &mut [f64; NA], i: usize, release: Release) {
+        let (mut iy, _) = split::<N, NA>(y);
+        self.inner.release_race(t, &mut iy, i, release);
+        y[..N].copy_from_slice(&iy);
+    }
+
+    fn radii(&self, y: &[f64; NA], i: usize) -> (f64, f64) {
+        self.inner.radii(&split::<N, NA>(y).0, i)
+    }
+
+    fn spin(&self, y: &[f64; NA]) -> (f64, f64) {
+        self.inner.spin(&split::<N, NA>(y).0)
+    }
+
+    fn touching(&self, y: &[f64; NA], i: usize) -> bool {
+        self.inner.touching(&split::<N, NA>(y).0, i)
+    }
+
+    fn pd_current(&self, gains: &PdGains, y: &[f64; NA], i: usize) -> [f64; 2] {
+        self.inner.pd_current(gains, &split::<N, NA>(y).0, i)
+    }
+
+    fn bearing_velocity(&self, y: &[f64; NA], i: usize) -> [f64; 2] {
+        self.inner.bearing_velocity(&split::<N, NA>(y).0, i)
+    }
+
+    /// The model's record with the commanded currents in the current columns and, with an
+    /// amplifier, the coils' currents and voltages.
+    fn record(&self, t: f64, y: &[f64; NA]) -> Record {
+        let (m, iy, volts) = self.synced(y);
+        let mut r = m.record(t, &iy);
+        drop(m);
+        let a = self.reference_current(&iy, 0);
+        r.a[col::IX_A] = a[0];
+        r.a[col::IY_A] = a[1];
+        if let (2, Some(b)) = (M::PLANES, r.b.as_mut()) {
+            let c = self.reference_current(&iy, 1);
+            b[colb::CURRENT] = c[0];
+            b[colb::CURRENT + 1] = c[1];
+        }
+        if self.hw.amplified() {
+            let mut hw = [f64::NAN; 8];
+            for i in 0..M::PLANES {
+                for j in 0..2 {
+                    let ax = 2 * i + j;
+                    let (current, voltage) = match self.hw.amplifiers[i] {
+                        Some(_) => (y[N + ex::CURRENT + ax], volts[ax]),
+                        None => (self.reference_current(&iy, i)[j], f64::NAN),
+                    };
+                    hw[4 * i + j] = current;
+                    hw[4 * i + 2 + j] = voltage;
+                }
+            }
+            r.hw = Some(hw);
+        }
+        r
+    }
+
+    fn voltage_saturation(&self, y: &[f64; NA]) -> Option<f64> {
+        self.hw.amplified().then(|| y[N + ex::SATURATED])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::load_scene;
+    use crate::model::{ix, Model};
+    use crate::sensor::Sensor;
+
+    fn realistic(sets: &[&str]) -> crate::config::Scene {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/realistic-10g.toml");
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load_scene(&file, &sets).expect("the realistic scene")
+    }
+
+    fn wired(scene: &crate::config::Scene) -> Wired<Model, { crate::model::N }, { crate::model::N + EXTRA }> {
+        let model = Model {
+            params: scene.params.clone(),
+            base: scene.base.clone(),
+            control: Control::Held([0.0; 2]),
+            race_parked: false,
+        };
+        Wired::new(model, [Control::Held([0.0; 2]); 2], scene.hardware.clone())
+    }
+
+    /// With the rotor held still at the centre, what the sensor reads is the runout's harmonics
+    /// exactly (the ideal low-pass: the sum itself; through the gain, the gain times it).
+    #[test]
+    fn runout_with_the_rotor_held_at_the_centre_is_the_harmonics() {
+        let scene = realistic(&["sensor.bandwidth_hz=0"]);
+        let w = wired(&scene);
+        let harmonics = &scene.hardware.front_end.runout;
+        assert_eq!(harmonics.len(), 4);
+        let gain = scene.params.loop_constants.sensor_gain_v_per_m;
+        let mut sensor = Sensor::new(scene.sensor);
+        for k in 0..100 {
+            let theta = 0.37 * k as f64;
+            let mut y = [0.0; crate::model::N + EXTRA];
+            y[ix::TR] = theta;
+            let sensed = Machine::sensed(&w, &y, 0);
+            let expect: [f64; 2] = std::array::from_fn(|axis| {
+                harmonics
+                    .iter()
+                    .filter(|h| h.axis == axis)
+                    .map(|h| h.amplitude * (f64::from(h.order) * theta + h.phase).cos())
+                    .sum::<f64>()
+            });
+            assert_eq!(sensed, expect, "θ = {theta}");
+            // The scene's 1× and 2× harmonics, written out.
+            let x = 1.5e-6 * theta.cos() + 0.75e-6 * (2.0 * theta + 30f64.to_radians()).cos();
+            assert!((sensed[0] - x).abs() < 1e-18, "θ = {theta}: {} against {x}", sensed[0]);
+            assert_eq!(sensor.read_with_gain(sensed, gain), [gain * expect[0], gain * expect[1]]);
+        }
+    }
+
+    /// The range clips what the sensor reads; the filter's output is what is read when the
+    /// sensor has a bandwidth.
+    #[test]
+    fn the_range_clips_and_the_filter_is_read() {
+        let scene = realistic(&["sensor.runout=[]"]);
+        let w = wired(&scene);
+        let mut y = [0.0; crate::model::N + EXTRA];
+        y[ix::XR] = 1e-4;
+        y[crate::model::N + ex::FILTER] = 3e-4;
+        y[crate::model::N + ex::FILTER + 1] = -1e-5;
+        assert_eq!(Machine::sensed(&w, &y, 0), [2.5e-4, -1e-5]);
+        let ideal = realistic(&["sensor.runout=[]", "sensor.bandwidth_hz=0"]);
+        assert_eq!(Machine::sensed(&wired(&ideal), &y, 0), [1e-4, 0.0]);
+    }
+}
