@@ -175,8 +175,13 @@ pub fn compare(
             };
             let rw = row(rate, mode, &r, &scene, xi);
             log(&format!(
-                "{name} at {rate} Hz: {}, deviation rms {:.2e} m max {:.2e} m, damping ratio {:.4}, recovered after {:.4} s, {}",
-                rw.status, rw.rms_dev_m, rw.max_dev_m, rw.damping_ratio, rw.recover_s, rw.post_shock_mode
+                "{name} at {rate} Hz: {}, deviation rms {:.2e} m max {:.2e} m, damping ratio {:.4}, {}, {}",
+                rw.status,
+                rw.rms_dev_m,
+                rw.max_dev_m,
+                rw.damping_ratio,
+                recovered(rw.recover_s),
+                rw.post_shock_mode
             ));
             rows.push(rw);
             if mode == ControlMode::Sampled {
@@ -297,6 +302,16 @@ pub fn parse_rates(text: &str) -> Result<Vec<f64>, String> {
             }
         })
         .collect()
+}
+
+/// The recovery for a progress line: "recovered after 0.1234 s", or "not recovered" for a run
+/// still in contact at its end (NaN in the tables).
+fn recovered(seconds: f64) -> String {
+    if seconds.is_finite() {
+        format!("recovered after {seconds:.4} s")
+    } else {
+        "not recovered".to_string()
+    }
 }
 
 #[cfg(test)]
@@ -484,10 +499,10 @@ pub fn compare_laws(
             whirl_hz: s.analysis.whirl_hz,
         };
         log(&format!(
-            "{law} ({}): {}, recovered after {:.4} s, {}, peak force {:.0} N, {:.4} s in contact, whirl {:.1} Hz",
+            "{law} ({}): {}, {}, {}, peak force {:.0} N, {:.4} s in contact, whirl {:.1} Hz",
             snake_name(&row.mode),
             row.status,
-            row.recovery_s,
+            recovered(row.recovery_s),
             row.post_shock_mode,
             row.max_contact_force_n,
             row.contact_time_s,
@@ -680,11 +695,7 @@ pub fn compare_realtime(
             r.tick_p999_us,
             r.tick_max_us,
             r.post_shock_mode,
-            if r.recovery_s.is_finite() {
-                format!("recovered after {:.4} s", r.recovery_s)
-            } else {
-                "still touching at the end".to_string()
-            },
+            recovered(r.recovery_s),
             r.max_contact_force_n,
             if r.same_as_lockstep { "the lockstep trace bit for bit".to_string() } else { format!("max {:.2e} m from lockstep", r.max_dev_m) },
             r.load_1min

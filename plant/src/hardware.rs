@@ -17,12 +17,12 @@
 //! in its input), or the displacement plus the runout when the sensor is ideal, clipped to the
 //! range.
 
+pub use crate::config::hardware::Hardware;
 use crate::machine::Machine;
 use crate::model::{Control, Params, Release};
-use crate::sensor::{runout, FrontEnd};
+use crate::sensor::runout;
 use crate::trace::{col, colb, Record};
 use controller::PdGains;
-use plant_physics::amplifier::Amplifier;
 use plant_physics::integrate::System;
 use std::cell::RefCell;
 
@@ -43,38 +43,17 @@ mod ex {
     pub const SATURATED: usize = 16;
 }
 
-/// The scene's hardware between wire and physics.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct Hardware {
-    /// Each bearing plane's amplifiers (both axes alike); `None`: an ideal current source.
-    pub amplifiers: [Option<Amplifier>; 2],
-    /// The sensor's front end (shared by all axes).
-    pub front_end: FrontEnd,
-}
-
-impl Hardware {
-    /// Whether any part is on (the model is then [`Wired`]).
-    pub fn is_on(&self) -> bool {
-        self.amplified() || self.front_end.is_on()
-    }
-
-    /// Whether a plane has an amplifier (the trace then has the coil columns).
-    pub fn amplified(&self) -> bool {
-        self.amplifiers.iter().any(Option::is_some)
-    }
-
-    /// Absolute tolerances of the hardware states: currents `1e-6` A, integrals `1e-4` V, the
-    /// filter like the positions `p` (m) and velocities `v` (m/s), the saturation time 1 s (it
-    /// never limits the step).
-    pub fn atol(p: f64, v: f64) -> [f64; EXTRA] {
-        let mut a = [0.0; EXTRA];
-        a[ex::CURRENT..ex::CURRENT + 4].fill(1e-6);
-        a[ex::INTEGRAL..ex::INTEGRAL + 4].fill(1e-4);
-        a[ex::FILTER..ex::FILTER + 4].fill(p);
-        a[ex::FILTER_RATE..ex::FILTER_RATE + 4].fill(v);
-        a[ex::SATURATED] = 1.0;
-        a
-    }
+/// Absolute tolerances of the hardware states: currents `1e-6` A, integrals `1e-4` V, the
+/// filter like the positions `p` (m) and velocities `v` (m/s), the saturation time 1 s (it
+/// never limits the step).
+pub fn atol(p: f64, v: f64) -> [f64; EXTRA] {
+    let mut a = [0.0; EXTRA];
+    a[ex::CURRENT..ex::CURRENT + 4].fill(1e-6);
+    a[ex::INTEGRAL..ex::INTEGRAL + 4].fill(1e-4);
+    a[ex::FILTER..ex::FILTER + 4].fill(p);
+    a[ex::FILTER_RATE..ex::FILTER_RATE + 4].fill(v);
+    a[ex::SATURATED] = 1.0;
+    a
 }
 
 /// A rotor model `M` on `N` states with the hardware's states appended: a model on `NA = N +

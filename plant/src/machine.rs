@@ -5,7 +5,6 @@
 
 use crate::model::{Control, Model, Params, Release};
 use crate::park::{self, GapMotion};
-use crate::run::Sink;
 use crate::trace::{self, Record};
 use controller::{saturate, PdGains};
 use plant_physics::integrate::System;
@@ -54,9 +53,10 @@ pub trait Machine<const N: usize>: System<N> {
     /// The output sample of state `y` at time `t`.
     fn record(&self, t: f64, y: &[f64; N]) -> Record;
 
-    /// Hands the output sample of state `y` at time `t` to `sink`.
-    fn feed(&self, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
-        sink.sample(&self.record(t, y));
+    /// The planar model itself (for a sink that reads its state, [`crate::run::Sink::planar_state`]);
+    /// `None` for any other model.
+    fn planar(&self) -> Option<&Model> {
+        None
     }
 
     /// Plane `i`'s continuous PD current in state `y` (A): what the model's
@@ -76,9 +76,8 @@ pub trait Machine<const N: usize>: System<N> {
 impl Machine<{ crate::model::N }> for Model {
     const PLANES: usize = 1;
 
-    fn feed(&self, sink: &mut dyn Sink, t: f64, y: &crate::model::State) {
-        sink.sample(&self.record(t, y));
-        sink.planar_state(self, t, y);
+    fn planar(&self) -> Option<&Model> {
+        Some(self)
     }
 
     fn bearing(&self, _i: usize) -> &Params {

@@ -12,7 +12,7 @@
 use crate::config::{ControlMode, Scene};
 use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
-use crate::hardware::{Hardware, Wired, EXTRA};
+use crate::hardware::{Wired, EXTRA};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
@@ -344,12 +344,22 @@ fn run_from(
     }
 }
 
-/// The model's tolerances `atol` with the hardware's after them ([`Hardware::atol`]).
+/// The model's tolerances `atol` with the hardware's after them ([`crate::hardware::atol`]).
 fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
     let mut a = [0.0; NA];
     a[..N].copy_from_slice(&atol);
-    a[N..].copy_from_slice(&Hardware::atol(p, v));
+    a[N..].copy_from_slice(&crate::hardware::atol(p, v));
     a
+}
+
+/// Hands the output sample of state `y` at time `t` to `sink` (and, on the planar model, its
+/// state: [`Sink::planar_state`]).
+#[inline]
+fn feed<const N: usize, M: Machine<N>>(model: &M, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
+    sink.sample(&model.record(t, y));
+    if let (Some(planar), Ok(state)) = (model.planar(), <&crate::model::State>::try_from(&y[..])) {
+        sink.planar_state(planar, t, state);
+    }
 }
 
 /// The macro-step loop (module doc) for a model of `N` state components starting at `y`.
@@ -375,7 +385,7 @@ fn drive<const N: usize, M: Machine<N>>(
     let period = scene.controller.period;
     let ticks = (scene.duration / period).ceil() as u64;
     let out_dt = scene.output_interval;
-    model.feed(sink, 0.0, &y);
+    feed(&model, sink, 0.0, &y);
     let mut next_out: u64 = 1;
     // Output samples per tick; a period longer than the run holds only the run's samples.
     let mut out_times: Vec<f64> = Vec::with_capacity((period.min(scene.duration) / out_dt).ceil() as usize + 2);
@@ -551,10 +561,10 @@ fn drive<const N: usize, M: Machine<N>>(
                 // The output rows' time is the sink's, not the integration's.
                 Some(_) => {
                     let row = Instant::now();
-                    model.feed(sink, ts, ys);
+                    feed(&model, sink, ts, ys);
                     rows += row.elapsed();
                 }
-                None => model.feed(sink, ts, ys),
+                None => feed(&model, sink, ts, ys),
             },
         );
         cost.max_rhs_evals = cost.max_rhs_evals.max(integrator.stats().rhs_evals - evals);

@@ -11,6 +11,7 @@
 //! (the resolved scene for `scene.toml`, a re-load with other overrides) is a
 //! method of [`Scene`].
 
+pub mod hardware;
 pub mod overrides;
 pub mod raw;
 pub mod validate;
@@ -211,7 +212,7 @@ pub struct Scene {
     /// The sensor as the digital controller reads it.
     pub sensor: crate::sensor::SensorSettings,
     /// The amplifiers and the sensor's front end (all off by default).
-    pub hardware: crate::hardware::Hardware,
+    pub hardware: hardware::Hardware,
     /// Trace interval (s).
     pub output_interval: f64,
     /// Write plots.

@@ -670,7 +670,7 @@ fn hardware(
     gaps: &[f64],
     integrator: &IntegratorSettings,
     period: f64,
-) -> Result<crate::hardware::Hardware, ConfigError> {
+) -> Result<super::hardware::Hardware, ConfigError> {
     use crate::sensor::{Harmonic, LowPass};
     // The largest fixed step: an explicit method is stable on a real pole −ω for ω h ≤ 2
     // (Euler; RK4: 2.79), which also keeps the pole below the step's Nyquist rate 1/(2h).
@@ -788,7 +788,7 @@ fn hardware(
         let phase = finite(&key("phase_deg"), h.phase_deg, "deg")?.to_radians();
         runout.push(Harmonic { axis, order: h.order, amplitude, phase, kind: h.kind });
     }
-    Ok(crate::hardware::Hardware {
+    Ok(super::hardware::Hardware {
         amplifiers,
         front_end: crate::sensor::FrontEnd { low_pass, runout, range: (range_um > 0.0).then_some(range_um * 1e-6) },
     })
