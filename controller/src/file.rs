@@ -38,6 +38,7 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "lockstep_timeout_ms",
     "realtime_priority",
     "max_miss_fraction",
+    "max_overrun_fraction",
     "max_invalid_burst",
     "max_invalid_fraction",
 ];

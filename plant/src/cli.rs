@@ -84,6 +84,13 @@ pub enum Command {
         /// once per law, e.g. `pd_delay,relev`; writes laws.csv and laws_*.png.
         #[arg(long, value_delimiter = ',', conflicts_with = "maps")]
         laws: Vec<String>,
+        /// Realtime against lockstep: run the scene in realtime `--runs` times and once in
+        /// lockstep on the same integrator setting (the realtime one); writes realtime.csv.
+        #[arg(long, conflicts_with_all = ["maps", "laws", "no_cosim"])]
+        realtime: bool,
+        /// Realtime runs of `--realtime`.
+        #[arg(long, default_value_t = 1, requires = "realtime")]
+        runs: usize,
     },
     /// The whirl modes of a two-plane scene's rotor on its continuous PD against spin speed
     /// (Campbell diagram, linearised) and the same frequencies from simulated free decays;
@@ -213,6 +220,30 @@ pub enum BenchCommand {
         /// Timed runs per variant (1 to 1000); the minimum counts.
         #[arg(long, default_value_t = 5, value_parser = repeats())]
         repeats: usize,
+    },
+    /// The plant's execution time per tick, alone (the law in process, no IPC), on the realtime
+    /// fixed-step setting and on the scene's own integrator: integration p50/p99/p99.9/max over
+    /// all ticks and over those in contact, the most model evaluations in one tick; writes
+    /// tick.csv. Build with `--release` for figures.
+    Tick {
+        /// The scene.
+        #[arg(long, default_value = "config/cosim-10g.toml")]
+        scene: PathBuf,
+        /// Override a scene key, e.g. `--set controller.rate_hz=10000`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Runs per setting.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Output folder (default: runs/bench-tick).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Pin the bench's thread to this core.
+        #[arg(long)]
+        pin_core: Option<usize>,
+        /// `SCHED_FIFO` at this priority (1 to 99) with memory locked; 0: the normal scheduler.
+        #[arg(long, default_value_t = 0)]
+        realtime_priority: u32,
     },
     /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
     /// of full-length impact and rub runs for each method at a representative setting, against a

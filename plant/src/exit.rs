@@ -38,13 +38,15 @@ pub enum Code {
     /// `plant assess`: a controller could not be graded (its rotor not levitated before the
     /// shock, or the excitation drove it into the touchdown bearing); the report was written.
     NotGradable = 9,
+    /// Realtime: the plant-overrun budget was exceeded (status `overrun_budget`).
+    OverrunBudget = 10,
     /// Stopped by SIGINT/SIGTERM; results up to that point were written.
     Interrupted = 130,
 }
 
 impl Code {
     /// Every code, in the order of the table in `docs/guide/running.md`.
-    pub const ALL: [Code; 10] = [
+    pub const ALL: [Code; 11] = [
         Code::Io,
         Code::BadInput,
         Code::Diverged,
@@ -54,6 +56,7 @@ impl Code {
         Code::Incomplete,
         Code::InvalidCommands,
         Code::NotGradable,
+        Code::OverrunBudget,
         Code::Interrupted,
     ];
 }
@@ -70,6 +73,7 @@ const _: fn(Code) = |c| match c {
     | Code::Incomplete
     | Code::InvalidCommands
     | Code::NotGradable
+    | Code::OverrunBudget
     | Code::Interrupted => {}
 };
 
@@ -150,6 +154,8 @@ pub enum StopKind {
     MissBudget,
     /// Past the budget of non-finite commands.
     InvalidCommands,
+    /// Realtime: past the plant-overrun budget.
+    OverrunBudget,
 }
 
 impl HasExitCode for Ending {
@@ -160,6 +166,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::PeerLost, .. } => Code::PeerLost,
             Ending::Stopped { kind: StopKind::MissBudget, .. } => Code::MissBudget,
             Ending::Stopped { kind: StopKind::InvalidCommands, .. } => Code::InvalidCommands,
+            Ending::Stopped { kind: StopKind::OverrunBudget, .. } => Code::OverrunBudget,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
         }
@@ -290,6 +297,7 @@ mod tests {
             (stopped(StopKind::MissBudget), 6),
             (stopped(StopKind::InvalidCommands), 8),
             (AnalyzeError::Interrupted("nothing was written").into(), 130),
+            (stopped(StopKind::OverrunBudget), 10),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),
             (

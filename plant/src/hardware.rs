@@ -247,6 +247,10 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         self.inner.spin(&split::<N, NA>(y).0)
     }
 
+    fn touching(&self, y: &[f64; NA], i: usize) -> bool {
+        self.inner.touching(&split::<N, NA>(y).0, i)
+    }
+
     fn pd_current(&self, gains: &PdGains, y: &[f64; NA], i: usize) -> [f64; 2] {
         self.inner.pd_current(gains, &split::<N, NA>(y).0, i)
     }

@@ -19,6 +19,11 @@ pub trait Hooks {
     /// Co-simulation: a controller process connected (at the start, or after a
     /// reconnection), with its process id from the handshake.
     fn controller_connected(&mut self, _pid: u32) {}
+    /// Measure the plant's execution time per tick in every mode (co-simulation runs always
+    /// do): `plant bench tick`.
+    fn time_ticks(&self) -> bool {
+        false
+    }
     /// A sine to add to the sensor signal the controller reads over the macro step from tick
     /// `k` at time `t` (s) (the summing point of a sensitivity measurement, ISO 14839-3);
     /// `sensor_v` holds the values read at that tick, before the sine, one per axis. The loop

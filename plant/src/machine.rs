@@ -47,6 +47,9 @@ pub trait Machine<const N: usize>: System<N> {
     /// The rotor's spin angle (rad, unwrapped) and speed (rad/s) in state `y`: the keyphasor.
     fn spin(&self, y: &[f64; N]) -> (f64, f64);
 
+    /// Whether the rotor touches plane `i`'s race (their distance exceeds the gap).
+    fn touching(&self, y: &[f64; N], i: usize) -> bool;
+
     /// The output sample of state `y` at time `t`.
     fn record(&self, t: f64, y: &[f64; N]) -> Record;
 
@@ -107,6 +110,13 @@ impl Machine<{ crate::model::N }> for Model {
 
     fn release_race(&self, t: f64, y: &mut crate::model::State, _i: usize, release: Release) {
         park::release(self, t, y, release);
+    }
+
+    fn touching(&self, y: &crate::model::State, _i: usize) -> bool {
+        use crate::model::ix::*;
+        let (dx, dy) = (y[XR] - y[XB], y[YR] - y[YB]);
+        let gap = self.params.contact.gap;
+        dx * dx + dy * dy > gap * gap
     }
 
     fn radii(&self, y: &crate::model::State, _i: usize) -> (f64, f64) {
@@ -171,6 +181,13 @@ impl Machine<{ two_plane::N }> for two_plane::Model {
             accel: (dy[ix::VX] + dy[ix::VSX] * z).hypot(dy[ix::VY] + dy[ix::VSY] * z),
         };
         park::stays_open(&plane.params, &self.base, t0, h, motion)
+    }
+
+    fn touching(&self, y: &two_plane::State, i: usize) -> bool {
+        let plane = &self.params.planes[i];
+        let (pos, _) = two_plane::at_station(y, plane.station);
+        let race = two_plane::ix::RACE[i];
+        (pos.x - y[race]).hypot(pos.y - y[race + 1]) > plane.params.contact.gap
     }
 
     fn park_race(&self, y: &mut two_plane::State, i: usize) {

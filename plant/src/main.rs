@@ -74,7 +74,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             run_scene(&scene, out, &set, quiet, controller.launch(run_id))
         }
         Command::Soak { programme, out, set, quiet } => soak_cmd(&programme, out, &set, quiet),
-        Command::Compare { scene, rates, out, set, no_cosim, maps, laws } => {
+        Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
             let req = plant::compare::Request {
                 scene: &scene,
                 set: &set,
@@ -83,6 +83,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 cosim: !no_cosim,
                 maps,
                 laws: &laws,
+                realtime: realtime.then_some(runs),
             };
             let written = plant::compare::command(&req, &mut |l| eprintln!("plant compare: {l}"), &mut |w| warn(w))?;
             eprintln!("plant compare: wrote {}", written.display());
@@ -131,6 +132,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             BenchCommand::Models { out, config, repeats } => {
                 bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
+            }
+            BenchCommand::Tick { scene, set, repeats, out, pin_core, realtime_priority } => {
+                let req = plant::bench::tick::Request {
+                    scene: &scene,
+                    set: &set,
+                    repeats,
+                    out: out.as_deref(),
+                    pin_core,
+                    realtime_priority,
+                };
+                bench_wrote([plant::bench::tick::command(&req, &mut bench_log)?])
             }
             BenchCommand::Engineering { out, config, repeats } => {
                 bench_wrote([plant::bench::engineering::command(out.as_deref(), &config, repeats, &mut bench_log)?])
@@ -242,6 +254,20 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
         eprintln!("plant: {chart} not drawn: nothing to draw");
     }
     eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
+    if let Some(c) = written.summary.cosim.as_ref().filter(|c| c.schedule_held == Some(false)) {
+        warn(&format!(
+            "the realtime schedule did not hold: {} deadline misses ({:.3} % of the ticks with a reply due, \
+             controller.max_miss_fraction = {}) and {} plant overruns ({:.3} %, controller.max_overrun_fraction = {}); \
+             a late command is another control loop: `plant compare {} --realtime` shows whether it changed the outcome",
+            c.deadline_misses,
+            100.0 * c.deadline_miss_fraction,
+            scene.controller.cosim.max_miss_fraction,
+            c.plant_overruns,
+            100.0 * c.plant_overrun_fraction,
+            scene.controller.cosim.max_overrun_fraction,
+            path.display()
+        ));
+    }
     stopped(&written.run.outcome, written.summary.simulated_s)
 }
 
@@ -254,6 +280,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
         Outcome::PeerLost(why) => (StopKind::PeerLost, why.clone()),
         Outcome::MissBudget(why) => (StopKind::MissBudget, why.clone()),
         Outcome::InvalidCommands(why) => (StopKind::InvalidCommands, why.clone()),
+        Outcome::OverrunBudget(why) => (StopKind::OverrunBudget, why.clone()),
     };
     Err(Ending::Stopped { kind, why, simulated_s }.into())
 }

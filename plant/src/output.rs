@@ -49,6 +49,7 @@ pub const RUN_FILES: &[&str] = &[
     "spectrogram_b.png",
     "poincare_b.png",
     "controller.log",
+    "tet.png",
 ];
 
 /// Why `plant run` stopped before it wrote its results.
@@ -184,6 +185,12 @@ impl RunFolder {
         let mut skipped = Vec::new();
         if let Some((planes, tilt)) = &charts {
             skipped.extend(write_charts(dir, scene, planes, tilt.as_ref()).context("writing charts")?);
+            if let Some(tet) = &run.ticks.tet {
+                match write_tet_chart(&dir.join("tet.png"), scene, tet) {
+                    Err(plot::PlotError::NoData { .. }) => skipped.push("tet.png"),
+                    other => other.context("writing tet.png")?,
+                }
+            }
             skipped.extend(write_analysis_charts(dir, scene, planes).context("writing analysis charts")?);
         }
         if interrupt(&mut run) {
@@ -410,6 +417,36 @@ pub fn write_charts(
     Ok(skipped)
 }
 
+/// `tet.png`: the plant's execution time per tick over the run (per bin of ticks, the largest
+/// of the whole tick, of the command and of the integration, and the mean tick), against the
+/// controller period.
+pub fn write_tet_chart(path: &Path, scene: &Scene, tet: &crate::cosim::stats::Tet) -> Result<(), plot::PlotError> {
+    let period = scene.controller.period;
+    let bins = tet.bins();
+    let us = |ns: u64| ns as f64 * 1e-3;
+    let t: Vec<f64> = bins.iter().map(|b| b.first_tick as f64 * period).collect();
+    let tick: Vec<f64> = bins.iter().map(|b| us(b.tick_max_ns)).collect();
+    let mean: Vec<f64> = bins.iter().map(|b| us(b.tick_sum_ns) / b.ticks.max(1) as f64).collect();
+    let command: Vec<f64> = bins.iter().map(|b| us(b.command_max_ns)).collect();
+    let integration: Vec<f64> = bins.iter().map(|b| us(b.integration_max_ns)).collect();
+    let line = vec![period * 1e6; t.len()];
+    let per_bin = bins.first().map_or(1, |b| b.ticks);
+    plot::lines(
+        path,
+        &format!("{} — plant execution time per tick (per {per_bin} ticks)", scene.name),
+        "time (s)",
+        "execution time (µs)",
+        &[
+            Series { label: "tick, largest", x: &t, y: &tick },
+            Series { label: "tick, mean", x: &t, y: &mean },
+            Series { label: "command, largest", x: &t, y: &command },
+            Series { label: "integration, largest", x: &t, y: &integration },
+            Series { label: "controller period", x: &t, y: &line },
+        ],
+        Scale::Log10,
+    )
+}
+
 /// Why `plant analyze` failed: bad input (the scene, the trace, an existing
 /// `summary.json` that is not JSON: exit 2) or an output that could not be
 /// written (exit 1). A failing analysis writes nothing.
@@ -558,6 +595,7 @@ mod tests {
             voltage_saturation_s: None,
             planes: 1,
             invalid_commands: 0,
+            ticks: Default::default(),
         };
         let written =
             folder.finish(&dir, &scene, run, &|| false).expect("a run with nothing to draw is not an output error");

@@ -10,6 +10,7 @@
 //! rate (dense output inside macro steps).
 
 use crate::config::{ControlMode, Scene};
+use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
 use crate::hardware::{Wired, EXTRA};
 pub use crate::hooks::{Hooks, Quiet};
@@ -22,6 +23,7 @@ use crate::trace::{Record, Trace};
 use controller::{build_rotor_law, saturate, saturate_axes, wrap_angle, PdGains, RotorLaw, RotorSample, ROTOR_AXES};
 use plant_physics::two_plane;
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 /// Why a run stopped before its end.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -84,6 +86,8 @@ pub enum Outcome {
     PeerLost(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
+    OverrunBudget(String),
     /// The law's commands were non-finite past `controller.max_invalid_burst` or
     /// `controller.max_invalid_fraction` ([`crate::invalid`]).
     InvalidCommands(String),
@@ -210,6 +214,17 @@ pub struct SinkRun {
     pub invalid_commands: u64,
     /// Time with an amplifier at its voltage limit (s); `None` without amplifiers.
     pub voltage_saturation_s: Option<f64>,
+    /// The cost of the ticks: the most model evaluations in one, and the execution times.
+    pub ticks: TickCost,
+}
+
+/// What the ticks of a run cost.
+#[derive(Clone, Debug, Default)]
+pub struct TickCost {
+    /// The most evaluations of the model the integrator made in one tick.
+    pub max_rhs_evals: u64,
+    /// The plant's execution time per tick (co-simulation runs, or [`Hooks::time_ticks`]).
+    pub tet: Option<Box<Tet>>,
 }
 
 /// Runs a scene from its initial state, sending every output sample (from
@@ -398,10 +413,15 @@ fn drive<const N: usize, M: Machine<N>>(
         Source::Cosim(session) => session.controller_pid(),
         _ => None,
     };
-    let start = std::time::Instant::now();
+    let mut cost = TickCost {
+        max_rhs_evals: 0,
+        tet: (matches!(source, Source::Cosim(_)) || hooks.time_ticks()).then(|| Box::new(Tet::new(ticks))),
+    };
+    let start = Instant::now();
     let mut outcome = Outcome::Completed;
     let mut t = 0.0;
     for k in 0..ticks {
+        let tick_start = Instant::now();
         let t0 = k as f64 * period;
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
         // Every axis's sensor (the planes in order, one noise sequence) and the keyphasor: the
@@ -455,6 +475,7 @@ fn drive<const N: usize, M: Machine<N>>(
                         Halt::Lost(why) => Outcome::PeerLost(why),
                         Halt::Interrupted(_) => Outcome::Interrupted,
                         Halt::MissBudget(why) => Outcome::MissBudget(why),
+                        Halt::OverrunBudget(why) => Outcome::OverrunBudget(why),
                     };
                     break;
                 }
@@ -488,6 +509,12 @@ fn drive<const N: usize, M: Machine<N>>(
                 }
             }
         }
+        // A realtime tick starts when the plant wakes at its wall-clock time.
+        let tick_start = match &source {
+            Source::Cosim(session) => session.tick_started().unwrap_or(tick_start),
+            _ => tick_start,
+        };
+        let commanded = Instant::now();
         // Park or release each race; the fixed step is the contact one while any race is free.
         let mut changed = false;
         for i in 0..planes {
@@ -520,6 +547,9 @@ fn drive<const N: usize, M: Machine<N>>(
             out_times.push(((next_out as f64) * out_dt).min(t1));
             next_out += 1;
         }
+        let (evals, touching) = (integrator.stats().rhs_evals, cost.tet.is_some() && touching(&model, &y, planes));
+        let mut rows = Duration::ZERO;
+        let integrating = Instant::now();
         let step = advance_across_breakpoints(
             &mut integrator,
             &model,
@@ -527,8 +557,30 @@ fn drive<const N: usize, M: Machine<N>>(
             &mut y,
             &out_times,
             (&breakpoints, &mut next_breakpoint),
-            |ts, ys| feed(&model, sink, ts, ys),
+            |ts, ys| match cost.tet {
+                // The output rows' time is the sink's, not the integration's.
+                Some(_) => {
+                    let row = Instant::now();
+                    feed(&model, sink, ts, ys);
+                    rows += row.elapsed();
+                }
+                None => feed(&model, sink, ts, ys),
+            },
         );
+        cost.max_rhs_evals = cost.max_rhs_evals.max(integrator.stats().rhs_evals - evals);
+        if let Some(tet) = cost.tet.as_mut() {
+            let end = Instant::now();
+            let ns = |d: Duration| d.as_nanos() as u64;
+            tet.record(
+                k,
+                TickTime {
+                    command_ns: ns(commanded - tick_start),
+                    integration_ns: ns((end - integrating).saturating_sub(rows)),
+                    tick_ns: ns(end - tick_start),
+                    contact: touching || self::touching(&model, &y, planes),
+                },
+            );
+        }
         t = t1;
         if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(&model, t1, &y)) {
             // The run reached the failure, not the end of its macro step (an integration
@@ -555,9 +607,12 @@ fn drive<const N: usize, M: Machine<N>>(
             if outcome == Outcome::Completed {
                 if let Some(why) = session.miss_budget_exceeded(1) {
                     outcome = Outcome::MissBudget(why);
+                } else if let Some(why) = session.overrun_budget_exceeded(1) {
+                    outcome = Outcome::OverrunBudget(why);
                 }
             }
             let mut report = session.finish(t, (t / period).round() as u64);
+            report.tet_us = cost.tet.as_ref().map(|tet| tet.report());
             report.invalid_replies = invalid.count();
             Some(report)
         }
@@ -573,9 +628,15 @@ fn drive<const N: usize, M: Machine<N>>(
         cosim,
         parked_steps,
         planes,
+        ticks: cost,
         invalid_commands,
         voltage_saturation_s: model.voltage_saturation(&y),
     })
+}
+
+/// The rotor touches one of its races (the rotor – race contact force is not zero).
+fn touching<const N: usize, M: Machine<N>>(model: &M, y: &[f64; N], planes: usize) -> bool {
+    (0..planes).any(|i| model.touching(y, i))
 }
 
 /// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it

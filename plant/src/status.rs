@@ -25,6 +25,8 @@ pub enum Status {
     MissBudget,
     /// The controller's commands were non-finite past the budget (exit 8).
     InvalidCommands,
+    /// Realtime: the plant-overrun budget was exceeded (exit 10).
+    OverrunBudget,
 }
 
 impl Status {
@@ -39,6 +41,7 @@ impl Status {
             Status::NotStarted => "not_started",
             Status::MissBudget => "miss_budget",
             Status::InvalidCommands => "invalid_commands",
+            Status::OverrunBudget => "overrun_budget",
         }
     }
 }
@@ -59,6 +62,7 @@ impl Outcome {
             Outcome::PeerLost(_) => Status::PeerLost,
             Outcome::MissBudget(_) => Status::MissBudget,
             Outcome::InvalidCommands(_) => Status::InvalidCommands,
+            Outcome::OverrunBudget(_) => Status::OverrunBudget,
         }
     }
 
@@ -68,7 +72,10 @@ impl Outcome {
             Outcome::Completed => None,
             Outcome::Diverged(e) => Some(e.to_string()),
             Outcome::Interrupted => Some("interrupted by a signal".to_string()),
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::InvalidCommands(why) => Some(why.clone()),
+            Outcome::PeerLost(why)
+            | Outcome::MissBudget(why)
+            | Outcome::InvalidCommands(why)
+            | Outcome::OverrunBudget(why) => Some(why.clone()),
         }
     }
 
@@ -131,6 +138,7 @@ mod tests {
             Status::NotStarted,
             Status::MissBudget,
             Status::InvalidCommands,
+            Status::OverrunBudget,
         ] {
             assert_eq!(serde_json::to_value(s).unwrap(), s.name());
         }

@@ -102,6 +102,12 @@ pub struct IntegratorInfo {
     pub contact_substeps: u32,
     /// Macro step (s).
     pub macro_step_s: f64,
+    /// Realtime runs: `fixed` (the fixed-step setting of bounded cost replaced the scene's
+    /// integrator) or `scene` (`integrator.realtime`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub realtime: Option<crate::config::RealtimeSetting>,
+    /// The most evaluations of the model the integrator made in one tick.
+    pub max_rhs_evals_per_tick: u64,
 }
 
 /// `summary.json`.
@@ -308,6 +314,8 @@ impl Summary {
                 substeps: scene.integrator.substeps,
                 contact_substeps: scene.integrator.contact_substeps,
                 macro_step_s: c.period,
+                realtime: (c.mode == crate::config::ControlMode::Realtime).then_some(scene.integrator.realtime),
+                max_rhs_evals_per_tick: run.ticks.max_rhs_evals,
             },
             analysis,
             cosim: run.cosim.clone(),

@@ -184,3 +184,48 @@ impl Table {
         self.text(row, name).parse().unwrap_or_else(|e| panic!("{name}: {e}"))
     }
 }
+
+/// Issue 22: `plant compare --realtime` runs the scene in realtime and once in lockstep on the
+/// same (realtime) integrator setting, and writes one row each. The lockstep row is its own
+/// reference; a realtime run without a deadline miss is the lockstep run bit for bit (the
+/// reply to sample k is applied at tick k + 1 in both), one with misses may not be.
+#[test]
+fn compare_realtime_puts_realtime_runs_beside_their_lockstep_twin() {
+    controller_bin();
+    let dir = TempDir::new("compare-realtime");
+    let out = dir.join("out");
+    let o = output_within(
+        Command::new(plant_bin())
+            .arg("compare")
+            .arg(scene("cosim-10g.toml"))
+            .args(["--realtime", "--runs", "2", "--out"])
+            .arg(&out)
+            .args(["--set", "scene.duration_s=0.04", "--set", "shock[0].start_s=0.01"]),
+        LIMIT,
+    );
+    assert_exit(&o, 0);
+    let text = std::fs::read_to_string(out.join("realtime.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let modes: Vec<(&str, &str)> = rows.iter().map(|r| (r[col("run")], r[col("mode")])).collect();
+    assert_eq!(modes, [("0", "lockstep"), ("1", "realtime"), ("2", "realtime")]);
+    assert_eq!((rows[0][col("same_as_lockstep")], rows[0][col("deadline_misses")]), ("true", "0"));
+    let num = |r: &Vec<&str>, c: &str| r[col(c)].parse::<f64>().unwrap_or_else(|_| panic!("{c}: {r:?}"));
+    assert_eq!(num(&rows[0], "max_dev_m"), 0.0);
+    for r in &rows[1..] {
+        if r[col("deadline_misses")] == "0" {
+            assert_eq!(r[col("same_as_lockstep")], "true", "a realtime run without a miss: {r:?}");
+        }
+        if r[col("same_as_lockstep")] == "true" {
+            assert_eq!(num(r, "max_dev_m"), 0.0, "{r:?}");
+        }
+    }
+    for r in &rows {
+        for c in ["tick_max_us", "integration_max_us"] {
+            assert!(num(r, c) > 0.0 && num(r, c).is_finite(), "{c}: {r:?}");
+        }
+    }
+    assert!(stderr(&o).contains("realtime 2:"), "{}", stderr(&o));
+    assert!(out.join("realtime_radius.png").exists());
+}

@@ -110,6 +110,8 @@ fn lockstep_trace_is_bit_identical_to_sampled() {
         assert_eq!(num(c, key), 0.0, "{key} in {c:#}");
     }
     assert_eq!(num(&c["round_trip_us"], "count") as u64, TICKS);
+    assert_tet(c, TICKS);
+    assert!(c["schedule_held"].is_null(), "a realtime figure: {c:#}");
     assert_eq!(event_kinds(&s), ["connected"]);
     // The sampled run has no cosim object.
     assert!(read_json(&dir.join("sampled").join("summary.json")).get("cosim").is_none());
@@ -155,6 +157,67 @@ fn realtime_run_completes_and_reports_misses() {
     }
     assert!(c["round_trip_us"].is_null(), "round trips are a lockstep figure: {c:#}");
     assert_sampled_rows(&out, 0.05);
+    // Every tick timed; the schedule held only without a miss and an overrun.
+    assert_tet(c, TICKS);
+    let overruns = num(c, "plant_overruns");
+    assert!((num(c, "plant_overrun_fraction") - overruns / TICKS as f64).abs() < 1e-12, "{c:#}");
+    assert_eq!(c["schedule_held"].as_bool(), Some(misses == 0.0 && overruns == 0.0), "{c:#}");
+    // The realtime setting by default: RK4 at fixed steps, at most 4 evaluations per substep.
+    let i = &s["integrator"];
+    assert_eq!((i["method"].as_str(), i["realtime"].as_str()), (Some("rk4"), Some("fixed")), "{i:#}");
+    assert_eq!(s["model"]["race_when_clear"], "parked");
+    assert!(num(i, "max_rhs_evals_per_tick") <= 2.0 * (4.0 * num(i, "contact_substeps") + 1.0), "{i:#}");
+    assert!(stderr(&run).contains("fixed-step setting"), "{}", stderr(&run));
+}
+
+/// The execution-time figures of a co-simulation run: every tick counted in each, percentiles
+/// in order, the parts within the whole.
+fn assert_tet(c: &serde_json::Value, ticks: u64) {
+    let tet = &c["tet_us"];
+    for key in ["tick", "command", "integration"] {
+        assert_eq!(num(&tet[key], "count") as u64, ticks, "tet_us.{key} in {c:#}");
+    }
+    for key in ["tick", "command", "integration", "integration_contact"] {
+        let p = |q: &str| num(&tet[key], q);
+        assert!(p("p50") <= p("p99") && p("p99") <= p("p999") && p("p999") <= p("max"), "tet_us.{key}: {tet:#}");
+    }
+    let max = |key: &str| num(&tet[key], "max");
+    assert!(max("command") <= max("tick") && max("integration") <= max("tick"), "{tet:#}");
+    assert!(num(&tet["integration_contact"], "count") as u64 <= ticks, "{tet:#}");
+}
+
+/// Issue 22: a realtime run whose plant cannot keep up is told so, and past
+/// `controller.max_overrun_fraction` it ends with status `overrun_budget` and exit 10. At 10
+/// MHz (a 100 ns period) no machine publishes a frame and integrates a tick in time, so every
+/// tick after the first few starts more than a period late, whatever the load.
+#[test]
+fn a_realtime_plant_that_cannot_keep_up_is_said_and_ends_past_its_overrun_budget() {
+    controller_bin();
+    let dir = TempDir::new("cosim-overruns");
+    let fast = ["controller.mode=realtime", "controller.rate_hz=1e7", "scene.duration_s=2e-4", "output.plots=false"];
+    let out = dir.join("warned");
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &fast));
+    assert_exit(&run, 0);
+    let err = stderr(&run);
+    assert!(err.contains("the realtime schedule did not hold") && err.contains("plant overruns"), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "completed");
+    let c = &s["cosim"];
+    assert_eq!(c["schedule_held"].as_bool(), Some(false), "{c:#}");
+    assert!(num(c, "plant_overrun_fraction") > 0.5, "{c:#}");
+
+    let out = dir.join("budget");
+    let budget: Vec<&str> = fast.iter().copied().chain(["controller.max_overrun_fraction=0.5"]).collect();
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &budget));
+    assert_exit(&run, 10);
+    let err = stderr(&run);
+    assert!(err.contains("max_overrun_fraction = 0.5") && err.contains("plant overruns"), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "overrun_budget", "{s:#}");
+    assert!(num(&s["cosim"], "plant_overrun_fraction") > 0.5, "{s:#}");
+    // Stopped at the first check, after 1000 ticks, with its results up to there.
+    assert!(num(&s, "simulated_s") < 2e-4, "{s:#}");
+    assert!(out.join("trace.csv").exists() && out.join("scene.toml").exists());
 }
 
 /// Asserts trace.csv holds rows 0, T_out, … up to `end` (s) at 20 kHz.

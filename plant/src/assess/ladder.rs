@@ -223,7 +223,7 @@ fn run_counted(
             _ if stop.load(Ordering::Relaxed) && run.outcome != Outcome::Completed => return Ok(None),
             // A member whose controller was lost says nothing of the controller's recovery: it
             // must not be counted (as a run that did not complete, it would count as diverged).
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) => {
+            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => {
                 return Err(ControllerLost(why.clone()).into());
             }
             Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),

@@ -214,7 +214,7 @@ fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)
         Outcome::Interrupted => None,
         Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
         Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
-        Outcome::MissBudget(why) => Some((Failure::PeerLost, why.clone())),
+        Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => Some((Failure::PeerLost, why.clone())),
         Outcome::InvalidCommands(why) => Some((Failure::InvalidCommands, why.clone())),
     }
 }

@@ -6,7 +6,9 @@
 //! revolutions and the post-shock mode. This bench runs the full-length impact (3 G) and rub
 //! (10 G) scenes with each method at a representative setting (including each scene's shipped
 //! default and the parked race), and compares those figures with a reference run (DOP853 at
-//! rtol 1e-12 with scaled absolute tolerances, free race). Writes
+//! rtol 1e-12 with scaled absolute tolerances, free race). The co-simulation scene
+//! (`cosim-10g.toml`, its law sampled in the plant) runs on its own setting and on the realtime
+//! one. Writes
 //! `engineering.csv` (columns in [`super::rows::EngineeringRow`]).
 
 use super::rows::{EngineeringRow, ENGINEERING_HEADER};
@@ -94,6 +96,14 @@ fn settings(scene: &Scene) -> anyhow::Result<Vec<(String, Scene)>> {
     Ok(v)
 }
 
+/// The settings compared on the co-simulation scene: its own and the realtime one
+/// ([`Scene::fixed_step_overrides`], what `mode = "realtime"` runs on by default).
+fn realtime_settings(scene: &Scene) -> anyhow::Result<Vec<(String, Scene)>> {
+    let fixed = scene.reload(&scene.fixed_step_overrides())?;
+    let label = format!("realtime fixed: {}", fixed.resolved()?.integrator_and_race());
+    Ok(vec![(format!("shipped default: {}", scene.resolved()?.integrator_and_race()), scene.clone()), (label, fixed)])
+}
+
 /// Each run's figures as a row of `engineering.csv`, with their differences from the
 /// reference run of the same scene (rows of a scene without one are left out).
 pub fn table(figures: &[Figures]) -> Vec<EngineeringRow> {
@@ -130,10 +140,19 @@ pub fn engineering(
 ) -> anyhow::Result<Vec<EngineeringRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut runs = Vec::new();
-    for (name, file) in [("impact", "paper-3g.toml"), ("rub", "paper-10g.toml")] {
+    // The co-simulation scene runs with its law in the plant's process (`sampled`: the
+    // arithmetic of lockstep, and of a realtime run without a miss), on its own setting and on
+    // the realtime one only.
+    let sampled = "controller.mode=\"sampled\"";
+    for (name, file, extra) in [
+        ("impact", "paper-3g.toml", None),
+        ("rub", "paper-10g.toml", None),
+        ("cosim-10g", "cosim-10g.toml", Some(sampled)),
+    ] {
         let path = config_dir.join(file);
-        let scene = load_scene(&path, &["output.plots=false".to_string()])
-            .with_context(|| format!("loading {}", path.display()))?;
+        let mut sets = vec!["output.plots=false".to_string()];
+        sets.extend(extra.map(str::to_string));
+        let scene = load_scene(&path, &sets).with_context(|| format!("loading {}", path.display()))?;
         let free = scene.reload(&["touchdown.race_when_clear=\"free\"".to_string()])?;
         let reference = with_integrator(&free, Method::Dop853, IntegratorSetting::Rtol(1e-12));
         log(&format!("{name}: reference (DOP853 rtol 1e-12, {} s)", scene.duration));
@@ -148,7 +167,8 @@ pub fn engineering(
             r.wall_s_per_sim_s
         ));
         runs.push(r);
-        for (label, s) in settings(&scene)? {
+        let settings = if extra.is_some() { realtime_settings(&scene)? } else { settings(&scene)? };
+        for (label, s) in settings {
             let f = figures(name, label, &s, repeats)?;
             log(&format!(
                 "{name}: {}: {}, peak contact {:.0} N, max radius {:.1} µm, contact fraction {:.3}, mode {}, {:.3e} s/s",

@@ -12,6 +12,8 @@
 //! * [`engineering`]: peak contact force, largest radius, contact fraction
 //!   and post-shock mode per integrator setting on full-length runs
 //!   (`engineering.csv`).
+//! * [`tick`]: the plant's execution time per tick, alone, on the realtime setting and on the
+//!   scene's own integrator (`tick.csv`).
 //! * [`rows`]: the columns of each table the benches write and read.
 //! * [`peer`]: the spec an independent implementation of the derivative
 //!   reads.
@@ -35,6 +37,7 @@ pub mod engineering;
 pub mod models;
 pub mod peer;
 pub mod rows;
+pub mod tick;
 
 use crate::config::{load_scene, Scene};
 use crate::integrate::Method;

@@ -18,8 +18,8 @@ pub mod validate;
 
 pub use overrides::apply_override;
 pub use raw::{
-    ControlMode, DragChoice, Fallback, ForceLaw, RaceWhenClearChoice, RawController, RawScene, ReleaseChoice,
-    RotorModel, SpinChoice, SupportChoice,
+    ControlMode, DragChoice, Fallback, ForceLaw, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
+    ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
 pub use validate::{finite, non_negative, positive, range, validate};
 
@@ -136,6 +136,9 @@ pub struct CosimSettings {
     pub realtime_priority: u32,
     /// Realtime: the largest deadline-miss fraction before the run ends (exit 6).
     pub max_miss_fraction: f64,
+    /// Realtime: the largest fraction of ticks started more than a period late before the run
+    /// ends (exit 10).
+    pub max_overrun_fraction: f64,
 }
 
 /// Integrator settings, validated (tolerances per state component).
@@ -156,6 +159,9 @@ pub struct IntegratorSettings {
     pub contact_substeps: u32,
     /// Largest allowed excursion beyond the clearances (m).
     pub radius_guard: f64,
+    /// The integrator of realtime runs (`integrator.realtime`); a realtime scene on `fixed`
+    /// already holds the fixed-step setting here.
+    pub realtime: RealtimeSetting,
 }
 
 impl IntegratorSettings {
@@ -307,6 +313,26 @@ impl Scene {
             delay_samples: c.delay_samples,
             constants: params.loop_constants,
         }
+    }
+
+    /// `--set` overrides of the fixed-step setting: RK4 with one step per tick while the race is
+    /// parked (the gap clear by a safe margin, [`crate::park`]), and while it is free the
+    /// substeps the stability estimate gives under a
+    /// [`plant_physics::stability::REFERENCE_CONTACT_FORCE`] contact (3 at 20 kHz on the study's
+    /// bearing). Its cost per tick is bounded: at most `4 × contact_substeps + 1` evaluations
+    /// of the model (the last for an output sample inside the last substep; twice that in a
+    /// tick split at a shock's breakpoint). The default of realtime
+    /// runs (`integrator.realtime = "fixed"`) and the fast setting of ensemble members.
+    pub fn fixed_step_overrides(&self) -> Vec<String> {
+        let contact =
+            plant_physics::stability::safe_contact_substeps(&self.params, Method::Rk4, self.controller.period).max(1);
+        vec![
+            "integrator.method=\"rk4\"".into(),
+            "integrator.substeps=1".into(),
+            format!("integrator.contact_substeps={contact}"),
+            "touchdown.race_when_clear=\"parked\"".into(),
+            "touchdown.race_release=\"equilibrium\"".into(),
+        ]
     }
 
     /// The scene as resolved (every key, overrides applied), as a scene file: `scene.toml` of

@@ -316,6 +316,17 @@ pub enum RaceWhenClearChoice {
     Parked,
 }
 
+/// `integrator.realtime`: the integrator a realtime run uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RealtimeSetting {
+    /// A bounded cost per tick: RK4 at fixed steps, the race parked while clear
+    /// ([`super::Scene::fixed_step_overrides`]).
+    Fixed,
+    /// The scene's own integrator keys.
+    Scene,
+}
+
 /// `touchdown.race_release`: the state a parked race is released with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -505,6 +516,10 @@ pub struct RawController {
     /// (judged from 1000 ticks on and over the whole run); past it the run ends with status
     /// `invalid_commands` (exit code 8); 1 is no limit.
     pub max_invalid_fraction: f64 = 0.01,
+    /// Co-simulation, realtime: the largest fraction of ticks that may start more than one
+    /// period late (plant overruns); past it the run ends with status `overrun_budget` (exit
+    /// code 10); 1 is no limit.
+    pub max_overrun_fraction: f64 = 1.0,
 }
 }
 
@@ -532,6 +547,12 @@ pub struct RawIntegrator {
     pub contact_substeps: u32 = 0,
     /// The run stops as diverged when the rotor or race leaves the clearance by more than this (mm).
     pub radius_guard_mm: f64 = 0.5,
+    /// The integrator of `controller.mode = "realtime"` runs: `fixed` (a bounded cost per
+    /// tick: RK4 with one step per tick while the race is parked and the contact substeps of
+    /// the stability estimate while it is free, the ensembles' fast setting; it overrides
+    /// `method`, `substeps`, `contact_substeps` and `touchdown.race_when_clear`/`race_release`)
+    /// or `scene` (the keys above as written). Other modes ignore it.
+    pub realtime: RealtimeSetting = RealtimeSetting::Fixed,
 }
 }
 
@@ -660,6 +681,30 @@ pub struct RawScene {
 }
 
 impl RawScene {
+    /// The integrator and the race's setting as written, in words (for messages): `dp5 rtol
+    /// 1e-6, race free`, `rk4 with 1 step per tick (3 while the race is free), race parked`.
+    pub fn integrator_and_race(&self) -> String {
+        fn name<T: Serialize>(v: &T) -> String {
+            toml::Value::try_from(v).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
+        }
+        let i = &self.integrator;
+        let (method, race) = (name(&i.method), name(&self.touchdown.race_when_clear));
+        let steps = match i.method.is_adaptive() {
+            true => format!("rtol {:e}", i.rtol),
+            false => {
+                let free = if i.contact_substeps == 0 { i.substeps } else { i.contact_substeps };
+                let plural = if i.substeps == 1 { "step" } else { "steps" };
+                match self.touchdown.race_when_clear {
+                    RaceWhenClearChoice::Parked => {
+                        format!("with {} {plural} per tick ({free} while the race is free)", i.substeps)
+                    }
+                    RaceWhenClearChoice::Free => format!("with {} {plural} per tick", i.substeps),
+                }
+            }
+        };
+        format!("{method} {steps}, race {race}")
+    }
+
     /// The tables `scene_table!` declares, by their name in the file, with their keys (the
     /// `[[shock]]` list and the `[ensemble]` table are declared by their own modules).
     pub fn tables() -> [(&'static str, &'static [&'static str]); 11] {

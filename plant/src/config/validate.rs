@@ -167,6 +167,9 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
     if !(ctl.max_miss_fraction.is_finite() && (0.0..=1.0).contains(&ctl.max_miss_fraction)) {
         return Err(range("controller.max_miss_fraction", ctl.max_miss_fraction, "", "must be between 0 and 1"));
     }
+    if !(ctl.max_overrun_fraction.is_finite() && (0.0..=1.0).contains(&ctl.max_overrun_fraction)) {
+        return Err(range("controller.max_overrun_fraction", ctl.max_overrun_fraction, "", "must be between 0 and 1"));
+    }
     Ok(CosimSettings {
         fallback,
         reply_timeout: ms("controller.reply_timeout_ms", ctl.reply_timeout_ms, false)?,
@@ -178,6 +181,7 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
         command: ctl.command.as_ref().map(command_argv).transpose()?,
         realtime_priority: ctl.realtime_priority,
         max_miss_fraction: ctl.max_miss_fraction,
+        max_overrun_fraction: ctl.max_overrun_fraction,
     })
 }
 
@@ -420,7 +424,38 @@ fn bearing(
 /// (with law `relev`; ignored otherwise), each with a warning in
 /// [`Scene::warnings`]; the resolved scene ([`Scene::to_toml`]) holds the
 /// parameters only.
-pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
+///
+/// A realtime scene on `integrator.realtime = "fixed"` (the default) is then given the
+/// fixed-step setting ([`Scene::fixed_step_overrides`]), written into the resolved scene, with
+/// a warning when that changes its integrator.
+pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
+    let scene = validate_as_written(raw, base_dir)?;
+    if scene.controller.mode != ControlMode::Realtime || scene.integrator.realtime != RealtimeSetting::Fixed {
+        return Ok(scene);
+    }
+    let overrides = scene.fixed_step_overrides();
+    let mut table = scene.table()?;
+    for arg in &overrides {
+        super::apply_override(&mut table, arg)?;
+    }
+    let fixed = toml::Value::Table(table)
+        .try_into::<RawScene>()
+        .map_err(|e| ConfigError::Parse { path: "the realtime setting".into(), message: e.to_string() })?;
+    let mut fixed = validate_as_written(fixed, base_dir)?;
+    // The first pass's warnings (deprecated keys are moved by it and not seen again).
+    fixed.warnings = scene.warnings;
+    let (was, is) = (scene.source.raw.integrator_and_race(), fixed.source.raw.integrator_and_race());
+    if was != is {
+        fixed.warnings.push(format!(
+            "controller.mode = \"realtime\" runs the fixed-step setting (integrator.realtime = \"fixed\", a bounded \
+             cost per tick): {is} instead of the scene's {was}; integrator.realtime = \"scene\" keeps the scene's"
+        ));
+    }
+    Ok(fixed)
+}
+
+/// [`validate`] without the realtime setting: the scene as written.
+fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     let mut warnings = Vec::new();
     migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
     resolve_command(&mut raw.controller, base_dir)?;
@@ -549,6 +584,7 @@ pub fn validate(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError
         substeps: int.substeps,
         contact_substeps: if int.contact_substeps == 0 { int.substeps } else { int.contact_substeps },
         radius_guard: positive("integrator.radius_guard_mm", int.radius_guard_mm, "mm")? * 1e-3,
+        realtime: int.realtime,
     };
 
     let output_rate = positive("output.rate_hz", raw.output.rate_hz, "Hz")?;

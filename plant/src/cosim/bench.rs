@@ -39,6 +39,7 @@ pub fn bench_round_trips(
         command: None,
         realtime_priority: 0,
         max_miss_fraction: 1.0,
+        max_overrun_fraction: 1.0,
     };
     let bias = [0.0; ROTOR_AXES];
     let mut s = Session::open(ControlMode::Lockstep, settings, hello, launch, bias, hello.period_s, hooks)?;
@@ -49,7 +50,7 @@ pub fn bench_round_trips(
         let sample = RotorSample { seq: k, t_s: k as f64 * hello.period_s, axes: hello.axes, ..Default::default() };
         if let Err(halt) = s.lockstep(&sample, hooks) {
             let why = match halt {
-                Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) => w,
+                Halt::Lost(w) | Halt::Interrupted(w) | Halt::MissBudget(w) | Halt::OverrunBudget(w) => w,
             };
             return Err(CosimError::NoController { waited_s: 0.0, run_id: s.run_id.clone(), hint: format!(": {why}") });
         }

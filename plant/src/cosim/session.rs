@@ -30,8 +30,8 @@ const EXIT_GRACE: Duration = Duration::from_secs(2);
 /// Blocked waits that the controller never ended with a notification before the plant
 /// warns that it does not serve wake requests.
 const UNWOKEN_WARNING: u64 = 50;
-/// Realtime ticks with a reply due before the miss budget is checked during the run (it is
-/// checked again at the end, over the whole run).
+/// Realtime ticks with a reply due (started, for overruns) before the miss (overrun) budget is
+/// checked during the run (it is checked again at the end, over the whole run).
 const MISS_BUDGET_MIN_DUE: u64 = 1000;
 
 /// Why the loop must stop at this tick.
@@ -44,6 +44,8 @@ pub enum Halt {
     Interrupted(String),
     /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
     MissBudget(String),
+    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
+    OverrunBudget(String),
 }
 
 /// What a lockstep wait saw besides the reply it waited for.
@@ -114,6 +116,8 @@ pub struct Session {
     controller_pid: Option<u32>,
     // Realtime.
     start: Option<Instant>,
+    /// When the plant woke for the current realtime tick (its start, for the execution time).
+    woke: Option<Instant>,
     sent_ns: [u64; RING],
     last_heard: Instant,
     next_check: Duration,
@@ -180,6 +184,28 @@ impl Session {
                 100.0 * f.miss_fraction()
             )
         })
+    }
+
+    /// Realtime: `Some(why)` if the share of ticks started more than a period late so far
+    /// exceeds `controller.max_overrun_fraction` (checked over at least `min_ticks` ticks).
+    pub fn overrun_budget_exceeded(&self, min_ticks: u64) -> Option<String> {
+        let f = &self.figures;
+        let budget = self.settings.max_overrun_fraction;
+        let over = self.mode == ControlMode::Realtime && f.ticks >= min_ticks.max(1) && f.overrun_fraction() > budget;
+        over.then(|| {
+            format!(
+                "realtime: {} plant overruns (ticks started more than a period late) in {} ticks ({:.3} %) exceed \
+                 controller.max_overrun_fraction = {budget}",
+                f.overruns,
+                f.ticks,
+                100.0 * f.overrun_fraction()
+            )
+        })
+    }
+
+    /// Realtime: when the plant woke for the current tick (the tick's start); `None` in lockstep.
+    pub fn tick_started(&self) -> Option<Instant> {
+        self.woke
     }
 
     fn event(&mut self, kind: &'static str, t_s: f64, seq: u64, detail: String) {
@@ -387,8 +413,14 @@ impl Session {
         let start = *self.start.get_or_insert_with(Instant::now);
         let deadline = start + Duration::from_secs_f64(k as f64 * self.period);
         pace_until(deadline);
-        if Instant::now() > deadline + Duration::from_secs_f64(self.period) {
+        let woke = Instant::now();
+        self.woke = Some(woke);
+        self.figures.ticks += 1;
+        if woke > deadline + Duration::from_secs_f64(self.period) {
             self.figures.overruns += 1;
+            if let Some(why) = self.overrun_budget_exceeded(MISS_BUDGET_MIN_DUE) {
+                return Err(Halt::OverrunBudget(why));
+            }
         }
         if hooks.cancelled() {
             return Err(Halt::Interrupted("interrupted by a signal".into()));
@@ -525,12 +557,15 @@ impl Session {
             deadline_miss_fraction: f.miss_fraction(),
             longest_miss_burst: f.misses.longest_burst,
             plant_overruns: f.overruns,
+            plant_overrun_fraction: f.overrun_fraction(),
+            schedule_held: (self.mode == ControlMode::Realtime).then_some(f.misses.total == 0 && f.overruns == 0),
             fallback_ticks: f.fallback_ticks,
             blocking_waits: self.frames.blocks(),
             woken_waits: self.frames.woken(),
             scheduling: self.scheduling.clone(),
             latency_us: f.latency.percentiles(),
             round_trip_us: (self.mode == ControlMode::Lockstep).then(|| f.round_trip.percentiles()),
+            tet_us: None,
             peer_events: f.events,
             controller_overrides: self.overrides.take(),
         }

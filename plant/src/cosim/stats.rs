@@ -82,6 +82,134 @@ impl Latencies {
     }
 }
 
+/// Bins of the chart of execution times over a run (`tet.png`).
+pub const TET_CHART_BINS: u64 = 2000;
+
+/// The plant's execution time of one tick (ns): what [`Tet`] records.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TickTime {
+    /// From the tick's start to the command applied to the model.
+    pub command_ns: u64,
+    /// The integration over the tick alone (the output rows it hands on left out).
+    pub integration_ns: u64,
+    /// From the tick's start to the end of its integration.
+    pub tick_ns: u64,
+    /// The rotor touched its race at the tick's start or end.
+    pub contact: bool,
+}
+
+/// The execution times of one bin of ticks over the run (ns): the largest and the sum.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TetBin {
+    /// First tick of the bin.
+    pub first_tick: u64,
+    /// Ticks recorded in the bin.
+    pub ticks: u64,
+    /// Largest tick time.
+    pub tick_max_ns: u64,
+    /// Sum of the tick times (for the mean).
+    pub tick_sum_ns: u64,
+    /// Largest command time.
+    pub command_max_ns: u64,
+    /// Largest integration time.
+    pub integration_max_ns: u64,
+}
+
+/// The plant's execution time per tick (TET, as real-time targets call a task's execution
+/// time), in fixed-size HDR histograms ([`Latencies`]) and at most [`TET_CHART_BINS`] bins
+/// over the run for its chart: allocated once, whatever the run's length.
+#[derive(Clone, Debug)]
+pub struct Tet {
+    tick: Latencies,
+    command: Latencies,
+    integration: Latencies,
+    contact: Latencies,
+    per_bin: u64,
+    bins: Vec<TetBin>,
+}
+
+impl Tet {
+    /// An empty record for a run of `ticks` ticks.
+    pub fn new(ticks: u64) -> Self {
+        let per_bin = ticks.div_ceil(TET_CHART_BINS).max(1);
+        Self {
+            tick: Latencies::new(),
+            command: Latencies::new(),
+            integration: Latencies::new(),
+            contact: Latencies::new(),
+            per_bin,
+            bins: Vec::with_capacity(ticks.div_ceil(per_bin).min(TET_CHART_BINS) as usize),
+        }
+    }
+
+    /// Records tick `k` (ticks come in order).
+    ///
+    /// ```
+    /// use plant::cosim::stats::{Tet, TickTime};
+    /// let mut tet = Tet::new(4);
+    /// for k in 0..4 {
+    ///     tet.record(k, TickTime { command_ns: 1000, integration_ns: 2000 * (k + 1), tick_ns: 4000 * (k + 1), contact: k == 3 });
+    /// }
+    /// let r = tet.report();
+    /// assert_eq!((r.tick.count, r.tick.max, r.integration_contact.count), (4, 16.0, 1));
+    /// assert_eq!(tet.bins().len(), 4);
+    /// ```
+    pub fn record(&mut self, k: u64, t: TickTime) {
+        self.tick.record(t.tick_ns);
+        self.command.record(t.command_ns);
+        self.integration.record(t.integration_ns);
+        if t.contact {
+            self.contact.record(t.integration_ns);
+        }
+        let first_tick = k / self.per_bin * self.per_bin;
+        if self.bins.last().is_none_or(|b| b.first_tick != first_tick) {
+            if self.bins.len() as u64 >= TET_CHART_BINS {
+                return; // a tick past the run's length (never: the loop runs the ticks it was made for)
+            }
+            self.bins.push(TetBin { first_tick, ..TetBin::default() });
+        }
+        if let Some(b) = self.bins.last_mut() {
+            b.ticks += 1;
+            b.tick_max_ns = b.tick_max_ns.max(t.tick_ns);
+            b.tick_sum_ns += t.tick_ns;
+            b.command_max_ns = b.command_max_ns.max(t.command_ns);
+            b.integration_max_ns = b.integration_max_ns.max(t.integration_ns);
+        }
+    }
+
+    /// The percentiles (µs).
+    pub fn report(&self) -> TetReport {
+        TetReport {
+            tick: self.tick.percentiles(),
+            command: self.command.percentiles(),
+            integration: self.integration.percentiles(),
+            integration_contact: self.contact.percentiles(),
+        }
+    }
+
+    /// The bins over the run, in order.
+    pub fn bins(&self) -> &[TetBin] {
+        &self.bins
+    }
+}
+
+/// The `tet_us` object of `summary.json`'s `cosim`: the plant's execution time per tick,
+/// percentiles in µs (see [`Percentiles`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TetReport {
+    /// From the tick's start (lockstep: the plant reads the sample; realtime: the plant wakes
+    /// at the tick's wall-clock time) to the end of its integration: the plant's whole tick,
+    /// its output rows included.
+    pub tick: Percentiles,
+    /// From the tick's start to the command applied to the model: lockstep, the round trip
+    /// through the controller; realtime, taking the reply that came and publishing the sample.
+    pub command: Percentiles,
+    /// The integration over the tick alone (the park decision and the output rows left out).
+    pub integration: Percentiles,
+    /// `integration` over the ticks that start or end with the rotor touching its race.
+    pub integration_contact: Percentiles,
+}
+
 /// Counts deadline misses and the longest run of consecutive ones.
 #[derive(Debug, Default, Clone, Copy, PartialEq)]
 pub struct Misses {
@@ -131,6 +259,8 @@ pub struct Figures {
     pub due: u64,
     /// Realtime ticks started more than a period late.
     pub overruns: u64,
+    /// Realtime ticks started.
+    pub ticks: u64,
     /// Ticks run on the fallback current.
     pub fallback_ticks: u64,
     /// The last reply's `seq` (for the gaps).
@@ -163,6 +293,11 @@ impl Figures {
     /// The deadline-miss fraction so far (misses over the ticks that had a reply due).
     pub fn miss_fraction(&self) -> f64 {
         self.misses.total as f64 / self.due.max(1) as f64
+    }
+
+    /// The plant-overrun fraction so far (overruns over the realtime ticks started).
+    pub fn overrun_fraction(&self) -> f64 {
+        self.overruns as f64 / self.ticks.max(1) as f64
     }
 
     /// Starts the latency figures afresh (after a warm-up).
@@ -207,6 +342,10 @@ pub struct CosimReport {
     pub longest_miss_burst: u64,
     /// Realtime ticks that started more than one period late (the plant could not keep up).
     pub plant_overruns: u64,
+    /// `plant_overruns` over the realtime ticks.
+    pub plant_overrun_fraction: f64,
+    /// Realtime: no deadline miss and no plant overrun, every tick on time (`null` in lockstep).
+    pub schedule_held: Option<bool>,
     /// Ticks run on the fallback current while no controller was connected.
     pub fallback_ticks: u64,
     /// Waits of the plant that outlasted the spin budget and blocked.
@@ -223,6 +362,9 @@ pub struct CosimReport {
     pub latency_us: Percentiles,
     /// Lockstep: sensor frame published → reply in the plant's hands, µs.
     pub round_trip_us: Option<Percentiles>,
+    /// The plant's execution time per tick, µs ([`TetReport`]), filled in by the run loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tet_us: Option<TetReport>,
     /// Connections, losses, reconnections, stops.
     pub peer_events: Vec<PeerEvent>,
     /// What the (last) controller ran differently from the scene (the `[controller]` table of

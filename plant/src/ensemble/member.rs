@@ -121,16 +121,7 @@ pub fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f6
 pub fn setting_overrides(scene: &Scene, setting: MemberSetting) -> Vec<String> {
     match setting {
         MemberSetting::Scene => Vec::new(),
-        MemberSetting::Fast => {
-            let contact = crate::stability::safe_contact_substeps(scene, Method::Rk4).max(1);
-            vec![
-                "integrator.method=\"rk4\"".into(),
-                "integrator.substeps=1".into(),
-                format!("integrator.contact_substeps={contact}"),
-                "touchdown.race_when_clear=\"parked\"".into(),
-                "touchdown.race_release=\"equilibrium\"".into(),
-            ]
-        }
+        MemberSetting::Fast => scene.fixed_step_overrides(),
     }
 }
 

@@ -243,6 +243,12 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     write(&report)?;
     if prog.plots {
         super::plots::write_plots(dir, prog, &sink.figures, &hooks.rss).context("writing plots").map_err(io)?;
+        if let Some(tet) = &result.ticks.tet {
+            match crate::output::write_tet_chart(&dir.join("tet.png"), scene, tet) {
+                Ok(()) | Err(crate::plot::PlotError::NoData { .. }) => {}
+                Err(e) => return Err(io(anyhow::Error::new(e).context("writing tet.png"))),
+            }
+        }
     }
     if late(&mut result) {
         report = super::report::report(prog, programme_file, &result, &sink.figures, &hooks.rss, started);

@@ -144,6 +144,7 @@ impl Session {
             controller: String::new(),
             controller_pid: None,
             start: None,
+            woke: None,
             sent_ns: [0; RING],
             last_heard: Instant::now(),
             next_check: Duration::from_secs_f64(settings.reply_timeout),
