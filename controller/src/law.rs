@@ -124,7 +124,7 @@ pub type BuildRotorLaw = fn(&RotorDesign, &Params) -> Result<Box<dyn RotorLaw>, 
 pub struct LawEntry {
     /// The name `controller.law` selects it by (what [`ControlLaw::name`] reports).
     pub name: &'static str,
-    /// One line for help texts and the README.
+    /// One line for help texts and the guide (docs/guide/controllers.md).
     pub summary: &'static str,
     /// Builds the law from a plane's design and its own parameters; refuses parameters it
     /// does not know or that are out of range.
@@ -142,7 +142,7 @@ impl std::fmt::Debug for LawEntry {
 pub struct RotorLawEntry {
     /// The name `controller.law` selects it by (what [`RotorLaw::name`] reports).
     pub name: &'static str,
-    /// One line for help texts and the README.
+    /// One line for help texts and the guide (docs/guide/controllers.md).
     pub summary: &'static str,
     /// Builds the law from the rotor's design and its own parameters; refuses a rotor it
     /// cannot drive ([`LawError::Axes`]) and parameters it does not know or that are out of

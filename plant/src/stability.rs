@@ -1,7 +1,7 @@
 //! Stability of the fixed-step integrators on the contact problem, checked before a run, so
 //! that the plant can warn about (or refuse) settings that are known to blow up. The estimate
 //! is [`plant_physics::stability`]'s; `plant bench accuracy` measures the real limits and
-//! prints them next to these estimates (README, "Speed against accuracy").
+//! prints them next to these estimates (docs/results/speed-accuracy.md).
 //!
 //! With `touchdown.race_when_clear = "parked"` the race rests in the housing frame while the gap
 //! is clear, and the stiff race-on-balls mode is gone: the fixed step then only has to resolve

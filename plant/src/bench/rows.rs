@@ -1,5 +1,5 @@
 //! The tables the benches write and read, one row type each: its fields are
-//! the columns, in order (the README lists them; scripts read them by name).
+//! the columns, in order (docs/results/speed-accuracy.md lists them; scripts read them by name).
 //! Written and read through [`crate::table`]; numbers in `{:e}` as they
 //! always were.
 //!
@@ -215,7 +215,7 @@ mod tests {
     use super::*;
 
     /// Each row type's columns are its header, in order (the header constants are what the
-    /// README, the peer and any script were promised).
+    /// guide, the peer and any script were promised).
     #[test]
     fn the_row_types_write_their_promised_headers() {
         let acc = AccuracyRow {

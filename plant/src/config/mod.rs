@@ -1,7 +1,7 @@
 //! Scene files: TOML parsed into raw structs ([`raw`], the file format;
 //! unknown keys are errors), then validated ([`validate`]) into SI parameter
 //! types. Units are in the key names; each key's default is the study's
-//! value (MODEL.md §7) and is listed in the README.
+//! value (MODEL.md §7) and is listed in docs/guide/scenes.md.
 //!
 //! Any key can be overridden from the command line with `--set a.b=value`
 //! ([`overrides`]; the value is read as a TOML literal, else as a string).

@@ -4,7 +4,7 @@
 //! # Bounds
 //!
 //! Every size that allocates or loops is bounded here, so a run stays finite
-//! and its allocations small (the README's key table lists them):
+//! and its allocations small (the key table of docs/guide/scenes.md lists them):
 //!
 //! | quantity | bound |
 //! |---|---|
