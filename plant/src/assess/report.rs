@@ -458,6 +458,23 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
     });
     row(&mut h, "vibration (ISO 14839-2)", &|c| {
         match &c.vibration.result {
+        Some(v) if v.planes.len() > 1 => format!(
+            "zone <b>{}</b> (plane {}): {} at {:.0} Hz; coil current swing {} A (RMS {} A; x_A / y_A / x_B / y_B) of {:.1} A",
+            v.zone,
+            v.plane,
+            v.planes
+                .iter()
+                .map(|p| format!(
+                    "plane {}: {:.2} µm = {:.3} C_min (C_min = {:.0} µm), zone {}",
+                    p.plane, p.peak_um, p.ratio, p.clearance_um, p.zone
+                ))
+                .collect::<Vec<_>>()
+                .join("; "),
+            v.speed_hz,
+            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_limit_a
+        ),
         Some(v) => format!(
             "zone <b>{}</b>: {:.2} µm = {:.3} C_min (C_min = {:.0} µm) at {:.0} Hz; coil current swing {} A (RMS {} A) of {:.1} A",
             v.zone,
