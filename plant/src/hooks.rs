@@ -25,14 +25,23 @@ pub trait Hooks {
         false
     }
     /// A sine to add to the sensor signal the controller reads over the macro step from tick
-    /// `k` at time `t` (s) (the summing point of a sensitivity measurement, ISO 14839-3);
-    /// `sensor_v` holds the values read at that tick, before the sine, one per axis. The loop
-    /// adds `E(t_k)` to the sample a sampled or co-simulated law gets, and hands the sine
-    /// itself to the continuous PD, which reads it inside the derivative. `None` (the
-    /// default): no excitation.
-    fn excitation(&mut self, _k: u64, _t: f64, _sensor_v: &[f64]) -> Option<crate::model::SensorSine> {
+    /// `k` at time `t` (s) (the summing point of a sensitivity measurement, ISO 14839-3), on
+    /// one bearing plane's two axes; `sensor_v` holds the values read at that tick, before the
+    /// sine, one per axis (the planes in order). The loop adds `E(t_k)` to the sample a sampled
+    /// or co-simulated law gets, and hands the sine itself to the plane's continuous PD, which
+    /// reads it inside the derivative. `None` (the default): no excitation.
+    fn excitation(&mut self, _k: u64, _t: f64, _sensor_v: &[f64]) -> Option<Excitation> {
         None
     }
+}
+
+/// A sine on one bearing plane's sensor signal ([`Hooks::excitation`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Excitation {
+    /// The bearing plane (0: A, the planar model's only one; 1: B).
+    pub plane: usize,
+    /// The sine on that plane's x and y axes.
+    pub sine: crate::model::SensorSine,
 }
 
 /// Hooks that do nothing.

@@ -59,6 +59,12 @@ pub trait Machine<const N: usize>: System<N> {
         None
     }
 
+    /// The two-plane rotor itself (for a sink that reads its state,
+    /// [`crate::run::Sink::two_plane_state`]); `None` for any other model.
+    fn two_plane(&self) -> Option<&two_plane::Model> {
+        None
+    }
+
     /// Plane `i`'s continuous PD current in state `y` (A): what the model's
     /// `Control::Continuous(gains)` applies, saturated at the plane's limit.
     fn pd_current(&self, gains: &PdGains, y: &[f64; N], i: usize) -> [f64; 2];
@@ -147,6 +153,10 @@ impl Machine<{ crate::model::N }> for Model {
 
 impl Machine<{ two_plane::N }> for two_plane::Model {
     const PLANES: usize = 2;
+
+    fn two_plane(&self) -> Option<&two_plane::Model> {
+        Some(self)
+    }
 
     fn bearing(&self, i: usize) -> &Params {
         &self.params.planes[i].params

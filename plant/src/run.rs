@@ -120,6 +120,16 @@ pub trait Sink {
     /// for a sink that needs what a row does not hold (the race's angle and acceleration, each
     /// ball's load: the assessment's touchdown-bearing duty). The default ignores it.
     fn planar_state(&mut self, _model: &crate::model::Model, _t: f64, _y: &crate::model::State) {}
+
+    /// The same for the two-plane rotor's state, after [`Sink::sample`] (two-plane runs only):
+    /// each touchdown bearing's duty. The default ignores it.
+    fn two_plane_state(
+        &mut self,
+        _model: &plant_physics::two_plane::Model,
+        _t: f64,
+        _y: &plant_physics::two_plane::State,
+    ) {
+    }
 }
 
 impl Sink for Trace {
@@ -352,13 +362,15 @@ fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> 
     a
 }
 
-/// Hands the output sample of state `y` at time `t` to `sink` (and, on the planar model, its
-/// state: [`Sink::planar_state`]).
+/// Hands the output sample of state `y` at time `t` to `sink` (and its state: on the planar
+/// model [`Sink::planar_state`], on the two-plane rotor [`Sink::two_plane_state`]).
 #[inline]
 fn feed<const N: usize, M: Machine<N>>(model: &M, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
     sink.sample(&model.record(t, y));
     if let (Some(planar), Ok(state)) = (model.planar(), <&crate::model::State>::try_from(&y[..])) {
         sink.planar_state(planar, t, state);
+    } else if let (Some(m), Ok(state)) = (model.two_plane(), <&plant_physics::two_plane::State>::try_from(&y[..])) {
+        sink.two_plane_state(m, t, state);
     }
 }
 
@@ -375,12 +387,13 @@ fn drive<const N: usize, M: Machine<N>>(
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
     let planes = M::PLANES;
-    // Plane A's continuous PD, for an excitation hook (ISO 14839-3's summing point).
+    // Each plane's continuous PD, for an excitation hook (ISO 14839-3's summing point).
     let continuous_gains = match source {
-        Source::Continuous => plane_gains(scene)?.first().copied(),
-        _ => None,
+        Source::Continuous => plane_gains(scene)?,
+        _ => Vec::new(),
     };
-    let mut excited = false;
+    // The plane whose continuous PD read the previous tick's sine.
+    let mut excited: Option<usize> = None;
     let mut integrator = Integrator::new(settings);
     let period = scene.controller.period;
     let ticks = (scene.duration / period).ceil() as u64;
@@ -441,20 +454,22 @@ fn drive<const N: usize, M: Machine<N>>(
             let v = sensor.read_with_gain(model.sensed(&y, i), gain);
             sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
         }
-        // The summing point of a sensitivity measurement (plane A's axes): added to what a law
-        // reads, handed to the continuous PD, which reads it inside the derivative.
-        let excitation = hooks.excitation(k, t0, &sample.sensor_v[..2 * planes]);
-        if let Some(sine) = excitation {
-            sample.sensor_v.iter_mut().zip(sine.at(t0).0).for_each(|(v, e)| *v += e);
+        // The summing point of a sensitivity measurement (one plane's axes): added to what a
+        // law reads, handed to the plane's continuous PD, which reads it inside the derivative.
+        let excitation = hooks.excitation(k, t0, &sample.sensor_v[..2 * planes]).filter(|e| e.plane < planes);
+        if let Some(e) = excitation {
+            let axes = &mut sample.sensor_v[2 * e.plane..2 * e.plane + 2];
+            axes.iter_mut().zip(e.sine.at(t0).0).for_each(|(v, e)| *v += e);
         }
-        if let (Source::Continuous, Some(gains)) = (&source, continuous_gains) {
-            if excitation.is_some() || excited {
-                model.set_control(
-                    0,
-                    excitation.map_or(Control::Continuous(gains), |e| Control::ContinuousExcited(gains, e)),
-                );
+        if let Source::Continuous = &source {
+            // The plane excited before goes back to its plain PD, the one excited now reads its sine.
+            if let Some(i) = excited.filter(|i| excitation.is_none_or(|e| e.plane != *i)) {
+                model.set_control(i, Control::Continuous(continuous_gains[i]));
             }
-            excited = excitation.is_some();
+            if let Some(e) = excitation {
+                model.set_control(e.plane, Control::ContinuousExcited(continuous_gains[e.plane], e.sine));
+            }
+            excited = excitation.map(|e| e.plane);
         }
         let command = match &mut source {
             Source::Continuous => None,

@@ -218,6 +218,10 @@ pub mod col {
     pub const VX_M_S: usize = 3;
     /// `vy_m_s`.
     pub const VY_M_S: usize = 4;
+    /// `xb_m`.
+    pub const XB_M: usize = 5;
+    /// `yb_m`.
+    pub const YB_M: usize = 6;
     /// `rotor_angle_rad`.
     pub const ROTOR_ANGLE_RAD: usize = 9;
     /// `rotor_speed_rad_s`.

@@ -257,3 +257,41 @@ fn ctrl_c_during_the_sensitivity_keeps_the_axes_measured() {
     }
     assert!(c["verdict"].as_str().expect("verdict").starts_with("sensitivity interrupted, on the"), "{}", c["verdict"]);
 }
+
+#[test]
+fn a_two_plane_scene_is_graded_at_each_bearing() {
+    // The four axes' sensitivity against the modal closed form is a plant test
+    // (`assess::tests::a_symmetric_two_plane_machine_…`); here the command takes a two-plane
+    // scene and grades the vibration and the duty at each of its two bearings.
+    let dir = TempDir::new("assess-two-plane");
+    let text = format!(
+        "scene = {:?}\nset = [\"scene.duration_s=0.3\"]\nparts = [\"vibration\", \"ladder\"]\n\
+         [[controller]]\nlabel = \"pd per plane\"\nset = []\n\
+         [ladder]\npeaks_g = [20.0]\nmembers = 2\nbatch = 2\nverify = false\nduty_g = 20.0\n",
+        scene("two-plane-asymmetric-10g.toml").display().to_string()
+    );
+    let path = dir.join("assess.toml");
+    std::fs::write(&path, text).expect("write");
+    let out = dir.join("out");
+    let o = assess(&path, &out);
+    assert_exit(&o, 0);
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    let v = &c["vibration"]["result"];
+    let planes = v["planes"].as_array().expect("planes");
+    assert_eq!(planes.len(), 2);
+    // Each plane against its own clearance (the scene's planes have different air gaps).
+    assert_ne!(num(&planes[0], "clearance_um"), num(&planes[1], "clearance_um"));
+    for p in planes {
+        assert!(num(p, "peak_um") > 0.0 && num(p, "ratio") < 0.3, "{p}");
+    }
+    assert_eq!(v["current_mean_a"].as_array().expect("currents").len(), 4);
+    // 20 G: both bearings hit; the rung's figure is the larger bearing's.
+    let rung = &c["ladder"]["result"]["rungs"][0];
+    let per = rung["duty_planes"].as_array().expect("duty per bearing");
+    assert_eq!(per.len(), 2);
+    let force = |d: &serde_json::Value| num(&d["peak_contact_force_n"], "max");
+    assert!(force(&per[0]) > 100.0 && force(&per[1]) > 100.0, "{per:?}");
+    assert_eq!(force(&rung["duty"]), force(&per[0]).max(force(&per[1])));
+    assert!(c["verdict"].as_str().expect("verdict").contains("at plane"));
+}

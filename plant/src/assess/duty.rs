@@ -19,6 +19,7 @@ use super::rainflow::Rainflow;
 use crate::model::{cage_angle, ix, Cage, Model, State, Support};
 use crate::run::Sink;
 use nalgebra::Vector2;
+use plant_physics::two_plane;
 use serde::Serialize;
 
 /// The bearing's geometry and materials the duty needs beyond the model's parameters (SI).
@@ -75,12 +76,31 @@ pub struct Duty {
     pub race_peak_accel_rad_s2: f64,
     /// Ball-load cycles with a range of at least the stated share of Q₀, all balls.
     pub ball_cycles: Option<f64>,
+    /// The two-plane rotor: each touchdown bearing's duty, A then B (the figures above are
+    /// each the larger of the two); empty for the planar model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub planes: Vec<Duty>,
 }
 
-/// Accumulates [`Duty`] from a run's samples and passes them on to `inner`.
-pub struct DutySink<'a> {
-    inner: &'a mut dyn Sink,
-    bearing: Bearing,
+/// What one bearing plane's duty reads at an output sample (SI, relative to the housing).
+struct PlaneSample<'p> {
+    /// The plane's bearing parameters.
+    params: &'p crate::model::Params,
+    /// Rotor – race normal and tangential force (N).
+    normal: f64,
+    tangential: f64,
+    /// The rotor at the bearing, and the race: positions and velocities.
+    rotor: (Vector2<f64>, Vector2<f64>),
+    race: (Vector2<f64>, Vector2<f64>),
+    /// Rotor spin speed, race angle, spin speed and spin acceleration.
+    rotor_speed: f64,
+    race_angle: f64,
+    race_speed: f64,
+    race_accel: f64,
+}
+
+/// One touchdown bearing's duty, accumulated sample by sample.
+struct PlaneDuty {
     duty: Duty,
     last: Option<(f64, f64)>,
     loads: Vec<f64>,
@@ -88,13 +108,10 @@ pub struct DutySink<'a> {
     lumped: bool,
 }
 
-impl<'a> DutySink<'a> {
-    /// A duty accumulator for `balls` balls in front of `inner`.
-    pub fn new(inner: &'a mut dyn Sink, bearing: Bearing, balls: usize) -> Self {
+impl PlaneDuty {
+    fn new(bearing: &Bearing, balls: usize) -> Self {
         let q0 = bearing.ball_static_load_n;
         Self {
-            inner,
-            bearing,
             duty: Duty::default(),
             last: None,
             loads: vec![0.0; balls],
@@ -103,43 +120,18 @@ impl<'a> DutySink<'a> {
         }
     }
 
-    /// The duty of the samples seen.
-    pub fn finish(self) -> Duty {
-        let mut d = self.duty;
-        let m = &self.bearing.materials;
-        if self.lumped {
-            d.peak_ball_load_n = None;
-            d.peak_ball_pressure_mpa = None;
-            d.ball_cycles = None;
-        } else {
-            let q = d.peak_ball_load_n.unwrap_or(0.0);
-            let p = hertz::ball_inner(m, q, self.bearing.ball_diameter_m, self.bearing.pitch_diameter_m);
-            d.peak_ball_pressure_mpa = Some(p.p_max_pa * 1e-6);
-            d.ball_cycles = Some(self.counters.into_iter().map(|c| c.finish().0).sum());
-        }
-        d
-    }
-}
-
-impl Sink for DutySink<'_> {
-    fn sample(&mut self, record: &crate::trace::Record) {
-        self.inner.sample(record);
-    }
-
-    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
-        self.inner.planar_state(model, t, y);
-        let p = &model.params;
-        let ev = model.evaluate(t, y);
+    fn push(&mut self, bearing: &Bearing, t: f64, s: &PlaneSample) {
+        let p = s.params;
         let d = &mut self.duty;
-        let normal = ev.contact.normal;
+        let normal = s.normal;
         // Slip at the contact point (MODEL.md §4), for the friction power |F_t v_t|.
-        let gap = Vector2::new(y[ix::XR] - y[ix::XB], y[ix::YR] - y[ix::YB]);
+        let gap = s.rotor.0 - s.race.0;
         let power = if normal > 0.0 && gap.norm() > 0.0 {
             let n = gap / gap.norm();
             let tangent = Vector2::new(-n.y, n.x);
-            let dv = Vector2::new(y[ix::VXR] - y[ix::VXB], y[ix::VYR] - y[ix::VYB]);
-            let slip = dv.dot(&tangent) + y[ix::WR] * p.contact.rotor_radius - y[ix::WB] * p.contact.bore_radius;
-            (ev.contact.tangential * slip).abs()
+            let dv = s.rotor.1 - s.race.1;
+            let slip = dv.dot(&tangent) + s.rotor_speed * p.contact.rotor_radius - s.race_speed * p.contact.bore_radius;
+            (s.tangential * slip).abs()
         } else {
             0.0
         };
@@ -154,32 +146,151 @@ impl Sink for DutySink<'_> {
         if normal > d.peak_contact_force_n {
             d.peak_contact_force_n = normal;
             let r = hertz::rotor_race(
-                &self.bearing.materials,
+                &bearing.materials,
                 normal,
                 p.contact.rotor_radius,
                 p.contact.bore_radius,
-                self.bearing.width_m,
+                bearing.width_m,
             );
             d.peak_race_pressure_mpa = r.p_max_pa * 1e-6;
             d.race_contact_half_width_mm = r.half_width_m * 1e3;
         }
-        d.race_peak_speed_rpm = d.race_peak_speed_rpm.max(y[ix::WB].abs() * 60.0 / std::f64::consts::TAU);
-        d.race_peak_accel_rad_s2 = d.race_peak_accel_rad_s2.max(ev.dy[ix::WB].abs());
+        d.race_peak_speed_rpm = d.race_peak_speed_rpm.max(s.race_speed.abs() * 60.0 / std::f64::consts::TAU);
+        d.race_peak_accel_rad_s2 = d.race_peak_accel_rad_s2.max(s.race_accel.abs());
         self.lumped = !matches!(p.support, Support::Balls);
         if let Support::Balls = p.support {
             let (cage, rate) = match p.cage {
-                Cage::Rotating => (cage_angle(p, y[ix::TB]), p.cage_ratio * y[ix::WB]),
-                Cage::Fixed => (cage_angle(p, y[ix::TB]), 0.0),
+                Cage::Rotating => (cage_angle(p, s.race_angle), p.cage_ratio * s.race_speed),
+                Cage::Fixed => (cage_angle(p, s.race_angle), 0.0),
             };
-            let eps = Vector2::new(y[ix::XB], y[ix::YB]);
-            let eps_dot = Vector2::new(y[ix::VXB], y[ix::VYB]);
-            p.balls.loads(eps, eps_dot, cage, rate, &mut self.loads);
+            if self.loads.len() != p.balls.count() {
+                // This bearing's own ball count (the sink was made with the scene's).
+                let fresh = Self::new(bearing, p.balls.count());
+                (self.loads, self.counters) = (fresh.loads, fresh.counters);
+            }
+            p.balls.loads(s.race.0, s.race.1, cage, rate, &mut self.loads);
+            let d = &mut self.duty;
             let mut most = d.peak_ball_load_n.unwrap_or(0.0);
             for (l, c) in self.loads.iter().zip(&mut self.counters) {
                 c.push(*l);
                 most = most.max(*l);
             }
             d.peak_ball_load_n = Some(most);
+        }
+    }
+
+    fn finish(self, bearing: &Bearing) -> Duty {
+        let mut d = self.duty;
+        let m = &bearing.materials;
+        if self.lumped {
+            d.peak_ball_load_n = None;
+            d.peak_ball_pressure_mpa = None;
+            d.ball_cycles = None;
+        } else {
+            let q = d.peak_ball_load_n.unwrap_or(0.0);
+            let p = hertz::ball_inner(m, q, bearing.ball_diameter_m, bearing.pitch_diameter_m);
+            d.peak_ball_pressure_mpa = Some(p.p_max_pa * 1e-6);
+            d.ball_cycles = Some(self.counters.into_iter().map(|c| c.finish().0).sum());
+        }
+        d
+    }
+}
+
+/// Accumulates [`Duty`] from a run's samples and passes them on to `inner`: one touchdown
+/// bearing's on the planar model, each of the two-plane rotor's two.
+pub struct DutySink<'a> {
+    inner: &'a mut dyn Sink,
+    bearing: Bearing,
+    balls: usize,
+    planes: Vec<PlaneDuty>,
+}
+
+impl<'a> DutySink<'a> {
+    /// A duty accumulator for `balls` balls per bearing in front of `inner`.
+    pub fn new(inner: &'a mut dyn Sink, bearing: Bearing, balls: usize) -> Self {
+        Self { inner, bearing, balls, planes: Vec::new() }
+    }
+
+    fn plane(&mut self, i: usize) -> &mut PlaneDuty {
+        while self.planes.len() <= i {
+            self.planes.push(PlaneDuty::new(&self.bearing, self.balls));
+        }
+        &mut self.planes[i]
+    }
+
+    /// The duty of the samples seen: the one bearing's; with two, each figure is the larger of
+    /// the two bearings' (they may come from different bearings), each bearing's in `planes`.
+    pub fn finish(self) -> Duty {
+        let bearing = self.bearing;
+        let mut planes: Vec<Duty> = self.planes.into_iter().map(|p| p.finish(&bearing)).collect();
+        if planes.len() <= 1 {
+            return planes.pop().unwrap_or_default();
+        }
+        let most = |f: fn(&Duty) -> f64| planes.iter().map(f).fold(0.0, f64::max);
+        let most_opt = |f: fn(&Duty) -> Option<f64>| planes.iter().filter_map(f).reduce(f64::max);
+        let governing = planes
+            .iter()
+            .max_by(|a, b| a.peak_contact_force_n.total_cmp(&b.peak_contact_force_n))
+            .cloned()
+            .unwrap_or_default();
+        Duty {
+            contact_time_s: most(|d| d.contact_time_s),
+            peak_contact_force_n: governing.peak_contact_force_n,
+            peak_race_pressure_mpa: governing.peak_race_pressure_mpa,
+            race_contact_half_width_mm: governing.race_contact_half_width_mm,
+            peak_ball_load_n: most_opt(|d| d.peak_ball_load_n),
+            peak_ball_pressure_mpa: most_opt(|d| d.peak_ball_pressure_mpa),
+            friction_energy_j: most(|d| d.friction_energy_j),
+            race_peak_speed_rpm: most(|d| d.race_peak_speed_rpm),
+            race_peak_accel_rad_s2: most(|d| d.race_peak_accel_rad_s2),
+            ball_cycles: most_opt(|d| d.ball_cycles),
+            planes,
+        }
+    }
+}
+
+impl Sink for DutySink<'_> {
+    fn sample(&mut self, record: &crate::trace::Record) {
+        self.inner.sample(record);
+    }
+
+    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
+        self.inner.planar_state(model, t, y);
+        let ev = model.evaluate(t, y);
+        let sample = PlaneSample {
+            params: &model.params,
+            normal: ev.contact.normal,
+            tangential: ev.contact.tangential,
+            rotor: (Vector2::new(y[ix::XR], y[ix::YR]), Vector2::new(y[ix::VXR], y[ix::VYR])),
+            race: (Vector2::new(y[ix::XB], y[ix::YB]), Vector2::new(y[ix::VXB], y[ix::VYB])),
+            rotor_speed: y[ix::WR],
+            race_angle: y[ix::TB],
+            race_speed: y[ix::WB],
+            race_accel: ev.dy[ix::WB],
+        };
+        let bearing = self.bearing;
+        self.plane(0).push(&bearing, t, &sample);
+    }
+
+    fn two_plane_state(&mut self, model: &two_plane::Model, t: f64, y: &two_plane::State) {
+        self.inner.two_plane_state(model, t, y);
+        use two_plane::ix;
+        let ev = model.evaluate(t, y);
+        let bearing = self.bearing;
+        for (i, plane) in model.params.planes.iter().enumerate() {
+            let race = ix::RACE[i];
+            let sample = PlaneSample {
+                params: &plane.params,
+                normal: ev.planes[i].contact.normal,
+                tangential: ev.planes[i].contact.tangential,
+                rotor: two_plane::at_station(y, plane.station),
+                race: (Vector2::new(y[race], y[race + 1]), Vector2::new(y[race + ix::V], y[race + 1 + ix::V])),
+                rotor_speed: y[ix::WR],
+                race_angle: y[race + 2],
+                race_speed: y[race + 2 + ix::V],
+                race_accel: ev.dy[race + 2 + ix::V],
+            };
+            self.plane(i).push(&bearing, t, &sample);
         }
     }
 }

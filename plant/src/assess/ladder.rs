@@ -147,8 +147,12 @@ pub struct Rung {
     pub numerically_sensitive: usize,
     /// The rung was decided (false: the ladder was interrupted).
     pub complete: bool,
-    /// The duty over the counted members.
+    /// The duty over the counted members (two-plane rotor: each figure the larger bearing's).
     pub duty: RungDuty,
+    /// The two-plane rotor: each touchdown bearing's duty over the counted members, A then B;
+    /// empty for the planar model.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub duty_planes: Vec<RungDuty>,
 }
 
 /// The ladder's result.
@@ -359,6 +363,9 @@ pub fn ladder(
             numerically_sensitive: stats.numerically_sensitive,
             complete: decided[i],
             duty: rung_duty(&duties),
+            duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
+                .map(|k| rung_duty(&duties.iter().map(|d| &d.planes[k]).collect::<Vec<_>>()))
+                .collect(),
         });
     }
     let safe_up_to_g = rungs.iter().take_while(|r| r.complete && r.p_lo >= settings.min_p).last().map(|r| r.peak_g);

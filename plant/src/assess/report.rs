@@ -22,12 +22,18 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
             let worst = s
                 .axes
                 .iter()
-                .max_by_key(|a| match a.zone.as_str() {
-                    "A" => 0,
-                    "B" => 1,
-                    "C" => 2,
-                    "D" => 3,
-                    _ => 4,
+                // The worst zone, and within it the highest peak (of 2 or 4 axes).
+                .max_by(|a, b| {
+                    let rank = |a: &super::sensitivity::AxisResult| match a.zone.as_str() {
+                        "A" => 0,
+                        "B" => 1,
+                        "C" => 2,
+                        "D" => 3,
+                        _ => 4,
+                    };
+                    let peak =
+                        |a: &super::sensitivity::AxisResult| a.peak.as_ref().map_or(f64::NEG_INFINITY, |p| p.s_db);
+                    rank(a).cmp(&rank(b)).then(peak(a).total_cmp(&peak(b)))
                 })
                 .map(|a| {
                     a.peak.as_ref().map_or(format!("{} ({} at {:.0} Hz)", a.zone, a.axis, a.speed_hz), |p| {
@@ -52,7 +58,8 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
         (None, status) => parts.push(format!("sensitivity {status}")),
     }
     if let Some(v) = &r.vibration.result {
-        parts.push(format!("vibration zone {} ({:.1} µm, {:.2} C_min)", v.zone, v.peak_um, v.ratio));
+        let plane = if v.planes.len() > 1 { format!(" at plane {}", v.plane) } else { String::new() };
+        parts.push(format!("vibration zone {} ({:.1} µm, {:.2} C_min{plane})", v.zone, v.peak_um, v.ratio));
     } else if r.vibration.status != "skipped" {
         parts.push(format!("vibration {}", r.vibration.status));
     }
@@ -220,13 +227,9 @@ fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotErro
         });
     }
     if let Some(cf) = &s.closed_form {
-        lines.push(Line {
-            label: "|S| closed form".into(),
-            points: cf.curve.clone(),
-            colour: BLACK,
-            dashed: true,
-            width: 2,
-        });
+        // The two-plane rotor: plane A's load share as a planar rotor, not the coupled loop.
+        let label = if s.closed_form_planes.is_empty() { "|S| closed form" } else { "|S| closed form, plane A alone" };
+        lines.push(Line { label: label.into(), points: cf.curve.clone(), colour: BLACK, dashed: true, width: 2 });
     }
     if lines.iter().all(|l| l.points.is_empty()) {
         return Ok(false);
@@ -441,7 +444,7 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             esc(c.sensitivity.why.as_deref().unwrap_or(""))
         ),
     });
-    row(&mut h, "closed form (where the law has one)", &|c| match c
+    row(&mut h, "closed form (where the law has one; two-plane: plane A's load share alone)", &|c| match c
         .sensitivity
         .result
         .as_ref()
@@ -455,6 +458,23 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
     });
     row(&mut h, "vibration (ISO 14839-2)", &|c| {
         match &c.vibration.result {
+        Some(v) if v.planes.len() > 1 => format!(
+            "zone <b>{}</b> (plane {}): {} at {:.0} Hz; coil current swing {} A (RMS {} A; x_A / y_A / x_B / y_B) of {:.1} A",
+            v.zone,
+            v.plane,
+            v.planes
+                .iter()
+                .map(|p| format!(
+                    "plane {}: {:.2} µm = {:.3} C_min (C_min = {:.0} µm), zone {}",
+                    p.plane, p.peak_um, p.ratio, p.clearance_um, p.zone
+                ))
+                .collect::<Vec<_>>()
+                .join("; "),
+            v.speed_hz,
+            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.current_limit_a
+        ),
         Some(v) => format!(
             "zone <b>{}</b>: {:.2} µm = {:.3} C_min (C_min = {:.0} µm) at {:.0} Hz; coil current swing {} A (RMS {} A) of {:.1} A",
             v.zone,
@@ -504,14 +524,28 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             let Some(l) = &c.ladder.result else { continue };
             let _ = writeln!(h, "<h3>{}</h3><table><tr><th>peak (G)</th><th>members</th><th>P(recovered) [95 %]</th><th>modes R/W/B/D</th><th>recovery median / p90 (ms)</th><th>contact (ms)</th><th>peak force (N)</th><th>rotor–race pressure (MPa)</th><th>most loaded ball (N / MPa)</th><th>friction energy (J)</th><th>race peak speed (rpm)</th><th>race peak accel. (krad/s²)</th><th>ball-load cycles ≥ {:.0} % Q₀</th></tr>",
                 esc(&c.label), r.bearing.map_or(50.0, |b| b.capacity_fraction * 100.0));
+            let mp = |s: &super::ladder::Spread, k: f64, dig: usize| {
+                format!("{} [{}]", num(s.median.map(|v| v * k), dig), num(s.p90.map(|v| v * k), dig))
+            };
+            // The duty's cells of one rung (or of one of the two-plane rotor's bearings).
+            let duty_cells = |d: &super::ladder::RungDuty| {
+                format!(
+                    "<td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+                    mp(&d.contact_time_s, 1e3, 1),
+                    mp(&d.peak_contact_force_n, 1.0, 0),
+                    mp(&d.peak_race_pressure_mpa, 1.0, 0),
+                    num(d.peak_ball_load_n.median, 0),
+                    num(d.peak_ball_pressure_mpa.median, 0),
+                    mp(&d.friction_energy_j, 1.0, 2),
+                    mp(&d.race_peak_speed_rpm, 1.0, 0),
+                    mp(&d.race_peak_accel_rad_s2, 1e-3, 0),
+                    mp(&d.ball_cycles, 1.0, 1),
+                )
+            };
             for x in &l.rungs {
-                let d = &x.duty;
-                let mp = |s: &super::ladder::Spread, k: f64, dig: usize| {
-                    format!("{} [{}]", num(s.median.map(|v| v * k), dig), num(s.p90.map(|v| v * k), dig))
-                };
                 let _ = writeln!(
                     h,
-                    "<tr><td>{}</td><td>{}{}</td><td>{:.2} [{:.2}, {:.2}]</td><td>{}/{}/{}/{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    "<tr><td>{}</td><td>{}{}</td><td>{:.2} [{:.2}, {:.2}]</td><td>{}/{}/{}/{}</td><td>{} / {}</td>{}</tr>",
                     x.peak_g,
                     x.members,
                     if x.complete { "" } else { " (incomplete)" },
@@ -524,16 +558,18 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
                     x.diverged,
                     num(x.recovery_median_s.map(|v| v * 1e3), 1),
                     num(x.recovery_p90_s.map(|v| v * 1e3), 1),
-                    mp(&d.contact_time_s, 1e3, 1),
-                    mp(&d.peak_contact_force_n, 1.0, 0),
-                    mp(&d.peak_race_pressure_mpa, 1.0, 0),
-                    num(d.peak_ball_load_n.median, 0),
-                    num(d.peak_ball_pressure_mpa.median, 0),
-                    mp(&d.friction_energy_j, 1.0, 2),
-                    mp(&d.race_peak_speed_rpm, 1.0, 0),
-                    mp(&d.race_peak_accel_rad_s2, 1e-3, 0),
-                    mp(&d.ball_cycles, 1.0, 1),
+                    duty_cells(&x.duty),
                 );
+                // The two-plane rotor: each touchdown bearing's own duty under the rung's
+                // (which holds, figure by figure, the larger of the two).
+                for (k, d) in x.duty_planes.iter().enumerate() {
+                    let _ = writeln!(
+                        h,
+                        "<tr class=\"note\"><td></td><td colspan=\"4\">touchdown bearing {}</td>{}</tr>",
+                        ["A", "B"][k.min(1)],
+                        duty_cells(d)
+                    );
+                }
             }
             let _ = writeln!(h, "</table>");
         }

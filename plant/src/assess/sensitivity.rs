@@ -34,8 +34,8 @@
 //! half-power width is `2ζ f`: at 0.2 % spacing the nearest point of a peak with ζ = 0.004 is
 //! within 0.1 % of it, 0.3 dB below it, and the parabola's vertex closer.
 
-use crate::hooks::Hooks;
-use crate::model::{ix, Model, SensorSine, State};
+use crate::hooks::{Excitation, Hooks};
+use crate::model::SensorSine;
 use crate::run::Sink;
 use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
 use serde::Serialize;
@@ -462,7 +462,7 @@ impl<'a> Measure<'a> {
         }
     }
 
-    fn tick(&mut self, t: f64, u: f64) -> Option<SensorSine> {
+    fn tick(&mut self, t: f64, u: f64) -> Option<Excitation> {
         if let Phase::Probe = self.phase {
             self.probe.push((t, u));
             if t + 0.5 * self.period >= self.settings.probe_s {
@@ -544,14 +544,13 @@ impl<'a> Measure<'a> {
         self.sine()
     }
 
-    /// The sine in force now.
-    fn sine(&self) -> Option<SensorSine> {
+    /// The sine in force now, on the axis' plane (axes 0, 1: plane A's x, y; 2, 3: plane B's).
+    fn sine(&self) -> Option<Excitation> {
         let Phase::Step(step) = &self.phase else { return None };
         let mut amplitude_v = [0.0; 2];
-        if let Some(a) = amplitude_v.get_mut(self.axis) {
-            *a = step.amplitude;
-        }
-        Some(SensorSine { amplitude_v, omega_rad_s: step.omega, phase_rad: step.theta0 - step.omega * step.t0 })
+        amplitude_v[self.axis % 2] = step.amplitude;
+        let sine = SensorSine { amplitude_v, omega_rad_s: step.omega, phase_rad: step.theta0 - step.omega * step.t0 };
+        Some(Excitation { plane: self.axis / 2, sine })
     }
 }
 
@@ -563,7 +562,7 @@ impl Hooks for Measure<'_> {
             || self.abandon.is_some_and(|a| a.load(Ordering::Relaxed))
     }
 
-    fn excitation(&mut self, _k: u64, t: f64, sensor_v: &[f64]) -> Option<SensorSine> {
+    fn excitation(&mut self, _k: u64, t: f64, sensor_v: &[f64]) -> Option<Excitation> {
         if let Some(t_touch) = self.touched.get() {
             if self.error.is_none() {
                 match &self.phase {
@@ -594,20 +593,19 @@ impl Hooks for Measure<'_> {
     }
 }
 
-/// A sink that notes the first rotor – race contact (the rotor and the race's centres farther
-/// apart than the air gap).
+/// A sink that notes the first rotor – race contact on any bearing plane (the rotor at the
+/// bearing and the race's centre farther apart than the plane's air gap, `gaps[i]`).
 pub struct ContactWatch {
     /// When the rotor first touched (s).
     pub touched: Rc<Cell<Option<f64>>>,
+    /// Each plane's air gap (m).
+    pub gaps: Vec<f64>,
 }
 
 impl Sink for ContactWatch {
-    fn sample(&mut self, _record: &crate::trace::Record) {}
-
-    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
-        let d = (y[ix::XR] - y[ix::XB]).hypot(y[ix::YR] - y[ix::YB]);
-        if d > model.params.contact.gap && self.touched.get().is_none() {
-            self.touched.set(Some(t));
+    fn sample(&mut self, record: &crate::trace::Record) {
+        if self.touched.get().is_none() && super::vibration::touching(record, &self.gaps) {
+            self.touched.set(Some(record.a[crate::trace::col::T_S]));
         }
     }
 }

@@ -7,10 +7,11 @@
 //! The run: the scene at its rotor speed with the shocks moved past its end, on the members'
 //! fast setting; the first `settle_s` are left out (the start from the continuous design's
 //! unbalance orbit settles under a sampled law), the figures come from the following `window_s`.
-//! A rotor that touches the touchdown bearing in this run is **not levitated**.
+//! A rotor that touches a touchdown bearing in this run is **not levitated**. The two-plane
+//! rotor is graded at each bearing plane against its own clearance; the worst plane governs.
 
-use crate::model::{ix, Model, State};
 use crate::run::Sink;
+use crate::trace::{col, Record};
 use serde::Serialize;
 
 /// The ISO 14839-2 zone of a displacement ratio `d / C_min`.
@@ -23,20 +24,21 @@ pub fn zone(ratio: f64) -> &'static str {
     }
 }
 
-/// The vibration figures.
+/// The vibration figures: the governing plane's (the largest `peak / C_min`) at the top,
+/// each bearing plane's in `planes` (one for the planar model).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Vibration {
     /// Rotor speed (Hz).
     pub speed_hz: f64,
-    /// Peak of the orbit over the window (µm).
+    /// Peak of the orbit over the window (µm), at the governing plane.
     pub peak_um: f64,
-    /// Minimum radial clearance C_min (µm).
+    /// Minimum radial clearance C_min (µm) of the governing plane.
     pub clearance_um: f64,
-    /// `peak / C_min`.
+    /// `peak / C_min` of the governing plane.
     pub ratio: f64,
-    /// `A` … `D`.
+    /// `A` … `D`: the governing plane's, the worst.
     pub zone: String,
-    /// Mean coil current per axis (A).
+    /// Mean coil current per axis (A): x, y of each plane in order.
     pub current_mean_a: Vec<f64>,
     /// Largest swing of the coil current about its mean per axis (A).
     pub current_swing_a: Vec<f64>,
@@ -48,77 +50,133 @@ pub struct Vibration {
     pub settle_s: f64,
     /// Window (s).
     pub window_s: f64,
+    /// The governing plane (`A` or `B`; the planar model: `A`).
+    pub plane: String,
+    /// Each plane's peak, clearance, ratio and zone.
+    pub planes: Vec<PlaneVibration>,
+}
+
+/// One bearing plane's vibration.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlaneVibration {
+    /// `A` or `B`.
+    pub plane: String,
+    /// Peak of the orbit at the bearing over the window (µm).
+    pub peak_um: f64,
+    /// The plane's minimum radial clearance C_min (µm).
+    pub clearance_um: f64,
+    /// `peak / C_min`.
+    pub ratio: f64,
+    /// `A` … `D`.
+    pub zone: String,
+}
+
+/// Whether the rotor at any plane's bearing is farther from the race's centre than that plane's
+/// air gap `gaps[i]` (m) in `record`.
+pub fn touching(record: &Record, gaps: &[f64]) -> bool {
+    (0..record.planes()).any(|i| {
+        let r = record.plane(i);
+        let d = (r[col::DX_M] - r[col::XB_M]).hypot(r[col::DY_M] - r[col::YB_M]);
+        gaps.get(i).is_some_and(|g| d > *g)
+    })
 }
 
 /// Takes the figures over `[from, ∞)` and notes the first contact.
 pub struct VibrationSink {
     from: f64,
+    gaps: Vec<f64>,
     /// First contact (s).
     pub touched: Option<f64>,
-    peak: f64,
+    peak: Vec<f64>,
     n: f64,
-    sum: [f64; 2],
-    sum2: [f64; 2],
-    min: [f64; 2],
-    max: [f64; 2],
+    sum: Vec<f64>,
+    sum2: Vec<f64>,
+    min: Vec<f64>,
+    max: Vec<f64>,
 }
 
 impl VibrationSink {
-    /// Figures from time `from` (s).
-    pub fn new(from: f64) -> Self {
+    /// Figures from time `from` (s), for planes of air gaps `gaps` (m).
+    pub fn new(from: f64, gaps: Vec<f64>) -> Self {
+        let axes = 2 * gaps.len();
         Self {
             from,
+            peak: vec![0.0; gaps.len()],
+            gaps,
             touched: None,
-            peak: 0.0,
             n: 0.0,
-            sum: [0.0; 2],
-            sum2: [0.0; 2],
-            min: [f64::INFINITY; 2],
-            max: [f64::NEG_INFINITY; 2],
+            sum: vec![0.0; axes],
+            sum2: vec![0.0; axes],
+            min: vec![f64::INFINITY; axes],
+            max: vec![f64::NEG_INFINITY; axes],
         }
     }
 
-    /// The figures; `clearance` (m), `limit` (A), speed (Hz), settle and window (s).
-    pub fn figures(&self, clearance: f64, limit: f64, speed_hz: f64, settle_s: f64, window_s: f64) -> Vibration {
-        let mean: Vec<f64> = self.sum.iter().map(|s| s / self.n.max(1.0)).collect();
-        let rms = (0..2).map(|k| (self.sum2[k] / self.n.max(1.0) - mean[k] * mean[k]).max(0.0).sqrt()).collect();
-        let swing = (0..2).map(|k| (self.max[k] - mean[k]).max(mean[k] - self.min[k])).collect();
-        let ratio = self.peak / clearance;
+    /// The figures; current `limit` (A), speed (Hz), settle and window (s).
+    pub fn figures(&self, limit: f64, speed_hz: f64, settle_s: f64, window_s: f64) -> Vibration {
+        let n = self.n.max(1.0);
+        let axes = self.sum.len();
+        let mean: Vec<f64> = self.sum.iter().map(|s| s / n).collect();
+        let rms = (0..axes).map(|k| (self.sum2[k] / n - mean[k] * mean[k]).max(0.0).sqrt()).collect();
+        let swing = (0..axes).map(|k| (self.max[k] - mean[k]).max(mean[k] - self.min[k])).collect();
+        let planes: Vec<PlaneVibration> = self
+            .peak
+            .iter()
+            .zip(&self.gaps)
+            .enumerate()
+            .map(|(i, (peak, gap))| PlaneVibration {
+                plane: ["A", "B"][i.min(1)].into(),
+                peak_um: peak * 1e6,
+                clearance_um: gap * 1e6,
+                ratio: peak / gap,
+                zone: zone(peak / gap).into(),
+            })
+            .collect();
+        let worst = planes.iter().max_by(|a, b| a.ratio.total_cmp(&b.ratio)).cloned().unwrap_or(PlaneVibration {
+            plane: "A".into(),
+            peak_um: 0.0,
+            clearance_um: 0.0,
+            ratio: f64::NAN,
+            zone: "none".into(),
+        });
         Vibration {
             speed_hz,
-            peak_um: self.peak * 1e6,
-            clearance_um: clearance * 1e6,
-            ratio,
-            zone: zone(ratio).to_string(),
+            peak_um: worst.peak_um,
+            clearance_um: worst.clearance_um,
+            ratio: worst.ratio,
+            zone: worst.zone,
             current_mean_a: mean,
             current_swing_a: swing,
             current_rms_a: rms,
             current_limit_a: limit,
             settle_s,
             window_s,
+            plane: worst.plane,
+            planes,
         }
     }
 }
 
 impl Sink for VibrationSink {
-    fn sample(&mut self, _record: &crate::trace::Record) {}
-
-    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
-        let d = (y[ix::XR] - y[ix::XB]).hypot(y[ix::YR] - y[ix::YB]);
-        if d > model.params.contact.gap && self.touched.is_none() {
+    fn sample(&mut self, record: &Record) {
+        let t = record.a[col::T_S];
+        if self.touched.is_none() && touching(record, &self.gaps) {
             self.touched = Some(t);
         }
         if t < self.from {
             return;
         }
-        self.peak = self.peak.max(y[ix::XR].hypot(y[ix::YR]));
-        let i = model.evaluate(t, y).current;
         self.n += 1.0;
-        for (k, &a) in i.iter().enumerate() {
-            self.sum[k] += a;
-            self.sum2[k] += a * a;
-            self.min[k] = self.min[k].min(a);
-            self.max[k] = self.max[k].max(a);
+        for i in 0..record.planes().min(self.gaps.len()) {
+            let r = record.plane(i);
+            self.peak[i] = self.peak[i].max(r[col::DX_M].hypot(r[col::DY_M]));
+            for (j, a) in [r[col::IX_A], r[col::IY_A]].into_iter().enumerate() {
+                let k = 2 * i + j;
+                self.sum[k] += a;
+                self.sum2[k] += a * a;
+                self.min[k] = self.min[k].min(a);
+                self.max[k] = self.max[k].max(a);
+            }
         }
     }
 }
