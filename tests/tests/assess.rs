@@ -58,6 +58,9 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
     }
     assert_eq!(s["closed_form"]["stable"], false);
     assert!(c[1]["verdict"].as_str().expect("verdict").contains("UNSTABLE"));
+    // Its orbit is a growing transient, not a vibration: measured, not graded.
+    assert_eq!(c[1]["vibration"]["result"]["zone"], "not graded (unstable loop)", "{}", c[1]["vibration"]);
+    assert!(["A", "B", "C", "D"].contains(&c[0]["vibration"]["result"]["zone"].as_str().expect("zone")));
     // Vibration and ladder with the duty, for both.
     for k in c {
         assert_eq!(k["vibration"]["status"], "measured", "{}", k["vibration"]);

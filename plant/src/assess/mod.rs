@@ -494,6 +494,9 @@ fn sensitivity_part(
     Ok(part)
 }
 
+/// The vibration zone of a loop the sensitivity part measured unstable: not graded.
+pub const UNSTABLE_ZONE: &str = "not graded (unstable loop)";
+
 /// The vibration part: the levitated rotor at its speed without shock.
 fn vibration_part(
     scene: &Scene,
@@ -598,7 +601,15 @@ fn assess_controller(
         log(&format!("{}: vibration (ISO 14839-2)", c.label));
         let t = Instant::now();
         report.vibration = match vibration_part(&scene, decay_at_speed, stop) {
-            Ok(v) => PartOutcome::measured(v, t.elapsed().as_secs_f64()),
+            Ok(mut v) => {
+                // A loop the sensitivity part found unstable has no steady orbit: its window is a
+                // growing transient, not a vibration to grade.
+                if decay_at_speed.is_some_and(|s| s < 0.0) {
+                    v.zone = UNSTABLE_ZONE.into();
+                    v.planes.iter_mut().for_each(|p| p.zone = UNSTABLE_ZONE.into());
+                }
+                PartOutcome::measured(v, t.elapsed().as_secs_f64())
+            }
             Err((kind, why)) => {
                 levitated = kind != Failure::NotGradable;
                 PartOutcome::failed(kind, why, t.elapsed().as_secs_f64())
