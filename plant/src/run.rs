@@ -257,21 +257,21 @@ pub fn run_into(
             if scene.controller.cosim.command.is_none() {
                 build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?;
             }
-            Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene)?, hooks)?))
+            Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene, &plane_gains(scene)?), hooks)?))
         }
     };
     run_from(scene, source, hooks, sink)
 }
 
-/// The bias currents per axis (A), each plane's within its limit (unused axes 0).
-fn bias_of(scene: &Scene) -> Result<[f64; ROTOR_AXES], SetupError> {
-    let gains = plane_gains(scene)?;
+/// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
+/// limit (unused axes 0).
+fn bias_of(scene: &Scene, gains: &[PdGains]) -> [f64; ROTOR_AXES] {
     let mut bias = [0.0; ROTOR_AXES];
     for (i, g) in gains.iter().enumerate() {
         let b = saturate(g.bias_a, scene.plane(i).current_limit);
         bias[2 * i..2 * i + 2].copy_from_slice(&b);
     }
-    Ok(bias)
+    bias
 }
 
 /// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
@@ -303,7 +303,7 @@ fn run_from(
     };
     let scene = effective.as_ref().unwrap_or(scene);
     let gains = plane_gains(scene)?;
-    let bias = bias_of(scene)?;
+    let bias = bias_of(scene, &gains);
     let limits = scene.rotor_design().current_limits();
     if let (Source::Cosim(session), Some(_)) = (&mut source, &effective) {
         session.adopt(bias, limits);
@@ -329,9 +329,9 @@ fn run_from(
                 let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
                 let y = wired.initial(&y);
                 let settings = settings_with(scene, extended::<{ crate::model::N }, NA>(scene.integrator.atol, p, v));
-                return drive(scene, wired, y, settings, source, (bias, limits), hooks, sink);
+                return drive(scene, wired, y, settings, source, (bias, limits), &gains, hooks, sink);
             }
-            drive(scene, model, y, integrator_settings(scene), source, (bias, limits), hooks, sink)
+            drive(scene, model, y, integrator_settings(scene), source, (bias, limits), &gains, hooks, sink)
         }
         Some(params) => {
             let model = two_plane::Model {
@@ -346,10 +346,10 @@ fn run_from(
                 let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
                 let y = wired.initial(&y);
                 let atol = extended::<{ two_plane::N }, NA>(scene.integrator.two_plane_atol(), p, v);
-                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), hooks, sink);
+                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), &gains, hooks, sink);
             }
             let settings = settings_with(scene, scene.integrator.two_plane_atol());
-            drive(scene, model, y, settings, source, (bias, limits), hooks, sink)
+            drive(scene, model, y, settings, source, (bias, limits), &gains, hooks, sink)
         }
     }
 }
@@ -383,15 +383,11 @@ fn drive<const N: usize, M: Machine<N>>(
     settings: Settings<N>,
     mut source: Source,
     (bias, limits): ([f64; ROTOR_AXES], [f64; ROTOR_AXES]),
+    gains: &[PdGains],
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
     let planes = M::PLANES;
-    // Each plane's continuous PD, for an excitation hook (ISO 14839-3's summing point).
-    let continuous_gains = match source {
-        Source::Continuous => plane_gains(scene)?,
-        _ => Vec::new(),
-    };
     // The plane whose continuous PD read the previous tick's sine.
     let mut excited: Option<usize> = None;
     let mut integrator = Integrator::new(settings);
@@ -439,14 +435,15 @@ fn drive<const N: usize, M: Machine<N>>(
         let t1 = ((k + 1) as f64 * period).min(scene.duration);
         // Every axis's sensor (the planes in order, one noise sequence) and the keyphasor: the
         // rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let (angle, speed) = model.spin(&y);
         let mut sample = RotorSample {
             seq: k,
             t_s: t0,
             axes: 2 * planes as u32,
-            speed_rad_s: model.spin(&y).1,
+            speed_rad_s: speed,
+            angle_rad: wrap_angle(angle),
             ..Default::default()
         };
-        sample.angle_rad = wrap_angle(model.spin(&y).0);
         // Every axis's sensor, in every mode: the continuous PD reads the exact state inside the
         // derivative, but an excitation hook reads the sensor signal there too.
         for i in 0..planes {
@@ -464,10 +461,10 @@ fn drive<const N: usize, M: Machine<N>>(
         if let Source::Continuous = &source {
             // The plane excited before goes back to its plain PD, the one excited now reads its sine.
             if let Some(i) = excited.filter(|i| excitation.is_none_or(|e| e.plane != *i)) {
-                model.set_control(i, Control::Continuous(continuous_gains[i]));
+                model.set_control(i, Control::Continuous(gains[i]));
             }
             if let Some(e) = excitation {
-                model.set_control(e.plane, Control::ContinuousExcited(continuous_gains[e.plane], e.sine));
+                model.set_control(e.plane, Control::ContinuousExcited(gains[e.plane], e.sine));
             }
             excited = excitation.map(|e| e.plane);
         }

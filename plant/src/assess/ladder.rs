@@ -125,9 +125,9 @@ pub struct Rung {
     pub members: usize,
     /// Members recovered.
     pub recovered: usize,
-    /// Members in dry whirl, rebounding, diverged.
+    /// Members in dry whirl.
     pub dry_whirl: usize,
-    /// Rebounding.
+    /// Members rebounding.
     pub rebound: usize,
     /// Diverged (also at the reference setting).
     pub diverged: usize,
