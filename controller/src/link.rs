@@ -420,6 +420,32 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
     }
 }
 
+/// Asks the kernel to keep every core's idle wake-up latency at 0 µs while the returned
+/// file is open (the PM QoS request of `/dev/cpu_dma_latency`, as `cyclictest` makes it):
+/// an idle core then polls instead of halting, and a timer or a peer's frame wakes it in
+/// microseconds. Closing the file (dropping it) withdraws the request.
+pub fn hold_zero_idle_latency() -> Result<std::fs::File, String> {
+    use std::io::Write;
+    let mut f = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/cpu_dma_latency")
+        .map_err(|e| format!("/dev/cpu_dma_latency: {e}"))?;
+    f.write_all(&0i32.to_ne_bytes()).map_err(|e| format!("/dev/cpu_dma_latency: {e}"))?;
+    Ok(f)
+}
+
+/// Sleeps until `CLOCK_MONOTONIC` reads `ns` (the clock of [`crate::wire::monotonic_ns`]):
+/// an absolute `clock_nanosleep`, so a late wake-up does not add to the next one.
+pub fn sleep_until_ns(ns: u64) {
+    let target =
+        libc::timespec { tv_sec: (ns / 1_000_000_000) as libc::time_t, tv_nsec: (ns % 1_000_000_000) as libc::c_long };
+    // SAFETY: `target` is a valid timespec; the remaining-time pointer may be null with
+    // TIMER_ABSTIME. EINTR (a signal) sleeps again: the caller checks its flags per tick.
+    while unsafe { libc::clock_nanosleep(libc::CLOCK_MONOTONIC, libc::TIMER_ABSTIME, &target, std::ptr::null_mut()) }
+        == libc::EINTR
+    {}
+}
+
 /// Pins the calling thread to one CPU core.
 pub fn pin_to_core(core: usize) -> Result<(), String> {
     // SAFETY: cpu_set_t is plain data; CPU_ZERO/CPU_SET write inside it;

@@ -964,6 +964,37 @@ fn a_realtime_run_past_its_miss_budget_exits_6() {
     assert!(num(&s["cosim"], "deadline_miss_fraction") > 0.1, "{s:#}");
 }
 
+/// Issue 22: `controller.pacing = "sleep"` lets the plant and the controller share one core:
+/// the plant sleeps to each tick and the controller blocks between frames (it never spins:
+/// the unit test of `controller_spin` holds that rule). The run completes with the two on
+/// one core, the controller answered, and `summary.json` says how the run was paced. A
+/// pacing that does not exist is refused, naming the key, the value and the choices.
+#[test]
+fn a_sleeping_realtime_run_shares_one_core() {
+    controller_bin();
+    let dir = TempDir::new("cosim-sleep");
+    let out = dir.join("run");
+    let run = output(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=realtime", "controller.pacing=\"sleep\"", "controller.pin_cores=[0, 0]"]),
+    ));
+    assert_exit(&run, 0);
+    let c = &read_json(&out.join("summary.json"))["cosim"];
+    assert_eq!(c["scheduling"]["pacing"], "sleep", "{c:#}");
+    assert!(num(c, "messages_received") > 0.0, "{c:#}");
+
+    let bad = output(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &dir.join("bad"),
+        &sets(&["controller.mode=realtime", "controller.pacing=\"nap\""]),
+    ));
+    assert_exit(&bad, 2);
+    let err = stderr(&bad);
+    assert!(err.contains("controller.pacing") && err.contains("nap") && err.contains("sleep"), "{err}");
+    assert!(!dir.join("bad").join("trace.csv").exists(), "a refused scene wrote a trace");
+}
+
 /// Issue 11 item 10: `controller.realtime_priority` puts both processes under SCHED_FIFO
 /// where the system permits it, and says so with a warning where it does not; either way the
 /// run completes and `summary.json` tells which.

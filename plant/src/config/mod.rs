@@ -18,7 +18,7 @@ pub mod validate;
 
 pub use overrides::apply_override;
 pub use raw::{
-    ControlMode, DragChoice, Fallback, ForceLaw, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
+    ControlMode, DragChoice, Fallback, ForceLaw, Pacing, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
     ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
 pub use validate::{finite, non_negative, positive, range, validate};
@@ -139,6 +139,8 @@ pub struct CosimSettings {
     /// Realtime: the largest fraction of ticks started more than a period late before the run
     /// ends (exit 10).
     pub max_overrun_fraction: f64,
+    /// Realtime: how the plant and the controller wait between ticks.
+    pub pacing: Pacing,
 }
 
 /// Integrator settings, validated (tolerances per state component).

@@ -347,6 +347,20 @@ pub enum ForceLaw {
     Nonlinear,
 }
 
+/// `controller.pacing`: how a realtime run waits between its ticks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pacing {
+    /// The plant busy-waits for each tick and the controller spins for at least 100
+    /// periods before it blocks: a core each, the shortest wake-up.
+    #[default]
+    Spin,
+    /// The plant sleeps to each tick (an absolute `clock_nanosleep`) and the controller
+    /// blocks between frames: both can share one core (`pin_cores = [c, c]`), and the
+    /// other cores stay free for the rest of the machine.
+    Sleep,
+}
+
 /// `controller.fallback`: what the plant applies when the controller process is lost.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -520,6 +534,9 @@ pub struct RawController {
     /// period late (plant overruns); past it the run ends with status `overrun_budget` (exit
     /// code 10); 1 is no limit.
     pub max_overrun_fraction: f64 = 1.0,
+    /// Co-simulation, realtime: `spin` (a core each, busy-waiting) or `sleep` (the plant
+    /// sleeps to each tick, the controller blocks between frames; both may share one core).
+    pub pacing: Pacing = Pacing::Spin,
 }
 }
 

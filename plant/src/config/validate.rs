@@ -182,6 +182,7 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
         realtime_priority: ctl.realtime_priority,
         max_miss_fraction: ctl.max_miss_fraction,
         max_overrun_fraction: ctl.max_overrun_fraction,
+        pacing: ctl.pacing,
     })
 }
 

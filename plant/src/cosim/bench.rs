@@ -40,6 +40,7 @@ pub fn bench_round_trips(
         realtime_priority: 0,
         max_miss_fraction: 1.0,
         max_overrun_fraction: 1.0,
+        pacing: crate::config::Pacing::Spin,
     };
     let bias = [0.0; ROTOR_AXES];
     let mut s = Session::open(ControlMode::Lockstep, settings, hello, launch, bias, hello.period_s, hooks)?;

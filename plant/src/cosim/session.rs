@@ -11,7 +11,7 @@ use super::log::OutputLog;
 use super::process::{Child, Program};
 use super::stats::{CosimReport, Figures, Scheduling};
 use super::{CosimError, PeerEvent};
-use crate::config::{ControlMode, CosimSettings, Fallback};
+use crate::config::{ControlMode, CosimSettings, Fallback, Pacing};
 use crate::hooks::Hooks;
 use controller::link::{self, Endpoint, Ipc, Mailbox, Peer};
 use controller::lock::RunLock;
@@ -93,6 +93,8 @@ pub struct Session {
     settings: CosimSettings,
     // Field order is drop order: ports before the node, the run-id lock last.
     pub(super) frames: Endpoint<SensorFrame, CommandFrame>,
+    /// Realtime with a priority: the open `/dev/cpu_dma_latency` request (0 µs) for the run.
+    _idle_latency: Option<std::fs::File>,
     handshake: Mailbox<Hello, Ack>,
     _node: Node<Ipc>,
     child: Option<Child>,
@@ -412,7 +414,7 @@ impl Session {
         let k = sample.seq;
         let start = *self.start.get_or_insert_with(Instant::now);
         let deadline = start + Duration::from_secs_f64(k as f64 * self.period);
-        pace_until(deadline);
+        pace_until(deadline, self.settings.pacing);
         let woke = Instant::now();
         self.woke = Some(woke);
         self.figures.ticks += 1;
@@ -630,8 +632,17 @@ fn controller_gone(run_id: &str, child: &mut Option<Child>, log: &mut OutputLog)
     Some(why.into())
 }
 
-/// Waits for a wall-clock instant: sleeps while it is far, then spins.
-fn pace_until(deadline: Instant) {
+/// Waits for a wall-clock instant. `spin`: sleeps while it is far, then spins.
+/// `sleep`: sleeps to it (an absolute `CLOCK_MONOTONIC` sleep, which a timer
+/// ends; under `SCHED_FIFO` without timer slack), leaving the core to others.
+fn pace_until(deadline: Instant, pacing: Pacing) {
+    if pacing == Pacing::Sleep {
+        let now = Instant::now();
+        if now < deadline {
+            link::sleep_until_ns(wire::monotonic_ns() + (deadline - now).as_nanos() as u64);
+        }
+        return;
+    }
     const SPIN: Duration = Duration::from_micros(200);
     loop {
         let now = Instant::now();

@@ -382,6 +382,13 @@ pub struct Scheduling {
     pub plant: String,
     /// The (last) controller's main thread, as the plant sees it.
     pub controller: String,
+    /// Realtime: `controller.pacing` (`spin` or `sleep`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pacing: Option<String>,
+    /// Realtime with a priority: the idle wake-up latency the run held every core to
+    /// through `/dev/cpu_dma_latency` (0 µs), absent where it could not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub idle_latency_us: Option<u32>,
     /// What the system refused (no `SCHED_FIFO`, no memory locking), if anything.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub refused: Vec<String>,

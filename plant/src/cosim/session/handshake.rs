@@ -4,7 +4,7 @@
 //! own fields.
 
 use super::{Session, RING};
-use crate::config::{ControlMode, CosimSettings, Scene};
+use crate::config::{ControlMode, CosimSettings, Pacing, Scene};
 use crate::cosim::log::OutputLog;
 use crate::cosim::process::{self, Child, Program};
 use crate::cosim::stats::{Figures, Scheduling};
@@ -32,7 +32,7 @@ pub fn hello_for(scene: &Scene, run_id: &str, token: u64) -> Result<Hello, Cosim
     let params = c.params.to_document()?;
     let mut hello = Hello::for_rotor(run_id, &c.law, &scene.rotor_design(), c.rate_hz, &params)?;
     hello.token = token;
-    hello.spin_ns = (controller_spin(c.mode, c.cosim.spin, c.period) * 1e9) as u64;
+    hello.spin_ns = (controller_spin(c.mode, c.cosim.pacing, c.cosim.spin, c.period) * 1e9) as u64;
     hello.mode = if c.mode == ControlMode::Realtime { mode::REALTIME } else { mode::LOCKSTEP };
     Ok(hello)
 }
@@ -46,9 +46,14 @@ const REALTIME_SPIN_PERIODS: f64 = 100.0;
 /// the scheduler (wake-affine), the two then share one core and most
 /// deadlines are missed (measured: 84 % misses at 20 kHz, against < 2 %
 /// spinning).
-fn controller_spin(mode: ControlMode, spin: f64, period: f64) -> f64 {
-    match mode {
-        ControlMode::Realtime => spin.max(REALTIME_SPIN_PERIODS * period),
+///
+/// With `controller.pacing = "sleep"` the controller never spins in realtime: it
+/// may share the plant's core, where a spinning controller would keep the plant
+/// (same `SCHED_FIFO` priority) from waking at its tick.
+fn controller_spin(mode: ControlMode, pacing: Pacing, spin: f64, period: f64) -> f64 {
+    match (mode, pacing) {
+        (ControlMode::Realtime, Pacing::Spin) => spin.max(REALTIME_SPIN_PERIODS * period),
+        (ControlMode::Realtime, Pacing::Sleep) => 0.0,
         _ => spin,
     }
 }
@@ -115,6 +120,26 @@ impl Session {
             }
         }
         scheduling.plant = link::policy(0).to_string();
+        let mut idle_latency = None;
+        if mode == ControlMode::Realtime {
+            scheduling.pacing = Some(format!("{:?}", settings.pacing).to_lowercase());
+            if settings.realtime_priority > 0 {
+                match link::hold_zero_idle_latency() {
+                    Ok(f) => {
+                        idle_latency = Some(f);
+                        scheduling.idle_latency_us = Some(0);
+                    }
+                    Err(e) => {
+                        hooks.note(&format!(
+                            "warning: controller.realtime_priority = {}: cannot hold the idle latency at 0 ({e}); \
+                             idle cores may wake slower",
+                            settings.realtime_priority
+                        ));
+                        scheduling.refused.push(format!("plant: {e}"));
+                    }
+                }
+            }
+        }
         let log = OutputLog::create(launch.log.as_deref()).map_err(|e| CosimError::Spawn {
             path: launch.log.clone().unwrap_or_default(),
             why: format!("cannot create the file for the controller's output: {e}"),
@@ -128,6 +153,7 @@ impl Session {
             frames,
             handshake,
             _node: node,
+            _idle_latency: idle_latency,
             child: None,
             program,
             log,
@@ -300,5 +326,21 @@ fn controller_overrides(ack: &Ack) -> Result<Option<toml::Table>, String> {
     match doc.remove("controller") {
         Some(toml::Value::Table(t)) if doc.is_empty() => Ok(Some(t)),
         _ => Err(format!("its overrides must be one [controller] table, got: {text}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A spinning realtime controller spins at least 100 periods; a sleeping one never spins
+    /// (it shares the plant's core); lockstep keeps `controller.spin_us`.
+    #[test]
+    fn the_controller_spins_only_where_it_owns_a_core() {
+        let period = 50e-6;
+        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Spin, 200e-6, period), 100.0 * period);
+        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Spin, 0.01, period), 0.01);
+        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Sleep, 200e-6, period), 0.0);
+        assert_eq!(controller_spin(ControlMode::Lockstep, Pacing::Sleep, 200e-6, period), 200e-6);
     }
 }
