@@ -499,8 +499,16 @@ impl Session {
                     }
                     if self.last_heard.elapsed() >= self.next_check {
                         self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
-                        if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
-                            return self.on_lost(sample, why, hooks);
+                        // A child of ours still running is alive: its exit is all there is to
+                        // watch, and a `waitpid` tells it. Listing the run's nodes reads the
+                        // file system (/tmp/iceoryx2) inside the tick, where a slow disk turns
+                        // a burst of misses into a longer one; an external controller has no
+                        // other sign of life.
+                        let running = self.child.as_mut().is_some_and(|c| c.exited().is_none());
+                        if !running {
+                            if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
+                                return self.on_lost(sample, why, hooks);
+                            }
                         }
                     }
                     self.last_cmd
