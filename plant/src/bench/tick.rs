@@ -18,7 +18,7 @@
 //! tick in contact (the rotor 2 µm into its race, the race free, the realtime setting's
 //! substeps) integrated from the same state as many times as the run has ticks. The work is
 //! identical every time, so its spread is the machine's: interrupts, the hypervisor, caches,
-//! other processes. Planar scenes only (a two-plane scene writes `tick.csv` alone).
+//! other processes. On a two-plane rotor both bearing planes are 2 µm into their races.
 
 use crate::analysis::classify::MotionMode;
 use crate::config::{load_scene, Scene};
@@ -103,6 +103,57 @@ pub struct TickRow {
     /// The machine's load average over the last minute when the run ended (`/proc/loadavg`).
     #[serde(with = "sci")]
     pub load_1min: f64,
+}
+
+/// [`repeat_contact_tick`] for the two-plane rotor: both bearing planes 2 µm into their races
+/// (straight down, the rotor level where the gaps are equal, tilted where they differ), the
+/// races free.
+fn repeat_two_plane_contact_tick(
+    scene: &Scene,
+    params: &plant_physics::two_plane::Params,
+    repeats: u64,
+) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+    use crate::model::Control;
+    use plant_physics::two_plane::{ix, Model};
+    let gains = crate::run::plane_gains(scene)?;
+    let bias = crate::run::bias_of(scene, &gains);
+    let model = Model {
+        params: params.clone(),
+        base: scene.base.clone(),
+        control: [Control::Held([bias[0], bias[1]]), Control::Held([bias[2], bias[3]])],
+        race_parked: [false; 2],
+    };
+    let y0 = two_plane_contact_state(scene, params);
+    let settings = crate::run::settings_with(scene, scene.integrator.two_plane_atol());
+    let mut integrator = crate::integrate::Integrator::new(settings);
+    integrator.set_substeps(scene.integrator.contact_substeps);
+    let (t0, t1) = (0.0, scene.controller.period);
+    let mut times = crate::cosim::Latencies::new();
+    for _ in 0..repeats {
+        let mut y = y0;
+        let start = std::time::Instant::now();
+        integrator.advance(&model, t0, t1, &mut y)?;
+        times.record(start.elapsed().as_nanos() as u64);
+        std::hint::black_box(&y);
+    }
+    Ok((times.percentiles(), integrator.stats().rhs_evals / repeats.max(1)))
+}
+
+/// The two-plane rotor's initial state with both bearing planes 2 µm into their races,
+/// straight down, and centred on them in x. Plane i's rotor position is `X + z_i a`,
+/// `Y + z_i b`: two planes, two unknowns per axis.
+fn two_plane_contact_state(
+    scene: &Scene,
+    params: &plant_physics::two_plane::Params,
+) -> plant_physics::two_plane::State {
+    use plant_physics::two_plane::ix;
+    let mut y = crate::initial::two_plane_initial_state(scene, params);
+    let [za, zb] = [params.planes[0].station, params.planes[1].station];
+    let line = |a: f64, b: f64| ((b - a) / (zb - za), a - za * (b - a) / (zb - za));
+    let want = |i: usize| y[ix::RACE[i] + 1] - params.planes[i].params.contact.gap - 2e-6;
+    (y[ix::SY], y[ix::Y]) = line(want(0), want(1));
+    (y[ix::SX], y[ix::X]) = line(y[ix::RACE_A], y[ix::RACE_B]);
+    y
 }
 
 /// Header of `repeat.csv`.
@@ -292,13 +343,11 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     crate::table::write_with_header(&path, TICK_HEADER, &rows)?;
 
     let (label, fixed) = &settings[0];
-    if fixed.two_plane.is_some() {
-        // The repeated tick is the planar model's; a two-plane rotor's is not built yet.
-        log("no repeat.csv: the repeated contact tick is the planar model's, not built for a two-plane rotor");
-        return Ok(path);
-    }
     let repeats = rows.first().map_or(1, |r| r.ticks.max(1));
-    let (p, rhs_evals) = repeat_contact_tick(fixed, repeats)?;
+    let (p, rhs_evals) = match &fixed.two_plane {
+        None => repeat_contact_tick(fixed, repeats)?,
+        Some(params) => repeat_two_plane_contact_tick(fixed, params, repeats)?,
+    };
     let repeat = RepeatRow {
         setting: format!("one contact tick repeated, {label}"),
         repeats: p.count,
@@ -324,4 +373,38 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     ));
     crate::table::write_with_header(&dir.join("repeat.csv"), REPEAT_HEADER, &[repeat])?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::Machine;
+
+    /// The repeated tick of a two-plane rotor starts with both planes in contact, each about
+    /// 2 µm into its race (the asymmetric scene: gaps of 150 and 250 µm, so the rotor tilts).
+    #[test]
+    fn the_two_plane_contact_tick_starts_with_both_planes_in_their_races() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
+        let scene = load_scene(&path, &[]).unwrap();
+        let params = scene.two_plane.as_ref().unwrap();
+        let y = two_plane_contact_state(&scene, params);
+        let model = plant_physics::two_plane::Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [crate::model::Control::Held([0.0; 2]); 2],
+            race_parked: [false; 2],
+        };
+        for i in 0..2 {
+            assert!(model.touching(&y, i), "plane {i} not in contact");
+            use plant_physics::two_plane::ix;
+            let z = params.planes[i].station;
+            let (x, yy) = (y[ix::X] + z * y[ix::SX], y[ix::Y] + z * y[ix::SY]);
+            let (dx, dy) = (x - y[ix::RACE[i]], yy - y[ix::RACE[i] + 1]);
+            let depth = dx.hypot(dy) - params.planes[i].params.contact.gap;
+            assert!(
+                (depth - 2e-6).abs() < 1e-9 && dx.abs() < 1e-12 && dy < 0.0,
+                "plane {i}: {depth} m in, ({dx}, {dy})"
+            );
+        }
+    }
 }
