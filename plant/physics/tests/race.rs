@@ -97,3 +97,42 @@ fn a_fixed_cage_keeps_its_balls_where_they_were_put() {
     assert_eq!(balls.loaded, 1, "{balls:?}");
     assert!((balls.on_race.y - hertz).abs() <= 1e-6 * hertz, "{balls:?}");
 }
+
+/// The race's rest position by bisection stops once its bracket no longer changes; the answer
+/// is the 200-halving bisection's bit for bit (written out here), for the study's race under
+/// gravity, under a 10 G shock in any direction and with the cage anywhere.
+#[test]
+fn the_rest_position_stops_early_with_the_full_bisections_answer() {
+    use nalgebra::Vector2;
+    use plant_physics::park::rest_position;
+    let p = study_params();
+    let full = |push: Vector2<f64>, cage: f64| {
+        let g = push.x.hypot(push.y);
+        let u = push / g;
+        let load = p.race_mass * g;
+        let resisting = |r: f64| -p.race_support(u * r, Vector2::zeros(), cage, 0.0).on_race.dot(&u);
+        let (mut lo, mut hi) = (p.balls.clearance, p.balls.clearance + 1e-3);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if resisting(mid) > load {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        u * (0.5 * (lo + hi))
+    };
+    let mut cases = 0;
+    for k in 0..24 {
+        let dir = TAU * k as f64 / 24.0;
+        for (push, cage) in [
+            (Vector2::new(0.0, -p.gravity), 0.1 * k as f64),
+            (98.1 * Vector2::new(dir.cos(), dir.sin()) - Vector2::new(0.0, p.gravity), 0.37 * k as f64),
+        ] {
+            let (a, b) = (rest_position(&p, push, cage), full(push, cage));
+            assert_eq!((a.x.to_bits(), a.y.to_bits()), (b.x.to_bits(), b.y.to_bits()), "push {push:?}, cage {cage}");
+            cases += 1;
+        }
+    }
+    assert_eq!(cases, 48);
+}
