@@ -39,6 +39,7 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "realtime_priority",
     "max_miss_fraction",
     "max_overrun_fraction",
+    "pacing",
     "max_invalid_burst",
     "max_invalid_fraction",
 ];
