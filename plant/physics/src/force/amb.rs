@@ -68,8 +68,8 @@ impl AmbLaw {
     /// magnets this way (MODEL.md §12.3); the linear law, which has no magnets, takes the
     /// differential current `(i₊ − i₋)/2`.
     ///
-    /// Out of line and cold: inlined into the derivatives beside [`AmbLaw::force`], it made the
-    /// two-plane derivative of the other controls 1.4 % longer (`examples/derivative_count.rs`).
+    /// Out of line and cold, to keep it off the path of the derivatives of the other controls
+    /// (their instruction counts: docs/results/fidelity.md, "The unipolar amplifier").
     #[cold]
     #[inline(never)]
     pub fn magnet_force(&self, delta: Vector2<f64>, plus: Vector2<f64>, minus: Vector2<f64>) -> Vector2<f64> {
