@@ -11,7 +11,15 @@
 //! ```
 //!
 //! one per axis in the order x_A, y_A, x_B, y_B (a planar model uses the first two), and the
-//! time spent with any amplifier at its voltage limit. The controller's command (held over the
+//! time spent with any amplifier at its voltage limit. With unipolar amplifiers (MODEL.md §12.3)
+//! each axis has two magnets, each with its own coil and amplifier: the coil states above are
+//! then the + side's magnets', and the − side's follow, `EXTRA_UNIPOLAR` numbers in all:
+//!
+//! ```text
+//! [ … as above (EXTRA) … | − side's currents i₋ (4) | − side's PI integrals q₋ (4) ]
+//! ```
+//!
+//! (the bipolar layout is kept as it was, so that its runs step the very same state). The controller's command (held over the
 //! macro step, or the continuous PD on the exact state) is the current reference; the model is
 //! evaluated with the coils' real currents. The sensor reads the filter's output (with the runout
 //! in its input), or the displacement plus the runout when the sensor is ideal, clipped to the
@@ -21,13 +29,17 @@ pub use crate::config::hardware::Hardware;
 use crate::machine::Machine;
 use crate::model::{Control, Params, Release};
 use crate::sensor::runout;
-use crate::trace::{col, colb, Record};
+use crate::trace::{col, colb, Record, WIDTH_MAGNETS};
 use controller::PdGains;
 use plant_physics::integrate::System;
 use std::cell::RefCell;
 
-/// Hardware states appended to the model's.
+/// Hardware states appended to the model's (bipolar amplifiers, or none).
 pub const EXTRA: usize = 17;
+
+/// Hardware states appended to the model's with unipolar amplifiers: the − side's magnets'
+/// currents and integrals after [`EXTRA`].
+pub const EXTRA_UNIPOLAR: usize = EXTRA + 8;
 
 /// Offsets of the hardware states after the model's.
 mod ex {
@@ -41,23 +53,40 @@ mod ex {
     pub const FILTER_RATE: usize = 12;
     /// Time with any amplifier at its voltage limit (s).
     pub const SATURATED: usize = 16;
+    /// Unipolar: the − side's magnets' coil currents (A), 4 axes (the + side's are `CURRENT`).
+    pub const MINUS_CURRENT: usize = 17;
+    /// Unipolar: the − side's magnets' PI integrals (V), 4 axes.
+    pub const MINUS_INTEGRAL: usize = 21;
 }
 
 /// Absolute tolerances of the hardware states: currents `1e-6` A, integrals `1e-4` V, the
 /// filter like the positions `p` (m) and velocities `v` (m/s), the saturation time 1 s (it
-/// never limits the step).
-pub fn atol(p: f64, v: f64) -> [f64; EXTRA] {
-    let mut a = [0.0; EXTRA];
+/// never limits the step); the unipolar layout's (the first [`EXTRA`] are the bipolar's).
+pub fn atol(p: f64, v: f64) -> [f64; EXTRA_UNIPOLAR] {
+    let mut a = [0.0; EXTRA_UNIPOLAR];
     a[ex::CURRENT..ex::CURRENT + 4].fill(1e-6);
     a[ex::INTEGRAL..ex::INTEGRAL + 4].fill(1e-4);
     a[ex::FILTER..ex::FILTER + 4].fill(p);
     a[ex::FILTER_RATE..ex::FILTER_RATE + 4].fill(v);
     a[ex::SATURATED] = 1.0;
+    a[ex::MINUS_CURRENT..ex::MINUS_CURRENT + 4].fill(1e-6);
+    a[ex::MINUS_INTEGRAL..ex::MINUS_INTEGRAL + 4].fill(1e-4);
     a
 }
 
+/// Each axis's coil voltages at one instant (V), x_A, y_A, x_B, y_B.
+#[derive(Clone, Copy, Debug, Default)]
+struct Volts {
+    /// The bipolar coil's; unipolar: the differential `(v₊ − v₋)/2`.
+    coil: [f64; 4],
+    /// Unipolar: the + side's magnets'.
+    plus: [f64; 4],
+    /// Unipolar: the − side's magnets'.
+    minus: [f64; 4],
+}
+
 /// A rotor model `M` on `N` states with the hardware's states appended: a model on `NA = N +
-/// EXTRA` states (module doc).
+/// EXTRA` states, `N + EXTRA_UNIPOLAR` with unipolar amplifiers (module doc).
 pub struct Wired<M, const N: usize, const NA: usize> {
     /// The model as the loop configures it (parameters, parked races).
     inner: M,
@@ -68,20 +97,22 @@ pub struct Wired<M, const N: usize, const NA: usize> {
     hw: Hardware,
 }
 
-/// The model's part and the hardware's part of an extended state.
+/// The model's part and the hardware's part of an extended state (the hardware's in the
+/// unipolar layout, zero past the state's end).
 #[inline]
-fn split<const N: usize, const NA: usize>(y: &[f64; NA]) -> ([f64; N], [f64; EXTRA]) {
+fn split<const N: usize, const NA: usize>(y: &[f64; NA]) -> ([f64; N], [f64; EXTRA_UNIPOLAR]) {
     let mut a = [0.0; N];
-    let mut b = [0.0; EXTRA];
+    let mut b = [0.0; EXTRA_UNIPOLAR];
     a.copy_from_slice(&y[..N]);
-    b.copy_from_slice(&y[N..]);
+    b[..NA - N].copy_from_slice(&y[N..]);
     (a, b)
 }
 
 impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
     /// Wraps `model` whose controls are `controls` (one per plane, as the loop set them).
     pub fn new(model: M, controls: [Control; 2], hw: Hardware) -> Self {
-        assert_eq!(NA, N + EXTRA, "a wired model has the model's states and EXTRA more");
+        let extra = if hw.is_unipolar() { EXTRA_UNIPOLAR } else { EXTRA };
+        assert_eq!(NA, N + extra, "a wired model has the model's states and EXTRA (EXTRA_UNIPOLAR) more");
         Self { work: RefCell::new(model.clone()), inner: model, reference: controls, hw }
     }
 
@@ -95,9 +126,19 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
             let signal = self.raw_signal(y0, i);
             for (j, (&current, &measured)) in reference.iter().zip(&signal).enumerate() {
                 let ax = 2 * i + j;
-                if let Some(a) = &self.hw.amplifiers[i] {
-                    y[N + ex::CURRENT + ax] = current;
-                    y[N + ex::INTEGRAL + ax] = a.steady_integral(current);
+                match (&self.hw.amplifiers[i], &self.hw.unipolar[i]) {
+                    (Some(a), None) => {
+                        y[N + ex::CURRENT + ax] = current;
+                        y[N + ex::INTEGRAL + ax] = a.steady_integral(current);
+                    }
+                    (Some(a), Some(u)) => {
+                        let (plus, minus) = ((u.bias + current).max(0.0), (u.bias - current).max(0.0));
+                        y[N + ex::CURRENT + ax] = plus;
+                        y[N + ex::INTEGRAL + ax] = a.steady_integral(plus);
+                        y[N + ex::MINUS_CURRENT + ax] = minus;
+                        y[N + ex::MINUS_INTEGRAL + ax] = a.steady_integral(minus);
+                    }
+                    (None, _) => {}
                 }
                 y[N + ex::FILTER + ax] = measured;
             }
@@ -114,6 +155,8 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
             // The sensitivity measurement's excitation is not added behind an amplifier or a
             // sensor front end: `plant assess` refuses a scene with them (not assessed yet).
             Control::ContinuousExcited(gains, _) => self.inner.pd_current(&gains, y, i),
+            // The run loop commands currents, never magnets; the differential current if it did.
+            Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
         }
     }
 
@@ -132,29 +175,63 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
     }
 
     /// Sets the working copy's controls to the coils' currents of state `(y, x)` (the
-    /// references where a plane has no amplifier), writing the hardware's rates into `dx` and
-    /// each axis's coil voltage into `volts`.
+    /// references where a plane has no amplifier; each magnet's current where it has unipolar
+    /// ones), writing the hardware's rates into `dx` and each coil's voltage into `volts`.
     #[inline]
-    fn apply(&self, m: &mut M, y: &[f64; N], x: &[f64; EXTRA], dx: &mut [f64; EXTRA], volts: &mut [f64; 4]) {
+    fn apply(
+        &self,
+        m: &mut M,
+        y: &[f64; N],
+        x: &[f64; EXTRA_UNIPOLAR],
+        dx: &mut [f64; EXTRA_UNIPOLAR],
+        volts: &mut Volts,
+    ) {
         let mut saturated = false;
         for i in 0..M::PLANES {
             let reference = self.reference_current(y, i);
-            let applied = match &self.hw.amplifiers[i] {
-                None => reference,
-                Some(a) => {
+            let control = match (&self.hw.amplifiers[i], &self.hw.unipolar[i]) {
+                (None, _) => Control::Held(reference),
+                (Some(a), None) => {
                     let velocity = m.bearing_velocity(y, i);
                     for j in 0..2 {
                         let ax = 2 * i + j;
                         let r = a.rates(reference[j], x[ex::CURRENT + ax], x[ex::INTEGRAL + ax], velocity[j]);
                         dx[ex::CURRENT + ax] = r.current_rate;
                         dx[ex::INTEGRAL + ax] = r.integral_rate;
-                        volts[ax] = r.voltage;
+                        volts.coil[ax] = r.voltage;
                         saturated |= r.saturated;
                     }
-                    [x[ex::CURRENT + 2 * i], x[ex::CURRENT + 2 * i + 1]]
+                    Control::Held([x[ex::CURRENT + 2 * i], x[ex::CURRENT + 2 * i + 1]])
+                }
+                (Some(a), Some(u)) => {
+                    // Each magnet's own loop: the + side's reference i_0 + i, its motional
+                    // voltage (k_b/2) ẋ (the rotor closing its gap at ẋ); the − side's i_0 − i
+                    // and −(k_b/2) ẋ (MODEL.md §12.3: the pair absorbs k_b i ẋ, as one coil).
+                    let velocity = m.bearing_velocity(y, i);
+                    let (mut plus, mut minus) = ([0.0; 2], [0.0; 2]);
+                    for j in 0..2 {
+                        let ax = 2 * i + j;
+                        let (ip, qp) = (x[ex::CURRENT + ax], x[ex::INTEGRAL + ax]);
+                        let (im, qm) = (x[ex::MINUS_CURRENT + ax], x[ex::MINUS_INTEGRAL + ax]);
+                        let emf = 0.5 * a.back_emf * velocity[j];
+                        let p = a.unipolar_rates(u.bridge, u.bias + reference[j], ip, qp, emf);
+                        let n = a.unipolar_rates(u.bridge, u.bias - reference[j], im, qm, -emf);
+                        dx[ex::CURRENT + ax] = p.current_rate;
+                        dx[ex::INTEGRAL + ax] = p.integral_rate;
+                        dx[ex::MINUS_CURRENT + ax] = n.current_rate;
+                        dx[ex::MINUS_INTEGRAL + ax] = n.integral_rate;
+                        volts.plus[ax] = p.voltage;
+                        volts.minus[ax] = n.voltage;
+                        volts.coil[ax] = (p.voltage - n.voltage) * 0.5;
+                        saturated |= p.saturated || n.saturated;
+                        // A current the integrator left a little below zero is none.
+                        plus[j] = ip.max(0.0);
+                        minus[j] = im.max(0.0);
+                    }
+                    Control::Magnets { plus, minus }
                 }
             };
-            m.set_control(i, Control::Held(applied));
+            m.set_control(i, control);
             if let Some(lp) = self.hw.front_end.low_pass {
                 let u = self.raw_signal(y, i);
                 for (j, &u) in u.iter().enumerate() {
@@ -169,10 +246,10 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
     }
 
     /// The working copy with its controls set for the extended state `y`.
-    fn synced(&self, y: &[f64; NA]) -> (std::cell::RefMut<'_, M>, [f64; N], [f64; 4]) {
+    fn synced(&self, y: &[f64; NA]) -> (std::cell::RefMut<'_, M>, [f64; N], Volts) {
         let (iy, x) = split::<N, NA>(y);
         let mut m = self.work.borrow_mut();
-        let (mut dx, mut volts) = ([0.0; EXTRA], [0.0; 4]);
+        let (mut dx, mut volts) = ([0.0; EXTRA_UNIPOLAR], Volts::default());
         self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
         (m, iy, volts)
     }
@@ -183,12 +260,12 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> System<NA> for Wire
     fn rhs(&self, t: f64, y: &[f64; NA], dy: &mut [f64; NA]) {
         let (iy, x) = split::<N, NA>(y);
         let mut m = self.work.borrow_mut();
-        let (mut dx, mut volts) = ([0.0; EXTRA], [0.0; 4]);
+        let (mut dx, mut volts) = ([0.0; EXTRA_UNIPOLAR], Volts::default());
         self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
         let mut idy = [0.0; N];
         m.rhs(t, &iy, &mut idy);
         dy[..N].copy_from_slice(&idy);
-        dy[N..].copy_from_slice(&dx);
+        dy[N..].copy_from_slice(&dx[..NA - N]);
     }
 }
 
@@ -260,7 +337,9 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
     }
 
     /// The model's record with the commanded currents in the current columns and, with an
-    /// amplifier, the coils' currents and voltages.
+    /// amplifier, the coils' currents and voltages: with unipolar ones, the differential
+    /// current `(i₊ − i₋)/2` and voltage `(v₊ − v₋)/2` in the coil columns and each magnet's
+    /// own in the magnets' columns.
     fn record(&self, t: f64, y: &[f64; NA]) -> Record {
         let (m, iy, volts) = self.synced(y);
         let mut r = m.record(t, &iy);
@@ -273,20 +352,38 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
             b[colb::CURRENT] = c[0];
             b[colb::CURRENT + 1] = c[1];
         }
+        let x = split::<N, NA>(y).1;
+        let magnet = |at: usize| x[at].max(0.0);
         if self.hw.amplified() {
             let mut hw = [f64::NAN; 8];
             for i in 0..M::PLANES {
                 for j in 0..2 {
                     let ax = 2 * i + j;
-                    let (current, voltage) = match self.hw.amplifiers[i] {
-                        Some(_) => (y[N + ex::CURRENT + ax], volts[ax]),
-                        None => (self.reference_current(&iy, i)[j], f64::NAN),
+                    let (current, voltage) = match (self.hw.amplifiers[i], self.hw.unipolar[i]) {
+                        (Some(_), None) => (x[ex::CURRENT + ax], volts.coil[ax]),
+                        (Some(_), Some(_)) => {
+                            ((magnet(ex::CURRENT + ax) - magnet(ex::MINUS_CURRENT + ax)) * 0.5, volts.coil[ax])
+                        }
+                        (None, _) => (self.reference_current(&iy, i)[j], f64::NAN),
                     };
                     hw[4 * i + j] = current;
                     hw[4 * i + 2 + j] = voltage;
                 }
             }
             r.hw = Some(hw);
+        }
+        if self.hw.is_unipolar() {
+            let mut row = [f64::NAN; WIDTH_MAGNETS];
+            for i in (0..M::PLANES).filter(|&i| self.hw.unipolar[i].is_some()) {
+                for j in 0..2 {
+                    let ax = 2 * i + j;
+                    row[8 * i + 2 * j] = magnet(ex::CURRENT + ax);
+                    row[8 * i + 2 * j + 1] = magnet(ex::MINUS_CURRENT + ax);
+                    row[8 * i + 4 + 2 * j] = volts.plus[ax];
+                    row[8 * i + 4 + 2 * j + 1] = volts.minus[ax];
+                }
+            }
+            r.magnets = Some(row);
         }
         r
     }
@@ -346,6 +443,58 @@ mod tests {
             let x = 1.5e-6 * theta.cos() + 0.75e-6 * (2.0 * theta + 30f64.to_radians()).cos();
             assert!((sensed[0] - x).abs() < 1e-18, "θ = {theta}: {} against {x}", sensed[0]);
             assert_eq!(sensor.read_with_gain(sensed, gain), [gain * expect[0], gain * expect[1]]);
+        }
+    }
+
+    /// With each magnet at rest at its reference (`i_0 ± i`) the unipolar model's derivative is
+    /// the bipolar model's: the nonlinear law's force from `i_0 + i`, `i_0 − i` is the one it
+    /// gives the control current `i`. The magnets' motional voltages `±(k_b/2) ẋ` move their
+    /// differential current at half the rate `k_b ẋ` moves the bipolar coil's, and their common
+    /// current not at all.
+    #[test]
+    fn magnets_at_their_references_give_the_bipolar_derivative() {
+        const N: usize = crate::model::N;
+        let sets = ["amb.force_law=nonlinear", "sensor.runout=[]", "sensor.bandwidth_hz=0"];
+        let bipolar = realistic(&sets);
+        let unipolar = realistic(&[sets[0], sets[1], sets[2], "amb.amplifier_topology=unipolar"]);
+        let model = |scene: &crate::config::Scene| Model {
+            params: scene.params.clone(),
+            base: scene.base.clone(),
+            control: Control::Held([0.0; 2]),
+            race_parked: false,
+        };
+        let control = [Control::Held([0.3, -0.7]); 2];
+        let wb = Wired::<Model, N, { N + EXTRA }>::new(model(&bipolar), control, bipolar.hardware.clone());
+        let wu = Wired::<Model, N, { N + EXTRA_UNIPOLAR }>::new(model(&unipolar), control, unipolar.hardware.clone());
+        let mut y0 = [0.0; N];
+        y0[ix::XR] = 3e-5;
+        y0[ix::YR] = -2e-5;
+        y0[ix::VXR] = 0.01;
+        y0[ix::VYR] = -0.02;
+        let (yb, yu) = (wb.initial(&y0), wu.initial(&y0));
+        let i0 = unipolar.hardware.unipolar[0].expect("unipolar").bias;
+        assert_eq!(yu[N + ex::CURRENT], i0 + 0.3);
+        assert_eq!(yu[N + ex::MINUS_CURRENT + 1], i0 + 0.7);
+        let (mut db, mut du) = ([0.0; N + EXTRA], [0.0; N + EXTRA_UNIPOLAR]);
+        wb.rhs(0.03, &yb, &mut db);
+        wu.rhs(0.03, &yu, &mut du);
+        for k in 0..N {
+            assert!((db[k] - du[k]).abs() <= 1e-12 * db[k].abs().max(1e-9), "state {k}: {} against {}", db[k], du[k]);
+        }
+        // The rotor accelerates: the force is not zero.
+        assert!(db[ix::VXR].abs() > 1.0);
+        let kb = unipolar.hardware.amplifiers[0].expect("amplifier").back_emf;
+        assert!(kb > 0.0);
+        for j in 0..2 {
+            let bipolar = db[N + ex::CURRENT + j];
+            let differential = (du[N + ex::CURRENT + j] - du[N + ex::MINUS_CURRENT + j]) / 2.0;
+            let expect = -kb * y0[ix::VXR + j] / unipolar.hardware.amplifiers[0].expect("amplifier").inductance;
+            assert!((bipolar - expect).abs() <= 1e-9 * expect.abs(), "axis {j}: bipolar {bipolar} against {expect}");
+            assert!(
+                (2.0 * differential - bipolar).abs() <= 1e-9 * bipolar.abs(),
+                "axis {j}: {bipolar}, {differential}"
+            );
+            assert!((du[N + ex::CURRENT + j] + du[N + ex::MINUS_CURRENT + j]).abs() <= 1e-9 * bipolar.abs());
         }
     }
 

@@ -138,8 +138,13 @@ impl RunFolder {
     /// Creates `dir/trace.csv` (header) for a run of `scene`.
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let path = dir.join("trace.csv");
-        let trace = TraceWriter::create(&path, scene.planes(), scene.hardware.amplified())
-            .with_context(|| format!("creating {}", path.display()))?;
+        let trace = TraceWriter::create_with_magnets(
+            &path,
+            scene.planes(),
+            scene.hardware.amplified(),
+            scene.hardware.is_unipolar(),
+        )
+        .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })
     }
 

@@ -12,7 +12,7 @@
 use crate::config::{ControlMode, Scene};
 use crate::cosim::stats::{Tet, TickTime};
 use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
-use crate::hardware::{Wired, EXTRA};
+use crate::hardware::{Wired, EXTRA, EXTRA_UNIPOLAR};
 pub use crate::hooks::{Hooks, Quiet};
 use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
@@ -324,6 +324,13 @@ fn run_from(
                 race_parked: false,
             };
             let y = initial_state(scene);
+            if hw.is_unipolar() {
+                const NA: usize = crate::model::N + EXTRA_UNIPOLAR;
+                let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
+                let y = wired.initial(&y);
+                let settings = settings_with(scene, extended::<{ crate::model::N }, NA>(scene.integrator.atol, p, v));
+                return drive(scene, wired, y, settings, source, (bias, limits), &gains, hooks, sink);
+            }
             if hw.is_on() {
                 const NA: usize = crate::model::N + EXTRA;
                 let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
@@ -341,6 +348,13 @@ fn run_from(
                 race_parked: [false; 2],
             };
             let y = crate::initial::two_plane_initial_state(scene, params);
+            if hw.is_unipolar() {
+                const NA: usize = two_plane::N + EXTRA_UNIPOLAR;
+                let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
+                let y = wired.initial(&y);
+                let atol = extended::<{ two_plane::N }, NA>(scene.integrator.two_plane_atol(), p, v);
+                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), &gains, hooks, sink);
+            }
             if hw.is_on() {
                 const NA: usize = two_plane::N + EXTRA;
                 let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
@@ -358,7 +372,7 @@ fn run_from(
 fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
     let mut a = [0.0; NA];
     a[..N].copy_from_slice(&atol);
-    a[N..].copy_from_slice(&crate::hardware::atol(p, v));
+    a[N..].copy_from_slice(&crate::hardware::atol(p, v)[..NA - N]);
     a
 }
 

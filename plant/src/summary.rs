@@ -149,7 +149,7 @@ pub struct Summary {
     /// `controller.max_invalid_burst`, `controller.max_invalid_fraction`).
     pub invalid_commands: u64,
     /// Time with an amplifier at its voltage limit (s), in runs with amplifiers
-    /// (`amb.amplifier`).
+    /// (`amb.amplifier`); with unipolar amplifiers, any magnet's (docs/MODEL.md §12.3).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub voltage_saturation_s: Option<f64>,
     /// Accepted integrator steps.

@@ -67,7 +67,8 @@ columns! {
     housing_x_m: "Housing displacement, x (m).",
     housing_y_m: "Housing displacement, y (m).";
     b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model).",
-    hw: Option<TraceHw>: "A run with amplifiers: the coils' currents and voltages (`None` without)."
+    hw: Option<TraceHw>: "A run with amplifiers: the coils' currents and voltages (`None` without).",
+    magnets: Option<TraceMagnets>: "A run with unipolar amplifiers: each magnet's current and voltage (`None` without)."
 }
 
 columns! {
@@ -91,6 +92,38 @@ pub const WIDTH_HW: usize = 8;
 
 /// A sample's coil currents and voltages: [`TraceHw::COLUMNS`], in order.
 pub type RowHw = [f64; WIDTH_HW];
+
+columns! {
+    /// Each magnet's coil current and voltage of a run with unipolar amplifiers
+    /// (`amb.amplifier_topology = "unipolar"`, docs/MODEL.md §12.3), after all other columns in
+    /// `trace.csv` (plane B's eight only in a two-plane run). `plus` is the magnet on the + side
+    /// of the axis (it pulls the rotor toward +x, +y), `minus` the one on the − side. The coil
+    /// columns (`ix_coil_a`, `vx_coil_v`, …) are then the differential current `(i₊ − i₋)/2`
+    /// and voltage `(v₊ − v₋)/2`: what the bipolar amplifier's coil carries.
+    TraceMagnets: RowMagnets;
+    ix_plus_a: "Current of the +x magnet's coil (A); two-plane: bearing A.",
+    ix_minus_a: "Current of the −x magnet's coil (A); two-plane: bearing A.",
+    iy_plus_a: "Current of the +y (upper) magnet's coil (A); two-plane: bearing A.",
+    iy_minus_a: "Current of the −y (lower) magnet's coil (A); two-plane: bearing A.",
+    vx_plus_v: "Voltage on the +x magnet's coil (V); two-plane: bearing A.",
+    vx_minus_v: "Voltage on the −x magnet's coil (V); two-plane: bearing A.",
+    vy_plus_v: "Voltage on the +y magnet's coil (V); two-plane: bearing A.",
+    vy_minus_v: "Voltage on the −y magnet's coil (V); two-plane: bearing A.",
+    b_ix_plus_a: "Current of bearing B's +x magnet's coil (A).",
+    b_ix_minus_a: "Current of bearing B's −x magnet's coil (A).",
+    b_iy_plus_a: "Current of bearing B's +y magnet's coil (A).",
+    b_iy_minus_a: "Current of bearing B's −y magnet's coil (A).",
+    b_vx_plus_v: "Voltage on bearing B's +x magnet's coil (V).",
+    b_vx_minus_v: "Voltage on bearing B's −x magnet's coil (V).",
+    b_vy_plus_v: "Voltage on bearing B's +y magnet's coil (V).",
+    b_vy_minus_v: "Voltage on bearing B's −y magnet's coil (V).";
+}
+
+/// Number of magnet columns (both planes').
+pub const WIDTH_MAGNETS: usize = 16;
+
+/// A sample's magnet currents and voltages: [`TraceMagnets::COLUMNS`], in order.
+pub type RowMagnets = [f64; WIDTH_MAGNETS];
 
 columns! {
     /// A two-plane trace's plane B and tilt columns, after the planar ones in `trace.csv`:
@@ -139,12 +172,14 @@ pub struct Record {
     pub b: Option<RowB>,
     /// The coils' currents and voltages (runs with amplifiers).
     pub hw: Option<RowHw>,
+    /// Each magnet's current and voltage (runs with unipolar amplifiers).
+    pub magnets: Option<RowMagnets>,
 }
 
 impl Record {
     /// A planar sample.
     pub fn planar(a: Row) -> Self {
-        Self { a, b: None, hw: None }
+        Self { a, b: None, hw: None, magnets: None }
     }
 
     /// Bearing planes in the sample: 1 (planar) or 2.
@@ -322,7 +357,7 @@ pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) 
     let mut b = [0.0; WIDTH_B];
     b[..14].copy_from_slice(&pb);
     b[colb::SLOPE..].copy_from_slice(&[y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]]);
-    Record { a, b: Some(b), hw: None }
+    Record { a, b: Some(b), hw: None, magnets: None }
 }
 
 impl Trace {
@@ -345,11 +380,19 @@ impl Trace {
         if let Some(hw) = &r.hw {
             self.hw.get_or_insert_with(TraceHw::default).push_row(hw);
         }
+        if let Some(m) = &r.magnets {
+            self.magnets.get_or_insert_with(TraceMagnets::default).push_row(m);
+        }
     }
 
     /// Sample `i`.
     pub fn record(&self, i: usize) -> Record {
-        Record { a: self.row(i), b: self.b.as_ref().map(|b| b.row(i)), hw: self.hw.as_ref().map(|h| h.row(i)) }
+        Record {
+            a: self.row(i),
+            b: self.b.as_ref().map(|b| b.row(i)),
+            hw: self.hw.as_ref().map(|h| h.row(i)),
+            magnets: self.magnets.as_ref().map(|m| m.row(i)),
+        }
     }
 
     /// The samples, in order.
@@ -382,7 +425,7 @@ impl Trace {
 
     /// Writes the trace as `trace.csv` (see the module docs).
     pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        let mut w = TraceWriter::create(path, self.planes(), self.hw.is_some())?;
+        let mut w = TraceWriter::create_with_magnets(path, self.planes(), self.hw.is_some(), self.magnets.is_some())?;
         for r in self.records() {
             w.write(&r)?;
         }
@@ -412,6 +455,8 @@ pub struct TraceWriter {
     b_cols: usize,
     /// Coil columns written (0, or 4 per plane).
     coils: usize,
+    /// Magnet columns written (0, or 8 per plane).
+    magnets: usize,
 }
 
 impl TraceWriter {
@@ -419,11 +464,19 @@ impl TraceWriter {
     /// (1: the planar columns; 2: also plane B's and the tilt's), with the coils' columns after
     /// them when `amplified`.
     pub fn create(path: &Path, planes: usize, amplified: bool) -> std::io::Result<Self> {
+        Self::create_with_magnets(path, planes, amplified, false)
+    }
+
+    /// [`TraceWriter::create`], with each magnet's columns after all the others when
+    /// `unipolar` (a run with unipolar amplifiers, [`TraceMagnets`]).
+    pub fn create_with_magnets(path: &Path, planes: usize, amplified: bool, unipolar: bool) -> std::io::Result<Self> {
         let coils = if amplified { 4 * planes } else { 0 };
+        let magnets = if unipolar { 8 * planes } else { 0 };
         let header: Vec<&str> = Trace::COLUMNS
             .iter()
             .chain(if planes == 2 { TraceB::COLUMNS } else { &[] })
             .chain(&TraceHw::COLUMNS[..coils])
+            .chain(&TraceMagnets::COLUMNS[..magnets])
             .copied()
             .collect();
         let rows = RowFile::create(path, &header)?;
@@ -432,6 +485,7 @@ impl TraceWriter {
             rows,
             b_cols: if planes == 2 { WIDTH_B } else { 0 },
             coils,
+            magnets,
         })
     }
 
@@ -441,7 +495,9 @@ impl TraceWriter {
         use std::fmt::Write as _;
         let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
         let hw = r.hw.unwrap_or([f64::NAN; WIDTH_HW]);
-        for (field, v) in self.fields.iter_mut().zip(r.a.iter().chain(&b[..self.b_cols]).chain(&hw[..self.coils])) {
+        let magnets = r.magnets.unwrap_or([f64::NAN; WIDTH_MAGNETS]);
+        let values = r.a.iter().chain(&b[..self.b_cols]).chain(&hw[..self.coils]).chain(&magnets[..self.magnets]);
+        for (field, v) in self.fields.iter_mut().zip(values) {
             field.clear();
             let _ = write!(field, "{v:e}");
         }
@@ -590,7 +646,7 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        if !row(&Record { a: values, b, hw: None }) {
+        if !row(&Record { a: values, b, hw: None, magnets: None }) {
             return Ok(false);
         }
     }

@@ -208,6 +208,16 @@ pub enum Control {
     ContinuousExcited(PdGains, SensorSine),
     /// A current held over the macro step (zero-order hold of a sampled law).
     Held([f64; 2]),
+    /// Each magnet's own current, x then y (A): `plus` the magnet on the + side of each axis,
+    /// `minus` the one on the − side ([`AmbLaw::magnet_force`]). Unipolar amplifiers
+    /// (MODEL.md §12.3) drive the plane this way; its current is the differential
+    /// `(i₊ − i₋)/2`.
+    Magnets {
+        /// The + side's magnets (A).
+        plus: [f64; 2],
+        /// The − side's magnets (A).
+        minus: [f64; 2],
+    },
 }
 
 /// A sine added to the sensor signal the controller reads, per axis (V):
@@ -396,8 +406,13 @@ impl Model {
                 saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
             }
             Control::Held(i) => i,
+            Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
         };
-        let amb_force = p.amb.force(delta, current.into());
+        let amb_force = match self.control {
+            // Unipolar amplifiers: each magnet's own current.
+            Control::Magnets { plus, minus } => p.amb.magnet_force(delta, plus.into(), minus.into()),
+            _ => p.amb.force(delta, current.into()),
+        };
         if self.race_parked {
             return self.evaluate_parked(t, y, a_h, current, amb_force);
         }

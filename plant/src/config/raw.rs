@@ -267,6 +267,13 @@ pub struct RawAmb {
     /// Back-EMF constant k_b (V·s/m) in L di/dt = v − R i − k_b ẋ; 0: none (k_i is the
     /// energy-consistent value).
     pub back_emf_v_s_per_m: f64 = 0.0,
+    /// With `amplifier`: `bipolar`, one amplifier per axis driving the control current
+    /// (default); `unipolar`, one amplifier per magnet driving `i_0 ± i` (needs the nonlinear
+    /// law, whose bias `i_0` it carries; docs/MODEL.md §12.3).
+    pub amplifier_topology: AmplifierTopology = AmplifierTopology::Bipolar,
+    /// A unipolar amplifier's bridge: `one_quadrant`, `0..V_dc` (default); `two_quadrant`,
+    /// `−V_dc..V_dc` while the current flows.
+    pub unipolar_bridge: plant_physics::amplifier::Bridge = plant_physics::amplifier::Bridge::OneQuadrant,
     /// Two-plane: plane A's own values of this table's keys (the others are shared).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub a: Option<toml::Table> = None,
@@ -359,6 +366,16 @@ pub enum Pacing {
     /// blocks between frames: both can share one core (`pin_cores = [c, c]`), and the
     /// other cores stay free for the rest of the machine.
     Sleep,
+}
+
+/// `amb.amplifier_topology`: how the amplifiers drive an axis's two magnets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AmplifierTopology {
+    /// One amplifier and coil per axis, the current of either sign (`±V_dc`).
+    Bipolar,
+    /// One amplifier and coil per magnet, the current one way only (`0..V_dc`).
+    Unipolar,
 }
 
 /// `controller.fallback`: what the plant applies when the controller process is lost.

@@ -631,7 +631,11 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         Some(m) => m.planes.iter().map(|p| p.params.contact.gap).collect(),
         None => vec![physics.contact.gap],
     };
-    let hardware = hardware(&raw, planes, &gaps, &integrator, 1.0 / rate)?;
+    let laws: Vec<AmbLaw> = match &two_plane {
+        Some(m) => m.planes.iter().map(|p| p.params.amb).collect(),
+        None => vec![physics.amb],
+    };
+    let hardware = hardware(&raw, planes, &gaps, &laws, &integrator, 1.0 / rate)?;
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
     // The resolved scene states the two-plane rotor's defaults.
     if two_plane.is_some() {
@@ -663,12 +667,14 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
 }
 
 /// The hardware between the wire and the physics (`amb.amplifier` and its keys, per plane;
-/// `[sensor]`'s bandwidth, range and runout), validated against the planes' air gaps `gaps` (m)
-/// and the integrator's step (a fixed-step method must resolve the fastest of them).
+/// `[sensor]`'s bandwidth, range and runout), validated against the planes' air gaps `gaps` (m),
+/// their force laws `laws` (a unipolar amplifier carries the nonlinear law's bias) and the
+/// integrator's step (a fixed-step method must resolve the fastest of them).
 fn hardware(
     raw: &RawScene,
     planes: usize,
     gaps: &[f64],
+    laws: &[AmbLaw],
     integrator: &IntegratorSettings,
     period: f64,
 ) -> Result<super::hardware::Hardware, ConfigError> {
@@ -704,6 +710,7 @@ fn hardware(
         Ok(())
     };
     let mut amplifiers = [None; 2];
+    let mut unipolar = [None; 2];
     for (i, slot) in amplifiers.iter_mut().enumerate().take(planes) {
         let (amb, own, name) = if planes == 2 {
             let own = if i == 0 { &raw.amb.a } else { &raw.amb.b };
@@ -725,6 +732,9 @@ fn hardware(
             let omega = std::f64::consts::TAU * f;
             resolve(&key("current_loop_hz"), f, "Hz", omega.max(r / l), "the current loop")?;
             *slot = Some(plant_physics::amplifier::Amplifier::design(v, l, r, f, kb));
+        }
+        if amb.amplifier_topology == AmplifierTopology::Unipolar {
+            unipolar[i] = Some(unipolar_drive(&amb, amb.amplifier, laws[i], v, r, &key)?);
         }
     }
     let s = &raw.sensor;
@@ -791,8 +801,58 @@ fn hardware(
     }
     Ok(super::hardware::Hardware {
         amplifiers,
+        unipolar,
         front_end: crate::sensor::FrontEnd { low_pass, runout, range: (range_um > 0.0).then_some(range_um * 1e-6) },
     })
+}
+
+/// A plane's unipolar drive (`amb.amplifier_topology = "unipolar"`, docs/MODEL.md §12.3): it
+/// needs the amplifier on (`amplifier`), the nonlinear law `law` (whose bias each magnet
+/// carries), and a bus `v` (V) above the voltage `R i_0` that holds the bias in a coil of
+/// resistance `r` (Ω): at or below it the magnets cannot even carry the bias at rest. `key`
+/// names a field as the scene wrote it (the plane's own table or the shared one).
+fn unipolar_drive(
+    amb: &RawAmb,
+    amplifier: bool,
+    law: AmbLaw,
+    v: f64,
+    r: f64,
+    key: &dyn Fn(&str) -> String,
+) -> Result<super::hardware::Unipolar, ConfigError> {
+    let topology = key("amplifier_topology");
+    if !amplifier {
+        return Err(range(
+            &topology,
+            "unipolar",
+            "",
+            &format!("needs {} = true: the topology is that of the amplifiers it models", key("amplifier")),
+        ));
+    }
+    let AmbLaw::Nonlinear { i0, .. } = law else {
+        return Err(range(
+            &topology,
+            "unipolar",
+            "",
+            &format!(
+                "needs {} = \"nonlinear\" (it is \"linear\"): each magnet's amplifier carries the bias i_0 \
+                 of the two opposed magnets, which the linear law does not have",
+                key("force_law")
+            ),
+        ));
+    };
+    if v <= r * i0 {
+        return Err(range(
+            &key("bus_voltage_v"),
+            amb.bus_voltage_v,
+            "V",
+            &format!(
+                "must exceed R i_0 = {:.4} V for a unipolar amplifier: the voltage that holds the bias current \
+                 i_0 = {i0:.4} A (s_0 k_s / k_i) in a magnet's coil of {r} Ω",
+                r * i0
+            ),
+        ));
+    }
+    Ok(super::hardware::Unipolar { bias: i0, bridge: amb.unipolar_bridge })
 }
 
 /// Most runout harmonics in a scene.

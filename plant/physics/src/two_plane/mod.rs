@@ -247,8 +247,13 @@ impl Model {
                     saturate(gains.current(u.into(), u_dot.into()), bearing.current_limit)
                 }
                 Control::Held(c) => c,
+                Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
             };
-            out.amb_force = bearing.amb.force(delta, out.current.into());
+            out.amb_force = match self.control[i] {
+                // Unipolar amplifiers: each magnet's own current.
+                Control::Magnets { plus, minus } => bearing.amb.magnet_force(delta, plus.into(), minus.into()),
+                _ => bearing.amb.force(delta, out.current.into()),
+            };
             let race = RaceInput::of(y, RACE[i]);
             let (x, v) = (RACE[i], RACE[i] + V);
             if self.race_parked[i] {
