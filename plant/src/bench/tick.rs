@@ -114,7 +114,7 @@ fn repeat_two_plane_contact_tick(
     repeats: u64,
 ) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
     use crate::model::Control;
-    use plant_physics::two_plane::{ix, Model};
+    use plant_physics::two_plane::Model;
     let gains = crate::run::plane_gains(scene)?;
     let bias = crate::run::bias_of(scene, &gains);
     let model = Model {
