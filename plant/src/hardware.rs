@@ -378,14 +378,14 @@ mod tests {
     #[test]
     fn the_continuous_pd_reads_the_sensors_front_end() {
         let pd = |scene: &crate::config::Scene, d: [f64; 2], rate: [f64; 2]| {
-            let g = crate::run::design_gains(scene).unwrap();
+            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
             let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
             let i = |k: usize| g.bias_a[k] - g.amp_gain_a_per_v * (g.kp * a_s * d[k] + g.kd * a_s * rate[k]);
             [i(0).clamp(-2.0, 2.0), i(1).clamp(-2.0, 2.0)]
         };
         let continuous = |scene: &crate::config::Scene| {
             let mut w = wired(scene);
-            let g = crate::run::design_gains(scene).unwrap();
+            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
             w.set_control(0, Control::Continuous(g));
             (w, g)
         };
