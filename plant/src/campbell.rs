@@ -88,6 +88,32 @@ pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
             scene.name
         ))
     })?;
+    // The linearisation is the rotor on the ideal loop: an amplifier's coil and current loop
+    // and a sensor's filter would add states it does not have, and runout forces the free
+    // decays at 1× and 2× the spin. Refused rather than drawn wrong; the range does not act
+    // on motions about the centre smaller than it, and stays.
+    let hw = &scene.hardware;
+    let mut parts = Vec::new();
+    if hw.amplified() {
+        parts.push("amb.amplifier = true");
+    }
+    if hw.front_end.low_pass.is_some() {
+        parts.push("sensor.bandwidth_hz > 0");
+    }
+    if !hw.front_end.runout.is_empty() {
+        parts.push("sensor.runout");
+    }
+    if !parts.is_empty() {
+        return Err(crate::bench::BadArgument(format!(
+            "{}: plant campbell linearises the rotor on the ideal loop, without the amplifier's and the \
+             sensor's states, and its free decays carry no runout; this scene has {} on: switch it off \
+             (--set amb.amplifier=false --set sensor.bandwidth_hz=0 --set 'sensor.runout=[]') for the \
+             ideal loop's diagram",
+            scene.name,
+            parts.join(", ")
+        ))
+        .into());
+    }
     let gains = plane_gains(scene)?;
     Ok(LinearRotor::from_gains(machine, &[gains[0], gains[1]]))
 }

@@ -124,6 +124,9 @@ pub enum Command {
     /// (each point an ensemble with an `[ensemble]` table); writes points.csv, poincare.csv and
     /// bifurcation diagrams. Resumes an interrupted sweep.
     Sweep(plant::sweep::SweepArgs),
+    /// Overlay the recovery probability of finished ensemble sweeps of one key on one chart,
+    /// each sweep a curve with its Wilson 95 % intervals; writes overlay.png and overlay.csv.
+    Overlay(plant::sweep::overlay::OverlayArgs),
     /// Judge controllers the way the field does: the stability margin of each axis (ISO 14839-3
     /// sensitivity, measured through the loop), the vibration (ISO 14839-2), the shock ladder
     /// and the touchdown bearing's duty; writes report.html, report.json and PNG charts.

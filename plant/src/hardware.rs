@@ -19,18 +19,20 @@
 //! [ … as above (EXTRA) … | − side's currents i₋ (4) | − side's PI integrals q₋ (4) ]
 //! ```
 //!
-//! (the bipolar layout is kept as it was, so that its runs step the very same state). The controller's command (held over the
-//! macro step, or the continuous PD on the exact state) is the current reference; the model is
-//! evaluated with the coils' real currents. The sensor reads the filter's output (with the runout
-//! in its input), or the displacement plus the runout when the sensor is ideal, clipped to the
-//! range.
+//! (the bipolar layout is kept as it was, so that its runs step the very same state). The
+//! controller's command (held over the macro step, or the continuous PD) is the current
+//! reference; the model is evaluated with the coils' real currents. The sensor reads the
+//! filter's output (with the runout in its input), or the displacement plus the runout when the
+//! sensor is ideal, clipped to the range. The continuous PD reads that signal too, and
+//! differentiates it as an analog controller does: the filter's output rate (or the
+//! displacement's and the runout's), 0 while the range clips; the noise and the ADC are the
+//! sampled controller's.
 
 pub use crate::config::hardware::Hardware;
 use crate::machine::Machine;
 use crate::model::{Control, Params, Release};
-use crate::sensor::runout;
+use crate::sensor::{runout, runout_rate};
 use crate::trace::{col, colb, Record, WIDTH_MAGNETS};
-use controller::PdGains;
 use plant_physics::integrate::System;
 use std::cell::RefCell;
 
@@ -116,15 +118,19 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
         Self { work: RefCell::new(model.clone()), inner: model, reference: controls, hw }
     }
 
-    /// The extended initial state of the model's `y0`: each coil at rest at its reference, the
-    /// sensor filter at rest at its input.
+    /// The extended initial state of the model's `y0`: the sensor filter at rest at its input,
+    /// each coil at rest at its reference.
     pub fn initial(&self, y0: &[f64; N]) -> [f64; NA] {
         let mut y = [0.0; NA];
         y[..N].copy_from_slice(y0);
         for i in 0..M::PLANES {
-            let reference = self.reference_current(y0, i);
-            let signal = self.raw_signal(y0, i);
-            for (j, (&current, &measured)) in reference.iter().zip(&signal).enumerate() {
+            for (j, &measured) in self.raw_signal(y0, i).iter().enumerate() {
+                y[N + ex::FILTER + 2 * i + j] = measured;
+            }
+        }
+        for i in 0..M::PLANES {
+            let reference = self.reference_current(&y, i);
+            for (j, &current) in reference.iter().enumerate() {
                 let ax = 2 * i + j;
                 match (&self.hw.amplifiers[i], &self.hw.unipolar[i]) {
                     (Some(a), None) => {
@@ -140,21 +146,21 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
                     }
                     (None, _) => {}
                 }
-                y[N + ex::FILTER + ax] = measured;
             }
         }
         y
     }
 
-    /// Plane `i`'s current reference in the model's state `y`.
+    /// Plane `i`'s current reference in the extended state `y`: the held command, or the
+    /// continuous PD on what the sensor's front end reads ([`Machine::pd_current`]).
     #[inline]
-    fn reference_current(&self, y: &[f64; N], i: usize) -> [f64; 2] {
+    fn reference_current(&self, y: &[f64; NA], i: usize) -> [f64; 2] {
         match self.reference[i] {
             Control::Held(c) => c,
-            Control::Continuous(gains) => self.inner.pd_current(&gains, y, i),
+            Control::Continuous(gains) => Machine::<NA>::pd_current(self, &gains, y, i),
             // The sensitivity measurement's excitation is not added behind an amplifier or a
             // sensor front end: `plant assess` refuses a scene with them (not assessed yet).
-            Control::ContinuousExcited(gains, _) => self.inner.pd_current(&gains, y, i),
+            Control::ContinuousExcited(gains, _) => Machine::<NA>::pd_current(self, &gains, y, i),
             // The run loop commands currents, never magnets; the differential current if it did.
             Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
         }
@@ -174,21 +180,22 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
         ]
     }
 
-    /// Sets the working copy's controls to the coils' currents of state `(y, x)` (the
-    /// references where a plane has no amplifier; each magnet's current where it has unipolar
-    /// ones), writing the hardware's rates into `dx` and each coil's voltage into `volts`.
+    /// Sets the working copy's controls to the coils' currents of the extended state `ye`, whose
+    /// parts are `(y, x)` (the references where a plane has no amplifier; each magnet's current
+    /// where it has unipolar ones), writing the hardware's rates into `dx` and each coil's
+    /// voltage into `volts`.
     #[inline]
     fn apply(
         &self,
         m: &mut M,
-        y: &[f64; N],
-        x: &[f64; EXTRA_UNIPOLAR],
+        ye: &[f64; NA],
+        (y, x): (&[f64; N], &[f64; EXTRA_UNIPOLAR]),
         dx: &mut [f64; EXTRA_UNIPOLAR],
         volts: &mut Volts,
     ) {
         let mut saturated = false;
         for i in 0..M::PLANES {
-            let reference = self.reference_current(y, i);
+            let reference = self.reference_current(ye, i);
             let control = match (&self.hw.amplifiers[i], &self.hw.unipolar[i]) {
                 (None, _) => Control::Held(reference),
                 (Some(a), None) => {
@@ -250,7 +257,7 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Wired<M, N, NA> {
         let (iy, x) = split::<N, NA>(y);
         let mut m = self.work.borrow_mut();
         let (mut dx, mut volts) = ([0.0; EXTRA_UNIPOLAR], Volts::default());
-        self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
+        self.apply(&mut m, y, (&iy, &x), &mut dx, &mut volts);
         (m, iy, volts)
     }
 }
@@ -261,7 +268,7 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> System<NA> for Wire
         let (iy, x) = split::<N, NA>(y);
         let mut m = self.work.borrow_mut();
         let (mut dx, mut volts) = ([0.0; EXTRA_UNIPOLAR], Volts::default());
-        self.apply(&mut m, &iy, &x, &mut dx, &mut volts);
+        self.apply(&mut m, y, (&iy, &x), &mut dx, &mut volts);
         let mut idy = [0.0; N];
         m.rhs(t, &iy, &mut idy);
         dy[..N].copy_from_slice(&idy);
@@ -288,6 +295,22 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
             self.raw_signal(&split::<N, NA>(y).0, i)
         };
         [fe.clip(d[0]), fe.clip(d[1])]
+    }
+
+    fn sensed_rate(&self, y: &[f64; NA], i: usize) -> [f64; 2] {
+        let (iy, x) = split::<N, NA>(y);
+        let v = self.inner.sensed_rate(&iy, i);
+        let fe = &self.hw.front_end;
+        if !fe.is_on() {
+            return v;
+        }
+        let u = self.raw_signal(&iy, i);
+        let (theta, speed) = self.inner.spin(&iy);
+        std::array::from_fn(|j| {
+            let ax = 2 * i + j;
+            let u_rate = if fe.runout.is_empty() { v[j] } else { v[j] + runout_rate(&fe.runout, ax, theta, speed) };
+            fe.rate(u[j], u_rate, [x[ex::FILTER + ax], x[ex::FILTER_RATE + ax]])
+        })
     }
 
     fn parked(&self, i: usize) -> bool {
@@ -328,10 +351,6 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         self.inner.touching(&split::<N, NA>(y).0, i)
     }
 
-    fn pd_current(&self, gains: &PdGains, y: &[f64; NA], i: usize) -> [f64; 2] {
-        self.inner.pd_current(gains, &split::<N, NA>(y).0, i)
-    }
-
     fn bearing_velocity(&self, y: &[f64; NA], i: usize) -> [f64; 2] {
         self.inner.bearing_velocity(&split::<N, NA>(y).0, i)
     }
@@ -344,11 +363,11 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         let (m, iy, volts) = self.synced(y);
         let mut r = m.record(t, &iy);
         drop(m);
-        let a = self.reference_current(&iy, 0);
+        let a = self.reference_current(y, 0);
         r.a[col::IX_A] = a[0];
         r.a[col::IY_A] = a[1];
         if let (2, Some(b)) = (M::PLANES, r.b.as_mut()) {
-            let c = self.reference_current(&iy, 1);
+            let c = self.reference_current(y, 1);
             b[colb::CURRENT] = c[0];
             b[colb::CURRENT + 1] = c[1];
         }
@@ -364,7 +383,7 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
                         (Some(_), Some(_)) => {
                             ((magnet(ex::CURRENT + ax) - magnet(ex::MINUS_CURRENT + ax)) * 0.5, volts.coil[ax])
                         }
-                        (None, _) => (self.reference_current(&iy, i)[j], f64::NAN),
+                        (None, _) => (self.reference_current(y, i)[j], f64::NAN),
                     };
                     hw[4 * i + j] = current;
                     hw[4 * i + 2 + j] = voltage;
@@ -496,6 +515,77 @@ mod tests {
             );
             assert!((du[N + ex::CURRENT + j] + du[N + ex::MINUS_CURRENT + j]).abs() <= 1e-9 * bipolar.abs());
         }
+    }
+
+    /// The continuous PD behind a front end reads what the sensor reads and differentiates it:
+    /// the runout and its rate at the centre, the range's limit and no rate past it, the
+    /// filter's output and its rate (`i = i_g − A_a (k_p A_s d + k_d A_s ḋ)`).
+    #[test]
+    fn the_continuous_pd_reads_the_sensors_front_end() {
+        let pd = |scene: &crate::config::Scene, d: [f64; 2], rate: [f64; 2]| {
+            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
+            let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
+            let i = |k: usize| g.bias_a[k] - g.amp_gain_a_per_v * (g.kp * a_s * d[k] + g.kd * a_s * rate[k]);
+            [i(0).clamp(-2.0, 2.0), i(1).clamp(-2.0, 2.0)]
+        };
+        let continuous = |scene: &crate::config::Scene| {
+            let mut w = wired(scene);
+            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
+            w.set_control(0, Control::Continuous(g));
+            (w, g)
+        };
+        let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+
+        // Runout alone: the rotor held at the centre, spinning at 500 Hz.
+        let scene = realistic(&["sensor.bandwidth_hz=0", "amb.amplifier=false"]);
+        let (w, g) = continuous(&scene);
+        let speed = std::f64::consts::TAU * 500.0;
+        let phase = 30f64.to_radians();
+        for k in 0..20 {
+            let theta = 0.41 * k as f64;
+            let mut y = [0.0; crate::model::N + EXTRA];
+            y[ix::TR] = theta;
+            y[ix::WR] = speed;
+            let d = [
+                1.5e-6 * theta.cos() + 0.75e-6 * (2.0 * theta + phase).cos(),
+                1.5e-6 * (theta - std::f64::consts::FRAC_PI_2).cos()
+                    + 0.75e-6 * (2.0 * theta - 60f64.to_radians()).cos(),
+            ];
+            let rate = [
+                -1.5e-6 * speed * theta.sin() - 1.5e-6 * speed * (2.0 * theta + phase).sin(),
+                -1.5e-6 * speed * (theta - std::f64::consts::FRAC_PI_2).sin()
+                    - 1.5e-6 * speed * (2.0 * theta - 60f64.to_radians()).sin(),
+            ];
+            let got = Machine::pd_current(&w, &g, &y, 0);
+            assert!(close(got, pd(&scene, d, rate)), "θ = {theta}: {got:?} against {:?}", pd(&scene, d, rate));
+            // Not the exact state's PD (the rotor is at rest at the centre: the bias).
+            assert!((got[0] - g.bias_a[0]).abs() > 1e-4, "θ = {theta}: the runout is not read");
+        }
+
+        // The range: past ±250 µm in x the PD reads the limit and no rate; y passes.
+        let scene = realistic(&["sensor.bandwidth_hz=0", "sensor.runout=[]", "amb.amplifier=false"]);
+        let (w, g) = continuous(&scene);
+        let mut y = [0.0; crate::model::N + EXTRA];
+        y[ix::XR] = 3e-4;
+        y[ix::VXR] = 0.1;
+        y[ix::YR] = -1e-5;
+        y[ix::VYR] = 0.05;
+        let got = Machine::pd_current(&w, &g, &y, 0);
+        assert!(close(got, pd(&scene, [2.5e-4, -1e-5], [0.0, 0.05])), "{got:?}");
+        y[ix::XR] = 2e-4;
+        let got = Machine::pd_current(&w, &g, &y, 0);
+        assert!(close(got, pd(&scene, [2e-4, -1e-5], [0.1, 0.05])), "{got:?}");
+
+        // The 5 kHz Butterworth: its output and its output's rate, not the rotor's.
+        let scene = realistic(&["sensor.runout=[]", "amb.amplifier=false"]);
+        let (w, g) = continuous(&scene);
+        let mut y = [0.0; crate::model::N + EXTRA];
+        y[ix::XR] = 1e-4;
+        y[ix::VXR] = 0.1;
+        y[crate::model::N + ex::FILTER] = 4e-5;
+        y[crate::model::N + ex::FILTER_RATE] = 0.02;
+        let got = Machine::pd_current(&w, &g, &y, 0);
+        assert!(close(got, pd(&scene, [4e-5, 0.0], [0.02, 0.0])), "{got:?}");
     }
 
     /// The range clips what the sensor reads; the filter's output is what is read when the

@@ -65,9 +65,19 @@ pub trait Machine<const N: usize>: System<N> {
         None
     }
 
-    /// Plane `i`'s continuous PD current in state `y` (A): what the model's
-    /// `Control::Continuous(gains)` applies, saturated at the plane's limit.
-    fn pd_current(&self, gains: &PdGains, y: &[f64; N], i: usize) -> [f64; 2];
+    /// The rate of [`Machine::sensed`] (m/s): the rotor's velocity at plane `i`'s sensor (through
+    /// a sensor's front end, the rate of what it reads, [`crate::hardware`]).
+    fn sensed_rate(&self, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// Plane `i`'s continuous PD current in state `y` (A): the PD on what the plane's sensor
+    /// reads ([`Machine::sensed`]) and its rate, saturated at the plane's limit. For the bare
+    /// models, what their `Control::Continuous(gains)` applies.
+    fn pd_current(&self, gains: &PdGains, y: &[f64; N], i: usize) -> [f64; 2] {
+        let p = self.bearing(i);
+        let a_s = p.loop_constants.sensor_gain_v_per_m;
+        let (d, v) = (self.sensed(y, i), self.sensed_rate(y, i));
+        saturate(gains.current([d[0] * a_s, d[1] * a_s], [v[0] * a_s, v[1] * a_s]), p.current_limit)
+    }
 
     /// The rotor's velocity at plane `i`'s bearing, relative to the housing (m/s).
     fn bearing_velocity(&self, y: &[f64; N], i: usize) -> [f64; 2];
@@ -138,12 +148,8 @@ impl Machine<{ crate::model::N }> for Model {
         Record::planar(trace::row(self, t, y))
     }
 
-    fn pd_current(&self, gains: &PdGains, y: &crate::model::State, _i: usize) -> [f64; 2] {
-        use crate::model::ix::*;
-        let p = &self.params;
-        let a_s = p.loop_constants.sensor_gain_v_per_m;
-        let (u, u_dot) = ([y[XR] * a_s, y[YR] * a_s], [y[VXR] * a_s, y[VYR] * a_s]);
-        saturate(gains.current(u, u_dot), p.current_limit)
+    fn sensed_rate(&self, y: &crate::model::State, _i: usize) -> [f64; 2] {
+        [y[crate::model::ix::VXR], y[crate::model::ix::VYR]]
     }
 
     fn bearing_velocity(&self, y: &crate::model::State, _i: usize) -> [f64; 2] {
@@ -222,11 +228,8 @@ impl Machine<{ two_plane::N }> for two_plane::Model {
         trace::two_plane_record(self, t, y)
     }
 
-    fn pd_current(&self, gains: &PdGains, y: &two_plane::State, i: usize) -> [f64; 2] {
-        let plane = &self.params.planes[i];
-        let a_s = plane.params.loop_constants.sensor_gain_v_per_m;
-        let (s, s_dot) = two_plane::at_station(y, plane.sensor);
-        saturate(gains.current((s * a_s).into(), (s_dot * a_s).into()), plane.params.current_limit)
+    fn sensed_rate(&self, y: &two_plane::State, i: usize) -> [f64; 2] {
+        two_plane::at_station(y, self.params.planes[i].sensor).1.into()
     }
 
     fn bearing_velocity(&self, y: &two_plane::State, i: usize) -> [f64; 2] {

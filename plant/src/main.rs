@@ -106,6 +106,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Sweep(args) => plant::sweep::command(&args),
+        Command::Overlay(args) => plant::sweep::overlay::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),
         Command::Assess(args) => {
             let dir = plant::assess::command(&args, &plant::interrupt::stop_flag())?;

@@ -458,8 +458,8 @@ fn drive<const N: usize, M: Machine<N>>(
             angle_rad: wrap_angle(angle),
             ..Default::default()
         };
-        // Every axis's sensor, in every mode: the continuous PD reads the exact state inside the
-        // derivative, but an excitation hook reads the sensor signal there too.
+        // Every axis's sensor, in every mode: the continuous PD reads its signal inside the
+        // derivative, but an excitation hook reads the sensor signal here too.
         for i in 0..planes {
             let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
             let v = sensor.read_with_gain(model.sensed(&y, i), gain);

@@ -48,6 +48,20 @@ pub fn runout(harmonics: &[Harmonic], axis: usize, angle: f64) -> f64 {
         .sum()
 }
 
+/// The rate of [`runout`] (m/s) of `axis` at rotor angle `angle` (rad) turning at `speed`
+/// (rad/s): `−Σ a k θ̇ sin(k θ + φ)`.
+#[inline]
+pub fn runout_rate(harmonics: &[Harmonic], axis: usize, angle: f64, speed: f64) -> f64 {
+    harmonics
+        .iter()
+        .filter(|h| h.axis == axis)
+        .map(|h| {
+            let k = f64::from(h.order);
+            -h.amplitude * k * speed * (k * angle + h.phase).sin()
+        })
+        .sum()
+}
+
 /// The sensor's low-pass (its bandwidth), on the displacement it measures.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 #[serde(tag = "order", rename_all = "snake_case")]
@@ -124,6 +138,22 @@ impl FrontEnd {
         match self.range {
             Some(r) => d.clamp(-r, r),
             None => d,
+        }
+    }
+
+    /// The rate (m/s) of what the sensor reads, the range's [`FrontEnd::clip`] of the filter's
+    /// output `z[0]` (of its input `u`, m, without a filter): the filter's output rate, or the
+    /// input's rate `u_rate` (m/s) without one; 0 while the range clips. What an analog
+    /// controller differentiates (MODEL.md §12.2).
+    #[inline]
+    pub fn rate(&self, u: f64, u_rate: f64, z: [f64; 2]) -> f64 {
+        let (d, rate) = match self.low_pass {
+            Some(lp) => (z[0], lp.rates(u, z)[0]),
+            None => (u, u_rate),
+        };
+        match self.range {
+            Some(r) if d.abs() > r => 0.0,
+            _ => rate,
         }
     }
 }
@@ -256,6 +286,52 @@ mod tests {
         assert_eq!(runout(&list, 0, theta), x);
         assert_eq!(runout(&list, 1, theta), 3e-6 * theta.cos());
         assert_eq!(runout(&list, 2, theta), 0.0);
+    }
+
+    /// The runout's rate is the derivative of the runout along a turning rotor (central
+    /// differences).
+    #[test]
+    fn runout_rate_is_the_runouts_derivative() {
+        let h =
+            |axis, order, amplitude, phase| Harmonic { axis, order, amplitude, phase, kind: RunoutKind::Electrical };
+        let list = [h(0, 1, 2e-6, 0.3), h(0, 3, 1e-6, -1.0), h(1, 2, 3e-6, 0.5)];
+        let speed = std::f64::consts::TAU * 500.0;
+        let dt = 1e-9;
+        for k in 0..50 {
+            let theta = 0.13 * k as f64;
+            for axis in 0..3 {
+                let numeric =
+                    (runout(&list, axis, theta + speed * dt) - runout(&list, axis, theta - speed * dt)) / (2.0 * dt);
+                let exact = runout_rate(&list, axis, theta, speed);
+                assert!(
+                    (numeric - exact).abs() < 1e-6 * (1.0 + exact.abs()),
+                    "axis {axis}, θ = {theta}: {numeric} against {exact}"
+                );
+            }
+        }
+        assert_eq!(runout_rate(&list, 2, 1.0, speed), 0.0);
+    }
+
+    /// What an analog controller differentiates: the input's rate, the filter's output rate, 0
+    /// while the range clips.
+    #[test]
+    fn the_front_ends_rate_is_the_filters_or_the_inputs_and_zero_when_clipped() {
+        let ideal = FrontEnd::default();
+        assert_eq!(ideal.rate(1e-4, 0.02, [0.0; 2]), 0.02);
+        let ranged = FrontEnd { range: Some(1.5e-4), ..FrontEnd::default() };
+        assert_eq!(ranged.rate(1e-4, 0.02, [0.0; 2]), 0.02);
+        assert_eq!(ranged.rate(1.6e-4, 0.02, [0.0; 2]), 0.0);
+        assert_eq!(ranged.rate(-1.6e-4, -0.02, [0.0; 2]), 0.0);
+        let w = 2.0 * std::f64::consts::PI * 5000.0;
+        let second = FrontEnd { low_pass: Some(LowPass::Second { corner: w }), ..FrontEnd::default() };
+        // The Butterworth's output rate is its second state, whatever the input.
+        assert_eq!(second.rate(1e-4, 0.02, [5e-5, 0.3]), 0.3);
+        let first =
+            FrontEnd { low_pass: Some(LowPass::First { corner: w }), range: Some(1.5e-4), ..FrontEnd::default() };
+        assert_eq!(first.rate(1e-4, 0.02, [5e-5, 0.0]), w * (1e-4 - 5e-5));
+        // Clipped on the filter's output, not the input.
+        assert_eq!(first.rate(2e-4, 0.02, [1.4e-4, 0.0]), w * (2e-4 - 1.4e-4));
+        assert_eq!(first.rate(2e-4, 0.02, [1.6e-4, 0.0]), 0.0);
     }
 
     #[test]

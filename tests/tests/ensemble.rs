@@ -321,3 +321,68 @@ fn bench_ensemble_compares_the_fast_setting_with_the_scenes_own() {
     let json = read_json(&out.join("bench.json"));
     assert!(num(&json, "fast_per_core_s") > 0.0 && num(&json, "scene_per_core_s") > 0.0);
 }
+
+/// `plant overlay`: the curves of finished ensemble sweeps in one chart and one table (each
+/// point's probability as its sweep wrote it); bad input exits 2 naming the folder: a missing
+/// folder, a sweep of single runs, a map, another key, a `--label` count that is not the
+/// folders'.
+#[test]
+fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
+    let dir = TempDir::new("overlay");
+    let file = ensemble_sweep(&dir, "s.toml", 2, "members = 2\nbatch = 2\nagree = 2\nseed = 3\nverify = false");
+    let sweep = dir.join("sweep");
+    assert_exit(&output_within(&mut plant_sweep(&file, &sweep, &["--quiet"]), LIMIT), 0);
+    let overlay = |args: &[&str], dirs: &[&Path], out: &Path| {
+        let mut cmd = Command::new(plant_bin());
+        cmd.arg("overlay").args(dirs).args(args).arg("--out").arg(out);
+        output_within(&mut cmd, LIMIT)
+    };
+    let out = dir.join("overlay");
+    let o = overlay(&["--label", "first", "--label", "second"], &[sweep.as_path(), sweep.as_path()], &out);
+    assert_exit(&o, 0);
+    assert!(std::fs::read(out.join("overlay.png")).unwrap_or_default().starts_with(b"\x89PNG"));
+    let (h, rows) = table(&out.join("overlay.csv"));
+    let (sh, srows) = table(&sweep.join("points.csv"));
+    assert_eq!(rows.len(), 2 * srows.len());
+    for (k, label) in ["first", "second"].iter().enumerate() {
+        for (i, s) in srows.iter().enumerate() {
+            let r = &rows[k * srows.len() + i];
+            assert_eq!(&r[col(&h, "label")], label);
+            assert_eq!(r[col(&h, "key")], "shock[0].peak_g");
+            for c in ["value", "members", "recovered", "p_recovered", "p_lo", "p_hi"] {
+                assert_eq!(r[col(&h, c)], s[col(&sh, c)], "{label}, point {i}, {c}");
+            }
+        }
+    }
+
+    // A sweep of single runs, another key, a map: each refused.
+    let plain = dir.join("plain");
+    let o = output_within(&mut plant_sweep(&plain_sweep(&dir, ""), &plain, &["--quiet"]), LIMIT);
+    assert_exit(&o, 0);
+    let json = read_text(&sweep.join("sweep.json"));
+    let other = dir.join("other-key");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("sweep.json"), json.replace("\"shock[0].peak_g\"", "\"touchdown.air_gap_mm\"")).unwrap();
+    let map = dir.join("map");
+    std::fs::create_dir_all(&map).unwrap();
+    std::fs::write(
+        map.join("sweep.json"),
+        json.replace("\"shock[0].peak_g\"", "\"shock[0].peak_g\", \"touchdown.air_gap_mm\""),
+    )
+    .unwrap();
+    let missing = dir.join("no-such-sweep");
+    let bad = dir.join("bad-out");
+    let cases: [(&[&str], Vec<&Path>, &str); 5] = [
+        (&[], vec![sweep.as_path(), missing.as_path()], "no-such-sweep: no such sweep folder"),
+        (&[], vec![plain.as_path()], "a sweep of single runs"),
+        (&[], vec![sweep.as_path(), other.as_path()], "mismatched axes"),
+        (&[], vec![map.as_path()], "a sweep of 2 keys"),
+        (&["--label", "one"], vec![sweep.as_path(), sweep.as_path()], "--label given 1 times for 2 sweep folders"),
+    ];
+    for (args, dirs, needle) in cases {
+        let o = overlay(args, &dirs, &bad);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(needle), "expected `{needle}` in: {}", stderr(&o));
+    }
+    assert!(!bad.join("overlay.png").exists(), "a refused overlay wrote a chart");
+}

@@ -19,6 +19,18 @@ fn no_shock(dir: &TempDir, from: &str) -> std::path::PathBuf {
     path
 }
 
+/// The free decay's overrides: 0.6 s, no unbalance, 10 µm off centre in x, damping ratio `xi`.
+fn decay_sets(xi: f64) -> Vec<String> {
+    vec![
+        "scene.duration_s=0.6".to_string(),
+        "rotor.eccentricity_um=0".into(),
+        "initial.rotor_x_um=10".into(),
+        "output.plots=false".into(),
+        "output.rate_hz=20000".into(),
+        format!("controller.damping_ratio={xi}"),
+    ]
+}
+
 /// A complex number as (re, im), for the root finder.
 type C = (f64, f64);
 
@@ -88,14 +100,7 @@ fn levitated_damping_with_the_amplifier_is_the_linear_analysis() {
     let cases = [("ideal", 0.04, 0.0, 0.0), ("1.5 kHz", 0.04, 1500.0, 0.0), ("1.5 kHz, back-EMF", 0.04, 1500.0, 216.0)];
     let mut report = Vec::new();
     for (label, xi, fc, kb) in cases {
-        let mut sets = vec![
-            "scene.duration_s=0.6".to_string(),
-            "rotor.eccentricity_um=0".into(),
-            "initial.rotor_x_um=10".into(),
-            "output.plots=false".into(),
-            "output.rate_hz=20000".into(),
-            format!("controller.damping_ratio={xi}"),
-        ];
+        let mut sets = decay_sets(xi);
         if fc > 0.0 {
             sets.extend([
                 "amb.amplifier=true".to_string(),
@@ -146,6 +151,53 @@ fn levitated_damping_with_the_amplifier_is_the_linear_analysis() {
     }
     // The bandwidth costs damping, the back-EMF gives some back: the three differ.
     eprintln!("{}", report.join("\n"));
+}
+
+/// The continuous PD reads the sensor's front end: its free decay with a 5 kHz sensor (second
+/// order, then first) is the least-damped root of the linear loop with the filter,
+/// `(m s² − k_s)(s² + √2 ω s + ω²) + k_i ω² (P + D s) = 0` (first order: `(m s² − k_s)(s + ω)
+/// + k_i ω (P + D s) = 0`), not the ideal loop's.
+#[test]
+fn the_continuous_pd_through_a_sensor_bandwidth_is_the_linear_analysis() {
+    let dir = TempDir::new("hw-sensor-damping");
+    let file = no_shock(&dir, "paper-10g.toml");
+    let (m, ks, ki, ke, xi): (f64, f64, f64, f64, f64) = (11.5, 4.32e5, 216.0, 1.0e6, 0.04);
+    let ce = 2.0 * xi * (ke * m).sqrt();
+    let (p, d) = ((ke + ks) / ki, ce / ki);
+    let w = std::f64::consts::TAU * 5000.0;
+    let wn = (ke / m).sqrt();
+    let ideal = -ce / (2.0 * m);
+    for order in [2u32, 1] {
+        let mut sets = decay_sets(xi);
+        sets.extend(["sensor.bandwidth_hz=5000".to_string(), format!("sensor.filter_order={order}")]);
+        let out = dir.join(&format!("order-{order}"));
+        let sets_ref: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let o = output_within(&mut plant_run(&file, &out, &sets_ref), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        let trace = Csv::read(&out.join("trace.csv"));
+        let measured = decay_rate(&trace.column("t_s"), &trace.column("dx_m"), 0.02);
+        let poly: Vec<f64> = if order == 2 {
+            // (m s² − k_s)(s² + √2 ω s + ω²) + k_i ω² (D s + P)
+            let r2 = std::f64::consts::SQRT_2 * w;
+            vec![m, m * r2, m * w * w - ks, -ks * r2 + ki * w * w * d, -ks * w * w + ki * w * w * p]
+        } else {
+            // (m s² − k_s)(s + ω) + k_i ω (D s + P)
+            vec![m, m * w, -ks + ki * w * d, -ks * w + ki * w * p]
+        };
+        let root = roots(&poly)
+            .into_iter()
+            .filter(|z| z.1 > 0.3 * wn && z.1 < 3.0 * wn)
+            .max_by(|a, b| a.0.partial_cmp(&b.0).unwrap())
+            .expect("the rigid mode's root");
+        eprintln!("order {order}: measured σ = {measured:.4} 1/s, linear {:.4} 1/s, ideal {ideal:.4} 1/s", root.0);
+        assert!(
+            (measured - root.0).abs() < 0.01 * root.0.abs() + 0.02,
+            "order {order}: measured σ = {measured} 1/s against the linear analysis's {} 1/s",
+            root.0
+        );
+        // The filter's lag is visible: at least a tenth of the ideal loop's damping is gone.
+        assert!(measured > 0.9 * ideal, "order {order}: σ = {measured} 1/s, the ideal loop's {ideal} 1/s");
+    }
 }
 
 /// An amplifier run's trace has the coils' columns after all the others, `plant analyze` still

@@ -86,6 +86,18 @@ fn bad_two_plane_input_is_refused_at_load_naming_the_key() {
         output_within(Command::new(plant_bin()).arg("campbell").arg(&planar).arg("--out").arg(dir.join("c")), QUICK);
     assert_exit(&out, 2);
     assert!(stderr(&out).contains("needs a two-plane scene"), "{}", stderr(&out));
+    // A two-plane scene with an amplifier or a sensor filter: not linearised (the diagram would
+    // leave their states out), refused naming what is on.
+    for (set, needle) in
+        [("amb.amplifier=true", "amb.amplifier = true"), ("sensor.bandwidth_hz=5000", "sensor.bandwidth_hz > 0")]
+    {
+        let out = output_within(
+            Command::new(plant_bin()).arg("campbell").arg(&two).args(["--set", set]).arg("--out").arg(dir.join("h")),
+            QUICK,
+        );
+        assert_exit(&out, 2);
+        assert!(stderr(&out).contains(needle) && stderr(&out).contains("ideal loop"), "{}", stderr(&out));
+    }
     // A law of the whole rotor on a planar scene.
     refused("modal-planar", &planar, &["controller.mode=sampled", "controller.law=modal"], &["modal"]);
 }

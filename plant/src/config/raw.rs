@@ -609,8 +609,9 @@ pub struct RawInitial {
 }
 
 scene_table! {
-/// `[sensor]`: what the digital controller reads (sampled and co-simulation modes; the
-/// continuous PD sees the exact state). The gain is `amb.sensor_gain_v_per_m`.
+/// `[sensor]`: what the controller reads. The bandwidth, runout and range act in every mode
+/// (the continuous PD reads the front end's output and its rate); the noise and the ADC in the
+/// sampled and co-simulation modes. The gain is `amb.sensor_gain_v_per_m`.
 pub struct RawSensor {
     /// White noise added to each sample, standard deviation (V).
     pub noise_v_rms: f64 = 0.0,

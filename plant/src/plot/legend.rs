@@ -73,6 +73,22 @@ pub(crate) enum Mark {
     Dot(RGBColor),
     /// A filled square.
     Square(RGBColor),
+    /// A solid line with a filled marker on it.
+    LineMarker(RGBColor, Shape),
+}
+
+/// A marker's shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Shape {
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+}
+
+impl Shape {
+    /// Every shape, in the order curves take them.
+    pub(crate) const ALL: [Shape; 4] = [Shape::Circle, Shape::Square, Shape::Triangle, Shape::Diamond];
 }
 
 /// Draws a legend in centred rows (wrapped to the width) at the top of
@@ -137,5 +153,18 @@ pub(crate) fn draw_mark(
         }
         Mark::Dot(c) => area.draw(&Circle::new((mid, y), 7, c.filled())),
         Mark::Square(c) => area.draw(&Rectangle::new([(mid - 6, y - 6), (mid + 6, y + 6)], c.filled())),
+        Mark::LineMarker(c, shape) => {
+            area.draw(&PathElement::new(vec![(x, y), (x + w, y)], c.stroke_width(2)))?;
+            match shape {
+                Shape::Circle => area.draw(&Circle::new((mid, y), 6, c.filled())),
+                Shape::Square => area.draw(&Rectangle::new([(mid - 5, y - 5), (mid + 5, y + 5)], c.filled())),
+                Shape::Triangle => {
+                    area.draw(&Polygon::new(vec![(mid, y - 6), (mid + 6, y + 5), (mid - 6, y + 5)], c.filled()))
+                }
+                Shape::Diamond => {
+                    area.draw(&Polygon::new(vec![(mid, y - 7), (mid + 7, y), (mid, y + 7), (mid - 7, y)], c.filled()))
+                }
+            }
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! One room per job: [`axes`] (ranges and tick labels), [`decimate`]
 //! (what of a long trace is drawn), [`legend`] (where legends go), and one
 //! file per chart kind ([`lines()`], [`orbit()`], [`scatter()`],
-//! [`heatmap()`], [`loglog()`]); this file holds the shared style.
+//! [`heatmap()`], [`loglog()`], [`probability()`]); this file holds the shared style.
 //!
 //! Every chart is a PNG with a white background, a grid, a title in 28 px
 //! and axis labels in 20 px DejaVu Sans. The font is embedded (the `dejavu`
@@ -56,6 +56,7 @@ mod legend;
 mod lines;
 mod loglog;
 mod orbit;
+mod probability;
 mod scatter;
 #[cfg(test)]
 mod tests;
@@ -64,6 +65,7 @@ pub use heatmap::{heatmap, to_db};
 pub use lines::lines;
 pub use loglog::loglog;
 pub use orbit::{orbit, orbit_with_circles};
+pub use probability::{probability, ProbabilityCurve};
 pub use scatter::scatter;
 
 use std::path::{Path, PathBuf};

@@ -314,3 +314,30 @@ fn equal_axes_have_equal_scale() {
     assert!(((x1 - x0) / 400.0 - (y1 - y0) / 300.0).abs() < 1e-12);
     assert!(x1 - x0 >= 2.0 && y1 - y0 >= 1.0);
 }
+
+/// Probability curves: every curve drawn in its colour, and a curve whose slices differ in
+/// length refused.
+#[test]
+fn probability_draws_every_curve_and_refuses_uneven_slices() {
+    let dir = temp_dir("probability");
+    let x: Vec<f64> = (1..=20).map(f64::from).collect();
+    let falling: Vec<f64> = x.iter().map(|x| if *x < 4.0 { 1.0 } else { 0.0 }).collect();
+    let rising: Vec<f64> = x.iter().map(|x| (x / 20.0).min(1.0)).collect();
+    let lo: Vec<f64> = falling.iter().map(|p| (p - 0.2f64).max(0.0)).collect();
+    let hi: Vec<f64> = falling.iter().map(|p| (p + 0.2f64).min(1.0)).collect();
+    let lo2: Vec<f64> = rising.iter().map(|p| (p - 0.1f64).max(0.0)).collect();
+    let hi2: Vec<f64> = rising.iter().map(|p| (p + 0.1f64).min(1.0)).collect();
+    let curves = [
+        ProbabilityCurve { label: "falling", x: &x, p: &falling, lo: &lo, hi: &hi },
+        ProbabilityCurve { label: "rising", x: &x, p: &rising, lo: &lo2, hi: &hi2 },
+    ];
+    let p = dir.join("p.png");
+    probability(&p, "two curves", "peak (G)", &curves, 0.25).unwrap();
+    let img = assert_drawn(&p, (1200, 900), colour(0), 500);
+    assert!(img.count_inside(colour(1)) > 500, "the second curve is not drawn");
+    let short = [ProbabilityCurve { label: "short", x: &x, p: &rising[..3], lo: &lo2, hi: &hi2 }];
+    let e = probability(&dir.join("bad.png"), "bad", "x", &short, 0.0).unwrap_err();
+    assert!(matches!(e, PlotError::BadInput { .. }), "{e}");
+    let nothing = [ProbabilityCurve { label: "none", x: &[f64::NAN], p: &[0.5], lo: &[0.4], hi: &[0.6] }];
+    assert!(matches!(probability(&dir.join("n.png"), "n", "x", &nothing, 0.0), Err(PlotError::NoData { .. })));
+}

@@ -30,6 +30,7 @@
 //! ensembles, its members' scenes at the ends of every drawn range) is loaded and validated
 //! before anything runs.
 
+pub mod overlay;
 pub mod single;
 
 use crate::config::ConfigError;
