@@ -2,6 +2,7 @@
 # The fidelity charts of docs/results/fidelity.md (docs/charts/fidelity_{sampled,continuous,all}.png
 # and .csv) from the finished sweeps of config/sweeps/fidelity/, run first with
 #   for n in ideal voltage current-loop sensor-bandwidth runout range realistic relev-ideal relev-realistic \
+#     relev-voltage relev-current-loop relev-sensor-bandwidth relev-runout \
 #     paper-ideal paper-voltage paper-current-loop paper-sensor-bandwidth paper-runout paper-range \
 #     paper-realistic paper-redesign-ideal paper-redesign-realistic; do
 #     plant sweep config/sweeps/fidelity/$n.toml --out runs/fid/$n --jobs 2
@@ -19,3 +20,6 @@ $P overlay $F/paper-ideal $F/paper-voltage $F/paper-current-loop $F/paper-sensor
 $P overlay $F/ideal $F/realistic $F/paper-ideal $F/paper-realistic $F/paper-redesign-ideal $F/paper-redesign-realistic $F/relev-ideal $F/relev-realistic \
  --label "sampled PD ξ_e = 0.045, ideal loop" --label "sampled PD ξ_e = 0.045, realistic loop" --label "continuous PD ξ_e = 0.01 (the study's), ideal loop" --label "continuous PD ξ_e = 0.01, realistic loop (unstable)" --label "continuous PD ξ_e = 0.029, ideal loop" --label "continuous PD ξ_e = 0.029, realistic loop" --label "relev, ideal loop" --label "relev, realistic loop" \
  --title "every controller, ideal against realistic loop: recovery against the shock's peak" --out runs/fidelity-all
+$P overlay $F/relev-ideal $F/relev-voltage $F/relev-current-loop $F/relev-sensor-bandwidth $F/relev-runout $F/relev-realistic \
+ --label "ideal loop" --label "voltage limit alone (150 V, 58 mH, 20 kHz loop)" --label "current loop alone (1.5 kHz)" --label "sensor bandwidth alone (5 kHz)" --label "runout alone" --label "all, ±250 µm" \
+ --title "relev (relev-10g, sampled at 20 kHz): recovery against the shock's peak" --out runs/fidelity-relev
