@@ -125,18 +125,7 @@ fn repeat_two_plane_contact_tick(
     };
     let y0 = two_plane_contact_state(scene, params);
     let settings = crate::run::settings_with(scene, scene.integrator.two_plane_atol());
-    let mut integrator = crate::integrate::Integrator::new(settings);
-    integrator.set_substeps(scene.integrator.contact_substeps);
-    let (t0, t1) = (0.0, scene.controller.period);
-    let mut times = crate::cosim::Latencies::new();
-    for _ in 0..repeats {
-        let mut y = y0;
-        let start = std::time::Instant::now();
-        integrator.advance(&model, t0, t1, &mut y)?;
-        times.record(start.elapsed().as_nanos() as u64);
-        std::hint::black_box(&y);
-    }
-    Ok((times.percentiles(), integrator.stats().rhs_evals / repeats.max(1)))
+    time_repeated_tick(scene, &model, settings, y0, repeats)
 }
 
 /// The two-plane rotor's initial state with both bearing planes 2 µm into their races,
@@ -203,14 +192,26 @@ fn repeat_contact_tick(scene: &Scene, repeats: u64) -> anyhow::Result<(crate::co
     // The rotor 2 µm into its race, straight down (about a kilonewton of contact).
     y0[ix::XR] = y0[ix::XB];
     y0[ix::YR] = y0[ix::YB] - scene.params.contact.gap - 2e-6;
-    let mut integrator = crate::integrate::Integrator::new(crate::run::integrator_settings(scene));
+    time_repeated_tick(scene, &model, crate::run::integrator_settings(scene), y0, repeats)
+}
+
+/// Integrates one tick of `model` (the scene's period, its contact substeps) from `y0`
+/// `repeats` times, timing each; the percentiles (µs) and the evaluations per repeat.
+fn time_repeated_tick<S: crate::integrate::System<N>, const N: usize>(
+    scene: &Scene,
+    model: &S,
+    settings: crate::integrate::Settings<N>,
+    y0: [f64; N],
+    repeats: u64,
+) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+    let mut integrator = crate::integrate::Integrator::new(settings);
     integrator.set_substeps(scene.integrator.contact_substeps);
     let (t0, t1) = (0.0, scene.controller.period);
     let mut times = crate::cosim::Latencies::new();
     for _ in 0..repeats {
         let mut y = y0;
         let start = std::time::Instant::now();
-        integrator.advance(&model, t0, t1, &mut y)?;
+        integrator.advance(model, t0, t1, &mut y)?;
         times.record(start.elapsed().as_nanos() as u64);
         std::hint::black_box(&y);
     }
