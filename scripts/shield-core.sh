@@ -32,6 +32,11 @@ on)
         echo "shield-core: core $core: must be 1 to $last (core 0 keeps the rest of the system)" >&2
         exit 2
     }
+    # A second `on` would save the first one's settings as the ones to restore.
+    [ -d "$state" ] && {
+        echo "shield-core: core $(cat "$state/core" 2>/dev/null) is already shielded: \`$0 off\` first" >&2
+        exit 2
+    }
     rest=$(seq -s, 0 "$last" | tr ',' '\n' | grep -vx "$core" | paste -sd, -)
     mkdir -p "$state" "$cg/system" "$cg/shield"
     [ -f "$cg/cgroup.subtree_control" ] && echo +cpuset >"$cg/cgroup.subtree_control" 2>/dev/null || true
