@@ -482,13 +482,17 @@ pub fn realtime(priority: i32) -> Vec<String> {
 }
 
 /// Puts thread `pid` (0: the calling thread) under `SCHED_FIFO` at `priority`, unless it
-/// already is.
+/// already runs there.
 pub fn set_fifo(pid: u32, priority: i32) -> Result<(), String> {
     let pid = libc::pid_t::try_from(pid).map_err(|_| format!("pid {pid} is out of range"))?;
-    // SAFETY: sched_getscheduler/sched_setscheduler read and write only `param`, a valid
-    // sched_param; they have no other preconditions.
+    // SAFETY: sched_getscheduler/sched_getparam/sched_setscheduler read and write only
+    // `param`, a valid sched_param; they have no other preconditions.
     unsafe {
-        if libc::sched_getscheduler(pid) == libc::SCHED_FIFO {
+        let mut param = libc::sched_param { sched_priority: 0 };
+        if libc::sched_getscheduler(pid) == libc::SCHED_FIFO
+            && libc::sched_getparam(pid, &mut param) == 0
+            && param.sched_priority == priority
+        {
             return Ok(());
         }
         let param = libc::sched_param { sched_priority: priority };
@@ -501,6 +505,50 @@ pub fn set_fifo(pid: u32, priority: i32) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Makes the calling thread an ordinary one: `SCHED_OTHER`, on every core the process may
+/// use but those in `avoid` (every core if that leaves none). For a realtime process's
+/// helper threads (writing its rows, reading its controller's output), which would otherwise
+/// inherit the loop's `SCHED_FIFO` priority and pinned core, or land on the loop's cores and
+/// take them from it (`avoid`: `controller.pin_cores`). Best effort: a refusal leaves the
+/// thread as it was.
+pub fn ordinary_thread(avoid: &[usize]) {
+    // SAFETY: sched_setscheduler reads a valid sched_param; cpu_set_t is plain data that
+    // CPU_SET writes inside; both calls affect only the calling thread (0). The kernel
+    // intersects the mask with the cores the process's cpuset allows, and refuses (EINVAL) a
+    // mask that leaves none.
+    unsafe {
+        let param = libc::sched_param { sched_priority: 0 };
+        if libc::sched_getscheduler(0) != libc::SCHED_OTHER {
+            libc::sched_setscheduler(0, libc::SCHED_OTHER, &param);
+        }
+        let mask = |skip: &[usize]| {
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            for core in (0..libc::CPU_SETSIZE as usize).filter(|c| !skip.contains(c)) {
+                libc::CPU_SET(core, &mut set);
+            }
+            set
+        };
+        let size = std::mem::size_of::<libc::cpu_set_t>();
+        if libc::sched_setaffinity(0, size, &mask(avoid)) != 0 {
+            libc::sched_setaffinity(0, size, &mask(&[]));
+        }
+    }
+}
+
+/// The `SCHED_FIFO`/`SCHED_RR` priority of thread `pid` (0: the calling thread); `None` for
+/// another policy or a thread that cannot be read.
+pub fn fifo_priority(pid: u32) -> Option<i32> {
+    let pid = libc::pid_t::try_from(pid).ok()?;
+    let mut param = libc::sched_param { sched_priority: 0 };
+    // SAFETY: sched_getscheduler has no preconditions; sched_getparam writes only `param`.
+    unsafe {
+        matches!(libc::sched_getscheduler(pid), libc::SCHED_FIFO | libc::SCHED_RR)
+            .then(|| libc::sched_getparam(pid, &mut param) == 0)
+            .filter(|ok| *ok)
+            .map(|_| param.sched_priority)
+    }
 }
 
 /// The scheduling policy of thread `pid` (0: the calling thread): `fifo`, `rr`, `other`, ….
@@ -522,4 +570,43 @@ pub fn cores_online() -> usize {
     // SAFETY: sysconf has no preconditions.
     let n = unsafe { libc::sysconf(libc::_SC_NPROCESSORS_ONLN) };
     usize::try_from(n).unwrap_or(1).max(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cores the calling thread may run on.
+    fn affinity() -> Vec<usize> {
+        // SAFETY: sched_getaffinity writes only `set`, plain data of the size given.
+        unsafe {
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            assert_eq!(libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set), 0);
+            (0..libc::CPU_SETSIZE as usize).filter(|c| libc::CPU_ISSET(*c, &set)).collect()
+        }
+    }
+
+    /// A helper thread started by a pinned loop leaves the loop's core and runs under
+    /// `SCHED_OTHER`; with every core to avoid it takes them all rather than none.
+    #[test]
+    fn an_ordinary_thread_leaves_the_loops_cores() {
+        std::thread::spawn(|| {
+            let all = affinity();
+            let first = all[0];
+            pin_to_core(first).unwrap();
+            assert_eq!(affinity(), vec![first]);
+            ordinary_thread(&[first]);
+            let now = affinity();
+            if all.len() > 1 {
+                assert!(!now.contains(&first) && !now.is_empty(), "{now:?}");
+            } else {
+                assert_eq!(now, all);
+            }
+            ordinary_thread(&all);
+            assert_eq!(affinity(), all, "avoiding every core leaves them all");
+            assert_eq!(policy(0), "other");
+        })
+        .join()
+        .unwrap();
+    }
 }

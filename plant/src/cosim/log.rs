@@ -90,6 +90,8 @@ pub struct OutputLog {
     /// One message per drain thread when its pipe ends.
     ended: (Sender<()>, Receiver<()>),
     running: usize,
+    /// Cores the drain threads keep off ([`OutputLog::avoiding`]).
+    avoid: Vec<usize>,
 }
 
 impl OutputLog {
@@ -101,7 +103,14 @@ impl OutputLog {
             path: path.map(Path::to_path_buf),
             ended: channel(),
             running: 0,
+            avoid: Vec::new(),
         })
+    }
+
+    /// Keeps the drain threads off `cores` (a realtime run's `controller.pin_cores`).
+    pub fn avoiding(mut self, cores: &[usize]) -> Self {
+        self.avoid = cores.to_vec();
+        self
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
@@ -115,8 +124,10 @@ impl OutputLog {
         let (mut reader, writer) = std::io::pipe()?;
         let second = writer.try_clone()?;
         self.state().take(format!("--- plant: started {what} ---\n").as_bytes());
-        let (state, ended) = (self.state.clone(), self.ended.0.clone());
+        let (state, ended, avoid) = (self.state.clone(), self.ended.0.clone(), self.avoid.clone());
         std::thread::Builder::new().name("controller-output".into()).spawn(move || {
+            // Started by a realtime loop: an ordinary thread, off the loop's priority and core.
+            controller::link::ordinary_thread(&avoid);
             let mut buf = [0u8; 8192];
             loop {
                 match reader.read(&mut buf) {

@@ -16,7 +16,8 @@
 //! when it has no `/`), with `--run-id <ID>` appended and the environment
 //! variables [`RUN_ID_ENV`] (the run id), [`CONNECT_TIMEOUT_ENV`] (how long
 //! the plant waits for the handshake, s) and, with
-//! `controller.realtime_priority = N > 0`, [`REALTIME_PRIORITY_ENV`]` = N`.
+//! `controller.realtime_priority = N > 0`, [`REALTIME_PRIORITY_ENV`] = the controller's own
+//! priority, next to the plant's `N` (the session's `controller_priority`).
 //! Relative paths were resolved against the scene file's folder when the
 //! scene loaded (see `config::validate`). A command that does not exist or is
 //! not executable is refused before anything starts ([`resolve`]).
@@ -117,7 +118,7 @@ pub struct Args<'a> {
     pub pin_core: Option<usize>,
     /// Its wait for the hello (s).
     pub connect_timeout_s: f64,
-    /// `controller.realtime_priority` (0: off).
+    /// Its `SCHED_FIFO` priority (0: off).
     pub realtime_priority: u32,
 }
 

@@ -382,9 +382,17 @@ pub struct Scheduling {
     pub plant: String,
     /// The (last) controller's main thread, as the plant sees it.
     pub controller: String,
+    /// The controller's `SCHED_FIFO` priority as the plant reads it: one below the plant's
+    /// (`controller.realtime_priority` − 1, at least 1); absent when it is not under FIFO.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_priority: Option<u32>,
     /// Realtime: `controller.pacing` (`spin` or `sleep`); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pacing: Option<String>,
+    /// Realtime: `kernel.sched_rt_runtime_us` during the run (`-1`: RT throttling off), where
+    /// `/proc` tells.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rt_runtime_us: Option<i64>,
     /// Realtime with a priority: the idle wake-up latency the run held every core to
     /// through `/dev/cpu_dma_latency` (0 µs), absent where it could not.
     #[serde(skip_serializing_if = "Option::is_none")]

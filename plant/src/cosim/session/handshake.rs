@@ -32,7 +32,7 @@ pub fn hello_for(scene: &Scene, run_id: &str, token: u64) -> Result<Hello, Cosim
     let params = c.params.to_document()?;
     let mut hello = Hello::for_rotor(run_id, &c.law, &scene.rotor_design(), c.rate_hz, &params)?;
     hello.token = token;
-    hello.spin_ns = (controller_spin(c.mode, c.cosim.pacing, c.cosim.spin, c.period) * 1e9) as u64;
+    hello.spin_ns = (controller_spin(c.mode, &c.cosim, c.period) * 1e9) as u64;
     hello.mode = if c.mode == ControlMode::Realtime { mode::REALTIME } else { mode::LOCKSTEP };
     Ok(hello)
 }
@@ -47,14 +47,56 @@ const REALTIME_SPIN_PERIODS: f64 = 100.0;
 /// deadlines are missed (measured: 84 % misses at 20 kHz, against < 2 %
 /// spinning).
 ///
-/// With `controller.pacing = "sleep"` the controller never spins in realtime: it
-/// may share the plant's core, where a spinning controller would keep the plant
-/// (same `SCHED_FIFO` priority) from waking at its tick.
-fn controller_spin(mode: ControlMode, pacing: Pacing, spin: f64, period: f64) -> f64 {
-    match (mode, pacing) {
-        (ControlMode::Realtime, Pacing::Spin) => spin.max(REALTIME_SPIN_PERIODS * period),
+/// A controller that shares the plant's core (`pin_cores = [c, c]`) never spins, in any
+/// mode: it runs above the plant ([`controller_priority`]) and would keep it from its tick.
+/// Nor does a realtime controller whose plant sleeps between ticks (`pacing = "sleep"`).
+fn controller_spin(mode: ControlMode, settings: &CosimSettings, period: f64) -> f64 {
+    match (mode, settings.pacing) {
+        _ if shares_core(settings) => 0.0,
+        (ControlMode::Realtime, Pacing::Spin) => settings.spin.max(REALTIME_SPIN_PERIODS * period),
         (ControlMode::Realtime, Pacing::Sleep) => 0.0,
-        _ => spin,
+        _ => settings.spin,
+    }
+}
+
+/// Plant and controller pinned to one core (`pin_cores = [c, c]`).
+fn shares_core(settings: &CosimSettings) -> bool {
+    settings.pin_cores.is_some_and(|[p, c]| p == c)
+}
+
+/// `kernel.sched_rt_runtime_us` (`-1`: RT throttling off), where `/proc` tells.
+fn rt_runtime_us() -> Option<i64> {
+    std::fs::read_to_string("/proc/sys/kernel/sched_rt_runtime_us").ok()?.trim().parse().ok()
+}
+
+/// The warning for a realtime plant that spins under `SCHED_FIFO` while RT throttling is on:
+/// Linux stops `SCHED_FIFO` threads for the rest of each second once they have run
+/// `sched_rt_runtime_us` of it, and a spinning plant wants all of it (measured: stalls of
+/// 44–50 ms, 1,400–2,400 plant overruns in the 1.5 s scene).
+fn rt_throttling_warning(settings: &CosimSettings, rt_runtime_us: Option<i64>) -> Option<String> {
+    let runtime = rt_runtime_us?;
+    (settings.realtime_priority > 0 && settings.pacing == Pacing::Spin && runtime >= 0).then(|| {
+        format!(
+            "warning: controller.pacing = \"spin\" under SCHED_FIFO with kernel.sched_rt_runtime_us = {runtime}: \
+             Linux stops the spinning plant for {} ms of every second (RT throttling); turn it off \
+             (`sysctl kernel.sched_rt_runtime_us=-1`, or scripts/shield-core.sh on) or use pacing = \"sleep\"",
+            (1_000_000 - runtime).max(0) / 1000
+        )
+    })
+}
+
+/// The controller's `SCHED_FIFO` priority next to the plant's `controller.realtime_priority`
+/// (0: off): the plant's, or one above it (at most 99) when the two share a core. There the
+/// controller runs only when the plant's frame wakes it, at once, preempting the plant: its
+/// reply is ready before the next tick whether the plant sleeps or spins between ticks
+/// (measured on the 10 G scene, spinning: 0 deadline misses in 10 of 10 runs, each the
+/// lockstep trace bit for bit; at one priority a spinning plant starves the controller, and
+/// one below the plant, a sleeping plant's clock preempts a controller still at work).
+pub(in crate::cosim) fn controller_priority(settings: &CosimSettings) -> u32 {
+    match settings.realtime_priority {
+        0 => 0,
+        p if shares_core(settings) => (p + 1).min(99),
+        p => p,
     }
 }
 
@@ -123,6 +165,10 @@ impl Session {
         let mut idle_latency = None;
         if mode == ControlMode::Realtime {
             scheduling.pacing = Some(format!("{:?}", settings.pacing).to_lowercase());
+            scheduling.rt_runtime_us = rt_runtime_us();
+            if let Some(why) = rt_throttling_warning(&settings, scheduling.rt_runtime_us) {
+                hooks.note(&why);
+            }
             if settings.realtime_priority > 0 {
                 match link::hold_zero_idle_latency() {
                     Ok(f) => {
@@ -140,10 +186,12 @@ impl Session {
                 }
             }
         }
-        let log = OutputLog::create(launch.log.as_deref()).map_err(|e| CosimError::Spawn {
-            path: launch.log.clone().unwrap_or_default(),
-            why: format!("cannot create the file for the controller's output: {e}"),
-        })?;
+        let log = OutputLog::create(launch.log.as_deref())
+            .map_err(|e| CosimError::Spawn {
+                path: launch.log.clone().unwrap_or_default(),
+                why: format!("cannot create the file for the controller's output: {e}"),
+            })?
+            .avoiding(settings.pin_cores.as_ref().map_or(&[][..], |c| &c[..]));
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
@@ -200,7 +248,7 @@ impl Session {
                 run_id: &self.run_id,
                 pin_core: self.settings.pin_cores.map(|c| c[1]),
                 connect_timeout_s: self.settings.connect_timeout.max(1.0),
-                realtime_priority: self.settings.realtime_priority,
+                realtime_priority: controller_priority(&self.settings),
             };
             self.child = Some(Child::spawn(program, &args, &mut self.log)?);
         }
@@ -263,12 +311,13 @@ impl Session {
         }
     }
 
-    /// With `controller.realtime_priority`, puts the controller under `SCHED_FIFO` too (a
-    /// controller the plant did not start, or one that did not take it itself).
+    /// With `controller.realtime_priority`, puts the controller under `SCHED_FIFO` too, next to
+    /// the plant ([`controller_priority`]; a controller the plant did not start, or one that
+    /// did not take it itself).
     fn schedule_controller(&mut self, pid: u32, hooks: &mut dyn Hooks) {
         let priority = self.settings.realtime_priority;
         if priority > 0 {
-            if let Err(refused) = link::set_fifo(pid, priority as i32) {
+            if let Err(refused) = link::set_fifo(pid, controller_priority(&self.settings) as i32) {
                 hooks.note(&format!(
                     "warning: controller.realtime_priority = {priority}: cannot put the controller under {refused}; running without it"
                 ));
@@ -276,6 +325,7 @@ impl Session {
             }
         }
         self.scheduling.controller = link::policy(pid).to_string();
+        self.scheduling.controller_priority = link::fifo_priority(pid).and_then(|p| u32::try_from(p).ok());
     }
 
     pub(super) fn handshake_blocking(&mut self, timeout: f64, hooks: &mut dyn Hooks) -> Result<(), CosimError> {
@@ -333,14 +383,57 @@ fn controller_overrides(ack: &Ack) -> Result<Option<toml::Table>, String> {
 mod tests {
     use super::*;
 
-    /// A spinning realtime controller spins at least 100 periods; a sleeping one never spins
-    /// (it shares the plant's core); lockstep keeps `controller.spin_us`.
+    /// The shipped 10 G scene's co-simulation settings with `pacing`, `pin_cores` and the
+    /// priority given.
+    fn settings(pacing: Pacing, pin_cores: Option<[usize; 2]>, priority: u32) -> CosimSettings {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/cosim-10g.toml");
+        let mut s = crate::config::load_scene(&path, &[]).unwrap().controller.cosim;
+        (s.pacing, s.pin_cores, s.realtime_priority) = (pacing, pin_cores, priority);
+        s
+    }
+
+    /// A spinning realtime controller with a core of its own spins at least 100 periods; one
+    /// that sleeps, or shares the plant's core (in any mode), never spins; lockstep keeps
+    /// `controller.spin_us`.
     #[test]
     fn the_controller_spins_only_where_it_owns_a_core() {
         let period = 50e-6;
-        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Spin, 200e-6, period), 100.0 * period);
-        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Spin, 0.01, period), 0.01);
-        assert_eq!(controller_spin(ControlMode::Realtime, Pacing::Sleep, 200e-6, period), 0.0);
-        assert_eq!(controller_spin(ControlMode::Lockstep, Pacing::Sleep, 200e-6, period), 200e-6);
+        let at = |pacing, cores, spin| {
+            let mut s = settings(pacing, cores, 0);
+            s.spin = spin;
+            s
+        };
+        let (rt, ls) = (ControlMode::Realtime, ControlMode::Lockstep);
+        assert_eq!(controller_spin(rt, &at(Pacing::Spin, None, 200e-6), period), 100.0 * period);
+        assert_eq!(controller_spin(rt, &at(Pacing::Spin, Some([1, 0]), 0.01), period), 0.01);
+        assert_eq!(controller_spin(rt, &at(Pacing::Spin, Some([1, 1]), 0.01), period), 0.0);
+        assert_eq!(controller_spin(rt, &at(Pacing::Sleep, None, 200e-6), period), 0.0);
+        assert_eq!(controller_spin(ls, &at(Pacing::Sleep, None, 200e-6), period), 200e-6);
+        assert_eq!(controller_spin(ls, &at(Pacing::Spin, Some([0, 0]), 200e-6), period), 0.0);
+    }
+
+    /// A spinning FIFO plant is warned of RT throttling unless it is off; a sleeping one, or one
+    /// without a priority, is not.
+    #[test]
+    fn a_spinning_fifo_plant_is_warned_of_rt_throttling() {
+        let spin = settings(Pacing::Spin, Some([1, 1]), 50);
+        let why = rt_throttling_warning(&spin, Some(950_000)).unwrap();
+        assert!(why.contains("kernel.sched_rt_runtime_us = 950000") && why.contains("for 50 ms"), "{why}");
+        assert_eq!(rt_throttling_warning(&spin, Some(-1)), None);
+        assert_eq!(rt_throttling_warning(&spin, None), None);
+        assert_eq!(rt_throttling_warning(&settings(Pacing::Sleep, Some([1, 1]), 50), Some(950_000)), None);
+        assert_eq!(rt_throttling_warning(&settings(Pacing::Spin, Some([1, 1]), 0), Some(950_000)), None);
+    }
+
+    /// The controller runs at the plant's priority, one above it on a shared core (at most 99);
+    /// 0 stays off.
+    #[test]
+    fn the_controller_runs_above_the_plant_on_a_shared_core() {
+        let p = |cores, priority| controller_priority(&settings(Pacing::Spin, cores, priority));
+        assert_eq!(p(Some([1, 1]), 50), 51);
+        assert_eq!(p(Some([1, 1]), 99), 99);
+        assert_eq!(p(Some([1, 0]), 50), 50);
+        assert_eq!(p(None, 50), 50);
+        assert_eq!(p(Some([1, 1]), 0), 0);
     }
 }
