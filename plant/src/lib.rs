@@ -36,6 +36,7 @@ pub mod initial;
 pub mod interrupt;
 pub mod invalid;
 pub mod machine;
+pub mod offload;
 pub mod output;
 pub mod plot;
 pub mod record;

@@ -16,7 +16,7 @@ use crate::cosim::Launch;
 use crate::hooks::Hooks;
 use crate::plot::{self, Scale, Series};
 use crate::record::{ChartData, PlaneRecorded, Recorder};
-use crate::run::{run_into, Outcome, RunResult, SetupError, Sink, SinkRun};
+use crate::run::{run_into_offloaded, Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{Record, TraceError, TraceWriter};
 use anyhow::Context;
@@ -252,7 +252,7 @@ pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Ho
     prepare(dir, scene).map_err(RunDirError::Output)?;
     let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
     let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
-    let run = run_into(scene, &launch, hooks, &mut folder)?;
+    let run = run_into_offloaded(scene, &launch, hooks, &mut folder)?;
     // What an external controller ran differently from the scene goes into the record, so that
     // the folder reproduces the run.
     let recorded = match run.cosim.as_ref().and_then(|c| c.controller_overrides.as_ref()) {

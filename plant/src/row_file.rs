@@ -25,13 +25,22 @@ pub struct RowFile {
     pending: Pending,
 }
 
-/// The rows the `csv` writer has formatted, not yet in the file.
+/// The rows the `csv` writer has formatted, not yet in the file. Shared with the writer
+/// through an `Arc<Mutex>` (never contended: one thread has both) so that a `RowFile` can
+/// be handed to another thread ([`crate::offload`]).
 #[derive(Clone, Default)]
-struct Pending(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+struct Pending(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl Pending {
+    fn bytes(&self) -> std::sync::MutexGuard<'_, Vec<u8>> {
+        // A panic while the lock was held left whole rows or none: the bytes are still good.
+        self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
 
 impl Write for Pending {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.borrow_mut().extend_from_slice(buf);
+        self.bytes().extend_from_slice(buf);
         Ok(buf.len())
     }
 
@@ -62,7 +71,7 @@ impl RowFile {
         // Out of the csv writer's own buffer after each record, so that `pending` holds
         // whole rows only.
         self.csv.flush()?;
-        if self.pending.0.borrow().len() >= FLUSH_BYTES {
+        if self.pending.bytes().len() >= FLUSH_BYTES {
             self.flush()?;
         }
         Ok(())
@@ -71,7 +80,7 @@ impl RowFile {
     /// Writes the pending whole rows to the file.
     pub fn flush(&mut self) -> std::io::Result<()> {
         self.csv.flush()?;
-        let mut pending = self.pending.0.borrow_mut();
+        let mut pending = self.pending.bytes();
         if !pending.is_empty() {
             self.file.write_all(&pending)?;
             pending.clear();

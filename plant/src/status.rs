@@ -97,7 +97,7 @@ impl SetupError {
             SetupError::Law(_) | SetupError::Overrides(_) => Status::Refused,
             SetupError::Cosim(CosimError::Interrupted) => Status::Interrupted,
             SetupError::Cosim(c) if c.is_refusal() => Status::Refused,
-            SetupError::Cosim(_) => Status::NotStarted,
+            SetupError::Cosim(_) | SetupError::Thread(_) => Status::NotStarted,
         }
     }
 }

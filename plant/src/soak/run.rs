@@ -8,7 +8,7 @@ use super::{monitor, rss, ENVELOPE_BIN_S, ENVELOPE_CSV_HEADER, RSS_CSV_HEADER, S
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
 use crate::row_file::RowFile;
-use crate::run::{run_into, SetupError};
+use crate::run::{run_into_offloaded, SetupError};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -199,7 +199,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         error: None,
     };
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
-    let mut result = match run_into(scene, &launch, &mut hooks, &mut sink) {
+    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink) {
         Ok(r) => r,
         Err(e) => {
             // The programme loaded: the folder records why the soak did not start.

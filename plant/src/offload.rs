@@ -1,0 +1,126 @@
+//! A sink on a thread of its own, for realtime runs: the loop hands each output sample
+//! over a bounded channel and goes on; the thread formats it, writes it out and feeds the
+//! recorder (`trace.csv` and the charts' data of `plant run`, the soak's monitor and files,
+//! a trace kept in memory).
+//!
+//! Inside the tick these took more than a 20 kHz period: writing a 64 KiB chunk of
+//! `trace.csv` took 50–200 µs every 170 rows, the recorder up to 100 µs every 256 rows,
+//! and formatting a row 2–3 µs of a tick whose integration takes 2 µs. What stays in the
+//! tick is a copy into the channel.
+//!
+//! Written here because the standard library's bounded channel does all it needs: the
+//! thread waits for the first sample, takes what has come since, then sleeps for
+//! [`PAUSE`], so that the loop's sends seldom find a thread waiting to be woken (a wake is
+//! a system call in the tick). A full channel makes the loop wait: no sample is dropped.
+
+use crate::run::Sink;
+use crate::trace::Record;
+use std::sync::mpsc::{sync_channel, SyncSender};
+use std::time::Duration;
+
+/// Samples the channel holds: 200 ms of a 20 kHz run with one row per tick.
+pub const CAPACITY: usize = 4096;
+
+/// How long the thread sleeps after taking what has come.
+const PAUSE: Duration = Duration::from_millis(2);
+
+/// The loop's side: sends each sample to the thread.
+struct Handoff(SyncSender<Record>);
+
+impl Sink for Handoff {
+    fn sample(&mut self, record: &Record) {
+        // Fails only when the thread has ended, which it does by panicking: the scope's join
+        // passes the panic on.
+        let _ = self.0.send(*record);
+    }
+}
+
+/// Runs `body` with a sink that hands every sample to `sink` on a thread named
+/// `plant-rows`, and returns what `body` returned once the thread has taken every sample.
+///
+/// The thread is an ordinary one (`SCHED_OTHER`, on any core the process may use but those
+/// in `avoid`, the loop's `controller.pin_cores`), whatever the caller's scheduling: a
+/// realtime loop puts its own thread under `SCHED_FIFO` and pins it. `sink` receives samples only:
+/// [`Sink::planar_state`] and [`Sink::two_plane_state`] are not handed over, so a sink that
+/// needs them must not be offloaded. A panic on the thread is passed on to the caller; a
+/// thread that cannot be started (a process at its thread limit) is an error, before `body`
+/// runs.
+pub fn offload<S: Sink + Send, R>(
+    sink: &mut S,
+    avoid: &[usize],
+    body: impl FnOnce(&mut dyn Sink) -> R,
+) -> std::io::Result<R> {
+    let (tx, rx) = sync_channel::<Record>(CAPACITY);
+    std::thread::scope(|scope| {
+        let thread = std::thread::Builder::new().name("plant-rows".into()).spawn_scoped(scope, move || {
+            // A run after a realtime one starts it from a thread under `SCHED_FIFO`,
+            // pinned: it must not take the loop's core at the loop's priority.
+            controller::link::ordinary_thread(avoid);
+            while let Ok(first) = rx.recv() {
+                sink.sample(&first);
+                while let Ok(r) = rx.try_recv() {
+                    sink.sample(&r);
+                }
+                std::thread::sleep(PAUSE);
+            }
+        });
+        thread.map(|_| body(&mut Handoff(tx)))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::WIDTH;
+
+    /// A sink that keeps the times it was given, on whatever thread.
+    struct Times(Vec<f64>, Option<String>);
+
+    impl Sink for Times {
+        fn sample(&mut self, r: &Record) {
+            self.0.push(r.a[0]);
+            self.1 = std::thread::current().name().map(String::from);
+        }
+    }
+
+    fn record(t: f64) -> Record {
+        let mut a = [0.0; WIDTH];
+        a[0] = t;
+        Record::planar(a)
+    }
+
+    #[test]
+    fn every_sample_arrives_in_order_on_the_rows_thread_even_past_the_channels_capacity() {
+        let mut sink = Times(Vec::new(), None);
+        let n = 3 * CAPACITY + 17;
+        let returned = offload(&mut sink, &[], |s| {
+            for i in 0..n {
+                s.sample(&record(i as f64));
+            }
+            "body's value"
+        })
+        .unwrap();
+        assert_eq!(returned, "body's value");
+        assert_eq!(sink.0.len(), n);
+        assert!(sink.0.iter().enumerate().all(|(i, t)| *t == i as f64), "out of order");
+        assert_eq!(sink.1.as_deref(), Some("plant-rows"));
+    }
+
+    #[test]
+    fn a_panic_on_the_rows_thread_reaches_the_caller() {
+        struct Fails;
+        impl Sink for Fails {
+            fn sample(&mut self, _: &Record) {
+                panic!("the sink failed");
+            }
+        }
+        let caught = std::panic::catch_unwind(|| {
+            offload(&mut Fails, &[], |s| {
+                for i in 0..(2 * CAPACITY) {
+                    s.sample(&record(i as f64));
+                }
+            })
+        });
+        assert!(caught.is_err());
+    }
+}
