@@ -38,6 +38,8 @@ on)
         exit 2
     }
     rest=$(seq -s, 0 "$last" | tr ',' '\n' | grep -vx "$core" | paste -sd, -)
+    mask=0
+    for c in $(echo "$rest" | tr ',' ' '); do mask=$((mask | (1 << c))); done
     mkdir -p "$state" "$cg/system" "$cg/shield"
     [ -f "$cg/cgroup.subtree_control" ] && echo +cpuset >"$cg/cgroup.subtree_control" 2>/dev/null || true
     echo "$rest" >"$cg/system/cpuset.cpus"
@@ -57,13 +59,33 @@ on)
     wq=/sys/devices/virtual/workqueue/cpumask
     if [ -w "$wq" ]; then
         cat "$wq" >"$state/wq_cpumask"
-        mask=0
-        for c in $(echo "$rest" | tr ',' ' '); do mask=$((mask | (1 << c))); done
         printf '%x\n' "$mask" >"$wq" || echo "shield-core: $wq: left as it was" >&2
     fi
+    # Device interrupts (the disk's and the network's completions) off the core. Those the
+    # kernel manages itself (a multi-queue disk's) refuse and stay: named below, since
+    # every disk write on the machine then interrupts the shielded core.
+    mkdir -p "$state/irq"
+    irqs=0
+    stay=""
+    for f in /proc/irq/*/smp_affinity_list; do
+        d=$(dirname "$f")
+        n=$(basename "$d")
+        old=$(cat "$f" 2>/dev/null) || continue
+        if echo "$rest" >"$f" 2>/dev/null; then
+            echo "$old" >"$state/irq/$n"
+            irqs=$((irqs + 1))
+        elif [ "$(cat "$d/effective_affinity_list" 2>/dev/null)" = "$core" ]; then
+            stay="$stay $n ($(grep -E "^ *$n:" /proc/interrupts | awk '{print $NF}'))"
+        fi
+    done
+    [ -z "$stay" ] || echo "shield-core: interrupts that cannot leave core $core:$stay" >&2
+    if [ -w /proc/irq/default_smp_affinity ]; then
+        cat /proc/irq/default_smp_affinity >"$state/irq_default"
+        printf '%x\n' "$mask" >/proc/irq/default_smp_affinity 2>/dev/null || true
+    fi
     echo -1 >/proc/sys/kernel/sched_rt_runtime_us
-    echo "shield-core: core $core shielded ($moved tasks moved to cores $rest, $kept kernel threads stay);" \
-        "kernel.sched_rt_runtime_us = -1 (was $(cat "$state/rt_runtime_us"))"
+    echo "shield-core: core $core shielded ($moved tasks moved to cores $rest, $kept kernel threads stay," \
+        "$irqs interrupts moved);" "kernel.sched_rt_runtime_us = -1 (was $(cat "$state/rt_runtime_us"))"
     ;;
 run)
     [ $# -ge 4 ] && [ "$3" = "--" ] || usage
@@ -93,6 +115,10 @@ off)
     if [ -f "$state/wq_cpumask" ]; then
         cat "$state/wq_cpumask" >/sys/devices/virtual/workqueue/cpumask || true
     fi
+    for f in "$state"/irq/*; do
+        [ -f "$f" ] && cat "$f" >"/proc/irq/$(basename "$f")/smp_affinity_list" 2>/dev/null || true
+    done
+    [ -f "$state/irq_default" ] && cat "$state/irq_default" >/proc/irq/default_smp_affinity 2>/dev/null || true
     if [ -f "$state/rt_runtime_us" ]; then
         cat "$state/rt_runtime_us" >/proc/sys/kernel/sched_rt_runtime_us
         echo "shield-core: off; kernel.sched_rt_runtime_us = $(cat "$state/rt_runtime_us")"
