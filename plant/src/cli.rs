@@ -248,6 +248,29 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 0)]
         realtime_priority: u32,
     },
+    /// What the host adds: how late this machine starts each tick of a realtime run with
+    /// nothing to compute, sleeping to each tick (`pacing = "sleep"`, as cyclictest) and
+    /// spinning (`pacing = "spin"`); p50/p99/p99.9/max and the ticks more than a period late
+    /// (a floor under a realtime run's plant overruns); writes host.csv. Build with
+    /// `--release`, and give the run's `--pin-core` and `--realtime-priority`.
+    Host {
+        /// Ticks per second (a realtime scene's `controller.rate_hz`), 1 to 1e6.
+        #[arg(long, default_value_t = 20_000.0)]
+        rate_hz: f64,
+        /// Seconds per loop (0.001 to 3600).
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+        /// Output folder (default: runs/bench-host).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Pin the bench's thread to this core.
+        #[arg(long)]
+        pin_core: Option<usize>,
+        /// `SCHED_FIFO` at this priority (1 to 99) with memory locked and every core's idle
+        /// latency held at 0; 0: the normal scheduler.
+        #[arg(long, default_value_t = 0)]
+        realtime_priority: u32,
+    },
     /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
     /// of full-length impact and rub runs for each method at a representative setting, against a
     /// DOP853 reference.

@@ -145,6 +145,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 };
                 bench_wrote([plant::bench::tick::command(&req, &mut bench_log)?])
             }
+            BenchCommand::Host { rate_hz, seconds, out, pin_core, realtime_priority } => {
+                let req =
+                    plant::bench::host::Request { rate_hz, seconds, out: out.as_deref(), pin_core, realtime_priority };
+                bench_wrote([plant::bench::host::command(&req, &mut bench_log)?])
+            }
             BenchCommand::Engineering { out, config, repeats } => {
                 bench_wrote([plant::bench::engineering::command(out.as_deref(), &config, repeats, &mut bench_log)?])
             }

@@ -14,6 +14,8 @@
 //!   (`engineering.csv`).
 //! * [`tick`]: the plant's execution time per tick, alone, on the realtime setting and on the
 //!   scene's own integrator (`tick.csv`).
+//! * [`host`]: how late this host starts a realtime run's ticks with nothing to compute,
+//!   sleeping and spinning (`host.csv`): the floor under every realtime run's overruns.
 //! * [`rows`]: the columns of each table the benches write and read.
 //! * [`peer`]: the spec an independent implementation of the derivative
 //!   reads.
@@ -34,6 +36,7 @@
 
 pub mod accuracy;
 pub mod engineering;
+pub mod host;
 pub mod models;
 pub mod peer;
 pub mod rows;

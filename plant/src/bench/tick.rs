@@ -226,6 +226,30 @@ pub fn load_average() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// Pins the calling thread to `pin_core` and puts it under `SCHED_FIFO` at `priority` with
+/// memory locked (0: the normal scheduler), as a realtime run's plant; returns what it got
+/// (`other` or `fifo N`, and the core). What the system refuses is logged as a warning.
+pub fn schedule(pin_core: Option<usize>, priority: u32, log: &mut dyn FnMut(&str)) -> anyhow::Result<String> {
+    let mut scheduling = String::from("other");
+    if let Some(core) = pin_core {
+        controller::link::pin_to_core(core).map_err(|e| super::BadArgument(format!("--pin-core: {e}")))?;
+    }
+    if priority > 0 {
+        let refused = controller::link::realtime(priority as i32);
+        for r in &refused {
+            log(&format!("warning: the system refused {r}"));
+        }
+        scheduling = controller::link::policy(0).to_string();
+        if scheduling == "fifo" {
+            scheduling = format!("fifo {priority}");
+        }
+    }
+    if let Some(core) = pin_core {
+        scheduling = format!("{scheduling}, core {core}");
+    }
+    Ok(scheduling)
+}
+
 /// What `plant bench tick` was asked to do.
 pub struct Request<'a> {
     /// The scene file.
@@ -274,23 +298,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     let settings = settings(req)?;
     let dir = super::out_dir(req.out, "bench-tick");
     let _claim = crate::claim::claim(&dir, true)?;
-    let mut scheduling = String::from("other");
-    if let Some(core) = req.pin_core {
-        controller::link::pin_to_core(core).map_err(|e| super::BadArgument(format!("--pin-core: {e}")))?;
-    }
-    if req.realtime_priority > 0 {
-        let refused = controller::link::realtime(req.realtime_priority as i32);
-        for r in &refused {
-            log(&format!("warning: the system refused {r}"));
-        }
-        scheduling = controller::link::policy(0).to_string();
-        if scheduling == "fifo" {
-            scheduling = format!("fifo {}", req.realtime_priority);
-        }
-    }
-    if let Some(core) = req.pin_core {
-        scheduling = format!("{scheduling}, core {core}");
-    }
+    let scheduling = schedule(req.pin_core, req.realtime_priority, log)?;
     let mut rows = Vec::new();
     for (label, scene) in &settings {
         for run in 1..=req.repeats {
