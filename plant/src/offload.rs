@@ -1,7 +1,6 @@
 //! A sink on a thread of its own, for realtime runs: the loop hands each output sample
 //! over a bounded channel and goes on; the thread formats it, writes it out and feeds the
-//! recorder (`trace.csv` and the charts' data of `plant run`, the soak's monitor and files,
-//! a trace kept in memory).
+//! recorder (`trace.csv` and the charts' data of `plant run`, the soak's monitor and files).
 //!
 //! Inside the tick these took more than a 20 kHz period: writing a 64 KiB chunk of
 //! `trace.csv` took 50–200 µs every 170 rows, the recorder up to 100 µs every 256 rows,
@@ -13,7 +12,10 @@
 //! [`PAUSE`], so that the loop's sends seldom find a thread waiting to be woken (a wake is
 //! a system call in the tick). A full channel makes the loop wait: no sample is dropped.
 
-use crate::run::Sink;
+use crate::config::{ControlMode, Scene};
+use crate::cosim::Launch;
+use crate::hooks::Hooks;
+use crate::run::{run_into, SetupError, Sink, SinkRun};
 use crate::trace::Record;
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::time::Duration;
@@ -32,6 +34,22 @@ impl Sink for Handoff {
         // Fails only when the thread has ended, which it does by panicking: the scope's join
         // passes the panic on.
         let _ = self.0.send(*record);
+    }
+}
+
+/// [`run_into`]; a realtime run hands its samples to `sink` on a thread of its own
+/// ([`crate::offload`]), so that writing and analysing them stays out of its ticks.
+pub fn run_into_offloaded<S: Sink + Send>(
+    scene: &Scene,
+    launch: &Launch,
+    hooks: &mut dyn Hooks,
+    sink: &mut S,
+) -> Result<SinkRun, SetupError> {
+    if scene.controller.mode == ControlMode::Realtime {
+        let avoid = scene.controller.cosim.pin_cores.as_ref().map_or(&[][..], |c| &c[..]);
+        offload(sink, avoid, |s| run_into(scene, launch, hooks, s)).map_err(SetupError::Thread)?
+    } else {
+        run_into(scene, launch, hooks, sink)
     }
 }
 

@@ -198,7 +198,7 @@ pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError
 /// Runs a scene from its initial state, launching a co-simulation as `launch` says.
 pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
     let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
-    let run = run_into_offloaded(scene, launch, hooks, &mut trace)?;
+    let run = run_into(scene, launch, hooks, &mut trace)?;
     Ok(RunResult { trace, run })
 }
 
@@ -264,22 +264,6 @@ pub fn run_into(
         }
     };
     run_from(scene, source, hooks, sink)
-}
-
-/// [`run_into`]; a realtime run hands its samples to `sink` on a thread of its own
-/// ([`crate::offload`]), so that writing and analysing them stays out of its ticks.
-pub fn run_into_offloaded<S: Sink + Send>(
-    scene: &Scene,
-    launch: &Launch,
-    hooks: &mut dyn Hooks,
-    sink: &mut S,
-) -> Result<SinkRun, SetupError> {
-    if scene.controller.mode == ControlMode::Realtime {
-        let avoid = scene.controller.cosim.pin_cores.as_ref().map_or(&[][..], |c| &c[..]);
-        crate::offload::offload(sink, avoid, |s| run_into(scene, launch, hooks, s)).map_err(SetupError::Thread)?
-    } else {
-        run_into(scene, launch, hooks, sink)
-    }
 }
 
 /// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
