@@ -164,6 +164,15 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
     if ctl.realtime_priority > 99 {
         return Err(range("controller.realtime_priority", ctl.realtime_priority, "", "must be 0 (off) to 99"));
     }
+    if ctl.realtime_priority > 97 && pin_cores.is_some_and(|[p, c]| p == c) {
+        return Err(range(
+            "controller.realtime_priority",
+            ctl.realtime_priority,
+            "",
+            "must be 0 (off) to 97 with plant and controller on one core (controller.pin_cores): the controller \
+             runs one level above the plant there, and the plant's watchdog one above that",
+        ));
+    }
     if !(ctl.max_miss_fraction.is_finite() && (0.0..=1.0).contains(&ctl.max_miss_fraction)) {
         return Err(range("controller.max_miss_fraction", ctl.max_miss_fraction, "", "must be between 0 and 1"));
     }

@@ -17,9 +17,13 @@
 //!   miss and the last current is held; a reply that comes later is stale
 //!   and dropped. The reply is one sample old by construction, so the
 //!   delay line is prefilled with `d − 1` commands and `d ≥ 1`. A plant
-//!   step that ends after the next tick's start is a plant overrun. Both
-//!   processes busy-wait (the controller for at least 100 periods before it
-//!   blocks): realtime at 20 kHz needs two free cores.
+//!   step that ends after the next tick's start is a plant overrun. How the
+//!   processes wait (`controller.pacing`, `controller.pin_cores`): on cores of
+//!   their own a spinning plant's controller spins too (at least 100 periods
+//!   before it blocks); on one shared core the controller never spins and
+//!   runs one `SCHED_FIFO` level above the plant, answering each frame at
+//!   once ([`watchdog`] gives the core back to the plant if it stops
+//!   blocking).
 //!
 //! # Faults
 //!
@@ -60,6 +64,7 @@ pub mod log;
 pub mod process;
 pub mod session;
 pub mod stats;
+pub mod watchdog;
 
 pub use bench::bench_round_trips;
 pub use session::{Halt, Session};

@@ -129,6 +129,9 @@ pub struct Session {
     figures: Figures,
     scheduling: Scheduling,
     wake_warned: bool,
+    /// Plant and controller on one core under `SCHED_FIFO`: demotes a controller that holds
+    /// the core ([`super::watchdog`]).
+    watchdog: Option<super::watchdog::Watchdog>,
 }
 
 impl Session {
@@ -248,6 +251,20 @@ impl Session {
     /// The command for sample `k` to push into the delay line: the reply to
     /// `k` (lockstep) or to `k − 1` (realtime), or a fallback.
     pub fn command(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
+        if let Some(w) = &self.watchdog {
+            w.tick();
+            if let Some(pid) = w.take_demoted() {
+                let why = format!(
+                    "the controller (pid {pid}) held the shared core for {} s without letting the plant tick: put \
+                     under the normal scheduler; a controller on the plant's core must block between frames",
+                    super::watchdog::STALL.as_secs_f64()
+                );
+                self.event("controller_demoted", sample.t_s, sample.seq, why.clone());
+                hooks.note(&format!("warning: {why}"));
+                self.scheduling.controller = controller::link::policy(pid).to_string();
+                self.scheduling.controller_priority = None;
+            }
+        }
         match self.mode {
             ControlMode::Realtime => self.realtime(sample, hooks),
             _ => self.lockstep(sample, hooks),

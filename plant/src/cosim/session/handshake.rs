@@ -59,6 +59,11 @@ fn controller_spin(mode: ControlMode, settings: &CosimSettings, period: f64) -> 
     }
 }
 
+/// The plant's loop thread runs under `SCHED_FIFO`.
+fn scheduling_is_fifo(s: &Scheduling) -> bool {
+    s.plant == "fifo"
+}
+
 /// Plant and controller pinned to one core (`pin_cores = [c, c]`).
 fn shares_core(settings: &CosimSettings) -> bool {
     settings.pin_cores.is_some_and(|[p, c]| p == c)
@@ -227,8 +232,22 @@ impl Session {
             figures: Figures::default(),
             scheduling,
             wake_warned: false,
+            watchdog: None,
             settings,
         };
+        // On a shared core the controller runs above the plant; the watchdog above both.
+        if let (Some([core, _]), true) = (s.settings.pin_cores, shares_core(&s.settings)) {
+            let priority = controller_priority(&s.settings);
+            if priority > 0 && scheduling_is_fifo(&s.scheduling) {
+                s.watchdog = super::super::watchdog::Watchdog::start(core, (priority as i32 + 1).min(99));
+                if s.watchdog.is_none() {
+                    hooks.note(
+                        "warning: cannot start the plant's watchdog on the shared core: a controller that stops \
+                         blocking between frames would hold the core",
+                    );
+                }
+            }
+        }
         if s.program.is_none() {
             hooks.note(&format!(
                 "waiting up to {} s for a controller: start `controller --run-id {}`",
@@ -323,6 +342,9 @@ impl Session {
                 ));
                 self.scheduling.refused.push(format!("controller: {refused}"));
             }
+        }
+        if let Some(w) = &self.watchdog {
+            w.watch_controller(pid);
         }
         self.scheduling.controller = link::policy(pid).to_string();
         self.scheduling.controller_priority = link::fifo_priority(pid).and_then(|p| u32::try_from(p).ok());
