@@ -537,6 +537,12 @@ pub fn ordinary_thread(avoid: &[usize]) {
     }
 }
 
+/// `kernel.sched_rt_runtime_us` (`-1`: RT throttling off), where `/proc` tells: the time of
+/// each second that `SCHED_FIFO` threads may run before Linux stops them for the rest of it.
+pub fn rt_runtime_us() -> Option<i64> {
+    std::fs::read_to_string("/proc/sys/kernel/sched_rt_runtime_us").ok()?.trim().parse().ok()
+}
+
 /// The `SCHED_FIFO`/`SCHED_RR` priority of thread `pid` (0: the calling thread); `None` for
 /// another policy or a thread that cannot be read.
 pub fn fifo_priority(pid: u32) -> Option<i32> {

@@ -69,11 +69,6 @@ fn shares_core(settings: &CosimSettings) -> bool {
     settings.pin_cores.is_some_and(|[p, c]| p == c)
 }
 
-/// `kernel.sched_rt_runtime_us` (`-1`: RT throttling off), where `/proc` tells.
-fn rt_runtime_us() -> Option<i64> {
-    std::fs::read_to_string("/proc/sys/kernel/sched_rt_runtime_us").ok()?.trim().parse().ok()
-}
-
 /// The warning for a realtime plant that spins under `SCHED_FIFO` while RT throttling is on:
 /// Linux stops `SCHED_FIFO` threads for the rest of each second once they have run
 /// `sched_rt_runtime_us` of it, and a spinning plant wants all of it (measured: stalls of
@@ -170,7 +165,7 @@ impl Session {
         let mut idle_latency = None;
         if mode == ControlMode::Realtime {
             scheduling.pacing = Some(format!("{:?}", settings.pacing).to_lowercase());
-            scheduling.rt_runtime_us = rt_runtime_us();
+            scheduling.rt_runtime_us = link::rt_runtime_us();
             if let Some(why) = rt_throttling_warning(&settings, scheduling.rt_runtime_us) {
                 hooks.note(&why);
             }
