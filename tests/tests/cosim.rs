@@ -1019,6 +1019,42 @@ fn realtime_priority_is_applied_or_refused_with_a_warning() {
     }
 }
 
+/// Issue 22: plant and controller on one core (`pin_cores = [c, c]`). Where the system grants
+/// SCHED_FIFO, the controller runs one level above the plant (and the run says so); a priority
+/// that leaves no level above the controller for the plant's watchdog is refused, naming the
+/// key. The run's timing is not asserted (a shared machine).
+#[test]
+fn on_a_shared_core_the_controller_runs_above_the_plant() {
+    controller_bin();
+    let dir = TempDir::new("cosim-shared-core");
+    let out = dir.join("run");
+    let shared = [
+        "controller.mode=realtime",
+        "controller.realtime_priority=10",
+        "controller.pin_cores=[0, 0]",
+        "controller.pacing=\"sleep\"",
+        "scene.duration_s=0.05",
+    ];
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&shared)));
+    assert_exit(&run, 0);
+    let sched = &read_json(&out.join("summary.json"))["cosim"]["scheduling"];
+    if sched["refused"].as_array().map_or(0, Vec::len) == 0 {
+        assert_eq!((sched["plant"].as_str(), sched["controller"].as_str()), (Some("fifo"), Some("fifo")), "{sched:#}");
+        assert_eq!(num(sched, "controller_priority"), 11.0, "{sched:#}");
+    } else {
+        assert!(stderr(&run).contains("warning: controller.realtime_priority = 10"), "{}", stderr(&run));
+    }
+    let bad = output(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &dir.join("bad"),
+        &sets(&["controller.mode=realtime", "controller.realtime_priority=98", "controller.pin_cores=[0, 0]"]),
+    ));
+    assert_exit(&bad, 2);
+    let err = stderr(&bad);
+    assert!(err.contains("controller.realtime_priority") && err.contains("98") && err.contains("97"), "{err}");
+    assert!(!dir.join("bad").join("trace.csv").exists(), "a refused scene wrote a trace");
+}
+
 /// Issue 10 item 7: a controller that never serves the plant's wake requests makes every
 /// blocked wait of the plant run out its slice. The run completes (same trace), and the plant
 /// warns once, saying what is wrong.
