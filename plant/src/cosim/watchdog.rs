@@ -5,8 +5,9 @@
 //!
 //! A thread one level above the controller, pinned to the same core, sleeps and looks at the
 //! plant's tick count every [`Watchdog::check`]; when the count has not moved for
-//! [`STALL`], it puts the controller under the normal scheduler (`SCHED_OTHER`), which
-//! gives the core back to the plant. The run goes on and says so: a peer event, a warning,
+//! [`STALL`] while the controller is running, it puts the controller under the normal
+//! scheduler (`SCHED_OTHER`), which gives the core back to the plant. A controller that is
+//! stopped (a debugger) or waiting holds no core and is left to the plant's own timeouts. The run goes on and says so: a peer event, a warning,
 //! and the misses that follow. The thread costs one wake-up every [`Watchdog::check`] on
 //! the core.
 
@@ -112,11 +113,21 @@ fn watch(s: &Shared, check: Duration, stall: Duration) {
             continue;
         }
         let pid = s.pid.load(Ordering::Relaxed);
-        if pid != 0 && since.elapsed() >= stall && demote(pid) {
+        // Only a controller that is running holds the core: one stopped (a debugger, SIGSTOP)
+        // or waiting is not demoted; the plant's own timeouts deal with it.
+        if pid != 0 && since.elapsed() >= stall && running(pid) && demote(pid) {
             s.demoted.store(pid, Ordering::Relaxed);
             s.pid.store(0, Ordering::Relaxed);
         }
     }
+}
+
+/// Process `pid` is running or runnable (`R` in `/proc/PID/stat`).
+fn running(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|s| s.rsplit_once(')').and_then(|(_, rest)| rest.split_whitespace().next().map(|st| st == "R")))
+        .unwrap_or(false)
 }
 
 /// Puts process `pid` (its main thread) under `SCHED_OTHER`; false where that fails.
@@ -131,15 +142,20 @@ fn demote(pid: u32) -> bool {
 mod tests {
     use super::*;
 
-    /// A process to demote: `sleep`, a child of the test (same user, so no privilege is
-    /// needed to set its policy).
-    fn child() -> std::process::Child {
+    /// A process to demote: a busy shell loop, a child of the test (same user, so no privilege
+    /// is needed to set its policy), running as a controller that holds its core does.
+    fn busy() -> std::process::Child {
+        std::process::Command::new("sh").args(["-c", "while :; do :; done"]).spawn().unwrap()
+    }
+
+    /// A waiting process: `sleep`.
+    fn waiting() -> std::process::Child {
         std::process::Command::new("sleep").arg("30").spawn().unwrap()
     }
 
     #[test]
     fn a_plant_that_stops_ticking_has_its_controller_demoted_and_one_that_ticks_does_not() {
-        let mut c = child();
+        let mut c = busy();
         let s = Arc::new(Shared::default());
         s.pid.store(c.id(), Ordering::Relaxed);
         let t = {
@@ -162,6 +178,23 @@ mod tests {
         assert_eq!(s.pid.load(Ordering::Relaxed), 0, "demoted once, then no longer watched");
         s.stop.store(true, Ordering::Relaxed);
         t.join().unwrap();
+        let _ = c.kill();
+        let _ = c.wait();
+    }
+
+    #[test]
+    fn a_controller_that_is_not_running_is_not_demoted() {
+        let mut c = waiting();
+        let s = Arc::new(Shared::default());
+        s.pid.store(c.id(), Ordering::Relaxed);
+        let t = {
+            let s = s.clone();
+            std::thread::spawn(move || watch(&s, Duration::from_millis(5), Duration::from_millis(20)))
+        };
+        std::thread::sleep(Duration::from_millis(200));
+        s.stop.store(true, Ordering::Relaxed);
+        t.join().unwrap();
+        assert_eq!(s.demoted.load(Ordering::Relaxed), 0, "a sleeping controller holds no core");
         let _ = c.kill();
         let _ = c.wait();
     }
