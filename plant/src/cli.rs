@@ -156,6 +156,18 @@ impl ControllerArg {
     }
 }
 
+/// How a timing bench's thread runs, as a realtime run's plant does.
+#[derive(clap::Args, Clone, Copy)]
+pub struct BenchScheduling {
+    /// Pin the bench's thread to this core.
+    #[arg(long)]
+    pub pin_core: Option<usize>,
+    /// `SCHED_FIFO` at this priority (1 to 99) with memory locked (`bench host`: and every
+    /// core's idle latency held at 0); 0: the normal scheduler.
+    #[arg(long, default_value_t = 0)]
+    pub realtime_priority: u32,
+}
+
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// Ensemble throughput (members per core-second, fast setting with and without
@@ -241,12 +253,8 @@ pub enum BenchCommand {
         /// Output folder (default: runs/bench-tick).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Pin the bench's thread to this core.
-        #[arg(long)]
-        pin_core: Option<usize>,
-        /// `SCHED_FIFO` at this priority (1 to 99) with memory locked; 0: the normal scheduler.
-        #[arg(long, default_value_t = 0)]
-        realtime_priority: u32,
+        #[command(flatten)]
+        sched: BenchScheduling,
     },
     /// What the host adds: how late this machine starts each tick of a realtime run with
     /// nothing to compute, sleeping to each tick (`pacing = "sleep"`, as cyclictest) and
@@ -263,13 +271,8 @@ pub enum BenchCommand {
         /// Output folder (default: runs/bench-host).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Pin the bench's thread to this core.
-        #[arg(long)]
-        pin_core: Option<usize>,
-        /// `SCHED_FIFO` at this priority (1 to 99) with memory locked and every core's idle
-        /// latency held at 0; 0: the normal scheduler.
-        #[arg(long, default_value_t = 0)]
-        realtime_priority: u32,
+        #[command(flatten)]
+        sched: BenchScheduling,
     },
     /// Engineering figures (peak contact force, max radius, contact fraction, post-shock mode)
     /// of full-length impact and rub runs for each method at a representative setting, against a

@@ -134,18 +134,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             BenchCommand::Models { out, config, repeats } => {
                 bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
             }
-            BenchCommand::Tick { scene, set, repeats, out, pin_core, realtime_priority } => {
+            BenchCommand::Tick { scene, set, repeats, out, sched } => {
                 let req = plant::bench::tick::Request {
                     scene: &scene,
                     set: &set,
                     repeats,
                     out: out.as_deref(),
-                    pin_core,
-                    realtime_priority,
+                    pin_core: sched.pin_core,
+                    realtime_priority: sched.realtime_priority,
                 };
                 bench_wrote([plant::bench::tick::command(&req, &mut bench_log)?])
             }
-            BenchCommand::Host { rate_hz, seconds, out, pin_core, realtime_priority } => {
+            BenchCommand::Host { rate_hz, seconds, out, sched } => {
+                let (pin_core, realtime_priority) = (sched.pin_core, sched.realtime_priority);
                 let req =
                     plant::bench::host::Request { rate_hz, seconds, out: out.as_deref(), pin_core, realtime_priority };
                 bench_wrote([plant::bench::host::command(&req, &mut bench_log)?])

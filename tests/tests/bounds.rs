@@ -130,6 +130,42 @@ fn bench_counts_are_bounded() {
     }
 }
 
+/// Issue 22: `plant bench host` measures every tick it was asked for, once sleeping and once
+/// spinning, into `host.csv`; a rate, a duration or a priority out of range is refused naming
+/// the flag and the value (exit 2), before anything is written.
+#[test]
+fn bench_host_writes_both_loops_and_refuses_absurd_values() {
+    let dir = TempDir::new("bench-host");
+    let out = dir.join("host");
+    let run = output_within(
+        Command::new(plant_bin()).args(["bench", "host", "--seconds", "0.01", "--rate-hz", "10000", "--out"]).arg(&out),
+        QUICK,
+    );
+    assert_exit(&run, 0);
+    let text = std::fs::read_to_string(out.join("host.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}: {header:?}"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.iter().map(|r| r[col("pacing")]).collect::<Vec<_>>(), ["sleep", "spin"], "{text}");
+    for r in &rows {
+        assert_eq!(r[col("ticks")], "100", "{text}");
+        let over: f64 = r[col("over_period")].parse().unwrap();
+        assert!((0.0..=100.0).contains(&over), "{text}");
+    }
+    for (flag, value) in
+        [("--rate-hz", "0"), ("--rate-hz", "nan"), ("--seconds", "7200"), ("--realtime-priority", "100")]
+    {
+        let bad = dir.join(&format!("bad{flag}"));
+        let run =
+            output_within(Command::new(plant_bin()).args(["bench", "host", flag, value, "--out"]).arg(&bad), QUICK);
+        assert_exit(&run, 2);
+        let err = stderr(&run);
+        assert!(err.contains(flag) && err.to_lowercase().contains(value), "{flag} {value}: {err}");
+        assert!(!bad.join("host.csv").exists(), "{flag} {value} wrote a table");
+    }
+}
+
 /// Issue 11 item 9: one controller tick in the whole run passed without a word.
 #[test]
 fn a_run_with_few_controller_ticks_gets_a_warning() {
