@@ -484,17 +484,13 @@ pub fn realtime(priority: i32) -> Vec<String> {
 /// Puts thread `pid` (0: the calling thread) under `SCHED_FIFO` at `priority`, unless it
 /// already runs there.
 pub fn set_fifo(pid: u32, priority: i32) -> Result<(), String> {
+    if policy(pid) == "fifo" && fifo_priority(pid) == Some(priority) {
+        return Ok(());
+    }
     let pid = libc::pid_t::try_from(pid).map_err(|_| format!("pid {pid} is out of range"))?;
-    // SAFETY: sched_getscheduler/sched_getparam/sched_setscheduler read and write only
-    // `param`, a valid sched_param; they have no other preconditions.
+    // SAFETY: sched_setscheduler reads only `param`, a valid sched_param; it has no other
+    // preconditions.
     unsafe {
-        let mut param = libc::sched_param { sched_priority: 0 };
-        if libc::sched_getscheduler(pid) == libc::SCHED_FIFO
-            && libc::sched_getparam(pid, &mut param) == 0
-            && param.sched_priority == priority
-        {
-            return Ok(());
-        }
         let param = libc::sched_param { sched_priority: priority };
         if libc::sched_setscheduler(pid, libc::SCHED_FIFO, &param) != 0 {
             return Err(format!(
@@ -541,6 +537,13 @@ pub fn ordinary_thread(avoid: &[usize]) {
 /// each second that `SCHED_FIFO` threads may run before Linux stops them for the rest of it.
 pub fn rt_runtime_us() -> Option<i64> {
     std::fs::read_to_string("/proc/sys/kernel/sched_rt_runtime_us").ok()?.trim().parse().ok()
+}
+
+/// How long RT throttling stops a `SCHED_FIFO` thread that wants its core all the time, ms of
+/// every second (the default `sched_rt_period_us`), for `kernel.sched_rt_runtime_us =
+/// runtime_us`; `None` when throttling is off (−1).
+pub fn rt_throttle_ms(runtime_us: i64) -> Option<i64> {
+    (runtime_us >= 0).then(|| (1_000_000 - runtime_us).max(0) / 1000)
 }
 
 /// The `SCHED_FIFO`/`SCHED_RR` priority of thread `pid` (0: the calling thread); `None` for

@@ -46,8 +46,8 @@ pub fn run_into_offloaded<S: Sink + Send>(
     sink: &mut S,
 ) -> Result<SinkRun, SetupError> {
     if scene.controller.mode == ControlMode::Realtime {
-        let avoid = scene.controller.cosim.pin_cores.as_ref().map_or(&[][..], |c| &c[..]);
-        offload(sink, avoid, |s| run_into(scene, launch, hooks, s)).map_err(SetupError::Thread)?
+        offload(sink, scene.controller.cosim.pinned_cores(), |s| run_into(scene, launch, hooks, s))
+            .map_err(SetupError::Thread)?
     } else {
         run_into(scene, launch, hooks, sink)
     }

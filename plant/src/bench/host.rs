@@ -137,12 +137,13 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     let dir = super::out_dir(req.out, "bench-host");
     let _claim = crate::claim::claim(&dir, true)?;
     let scheduling = super::tick::schedule(req.pin_core, req.realtime_priority, log)?;
-    if let Some(runtime) = controller::link::rt_runtime_us().filter(|r| *r >= 0 && scheduling.starts_with("fifo")) {
+    let runtime = controller::link::rt_runtime_us().filter(|_| scheduling.starts_with("fifo"));
+    let stall = runtime.and_then(controller::link::rt_throttle_ms);
+    if let (Some(runtime), Some(stall)) = (runtime, stall) {
         log(&format!(
-            "warning: kernel.sched_rt_runtime_us = {runtime}: RT throttling stops the spinning loop for {} ms of \
-             every second, as it would a spinning realtime plant (`sysctl kernel.sched_rt_runtime_us=-1` or \
-             scripts/shield-core.sh on to measure without it)",
-            (1_000_000 - runtime).max(0) / 1000
+            "warning: kernel.sched_rt_runtime_us = {runtime}: RT throttling stops the spinning loop for {stall} ms \
+             of every second, as it would a spinning realtime plant (`sysctl kernel.sched_rt_runtime_us=-1` or \
+             scripts/shield-core.sh on to measure without it)"
         ));
     }
     // As a realtime run with a priority does: idle cores poll instead of halting.

@@ -143,6 +143,14 @@ pub struct CosimSettings {
     pub pacing: Pacing,
 }
 
+impl CosimSettings {
+    /// The cores of `pin_cores` (none when unpinned): those a realtime run's helper threads keep
+    /// off.
+    pub fn pinned_cores(&self) -> &[usize] {
+        self.pin_cores.as_ref().map_or(&[], |c| &c[..])
+    }
+}
+
 /// Integrator settings, validated (tolerances per state component).
 #[derive(Clone, Debug, Serialize)]
 pub struct IntegratorSettings {

@@ -80,12 +80,9 @@ impl Watchdog {
 
     /// The process id of the controller the watchdog demoted, the first time it is asked.
     pub fn take_demoted(&self) -> Option<u32> {
-        match self.shared.demoted.load(Ordering::Relaxed) {
+        match self.shared.demoted.swap(0, Ordering::Relaxed) {
             0 => None,
-            pid => {
-                self.shared.demoted.store(0, Ordering::Relaxed);
-                Some(pid)
-            }
+            pid => Some(pid),
         }
     }
 }

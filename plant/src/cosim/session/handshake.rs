@@ -59,11 +59,6 @@ fn controller_spin(mode: ControlMode, settings: &CosimSettings, period: f64) -> 
     }
 }
 
-/// The plant's loop thread runs under `SCHED_FIFO`.
-fn scheduling_is_fifo(s: &Scheduling) -> bool {
-    s.plant == "fifo"
-}
-
 /// Plant and controller pinned to one core (`pin_cores = [c, c]`).
 fn shares_core(settings: &CosimSettings) -> bool {
     settings.pin_cores.is_some_and(|[p, c]| p == c)
@@ -75,12 +70,12 @@ fn shares_core(settings: &CosimSettings) -> bool {
 /// 44–50 ms, 1,400–2,400 plant overruns in the 1.5 s scene).
 fn rt_throttling_warning(settings: &CosimSettings, rt_runtime_us: Option<i64>) -> Option<String> {
     let runtime = rt_runtime_us?;
-    (settings.realtime_priority > 0 && settings.pacing == Pacing::Spin && runtime >= 0).then(|| {
+    let stall = link::rt_throttle_ms(runtime)?;
+    (settings.realtime_priority > 0 && settings.pacing == Pacing::Spin).then(|| {
         format!(
             "warning: controller.pacing = \"spin\" under SCHED_FIFO with kernel.sched_rt_runtime_us = {runtime}: \
-             Linux stops the spinning plant for {} ms of every second (RT throttling); turn it off \
-             (`sysctl kernel.sched_rt_runtime_us=-1`, or scripts/shield-core.sh on) or use pacing = \"sleep\"",
-            (1_000_000 - runtime).max(0) / 1000
+             Linux stops the spinning plant for {stall} ms of every second (RT throttling); turn it off \
+             (`sysctl kernel.sched_rt_runtime_us=-1`, or scripts/shield-core.sh on) or use pacing = \"sleep\""
         )
     })
 }
@@ -191,7 +186,7 @@ impl Session {
                 path: launch.log.clone().unwrap_or_default(),
                 why: format!("cannot create the file for the controller's output: {e}"),
             })?
-            .avoiding(settings.pin_cores.as_ref().map_or(&[][..], |c| &c[..]));
+            .avoiding(settings.pinned_cores());
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
@@ -231,10 +226,10 @@ impl Session {
             settings,
         };
         // On a shared core the controller runs above the plant; the watchdog above both.
-        if let (Some([core, _]), true) = (s.settings.pin_cores, shares_core(&s.settings)) {
-            let priority = controller_priority(&s.settings);
-            if priority > 0 && scheduling_is_fifo(&s.scheduling) {
-                s.watchdog = super::super::watchdog::Watchdog::start(core, (priority as i32 + 1).min(99));
+        let above = controller_priority(&s.settings);
+        if let Some([core, _]) = s.settings.pin_cores {
+            if shares_core(&s.settings) && above > 0 && s.scheduling.plant == "fifo" {
+                s.watchdog = super::super::watchdog::Watchdog::start(core, (above as i32 + 1).min(99));
                 if s.watchdog.is_none() {
                     hooks.note(
                         "warning: cannot start the plant's watchdog on the shared core: a controller that stops \
