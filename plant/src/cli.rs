@@ -39,6 +39,16 @@ pub enum Command {
         /// Co-simulation run id (names the shared-memory services); default: a fresh one.
         #[arg(long)]
         run_id: Option<String>,
+        /// Save the plant's whole state at these times (s, ascending, within the run), each at
+        /// the end of the first controller tick at or after it, as `state-T.json` in the output
+        /// folder: `--from-state` continues from one.
+        #[arg(long, value_delimiter = ',', value_name = "T[,T...]")]
+        save_state_at: Vec<f64>,
+        /// Start from a state saved with `--save-state-at` (of a scene with the same rotor,
+        /// hardware, integrator and rates; the controller, its law and gains, and the shock
+        /// programme may differ): `trace.csv` then holds the rows after that state's time.
+        #[arg(long, value_name = "FILE")]
+        from_state: Option<PathBuf>,
     },
     /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
     /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.

@@ -190,7 +190,7 @@ pub fn compare(
         }
     }
     crate::table::write_with_header(&out.join("compare.csv"), COMPARE_HEADER, &rows)?;
-    plots(out, &traces, start, continuous.params.contact.gap, &continuous.name)?;
+    plots(out, &traces, start, &continuous)?;
     Ok(rows)
 }
 
@@ -206,8 +206,8 @@ struct Window {
 }
 
 impl Window {
-    fn of(r: &RunResult, start: f64) -> Self {
-        let tr = &r.trace;
+    /// Of a trace in the planar columns (one bearing plane's, [`crate::trace::Trace::plane`]).
+    fn of(tr: &crate::trace::Trace, start: f64) -> Self {
         let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start && tr.t_s[i] <= start + WINDOW).collect();
         Window {
             t_ms: idx.iter().map(|&i| (tr.t_s[i] - start) * 1e3).collect(),
@@ -218,12 +218,32 @@ impl Window {
     }
 }
 
-fn plots(out: &Path, traces: &[(String, RunResult)], start: f64, gap: f64, name: &str) -> anyhow::Result<()> {
-    let data: Vec<(String, Window)> = traces.iter().map(|(l, r)| (l.clone(), Window::of(r, start))).collect();
+/// The air gap in a chart's title: `air gap 250 µm`, or each bearing plane's of a two-plane rotor.
+fn gap_words(scene: &Scene) -> String {
+    let um = |i: usize| scene.plane(i).contact.gap * 1e6;
+    match scene.planes() {
+        1 => format!("air gap {:.0} µm", um(0)),
+        _ => format!("air gaps A {:.0} µm, B {:.0} µm", um(0), um(1)),
+    }
+}
+
+/// Each bearing plane's trace (in the planar columns) with its label: `label` for a planar run,
+/// `label A`, `label B` for a two-plane one (each plane's radius is against its own gap).
+fn plane_traces(label: &str, trace: &crate::trace::Trace) -> Vec<(String, crate::trace::Trace)> {
+    match trace.planes() {
+        1 => vec![(label.to_owned(), trace.clone())],
+        n => (0..n).map(|i| (format!("{label} {}", ["A", "B"][i]), trace.plane(i))).collect(),
+    }
+}
+
+fn plots(out: &Path, traces: &[(String, RunResult)], start: f64, scene: &Scene) -> anyhow::Result<()> {
+    let (gap, name) = (gap_words(scene), &scene.name);
+    let data: Vec<(String, Window)> =
+        traces.iter().flat_map(|(l, r)| plane_traces(l, &r.trace)).map(|(l, t)| (l, Window::of(&t, start))).collect();
     let radius: Vec<Series> = data.iter().map(|(l, d)| Series { label: l, x: &d.t_ms, y: &d.radius_um }).collect();
     plot::lines(
         &out.join("compare_radius.png"),
-        &format!("{name}: rotor radius, first {:.0} ms after the shock (air gap {:.0} µm)", WINDOW * 1e3, gap * 1e6),
+        &format!("{name}: rotor radius, first {:.0} ms after the shock ({gap})", WINDOW * 1e3),
         "time after the shock (ms)",
         "radius (µm)",
         &radius,
@@ -521,15 +541,17 @@ pub fn compare_laws(
 
 fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow::Result<()> {
     let name = &scene.name;
-    let gap_um = scene.params.contact.gap * 1e6;
-    let radius: Vec<Vec<f64>> = runs.iter().map(|(_, r)| r.trace.radius().iter().map(|v| v * 1e6).collect()).collect();
+    let gap = gap_words(scene);
+    // Each plane's radius and coil current of each law's run.
+    let planes: Vec<(String, crate::trace::Trace)> = runs.iter().flat_map(|(l, r)| plane_traces(l, &r.trace)).collect();
+    let radius: Vec<Vec<f64>> = planes.iter().map(|(_, t)| t.radius().iter().map(|v| v * 1e6).collect()).collect();
     let current: Vec<Vec<f64>> =
-        runs.iter().map(|(_, r)| r.trace.ix_a.iter().zip(&r.trace.iy_a).map(|(x, y)| x.hypot(*y)).collect()).collect();
+        planes.iter().map(|(_, t)| t.ix_a.iter().zip(&t.iy_a).map(|(x, y)| x.hypot(*y)).collect()).collect();
     let series = |ys: &[Vec<f64>]| -> Vec<(String, Vec<f64>, Vec<f64>)> {
-        runs.iter().zip(ys).map(|((l, r), y)| (l.clone(), r.trace.t_s.clone(), y.clone())).collect()
+        planes.iter().zip(ys).map(|((l, t), y)| (l.clone(), t.t_s.clone(), y.clone())).collect()
     };
     for (file, title, ylabel, data) in [
-        ("laws_radius.png", format!("{name}: rotor radius by law (air gap {gap_um:.0} µm)"), "radius (µm)", &radius),
+        ("laws_radius.png", format!("{name}: rotor radius by law ({gap})"), "radius (µm)", &radius),
         ("laws_current.png", format!("{name}: coil current magnitude by law"), "|i| (A)", &current),
     ] {
         let d = series(data);
@@ -537,10 +559,9 @@ fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow:
         plot::lines(&out.join(file), &title, "time (s)", ylabel, &s, Scale::Linear)?;
     }
     let start = scene.first_shock_start();
-    let orbits: Vec<(String, Vec<f64>, Vec<f64>)> = runs
+    let orbits: Vec<(String, Vec<f64>, Vec<f64>)> = planes
         .iter()
-        .map(|(l, r)| {
-            let tr = &r.trace;
+        .map(|(l, tr)| {
             let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start).collect();
             (
                 l.clone(),
@@ -717,16 +738,13 @@ pub fn compare_realtime(
     traces.insert(0, ("lockstep".into(), reference));
     let radius: Vec<(String, Vec<f64>, Vec<f64>)> = traces
         .iter()
-        .map(|(l, r)| (l.clone(), r.trace.t_s.clone(), r.trace.radius().iter().map(|v| v * 1e6).collect()))
+        .flat_map(|(l, r)| plane_traces(l, &r.trace))
+        .map(|(l, t)| (l, t.t_s.clone(), t.radius().iter().map(|v| v * 1e6).collect()))
         .collect();
     let series: Vec<Series> = radius.iter().map(|(l, x, y)| Series { label: l, x, y }).collect();
     plot::lines(
         &out.join("realtime_radius.png"),
-        &format!(
-            "{}: rotor radius, realtime against lockstep (air gap {:.0} µm)",
-            realtime.name,
-            realtime.params.contact.gap * 1e6
-        ),
+        &format!("{}: rotor radius, realtime against lockstep ({})", realtime.name, gap_words(&realtime)),
         "time (s)",
         "radius (µm)",
         &series,

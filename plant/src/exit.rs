@@ -116,6 +116,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         crate::bench::BadArgument,
         AnalyzeError,
         AssessError,
+        crate::snapshot::SnapshotError,
     );
     None
 }
@@ -223,6 +224,15 @@ impl HasExitCode for AnalyzeError {
             AnalyzeError::Scene(_) | AnalyzeError::Trace(_) | AnalyzeError::Summary { .. } => Code::BadInput,
             AnalyzeError::Output(_) => Code::Io,
             AnalyzeError::Interrupted(_) => Code::Interrupted,
+        }
+    }
+}
+
+impl HasExitCode for crate::snapshot::SnapshotError {
+    fn exit_code(&self) -> Code {
+        match self {
+            crate::snapshot::SnapshotError::Write { .. } => Code::Io,
+            _ => Code::BadInput,
         }
     }
 }

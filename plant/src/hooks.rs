@@ -33,6 +33,14 @@ pub trait Hooks {
     fn excitation(&mut self, _k: u64, _t: f64, _sensor_v: &[f64]) -> Option<Excitation> {
         None
     }
+    /// Times (s, sorted) at which to take the plant's state (`plant run --save-state-at`): the
+    /// loop takes it at the end of the first tick at or after each, and hands it to
+    /// [`Hooks::state_saved`]. The default: none.
+    fn save_state_at(&self) -> &[f64] {
+        &[]
+    }
+    /// The state asked for at `at` (s) by [`Hooks::save_state_at`].
+    fn state_saved(&mut self, _at: f64, _snapshot: crate::snapshot::Snapshot) {}
 }
 
 /// A sine on one bearing plane's sensor signal ([`Hooks::excitation`]).

@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 pub use plant_physics::{force, integrate, model, park};
+pub use stepper::Plant;
 
 pub mod analysis;
 pub mod assess;
@@ -26,6 +27,7 @@ pub mod claim;
 pub mod compare;
 pub mod config;
 pub mod cosim;
+pub mod digital;
 pub mod ensemble;
 pub mod exit;
 pub mod figures;
@@ -44,9 +46,11 @@ pub mod rng;
 pub mod row_file;
 pub mod run;
 pub mod sensor;
+pub mod snapshot;
 pub mod soak;
 pub mod stability;
 pub mod status;
+pub mod stepper;
 pub mod summary;
 pub mod sweep;
 pub mod table;

@@ -7,6 +7,7 @@
 
 mod cli;
 
+use anyhow::Context;
 use clap::Parser;
 use cli::{BenchCommand, Cli, Command, ControllerArg};
 use plant::config::{load_scene, Scene};
@@ -70,8 +71,9 @@ fn warn(message: &str) {
 /// Runs one command.
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, out, set, quiet, controller, run_id } => {
-            run_scene(&scene, out, &set, quiet, controller.launch(run_id))
+        Command::Run { scene, out, set, quiet, controller, run_id, save_state_at, from_state } => {
+            let states = States { save_at: save_state_at, from: from_state };
+            run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
         }
         Command::Soak { programme, out, set, quiet } => soak_cmd(&programme, out, &set, quiet),
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
@@ -195,6 +197,63 @@ struct CliHooks {
     last: Instant,
     quiet: bool,
     terminal: bool,
+    /// `--save-state-at`, and the run folder the snapshots go to.
+    save_at: Vec<f64>,
+    dir: PathBuf,
+    /// The first snapshot that could not be written.
+    save_error: Option<plant::snapshot::SnapshotError>,
+}
+
+/// `plant run`'s `--save-state-at` and `--from-state`.
+struct States {
+    save_at: Vec<f64>,
+    from: Option<PathBuf>,
+}
+
+impl States {
+    /// The snapshot to start from, read and checked against `scene`, and the save times checked:
+    /// bad input before anything is written.
+    fn check(&self, scene: &Scene) -> anyhow::Result<Option<plant::snapshot::Snapshot>> {
+        let from = match &self.from {
+            None => None,
+            Some(path) => {
+                let snapshot = plant::snapshot::Snapshot::read(path)?;
+                let initial = plant::stepper::Command::Continuous(None);
+                let mut plant = plant::Plant::new(scene, &initial).context("--from-state")?;
+                plant.restore(&snapshot).with_context(|| format!("--from-state {}", path.display()))?;
+                if snapshot.t_s >= scene.duration {
+                    return Err(Ending::BadArgument(format!(
+                        "--from-state {}: the state is at t = {} s, not before the scene's end, \
+                         scene.duration_s = {} s: nothing to run",
+                        path.display(),
+                        snapshot.t_s,
+                        scene.duration
+                    ))
+                    .into());
+                }
+                Some(snapshot)
+            }
+        };
+        let start = from.as_ref().map_or(0.0, |s| s.t_s);
+        for (i, &t) in self.save_at.iter().enumerate() {
+            let bad = |why: String| Ending::BadArgument(format!("--save-state-at {t} s: {why}"));
+            if !(t.is_finite() && t > start && t <= scene.duration) {
+                return Err(bad(format!(
+                    "outside the run (after {start} s, up to scene.duration_s = {} s)",
+                    scene.duration
+                ))
+                .into());
+            }
+            if i > 0 && t <= self.save_at[i - 1] {
+                return Err(bad(format!(
+                    "not after the time before it, {} s: give the times ascending",
+                    self.save_at[i - 1]
+                ))
+                .into());
+            }
+        }
+        Ok(from)
+    }
 }
 
 impl Hooks for CliHooks {
@@ -227,12 +286,35 @@ impl Hooks for CliHooks {
         }
         eprintln!("plant: {message}");
     }
+
+    fn save_state_at(&self) -> &[f64] {
+        &self.save_at
+    }
+
+    fn state_saved(&mut self, at: f64, snapshot: plant::snapshot::Snapshot) {
+        let path = self.dir.join(plant::snapshot::Snapshot::file_name(at));
+        match snapshot.write(&path) {
+            Ok(()) => self.note(&format!("state at t = {} s saved in {}", snapshot.t_s, path.display())),
+            Err(e) => {
+                self.note(&format!("warning: {e}"));
+                self.save_error.get_or_insert(e);
+            }
+        }
+    }
 }
 
 /// `plant run`.
-fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, launch: Launch) -> anyhow::Result<()> {
+fn run_scene(
+    path: &Path,
+    out: Option<PathBuf>,
+    set: &[String],
+    quiet: bool,
+    launch: Launch,
+    states: States,
+) -> anyhow::Result<()> {
     let scene = load_scene(path, set)?;
     load_checked(&scene)?;
+    let from = states.check(&scene)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
     let mut hooks = CliHooks {
@@ -242,8 +324,11 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
         last: Instant::now(),
         quiet,
         terminal: std::io::stderr().is_terminal(),
+        save_at: states.save_at,
+        dir: dir.clone(),
+        save_error: None,
     };
-    let written = match plant::output::run_to_dir(&dir, &scene, &launch, &mut hooks) {
+    let written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
@@ -275,7 +360,11 @@ fn run_scene(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, lau
             path.display()
         ));
     }
-    stopped(&written.run.outcome, written.summary.simulated_s)
+    stopped(&written.run.outcome, written.summary.simulated_s)?;
+    match hooks.save_error {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
 }
 
 /// `Err` for a run that did not complete (its results were written).
@@ -380,6 +469,9 @@ fn bench_ipc(
         last: Instant::now(),
         quiet: true,
         terminal: false,
+        save_at: Vec::new(),
+        dir: PathBuf::new(),
+        save_error: None,
     };
     let started = Instant::now();
     let launch = controller.launch(run_id);

@@ -15,7 +15,8 @@
 use crate::config::{ControlMode, Scene};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
-use crate::run::{run_into, SetupError, Sink, SinkRun};
+use crate::run::{run_into_from, SetupError, Sink, SinkRun};
+use crate::snapshot::Snapshot;
 use crate::trace::Record;
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::time::Duration;
@@ -39,17 +40,20 @@ impl Sink for Handoff {
 
 /// [`run_into`]; a realtime run hands its samples to `sink` on a thread of its own
 /// ([`crate::offload`]), so that writing and analysing them stays out of its ticks.
+///
+/// The run starts from `from` if given ([`run_into_from`]).
 pub fn run_into_offloaded<S: Sink + Send>(
     scene: &Scene,
     launch: &Launch,
     hooks: &mut dyn Hooks,
     sink: &mut S,
+    from: Option<&Snapshot>,
 ) -> Result<SinkRun, SetupError> {
     if scene.controller.mode == ControlMode::Realtime {
-        offload(sink, scene.controller.cosim.pinned_cores(), |s| run_into(scene, launch, hooks, s))
+        offload(sink, scene.controller.cosim.pinned_cores(), |s| run_into_from(scene, launch, hooks, s, from))
             .map_err(SetupError::Thread)?
     } else {
-        run_into(scene, launch, hooks, sink)
+        run_into_from(scene, launch, hooks, sink, from)
     }
 }
 

@@ -21,7 +21,7 @@ use crate::run::{Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{Record, TraceError, TraceWriter};
 use anyhow::Context;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The files a run writes into its folder (and removes first when the folder is reused).
 pub const RUN_FILES: &[&str] = &[
@@ -116,8 +116,15 @@ pub fn remove_stale(dir: &Path) -> anyhow::Result<()> {
 
 /// [`remove_stale`], keeping the files named in `keep`.
 fn remove_stale_except(dir: &Path, keep: &[&str]) -> anyhow::Result<()> {
-    for name in RUN_FILES.iter().filter(|n| !keep.contains(n)) {
-        let path = dir.join(name);
+    // An earlier run's state snapshots (`state-T.json`, `--save-state-at`) go too: a folder's
+    // snapshots are its own run's.
+    let snapshots: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("listing {}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(crate::snapshot::is_file_name))
+        .collect();
+    for path in RUN_FILES.iter().filter(|n| !keep.contains(n)).map(|name| dir.join(name)).chain(snapshots) {
         match std::fs::remove_file(&path) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -250,10 +257,22 @@ impl Sink for RunFolder {
 
 /// `plant run`: runs `scene`, streaming its rows to `dir` (see the module docs).
 pub fn run_to_dir(dir: &Path, scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result<Written, RunDirError> {
+    run_to_dir_from(dir, scene, launch, hooks, None)
+}
+
+/// [`run_to_dir`] from a saved state (`plant run --from-state`): `trace.csv` holds the rows
+/// after the snapshot's time, the rows the run that saved it would have written next.
+pub fn run_to_dir_from(
+    dir: &Path,
+    scene: &Scene,
+    launch: &Launch,
+    hooks: &mut dyn Hooks,
+    from: Option<&crate::snapshot::Snapshot>,
+) -> Result<Written, RunDirError> {
     prepare(dir, scene).map_err(RunDirError::Output)?;
     let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
     let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
-    let run = run_into_offloaded(scene, &launch, hooks, &mut folder)?;
+    let run = run_into_offloaded(scene, &launch, hooks, &mut folder, from)?;
     // What an external controller ran differently from the scene goes into the record, so that
     // the folder reproduces the run.
     let recorded = match run.cosim.as_ref().and_then(|c| c.controller_overrides.as_ref()) {

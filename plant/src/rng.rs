@@ -31,6 +31,11 @@ impl SplitMix64 {
         Self(seed)
     }
 
+    /// The generator's whole state: [`SplitMix64::new`] of it goes on with the same numbers.
+    pub fn state(&self) -> u64 {
+        self.0
+    }
+
     /// Stream `index` of `seed`: an independent generator per member, shard
     /// or axis, the same wherever it is made.
     ///

@@ -10,20 +10,16 @@
 //! rate (dense output inside macro steps).
 
 use crate::config::{ControlMode, Scene};
-use crate::cosim::stats::{Tet, TickTime};
-use crate::cosim::{CosimError, CosimReport, Halt, Launch, Session};
-use crate::hardware::{Wired, EXTRA, EXTRA_UNIPOLAR};
+use crate::cosim::stats::Tet;
+use crate::cosim::{CosimError, CosimReport, Launch, Session};
+use crate::digital::{DigitalLoop, Source};
 pub use crate::hooks::{Hooks, Quiet};
-use crate::initial::initial_state;
-use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
-use crate::machine::Machine;
-use crate::model::{Control, Model, RaceWhenClear};
-use crate::sensor::Sensor;
+use crate::integrate::{IntegrationError, Settings, Stats};
+use crate::snapshot::{DigitalState, Snapshot, SnapshotError};
+use crate::stepper::{Command, Plant};
 use crate::trace::{Record, Trace};
-use controller::{build_rotor_law, saturate, saturate_axes, wrap_angle, PdGains, RotorLaw, RotorSample, ROTOR_AXES};
-use plant_physics::two_plane;
-use std::collections::VecDeque;
-use std::time::{Duration, Instant};
+use controller::{build_rotor_law, saturate, PdGains, RotorLaw, ROTOR_AXES};
+use std::time::Instant;
 
 /// Why a run stopped before its end.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -105,6 +101,9 @@ pub enum SetupError {
     /// The design an external controller runs instead of the scene's is not a valid scene.
     #[error("the controller's overrides: {0}")]
     Overrides(#[from] crate::config::ConfigError),
+    /// The state to start from does not fit the scene, or could not be read.
+    #[error("--from-state: {0}")]
+    State(#[from] SnapshotError),
     /// The thread that takes a realtime run's samples could not be started.
     #[error("starting the thread that takes the run's samples: {0}")]
     Thread(std::io::Error),
@@ -179,16 +178,6 @@ pub fn settings_with<const N: usize>(scene: &Scene, atol: [f64; N]) -> Settings<
     }
 }
 
-/// Where the command of each tick comes from.
-enum Source {
-    /// The PD inside the derivative.
-    Continuous,
-    /// The law in this process: one per plane (decentralised) or one of the whole rotor.
-    InProcess(Box<dyn RotorLaw>),
-    /// The law in the controller process.
-    Cosim(Box<Session>),
-}
-
 /// Runs a scene from its initial state; a co-simulation starts the
 /// `controller` next to the running executable.
 pub fn run(scene: &Scene, hooks: &mut dyn Hooks) -> Result<RunResult, SetupError> {
@@ -248,6 +237,23 @@ pub fn run_into(
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
+    run_into_from(scene, launch, hooks, sink, None)
+}
+
+/// [`run_into`] from the state `from` if given (`plant run --from-state`): the plant continues
+/// from it ([`Plant::restore`]), under this scene's controller and shock programme, and `sink`
+/// gets the rows after the snapshot's time.
+pub fn run_into_from(
+    scene: &Scene,
+    launch: &Launch,
+    hooks: &mut dyn Hooks,
+    sink: &mut dyn Sink,
+    from: Option<&Snapshot>,
+) -> Result<SinkRun, SetupError> {
+    if let Some(snapshot) = from {
+        // Refused before a controller process starts.
+        Plant::new(scene, &Command::Continuous(None))?.restore(snapshot)?;
+    }
     let params = &scene.controller.params;
     let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
@@ -263,7 +269,7 @@ pub fn run_into(
             Source::Cosim(Box::new(Session::connect(scene, launch, bias_of(scene, &plane_gains(scene)?), hooks)?))
         }
     };
-    run_from(scene, source, hooks, sink)
+    run_from(scene, source, hooks, sink, from)
 }
 
 /// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
@@ -287,15 +293,16 @@ pub fn run_law_into(
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
 ) -> Result<SinkRun, SetupError> {
-    run_from(scene, Source::InProcess(law), hooks, sink)
+    run_from(scene, Source::InProcess(law), hooks, sink, None)
 }
 
-/// The loop, from a command source.
+/// The loop, from a command source, from the scene's initial state or `from`.
 fn run_from(
     scene: &Scene,
     mut source: Source,
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
+    from: Option<&Snapshot>,
 ) -> Result<SinkRun, SetupError> {
     // An external controller may run a design of its own (its `--config` or `--law`): the run
     // is then the scene with those overrides, initial state and bias included, so that the
@@ -305,431 +312,100 @@ fn run_from(
         _ => None,
     };
     let scene = effective.as_ref().unwrap_or(scene);
-    let gains = plane_gains(scene)?;
-    let bias = bias_of(scene, &gains);
+    let bias = bias_of(scene, &plane_gains(scene)?);
     let limits = scene.rotor_design().current_limits();
     if let (Source::Cosim(session), Some(_)) = (&mut source, &effective) {
         session.adopt(bias, limits);
     }
-    let control = |i: usize| match source {
-        Source::Continuous => Control::Continuous(gains[i]),
-        _ => Control::Held([bias[2 * i], bias[2 * i + 1]]),
+    let initial = match source {
+        Source::Continuous => Command::Continuous(None),
+        _ => Command::Held(bias),
     };
-    let hw = &scene.hardware;
-    let controls = if scene.two_plane.is_some() { [control(0), control(1)] } else { [control(0); 2] };
-    let [p, v, ..] = scene.integrator.atol_groups;
-    match &scene.two_plane {
-        None => {
-            let model = Model {
-                params: scene.params.clone(),
-                base: scene.base.clone(),
-                control: control(0),
-                race_parked: false,
-            };
-            let y = initial_state(scene);
-            if hw.is_unipolar() {
-                const NA: usize = crate::model::N + EXTRA_UNIPOLAR;
-                let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
-                let y = wired.initial(&y);
-                let settings = settings_with(scene, extended::<{ crate::model::N }, NA>(scene.integrator.atol, p, v));
-                return drive(scene, wired, y, settings, source, (bias, limits), &gains, hooks, sink);
-            }
-            if hw.is_on() {
-                const NA: usize = crate::model::N + EXTRA;
-                let wired = Wired::<Model, { crate::model::N }, NA>::new(model, controls, hw.clone());
-                let y = wired.initial(&y);
-                let settings = settings_with(scene, extended::<{ crate::model::N }, NA>(scene.integrator.atol, p, v));
-                return drive(scene, wired, y, settings, source, (bias, limits), &gains, hooks, sink);
-            }
-            drive(scene, model, y, integrator_settings(scene), source, (bias, limits), &gains, hooks, sink)
-        }
-        Some(params) => {
-            let model = two_plane::Model {
-                params: params.clone(),
-                base: scene.base.clone(),
-                control: [control(0), control(1)],
-                race_parked: [false; 2],
-            };
-            let y = crate::initial::two_plane_initial_state(scene, params);
-            if hw.is_unipolar() {
-                const NA: usize = two_plane::N + EXTRA_UNIPOLAR;
-                let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
-                let y = wired.initial(&y);
-                let atol = extended::<{ two_plane::N }, NA>(scene.integrator.two_plane_atol(), p, v);
-                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), &gains, hooks, sink);
-            }
-            if hw.is_on() {
-                const NA: usize = two_plane::N + EXTRA;
-                let wired = Wired::<two_plane::Model, { two_plane::N }, NA>::new(model, controls, hw.clone());
-                let y = wired.initial(&y);
-                let atol = extended::<{ two_plane::N }, NA>(scene.integrator.two_plane_atol(), p, v);
-                return drive(scene, wired, y, settings_with(scene, atol), source, (bias, limits), &gains, hooks, sink);
-            }
-            let settings = settings_with(scene, scene.integrator.two_plane_atol());
-            drive(scene, model, y, settings, source, (bias, limits), &gains, hooks, sink)
+    let mut plant = Plant::new(scene, &initial)?;
+    let mut digital = DigitalLoop::new(scene, source, plant.planes(), bias, limits);
+    let mut primed = Ok(());
+    if let Some(snapshot) = from {
+        plant.restore(snapshot)?;
+        if let Some(d) = &snapshot.digital {
+            digital.path_mut().set_in_flight(&d.in_flight);
+            let recent: Vec<controller::RotorSample> = d.recent.iter().map(Into::into).collect();
+            primed = digital.prime(&recent, hooks);
         }
     }
-}
-
-/// The model's tolerances `atol` with the hardware's after them ([`crate::hardware::atol`]).
-fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
-    let mut a = [0.0; NA];
-    a[..N].copy_from_slice(&atol);
-    a[N..].copy_from_slice(&crate::hardware::atol(p, v)[..NA - N]);
-    a
-}
-
-/// Hands the output sample of state `y` at time `t` to `sink` (and its state: on the planar
-/// model [`Sink::planar_state`], on the two-plane rotor [`Sink::two_plane_state`]).
-#[inline]
-fn feed<const N: usize, M: Machine<N>>(model: &M, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
-    sink.sample(&model.record(t, y));
-    if let (Some(planar), Ok(state)) = (model.planar(), <&crate::model::State>::try_from(&y[..])) {
-        sink.planar_state(planar, t, state);
-    } else if let (Some(m), Ok(state)) = (model.two_plane(), <&plant_physics::two_plane::State>::try_from(&y[..])) {
-        sink.two_plane_state(m, t, state);
+    if digital.is_cosim() || hooks.time_ticks() {
+        plant.time_ticks();
     }
+    Ok(drive(scene, &mut plant, digital, hooks, sink, (from.is_some(), primed)))
 }
 
-/// The macro-step loop (module doc) for a model of `N` state components starting at `y`.
-#[allow(clippy::too_many_arguments)]
-fn drive<const N: usize, M: Machine<N>>(
+/// The macro-step loop (module doc): the digital loop makes each tick's command from what the
+/// plant read, the plant steps. A restored plant (`resumed`) does not write its first row
+/// again: the run it continues wrote it.
+fn drive(
     scene: &Scene,
-    mut model: M,
-    mut y: [f64; N],
-    settings: Settings<N>,
-    mut source: Source,
-    (bias, limits): ([f64; ROTOR_AXES], [f64; ROTOR_AXES]),
-    gains: &[PdGains],
+    plant: &mut Plant,
+    mut digital: DigitalLoop,
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
-) -> Result<SinkRun, SetupError> {
-    let planes = M::PLANES;
-    // The plane whose continuous PD read the previous tick's sine.
-    let mut excited: Option<usize> = None;
-    let mut integrator = Integrator::new(settings);
-    let period = scene.controller.period;
-    let ticks = (scene.duration / period).ceil() as u64;
-    let out_dt = scene.output_interval;
-    feed(&model, sink, 0.0, &y);
-    let mut next_out: u64 = 1;
-    // Output samples per tick; a period longer than the run holds only the run's samples.
-    let mut out_times: Vec<f64> = Vec::with_capacity((period.min(scene.duration) / out_dt).ceil() as usize + 2);
-    let inherent = match &mut source {
-        Source::Cosim(session) => {
-            if let Some(pid) = session.controller_pid() {
-                hooks.controller_connected(pid);
-            }
-            session.inherent_delay()
-        }
-        _ => 0,
-    };
-    let delay = scene.controller.delay_samples.saturating_sub(inherent) as usize;
-    let mut queue: VecDeque<[f64; ROTOR_AXES]> = VecDeque::with_capacity(delay + 1);
-    queue.extend(std::iter::repeat_n(bias, delay));
-    let mut sensor = Sensor::new(scene.sensor);
-    let c = &scene.controller;
-    let mut invalid = crate::invalid::InvalidCommands::new(bias, c.max_invalid_burst, c.max_invalid_fraction);
-    let guards = Guards::new(scene, &model);
-    let breakpoints = scene.base.breakpoints();
-    let mut next_breakpoint = 0;
-    let mut parked_steps = 0u64;
-
-    let mut controller_pid = match &source {
-        Source::Cosim(session) => session.controller_pid(),
-        _ => None,
-    };
-    let mut cost = TickCost {
-        max_rhs_evals: 0,
-        tet: (matches!(source, Source::Cosim(_)) || hooks.time_ticks()).then(|| Box::new(Tet::new(ticks))),
-    };
+    (resumed, primed): (bool, Result<(), Outcome>),
+) -> SinkRun {
+    if !resumed {
+        plant.record(sink);
+    }
+    if let Some(pid) = digital.controller_pid() {
+        hooks.controller_connected(pid);
+    }
+    let saves = hooks.save_state_at().to_vec();
+    let mut next_save = saves.partition_point(|t| *t < plant.time() - 1e-9 * scene.controller.period);
     let start = Instant::now();
-    let mut outcome = Outcome::Completed;
-    let mut t = 0.0;
-    for k in 0..ticks {
+    let mut outcome = primed.err().unwrap_or(Outcome::Completed);
+    while outcome == Outcome::Completed && !plant.finished() {
         let tick_start = Instant::now();
-        let t0 = k as f64 * period;
-        let t1 = ((k + 1) as f64 * period).min(scene.duration);
-        // Every axis's sensor (the planes in order, one noise sequence) and the keyphasor: the
-        // rotor's speed and its angle wrapped to [0, 2π), from the state.
-        let (angle, speed) = model.spin(&y);
-        let mut sample = RotorSample {
-            seq: k,
-            t_s: t0,
-            axes: 2 * planes as u32,
-            speed_rad_s: speed,
-            angle_rad: wrap_angle(angle),
-            ..Default::default()
+        let command = match digital.command(plant.sample(), hooks) {
+            Ok(command) => command,
+            Err(ended) => {
+                outcome = ended;
+                break;
+            }
         };
-        // Every axis's sensor, in every mode: the continuous PD reads its signal inside the
-        // derivative, but an excitation hook reads the sensor signal here too.
-        for i in 0..planes {
-            let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
-            let v = sensor.read_with_gain(model.sensed(&y, i), gain);
-            sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
-        }
-        // The summing point of a sensitivity measurement (one plane's axes): added to what a
-        // law reads, handed to the plane's continuous PD, which reads it inside the derivative.
-        let excitation = hooks.excitation(k, t0, &sample.sensor_v[..2 * planes]).filter(|e| e.plane < planes);
-        if let Some(e) = excitation {
-            let axes = &mut sample.sensor_v[2 * e.plane..2 * e.plane + 2];
-            axes.iter_mut().zip(e.sine.at(t0).0).for_each(|(v, e)| *v += e);
-        }
-        if let Source::Continuous = &source {
-            // The plane excited before goes back to its plain PD, the one excited now reads its sine.
-            if let Some(i) = excited.filter(|i| excitation.is_none_or(|e| e.plane != *i)) {
-                model.set_control(i, Control::Continuous(gains[i]));
-            }
-            if let Some(e) = excitation {
-                model.set_control(e.plane, Control::ContinuousExcited(gains[e.plane], e.sine));
-            }
-            excited = excitation.map(|e| e.plane);
-        }
-        let command = match &mut source {
-            Source::Continuous => None,
-            Source::InProcess(law) => Some(saturate_axes(law.update(&sample), limits)),
-            Source::Cosim(session) => match session.command(&sample, hooks) {
-                Ok(cmd) => {
-                    let pid = session.controller_pid();
-                    if pid != controller_pid {
-                        controller_pid = pid;
-                        if let Some(pid) = pid {
-                            hooks.controller_connected(pid);
-                        }
-                    }
-                    Some(cmd)
-                }
-                Err(halt) => {
-                    outcome = match halt {
-                        Halt::Lost(why) => Outcome::PeerLost(why),
-                        Halt::Interrupted(_) => Outcome::Interrupted,
-                        Halt::MissBudget(why) => Outcome::MissBudget(why),
-                        Halt::OverrunBudget(why) => Outcome::OverrunBudget(why),
-                    };
-                    break;
-                }
-            },
-        };
-        if let Some(cmd) = command {
-            let cmd = match invalid.check(cmd, &sample) {
-                Ok(checked) => {
-                    if checked.first {
-                        hooks.note(&format!(
-                            "warning: the controller's command for sample {} (t = {} s) is non-finite, {:?} A: \
-                             the last valid command is held for it and for every later non-finite one, up to \
-                             controller.max_invalid_burst = {} in a row (counted in summary.json, invalid_commands)",
-                            sample.seq,
-                            sample.t_s,
-                            &cmd[..2 * planes],
-                            c.max_invalid_burst
-                        ));
-                    }
-                    checked.command
-                }
-                Err(why) => {
-                    outcome = Outcome::InvalidCommands(why);
-                    break;
-                }
-            };
-            queue.push_back(cmd);
-            if let Some(applied) = queue.pop_front() {
-                for i in 0..planes {
-                    model.set_control(i, Control::Held([applied[2 * i], applied[2 * i + 1]]));
-                }
-            }
-        }
         // A realtime tick starts when the plant wakes at its wall-clock time.
-        let tick_start = match &source {
-            Source::Cosim(session) => session.tick_started().unwrap_or(tick_start),
-            _ => tick_start,
-        };
-        let commanded = Instant::now();
-        // Park or release each race; the fixed step is the contact one while any race is free.
-        let mut changed = false;
-        for i in 0..planes {
-            if let RaceWhenClear::Parked(release) = model.bearing(i).race_when_clear {
-                let clear = model.race_clear(t0, t1 - t0, &y, i);
-                if clear && !model.parked(i) {
-                    model.park_race(&mut y, i);
-                    model.set_parked(i, true);
-                    changed = true;
-                } else if !clear && (model.parked(i) || k == 0) {
-                    if model.parked(i) {
-                        model.release_race(t0, &mut y, i, release);
-                    }
-                    model.set_parked(i, false);
-                    changed = true;
-                }
-                parked_steps += u64::from(model.parked(i));
-            }
-        }
-        if changed {
-            let all_parked = (0..planes).all(|i| model.parked(i));
-            integrator.set_substeps(if all_parked {
-                scene.integrator.substeps
-            } else {
-                scene.integrator.contact_substeps
-            });
-        }
-        out_times.clear();
-        while (next_out as f64) * out_dt <= t1 + 1e-9 * out_dt {
-            out_times.push(((next_out as f64) * out_dt).min(t1));
-            next_out += 1;
-        }
-        let (evals, touching) = (integrator.stats().rhs_evals, cost.tet.is_some() && touching(&model, &y, planes));
-        let mut rows = Duration::ZERO;
-        let integrating = Instant::now();
-        let step = advance_across_breakpoints(
-            &mut integrator,
-            &model,
-            (t0, t1),
-            &mut y,
-            &out_times,
-            (&breakpoints, &mut next_breakpoint),
-            |ts, ys| match cost.tet {
-                // The output rows' time is the sink's, not the integration's.
-                Some(_) => {
-                    let row = Instant::now();
-                    feed(&model, sink, ts, ys);
-                    rows += row.elapsed();
-                }
-                None => feed(&model, sink, ts, ys),
-            },
-        );
-        cost.max_rhs_evals = cost.max_rhs_evals.max(integrator.stats().rhs_evals - evals);
-        if let Some(tet) = cost.tet.as_mut() {
-            let end = Instant::now();
-            let ns = |d: Duration| d.as_nanos() as u64;
-            tet.record(
-                k,
-                TickTime {
-                    command_ns: ns(commanded - tick_start),
-                    integration_ns: ns((end - integrating).saturating_sub(rows)),
-                    tick_ns: ns(end - tick_start),
-                    contact: touching || self::touching(&model, &y, planes),
-                },
-            );
-        }
-        t = t1;
-        if let Err(e) = step.map_err(RunError::from).and_then(|()| guards.check(&model, t1, &y)) {
-            // The run reached the failure, not the end of its macro step (an integration
-            // error stops inside it).
-            t = e.time();
+        let tick_start = digital.tick_started().unwrap_or(tick_start);
+        if let Err(e) = plant.step_from(&command, sink, tick_start) {
             outcome = Outcome::Diverged(e);
             break;
         }
-        hooks.progress(t1);
+        let t = plant.time();
+        while next_save < saves.len() && saves[next_save] <= t + 1e-9 * scene.controller.period {
+            let mut snapshot = plant.snapshot();
+            let recent = digital.recent().iter().map(Into::into).collect();
+            snapshot.digital = Some(DigitalState { in_flight: digital.path().in_flight(), recent });
+            hooks.state_saved(saves[next_save], snapshot);
+            next_save += 1;
+        }
+        hooks.progress(t);
         if hooks.cancelled() {
             outcome = Outcome::Interrupted;
             break;
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
-    // A run that completed is judged over all its ticks.
-    if outcome == Outcome::Completed {
-        if let Some(why) = invalid.at_end() {
-            outcome = Outcome::InvalidCommands(why);
-        }
+    let t = plant.time();
+    let ticks = plant.take_cost();
+    let (outcome, mut cosim, invalid_commands) = digital.finish(outcome, t, scene.controller.period);
+    if let Some(report) = cosim.as_mut() {
+        report.tet_us = ticks.tet.as_ref().map(|tet| tet.report());
     }
-    let cosim = match source {
-        Source::Cosim(session) => {
-            if outcome == Outcome::Completed {
-                if let Some(why) = session.miss_budget_exceeded(1) {
-                    outcome = Outcome::MissBudget(why);
-                } else if let Some(why) = session.overrun_budget_exceeded(1) {
-                    outcome = Outcome::OverrunBudget(why);
-                }
-            }
-            let mut report = session.finish(t, (t / period).round() as u64);
-            report.tet_us = cost.tet.as_ref().map(|tet| tet.report());
-            report.invalid_replies = invalid.count();
-            Some(report)
-        }
-        _ => None,
-    };
-    let invalid_commands = invalid.count();
-    Ok(SinkRun {
-        stats: integrator.stats(),
+    SinkRun {
+        stats: plant.stats(),
         simulated: t,
         wall_time,
         outcome,
-        final_state: y.to_vec(),
+        final_state: plant.state().to_vec(),
         cosim,
-        parked_steps,
-        planes,
-        ticks: cost,
+        parked_steps: plant.parked_steps(),
+        planes: plant.planes(),
+        ticks,
         invalid_commands,
-        voltage_saturation_s: model.voltage_saturation(&y),
-    })
-}
-
-/// The rotor touches one of its races (the rotor – race contact force is not zero).
-fn touching<const N: usize, M: Machine<N>>(model: &M, y: &[f64; N], planes: usize) -> bool {
-    (0..planes).any(|i| model.touching(y, i))
-}
-
-/// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it
-/// (where the housing acceleration or its slope jumps): a step across such a kink has an
-/// O(h²) local error whatever the method's order. `breakpoints` is sorted; `next` is the index
-/// of the first one not yet passed. Samples at `times` go to `sample`.
-fn advance_across_breakpoints<const N: usize, S: System<N>, F: FnMut(f64, &[f64; N])>(
-    integrator: &mut Integrator<N>,
-    model: &S,
-    (t0, t1): (f64, f64),
-    y: &mut [f64; N],
-    times: &[f64],
-    (breakpoints, next): (&[f64], &mut usize),
-    mut sample: F,
-) -> Result<(), IntegrationError> {
-    let tiny = 1e-9 * (t1 - t0);
-    let mut from = t0;
-    let mut done = 0;
-    while *next < breakpoints.len() && breakpoints[*next] < t1 - tiny {
-        let b = breakpoints[*next];
-        *next += 1;
-        if b <= from + tiny {
-            continue;
-        }
-        let upto = done + times[done..].partition_point(|t| *t <= b);
-        integrator.advance_dense(model, from, b, y, &times[done..upto], &mut sample)?;
-        done = upto;
-        from = b;
-    }
-    integrator.advance_dense(model, from, t1, y, &times[done..], sample)
-}
-
-/// Radius limits beyond which the contact model has failed, per bearing plane.
-struct Guards {
-    /// (rotor, race) limits of each plane (m).
-    limits: Vec<(f64, f64)>,
-}
-
-impl Guards {
-    fn new<const N: usize, M: Machine<N>>(scene: &Scene, model: &M) -> Self {
-        let g = scene.integrator.radius_guard;
-        let limits = (0..M::PLANES)
-            .map(|i| {
-                let p = model.bearing(i);
-                (p.contact.gap + p.balls.clearance + g, p.balls.clearance + g)
-            })
-            .collect();
-        Self { limits }
-    }
-
-    fn check<const N: usize, M: Machine<N>>(&self, model: &M, t: f64, y: &[f64; N]) -> Result<(), RunError> {
-        const NAMES: [[&str; 2]; 2] =
-            [["rotor radius at bearing A", "race A radius"], ["rotor radius at bearing B", "race B radius"]];
-        for (i, &(rotor_limit, race_limit)) in self.limits.iter().enumerate() {
-            let (rotor, race) = model.radii(y, i);
-            let [rotor_name, race_name] = if M::PLANES == 1 { ["rotor radius", "race radius"] } else { NAMES[i] };
-            let fail = |what, value_m, limit_m| RunError::RadiusGuard { t, what, value_m, limit_m, state: y.to_vec() };
-            if rotor > rotor_limit {
-                return Err(fail(rotor_name, rotor, rotor_limit));
-            }
-            if race > race_limit {
-                return Err(fail(race_name, race, race_limit));
-            }
-        }
-        Ok(())
+        voltage_saturation_s: plant.voltage_saturation(),
     }
 }

@@ -186,6 +186,16 @@ impl Sensor {
         Self { settings, rng: SplitMix64::new(settings.seed) }
     }
 
+    /// The noise generator's state (a snapshot's).
+    pub fn rng_state(&self) -> u64 {
+        self.rng.state()
+    }
+
+    /// Puts the noise generator at `state` ([`Sensor::rng_state`]).
+    pub fn set_rng_state(&mut self, state: u64) {
+        self.rng = SplitMix64::new(state);
+    }
+
     /// The voltages the controller reads for displacement `delta` (m), x then y.
     pub fn read(&mut self, delta: [f64; 2]) -> [f64; 2] {
         self.read_with_gain(delta, self.settings.gain)

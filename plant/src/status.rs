@@ -94,7 +94,7 @@ impl SetupError {
     /// `interrupted` (a signal while waiting for it), else `not_started`.
     pub fn status(&self) -> Status {
         match self {
-            SetupError::Law(_) | SetupError::Overrides(_) => Status::Refused,
+            SetupError::Law(_) | SetupError::Overrides(_) | SetupError::State(_) => Status::Refused,
             SetupError::Cosim(CosimError::Interrupted) => Status::Interrupted,
             SetupError::Cosim(c) if c.is_refusal() => Status::Refused,
             SetupError::Cosim(_) | SetupError::Thread(_) => Status::NotStarted,

@@ -279,7 +279,7 @@ impl Summary {
             status: run.outcome.status(),
             error: run.outcome.error(),
             failure_time_s: run.outcome.failure_time(),
-            failure_state: failure.and_then(FailureState::of),
+            failure_state: failure.and_then(|e| FailureState::of(scene, e)),
             simulated_s: run.simulated,
             max_radius_m: figures.max_radius_m,
             contact_fraction: analysis.steady_contact_fraction,
@@ -393,10 +393,15 @@ pub struct TwoPlaneFailure {
 }
 
 impl FailureState {
-    /// The failing state of a divergence, if the error holds a whole state.
-    pub fn of(e: &RunError) -> Option<Self> {
+    /// The failing state of a divergence of a run of `scene`: the rotor model's part of the
+    /// state (the hardware's states of a run with amplifiers or a sensor front end follow it,
+    /// [`crate::hardware`]); `None` if the error holds less than the model's state.
+    pub fn of(scene: &Scene, e: &RunError) -> Option<Self> {
         let y = e.state();
-        if y.len() == crate::model::N {
+        if scene.two_plane.is_none() {
+            if y.len() < crate::model::N {
+                return None;
+            }
             use crate::model::ix;
             return Some(Self::Planar(PlanarFailure {
                 t_s: e.time(),
@@ -410,7 +415,7 @@ impl FailureState {
                 race_spin: [y[ix::TB], y[ix::WB]],
             }));
         }
-        if y.len() == plant_physics::two_plane::N {
+        if y.len() >= plant_physics::two_plane::N {
             use plant_physics::two_plane::ix;
             let race = |x: usize| RaceFailure {
                 race_radius_m: y[x].hypot(y[x + 1]),

@@ -334,8 +334,14 @@ impl Scene {
     /// tick split at a shock's breakpoint). The default of realtime
     /// runs (`integrator.realtime = "fixed"`) and the fast setting of ensemble members.
     pub fn fixed_step_overrides(&self) -> Vec<String> {
-        let contact =
-            plant_physics::stability::safe_contact_substeps(&self.params, Method::Rk4, self.controller.period).max(1);
+        // Every bearing plane's contact must be stable: the most substeps any plane needs.
+        let contact = (0..self.planes())
+            .map(|i| {
+                plant_physics::stability::safe_contact_substeps(self.plane(i), Method::Rk4, self.controller.period)
+            })
+            .max()
+            .unwrap_or(1)
+            .max(1);
         vec![
             "integrator.method=\"rk4\"".into(),
             "integrator.substeps=1".into(),
@@ -343,6 +349,39 @@ impl Scene {
             "touchdown.race_when_clear=\"parked\"".into(),
             "touchdown.race_release=\"equilibrium\"".into(),
         ]
+    }
+
+    /// What a plant's state depends on besides its length (a snapshot's
+    /// [`crate::snapshot::Fingerprint`]): every `[rotor]` key as resolved, the hardware's layout,
+    /// the integrator as the run uses it, and the controller's and the output's rates. The
+    /// controller's law and gains, the touchdown bearings, the shock programme and the duration
+    /// are not in it.
+    pub fn state_fingerprint(&self) -> Vec<(String, String)> {
+        let mut entries = Vec::new();
+        if let Ok(toml::Value::Table(rotor)) = toml::Value::try_from(&self.source.raw.rotor) {
+            flatten("rotor", &rotor, &mut entries);
+        }
+        let hw = &self.hardware;
+        let layout = if hw.is_unipolar() {
+            "unipolar amplifiers"
+        } else if hw.is_on() {
+            "amplifiers or a sensor front end"
+        } else {
+            "bare"
+        };
+        entries.push(("hardware".into(), layout.into()));
+        let i = &self.integrator;
+        entries.push(("integrator.method".into(), format!("{:?}", i.method)));
+        if i.method.is_adaptive() {
+            entries.push(("integrator.rtol".into(), format!("{:?}", i.rtol)));
+            entries.push(("integrator.atol".into(), format!("{:?}", i.atol_groups)));
+        } else {
+            entries.push(("integrator.substeps".into(), i.substeps.to_string()));
+            entries.push(("integrator.contact_substeps".into(), i.contact_substeps.to_string()));
+        }
+        entries.push(("controller.rate_hz".into(), format!("{:?}", self.controller.rate_hz)));
+        entries.push(("output.rate_hz".into(), format!("{:?}", 1.0 / self.output_interval)));
+        entries
     }
 
     /// The scene as resolved (every key, overrides applied), as a scene file: `scene.toml` of
@@ -453,4 +492,16 @@ pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigErro
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     validate(raw, base_dir)
+}
+
+/// `table`'s values as `(prefix.key, value)` pairs, sub-tables flattened, in key order.
+fn flatten(prefix: &str, table: &toml::Table, out: &mut Vec<(String, String)>) {
+    for (key, value) in table {
+        let name = format!("{prefix}.{key}");
+        match value {
+            toml::Value::Table(t) => flatten(&name, t, out),
+            toml::Value::Float(f) => out.push((name, format!("{f:?}"))),
+            other => out.push((name, other.to_string())),
+        }
+    }
 }

@@ -90,6 +90,14 @@ impl ShockTracker {
     /// One sample at `t` (s): rotor radius (m) and contact normal force (N). Each window that
     /// this sample closes is passed to `closed`.
     pub fn sample(&mut self, t: f64, radius: f64, force: f64, closed: &mut dyn FnMut(ShockFigures)) {
+        let clear = radius < self.clear_radius;
+        self.sample_with(t, radius, force, clear, closed);
+    }
+
+    /// [`ShockTracker::sample`] with the radius test made by the caller: `within` is true when
+    /// the rotor is inside its clear radius (each bearing plane inside its own, for a rotor of
+    /// two planes with different gaps), and `radius` the largest radius, for the figures.
+    pub fn sample_with(&mut self, t: f64, radius: f64, force: f64, within: bool, closed: &mut dyn FnMut(ShockFigures)) {
         // Windows that start at or before t close the previous one.
         loop {
             let next = self.current.map_or(0, |j| j + 1);
@@ -107,7 +115,7 @@ impl ShockTracker {
             self.acc.episodes += 1;
         }
         self.in_contact = contact;
-        if contact || radius >= self.clear_radius || !radius.is_finite() {
+        if contact || !within || !radius.is_finite() {
             self.clear_since = None;
         } else if self.clear_since.is_none() {
             self.clear_since = Some(t);

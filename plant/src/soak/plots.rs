@@ -19,15 +19,19 @@ pub(crate) fn write_plots(
     rss: &[RssSample],
 ) -> anyhow::Result<()> {
     let name = &prog.name;
-    let gap_um = prog.scene.params.contact.gap * 1e6;
+    let scene = &prog.scene;
+    // Each plane's gap and clear radius: one line each where the planes' differ.
+    let gaps_um: Vec<f64> = (0..scene.planes()).map(|i| scene.plane(i).contact.gap * 1e6).collect();
+    let gap_um = gaps_um[0];
     let env = read_envelope(&dir.join("envelope.csv"))?;
     if env.is_empty() {
         return Ok(());
     }
     let t: Vec<f64> = env.iter().map(|r| r.t_s).collect();
     let r_um: Vec<f64> = env.iter().map(|r| r.max_radius_m * 1e6).collect();
-    let gap_line = vec![gap_um; t.len()];
-    let clear_line = vec![prog.clear_radius * 1e6; t.len()];
+    let two = gaps_um.len() == 2 && gaps_um[0] != gaps_um[1];
+    let gap_lines: Vec<Vec<f64>> = gaps_um.iter().map(|g| vec![*g; t.len()]).collect();
+    let clear_lines: Vec<Vec<f64>> = prog.clear_radius.iter().map(|c| vec![c * 1e6; t.len()]).collect();
     let t_end = t.last().copied().unwrap_or(0.0);
     let (mut mx, mut my) = (Vec::new(), Vec::new());
     for s in prog.shocks.iter().filter(|s| s.start_s <= t_end) {
@@ -39,11 +43,20 @@ pub(crate) fn write_plots(
     if !mx.is_empty() {
         series.push(Series { label: "shock start", x: &mx, y: &my });
     }
-    series.extend([
-        Series { label: "rotor radius (max per 5 ms)", x: &t, y: &r_um },
-        Series { label: "air gap r0", x: &t, y: &gap_line },
-        Series { label: "clear radius", x: &t, y: &clear_line },
-    ]);
+    series.push(Series { label: "rotor radius (max per 5 ms)", x: &t, y: &r_um });
+    if two {
+        series.extend([
+            Series { label: "air gap r0 at A", x: &t, y: &gap_lines[0] },
+            Series { label: "air gap r0 at B", x: &t, y: &gap_lines[1] },
+            Series { label: "clear radius at A", x: &t, y: &clear_lines[0] },
+            Series { label: "clear radius at B", x: &t, y: &clear_lines[1] },
+        ]);
+    } else {
+        series.extend([
+            Series { label: "air gap r0", x: &t, y: &gap_lines[0] },
+            Series { label: "clear radius", x: &t, y: &clear_lines[0] },
+        ]);
+    }
     plot::lines(
         &dir.join("radius.png"),
         &format!("{name} — rotor radius through the soak"),

@@ -215,8 +215,8 @@ pub struct Programme {
     pub shocks: Vec<PlannedShock>,
     /// Recovery hold (s).
     pub hold: f64,
-    /// Clear radius (m).
-    pub clear_radius: f64,
+    /// Each bearing plane's clear radius (m): `recovery.radius_fraction` of its own air gap.
+    pub clear_radius: Vec<f64>,
     /// RSS sampling period (s, simulated).
     pub rss_every: f64,
     /// Draw the soak's plots (the scene's `output.plots`, after the overrides).
@@ -427,7 +427,7 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
             &format!("must be at least 10 output samples ({} s at output.rate_hz)", 10.0 * scene.output_interval),
         ));
     }
-    let clear_radius = fraction * scene.params.contact.gap;
+    let clear_radius = (0..scene.planes()).map(|i| fraction * scene.plane(i).contact.gap).collect();
     Ok(Programme {
         name: raw.name.clone(),
         scene,

@@ -116,8 +116,12 @@ pub struct Report {
     pub rss: RssReport,
     /// The recovery rule: hold (s).
     pub recovery_hold_s: f64,
-    /// The recovery rule: clear radius (m).
+    /// The recovery rule: clear radius (m) (bearing plane A's, of a two-plane rotor).
     pub recovery_clear_radius_m: f64,
+    /// Each bearing plane's clear radius (m), A then B: a two-plane rotor's planes each have
+    /// their own air gap.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recovery_clear_radius_per_plane_m: Option<Vec<f64>>,
     /// The programme's criteria, judged (only those given).
     pub criteria: Vec<CriterionResult>,
     /// All criteria met and the run completed.
@@ -237,7 +241,8 @@ pub(crate) fn report(
         deadline_miss_fraction: miss_fraction,
         rss,
         recovery_hold_s: prog.hold,
-        recovery_clear_radius_m: prog.clear_radius,
+        recovery_clear_radius_m: prog.clear_radius[0],
+        recovery_clear_radius_per_plane_m: (prog.clear_radius.len() > 1).then(|| prog.clear_radius.clone()),
         criteria: Vec::new(),
         passed: false,
         cosim,

@@ -164,12 +164,12 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
             starts.clone(),
             scene.duration,
             scene.output_interval,
-            prog.clear_radius,
+            prog.clear_radius[0],
             prog.hold,
         ),
         envelope: monitor::Envelope::new(ENVELOPE_BIN_S),
         planned: &prog.shocks,
-        gap_ratio: if scene.planes() == 2 { scene.plane(0).contact.gap / scene.plane(1).contact.gap } else { 1.0 },
+        clear_radius: prog.clear_radius.clone(),
         figures: Vec::with_capacity(prog.shocks.len()),
         soak_csv,
         envelope_csv,
@@ -200,7 +200,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         error: None,
     };
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
-    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink) {
+    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink, None) {
         Ok(r) => r,
         Err(e) => {
             // The programme loaded: the folder records why the soak did not start.

@@ -14,8 +14,8 @@ pub struct SoakSink<'a> {
     pub(crate) tracker: ShockTracker,
     pub(crate) envelope: Envelope,
     pub(crate) planned: &'a [PlannedShock],
-    /// Two-plane: plane A's gap over plane B's (plane B's radius is scaled by it).
-    pub(crate) gap_ratio: f64,
+    /// Each bearing plane's clear radius (m): a fraction of its own air gap.
+    pub(crate) clear_radius: Vec<f64>,
     pub(crate) figures: Vec<ShockFigures>,
     pub(crate) soak_csv: RowFile,
     pub(crate) envelope_csv: RowFile,
@@ -72,21 +72,22 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn sample(&mut self, record: &Record) {
-        // Of a two-plane rotor, the plane nearer its gap: the larger of r_A and r_B·r0_A/r0_B
-        // (plane B's radius on plane A's gap, so that the clear test holds each plane to its
-        // own gap), and the larger contact force.
+        // Of a two-plane rotor: the larger radius and contact force of the planes, and clear
+        // while each plane is inside its own clear radius.
         let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
         let (mut radius, mut force) = of(&record.a);
+        let mut within = radius < self.clear_radius[0];
         if record.planes() == 2 {
             let (rb, fb) = of(&record.plane(1));
-            (radius, force) = (radius.max(rb * self.gap_ratio), force.max(fb));
+            within &= rb < self.clear_radius[1];
+            (radius, force) = (radius.max(rb), force.max(fb));
         }
         let t = record.a[col::T_S];
         if let Some(r) = self.envelope.sample(t, radius, force) {
             self.write_bin(r);
         }
         let mut closed = None;
-        self.tracker.sample(t, radius, force, &mut |f| closed = Some(f));
+        self.tracker.sample_with(t, radius, force, within, &mut |f| closed = Some(f));
         if let Some(f) = closed {
             self.write_shock(f);
         }

@@ -608,6 +608,11 @@ impl<const N: usize> Integrator<N> {
         self.stats
     }
 
+    /// Sets the work counters (resume from a snapshot: the counters go on from its).
+    pub fn set_stats(&mut self, stats: Stats) {
+        self.stats = stats;
+    }
+
     /// Zeroes the work counters.
     pub fn reset_stats(&mut self) {
         self.stats = Stats::default();

@@ -1,0 +1,863 @@
+//! The plant as a value: a [`Plant`] that anything can step, one controller tick at a time.
+//!
+//! A `Plant` holds everything a run evolves: the rotor model with its state (the hardware's
+//! states appended when the scene has amplifiers or a sensor front end), the integrator and its
+//! step-size memory, where the run is among the base motion's breakpoints, each race's parking,
+//! the sensor's noise generator, the output rows' clock and the execution-time histograms.
+//! Given the command of one tick (each axis's coil current, as the wire carries them; or the
+//! continuous PD inside the derivative) it integrates the tick, hands the output rows of the
+//! tick to a [`Sink`], and returns what the controller reads next: every axis's sensor sample
+//! with the keyphasor.
+//!
+//! The CLI's run loop ([`crate::run`]) is one driver of it: the digital loop
+//! ([`crate::digital`]: the law or the controller session, saturation, the invalid-command
+//! budget, the delay line) makes the command from the sample, the plant steps. Another driver
+//! (an FMU, a test, a user's program) does the same:
+//!
+//! ```
+//! use plant::stepper::{Command, Plant};
+//! let scene = plant::config::load_scene("../config/cosim-10g.toml".as_ref(), &["scene.duration_s=0.002".into()])?;
+//! let bias = plant::run::bias_of(&scene, &plant::run::plane_gains(&scene)?);
+//! let mut plant = Plant::new(&scene, &Command::Held(bias))?;
+//! let mut trace = plant::trace::Trace::with_capacity(64);
+//! plant.record(&mut trace); // the row at t = 0
+//! while !plant.finished() {
+//!     let sample = *plant.sample();
+//!     // A proportional law of our own on the sensor signal (V → A), bias added.
+//!     let mut command = bias;
+//!     command[0] -= 0.05 * sample.sensor_v[0];
+//!     command[1] -= 0.05 * sample.sensor_v[1];
+//!     plant.step(&Command::Held(command), &mut trace)?;
+//! }
+//! assert_eq!(plant.tick(), 40);
+//! assert_eq!(trace.len(), 41);
+//! // Its whole state as a value: a copy steps on exactly as the original.
+//! let saved = plant.snapshot();
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! [`Plant::snapshot`] and [`Plant::restore`] give that state as a value
+//! ([`crate::snapshot::Snapshot`]); a plant restored at any tick writes the same rows as the
+//! one that never stopped.
+
+use crate::config::Scene;
+use crate::cosim::stats::{Tet, TickTime};
+use crate::hardware::{Wired, EXTRA, EXTRA_UNIPOLAR};
+pub use crate::hooks::Excitation;
+use crate::initial::initial_state;
+use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
+use crate::machine::Machine;
+use crate::model::{Control, Model, RaceWhenClear};
+use crate::run::{integrator_settings, plane_gains, settings_with, RunError, SetupError, Sink, TickCost};
+use crate::sensor::Sensor;
+use crate::snapshot::{Fingerprint, Snapshot, SnapshotError};
+use controller::{wrap_angle, PdGains, RotorSample, ROTOR_AXES};
+use plant_physics::integrate::AdaptiveState;
+use plant_physics::two_plane;
+use std::time::{Duration, Instant};
+
+/// What the plant applies over one tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Command {
+    /// Each axis's coil current reference (A), as the wire carries them: x_A, y_A, x_B, y_B
+    /// (a planar rotor reads the first two), held over the tick (zero-order hold).
+    Held([f64; ROTOR_AXES]),
+    /// The continuous PD inside the derivative (`controller.mode = "continuous"`), with a sine
+    /// on one plane's sensor signal, which the PD then reads (a sensitivity measurement).
+    Continuous(Option<Excitation>),
+}
+
+/// The plant of one scene, stepped one controller tick at a time (module doc).
+pub struct Plant {
+    core: Box<dyn Core>,
+    sample: RotorSample,
+    fingerprint: Fingerprint,
+}
+
+impl std::fmt::Debug for Plant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Plant").field("tick", &self.tick()).field("t", &self.time()).finish_non_exhaustive()
+    }
+}
+
+impl Plant {
+    /// The plant of `scene` at its initial state (levitated on the unbalance orbit, each race at
+    /// rest), with `initial` applied: the command the row at t = 0 shows (the bias currents of a
+    /// sampled or co-simulated loop, [`crate::run::bias_of`], or the continuous PD).
+    ///
+    /// The execution time of each tick is measured when `scene`'s controller runs in another
+    /// process, or after [`Plant::time_ticks`].
+    pub fn new(scene: &Scene, initial: &Command) -> Result<Self, SetupError> {
+        let gains = plane_gains(scene)?;
+        let timed = matches!(
+            scene.controller.mode,
+            crate::config::ControlMode::Lockstep | crate::config::ControlMode::Realtime
+        );
+        let control = |i: usize| match initial {
+            Command::Continuous(_) => Control::Continuous(gains[i]),
+            Command::Held(c) => Control::Held([c[2 * i], c[2 * i + 1]]),
+        };
+        let hw = &scene.hardware;
+        let controls = if scene.two_plane.is_some() { [control(0), control(1)] } else { [control(0); 2] };
+        let [p, v, ..] = scene.integrator.atol_groups;
+        let core: Box<dyn Core> = match &scene.two_plane {
+            None => {
+                let model = Model {
+                    params: scene.params.clone(),
+                    base: scene.base.clone(),
+                    control: control(0),
+                    race_parked: false,
+                };
+                let y = initial_state(scene);
+                const N: usize = crate::model::N;
+                if hw.is_unipolar() {
+                    const NA: usize = N + EXTRA_UNIPOLAR;
+                    let wired = Wired::<Model, N, NA>::new(model, controls, hw.clone());
+                    let y = wired.initial(&y);
+                    let settings = settings_with(scene, extended::<N, NA>(scene.integrator.atol, p, v));
+                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
+                } else if hw.is_on() {
+                    const NA: usize = N + EXTRA;
+                    let wired = Wired::<Model, N, NA>::new(model, controls, hw.clone());
+                    let y = wired.initial(&y);
+                    let settings = settings_with(scene, extended::<N, NA>(scene.integrator.atol, p, v));
+                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
+                } else {
+                    Box::new(Stepper::new(scene, model, y, integrator_settings(scene), gains, timed))
+                }
+            }
+            Some(params) => {
+                let model = two_plane::Model {
+                    params: params.clone(),
+                    base: scene.base.clone(),
+                    control: [control(0), control(1)],
+                    race_parked: [false; 2],
+                };
+                let y = crate::initial::two_plane_initial_state(scene, params);
+                const N: usize = two_plane::N;
+                let atol = scene.integrator.two_plane_atol();
+                if hw.is_unipolar() {
+                    const NA: usize = N + EXTRA_UNIPOLAR;
+                    let wired = Wired::<two_plane::Model, N, NA>::new(model, controls, hw.clone());
+                    let y = wired.initial(&y);
+                    let settings = settings_with(scene, extended::<N, NA>(atol, p, v));
+                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
+                } else if hw.is_on() {
+                    const NA: usize = N + EXTRA;
+                    let wired = Wired::<two_plane::Model, N, NA>::new(model, controls, hw.clone());
+                    let y = wired.initial(&y);
+                    let settings = settings_with(scene, extended::<N, NA>(atol, p, v));
+                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
+                } else {
+                    Box::new(Stepper::new(scene, model, y, settings_with(scene, atol), gains, timed))
+                }
+            }
+        };
+        let fingerprint = Fingerprint::of(scene, core.state().len());
+        let mut plant = Self { core, sample: RotorSample::default(), fingerprint };
+        plant.sample = plant.core.read_sample();
+        Ok(plant)
+    }
+
+    /// Measures the execution time of every tick from now on (as co-simulated runs always do):
+    /// `plant bench tick`.
+    pub fn time_ticks(&mut self) {
+        self.core.time_ticks();
+    }
+
+    /// What the controller reads at the current tick: every axis's sensor signal (V; gain,
+    /// noise and ADC applied; through the front end if the scene has one) and the keyphasor.
+    pub fn sample(&self) -> &RotorSample {
+        &self.sample
+    }
+
+    /// Integrates one tick with `command` applied, hands its output rows to `sink`, and returns
+    /// what the controller reads at the next tick. A numerical failure (the integrator's, or a
+    /// radius past its guard) is returned with its time and state; the plant then stays where
+    /// the failure left it.
+    ///
+    /// Steps past the scene's duration go on, a whole period each.
+    pub fn step(&mut self, command: &Command, sink: &mut dyn Sink) -> Result<&RotorSample, RunError> {
+        self.step_from(command, sink, Instant::now())
+    }
+
+    /// [`Plant::step`] for a tick that started at `tick_start` (a realtime tick starts when the
+    /// plant wakes at its wall-clock time): the execution time counts from there.
+    pub fn step_from(
+        &mut self,
+        command: &Command,
+        sink: &mut dyn Sink,
+        tick_start: Instant,
+    ) -> Result<&RotorSample, RunError> {
+        self.core.step(command, sink, tick_start)?;
+        self.sample = self.core.read_sample();
+        Ok(&self.sample)
+    }
+
+    /// Hands the current state's output row to `sink` (a run's row at t = 0).
+    pub fn record(&self, sink: &mut dyn Sink) {
+        self.core.record(sink);
+    }
+
+    /// Ticks done.
+    pub fn tick(&self) -> u64 {
+        self.core.position().tick
+    }
+
+    /// Simulated time reached (s): the end of the last tick, or where a failure stopped it.
+    pub fn time(&self) -> f64 {
+        self.core.position().t
+    }
+
+    /// Ticks of the scene's duration.
+    pub fn ticks(&self) -> u64 {
+        self.core.position().ticks
+    }
+
+    /// The scene's duration is reached.
+    pub fn finished(&self) -> bool {
+        self.tick() >= self.ticks()
+    }
+
+    /// Bearing planes of the rotor (1 or 2).
+    pub fn planes(&self) -> usize {
+        self.core.planes()
+    }
+
+    /// The state (SI, ordered as the model's: [`crate::model::ix`] or
+    /// [`plant_physics::two_plane::ix`], the hardware's states after it, [`crate::hardware`]).
+    pub fn state(&self) -> &[f64] {
+        self.core.state()
+    }
+
+    /// Integrator statistics since the start of the run.
+    pub fn stats(&self) -> Stats {
+        self.core.stats()
+    }
+
+    /// Macro steps run with a race parked, summed over the planes.
+    pub fn parked_steps(&self) -> u64 {
+        self.core.parked_steps()
+    }
+
+    /// Time with an amplifier at its voltage limit (s); `None` without amplifiers.
+    pub fn voltage_saturation(&self) -> Option<f64> {
+        self.core.voltage_saturation()
+    }
+
+    /// The cost of the ticks so far (the most evaluations in one, the execution times), taken
+    /// out of the plant.
+    pub fn take_cost(&mut self) -> TickCost {
+        self.core.take_cost()
+    }
+
+    /// What the state of this plant must match to be restored into it.
+    pub fn fingerprint(&self) -> &Fingerprint {
+        &self.fingerprint
+    }
+
+    /// The whole evolving state, as a value ([`Snapshot`]). It allocates: take it between ticks,
+    /// not inside a realtime loop's deadline.
+    pub fn snapshot(&self) -> Snapshot {
+        self.core.snapshot(self.fingerprint.clone())
+    }
+
+    /// Continues from `snapshot`: the next steps write the rows the plant that took it would
+    /// have written. Refused, with the first difference named, when the snapshot is of another
+    /// rotor, state layout, integrator or rate ([`Fingerprint`]); the plant is then unchanged.
+    pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), SnapshotError> {
+        snapshot.check_against(&self.fingerprint)?;
+        self.core.restore(snapshot)?;
+        self.sample = self.core.read_sample();
+        Ok(())
+    }
+}
+
+/// Where a plant is in its run.
+#[derive(Clone, Copy, Debug)]
+struct Position {
+    tick: u64,
+    t: f64,
+    ticks: u64,
+}
+
+/// A [`Stepper`] of any state size, behind one object-safe interface: a call per tick, the
+/// integration itself monomorphic inside.
+trait Core {
+    fn read_sample(&mut self) -> RotorSample;
+    fn step(&mut self, command: &Command, sink: &mut dyn Sink, tick_start: Instant) -> Result<(), RunError>;
+    fn record(&self, sink: &mut dyn Sink);
+    fn position(&self) -> Position;
+    fn planes(&self) -> usize;
+    fn state(&self) -> &[f64];
+    fn stats(&self) -> Stats;
+    fn parked_steps(&self) -> u64;
+    fn voltage_saturation(&self) -> Option<f64>;
+    fn take_cost(&mut self) -> TickCost;
+    fn time_ticks(&mut self);
+    fn snapshot(&self, fingerprint: Fingerprint) -> Snapshot;
+    fn restore(&mut self, snapshot: &Snapshot) -> Result<(), SnapshotError>;
+}
+
+/// The plant of a model `M` on `N` states.
+struct Stepper<const N: usize, M: Machine<N>> {
+    model: M,
+    y: [f64; N],
+    integrator: Integrator<N>,
+    /// Each plane's continuous PD (`Command::Continuous`).
+    gains: Vec<PdGains>,
+    sensor: Sensor,
+    /// The sensor as it was before the current sample was read (what a snapshot keeps).
+    sensor_at_tick: Sensor,
+    guards: Guards,
+    breakpoints: Vec<f64>,
+    next_breakpoint: usize,
+    tick: u64,
+    t: f64,
+    ticks: u64,
+    period: f64,
+    duration: f64,
+    out_dt: f64,
+    /// The next output row's number (row `n` at `n · out_dt`).
+    next_out: u64,
+    /// The output times of the current tick (allocated once).
+    out_times: Vec<f64>,
+    parked_steps: u64,
+    substeps: u32,
+    contact_substeps: u32,
+    cost: TickCost,
+}
+
+impl<const N: usize, M: Machine<N>> Stepper<N, M> {
+    fn new(scene: &Scene, model: M, y: [f64; N], settings: Settings<N>, gains: Vec<PdGains>, timed: bool) -> Self {
+        let period = scene.controller.period;
+        let ticks = (scene.duration / period).ceil() as u64;
+        let out_dt = scene.output_interval;
+        let sensor = Sensor::new(scene.sensor);
+        Self {
+            guards: Guards::new(scene, &model),
+            model,
+            y,
+            integrator: Integrator::new(settings),
+            gains,
+            sensor_at_tick: sensor.clone(),
+            sensor,
+            breakpoints: scene.base.breakpoints(),
+            next_breakpoint: 0,
+            tick: 0,
+            t: 0.0,
+            ticks,
+            period,
+            duration: scene.duration,
+            out_dt,
+            next_out: 1,
+            // Output samples per tick; a period longer than the run holds only the run's samples.
+            out_times: Vec::with_capacity((period.min(scene.duration) / out_dt).ceil() as usize + 2),
+            parked_steps: 0,
+            substeps: scene.integrator.substeps,
+            contact_substeps: scene.integrator.contact_substeps,
+            cost: TickCost { max_rhs_evals: 0, tet: timed.then(|| Box::new(Tet::new(ticks))) },
+        }
+    }
+
+    /// The end of the current tick: the scene's duration caps the last one; past it, whole periods.
+    fn tick_end(&self) -> f64 {
+        let t1 = (self.tick + 1) as f64 * self.period;
+        if self.tick < self.ticks {
+            t1.min(self.duration)
+        } else {
+            t1
+        }
+    }
+}
+
+impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
+    fn read_sample(&mut self) -> RotorSample {
+        self.sensor_at_tick = self.sensor.clone();
+        let planes = M::PLANES;
+        let (model, y) = (&self.model, &self.y);
+        // The rotor's speed and its angle wrapped to [0, 2π), from the state.
+        let (angle, speed) = model.spin(y);
+        let mut sample = RotorSample {
+            seq: self.tick,
+            t_s: self.tick as f64 * self.period,
+            axes: 2 * planes as u32,
+            speed_rad_s: speed,
+            angle_rad: wrap_angle(angle),
+            ..Default::default()
+        };
+        // Every axis's sensor, the planes in order, one noise sequence (read in every mode: the
+        // continuous PD reads its signal inside the derivative, but an excitation reads it here).
+        for i in 0..planes {
+            let gain = model.bearing(i).loop_constants.sensor_gain_v_per_m;
+            let v = self.sensor.read_with_gain(model.sensed(y, i), gain);
+            sample.sensor_v[2 * i..2 * i + 2].copy_from_slice(&v);
+        }
+        sample
+    }
+
+    fn step(&mut self, command: &Command, sink: &mut dyn Sink, tick_start: Instant) -> Result<(), RunError> {
+        let planes = M::PLANES;
+        let k = self.tick;
+        let t0 = k as f64 * self.period;
+        let t1 = self.tick_end();
+        match command {
+            Command::Held(c) => {
+                for i in 0..planes {
+                    self.model.set_control(i, Control::Held([c[2 * i], c[2 * i + 1]]));
+                }
+            }
+            Command::Continuous(excitation) => {
+                for i in 0..planes {
+                    let control = match excitation {
+                        Some(e) if e.plane == i => Control::ContinuousExcited(self.gains[i], e.sine),
+                        _ => Control::Continuous(self.gains[i]),
+                    };
+                    self.model.set_control(i, control);
+                }
+            }
+        }
+        let commanded = Instant::now();
+        // Park or release each race; the fixed step is the contact one while any race is free.
+        let mut changed = false;
+        for i in 0..planes {
+            if let RaceWhenClear::Parked(release) = self.model.bearing(i).race_when_clear {
+                let clear = self.model.race_clear(t0, t1 - t0, &self.y, i);
+                if clear && !self.model.parked(i) {
+                    self.model.park_race(&mut self.y, i);
+                    self.model.set_parked(i, true);
+                    changed = true;
+                } else if !clear && (self.model.parked(i) || k == 0) {
+                    if self.model.parked(i) {
+                        self.model.release_race(t0, &mut self.y, i, release);
+                    }
+                    self.model.set_parked(i, false);
+                    changed = true;
+                }
+                self.parked_steps += u64::from(self.model.parked(i));
+            }
+        }
+        if changed {
+            let all_parked = (0..planes).all(|i| self.model.parked(i));
+            self.integrator.set_substeps(if all_parked { self.substeps } else { self.contact_substeps });
+        }
+        self.out_times.clear();
+        let out_dt = self.out_dt;
+        while (self.next_out as f64) * out_dt <= t1 + 1e-9 * out_dt {
+            self.out_times.push(((self.next_out as f64) * out_dt).min(t1));
+            self.next_out += 1;
+        }
+        let timed = self.cost.tet.is_some();
+        let (evals, touching) = (self.integrator.stats().rhs_evals, timed && touching(&self.model, &self.y));
+        let mut rows = Duration::ZERO;
+        let integrating = Instant::now();
+        let model = &self.model;
+        let step = advance_across_breakpoints(
+            &mut self.integrator,
+            model,
+            (t0, t1),
+            &mut self.y,
+            &self.out_times,
+            (&self.breakpoints, &mut self.next_breakpoint),
+            |ts, ys| {
+                if timed {
+                    // The output rows' time is the sink's, not the integration's.
+                    let row = Instant::now();
+                    feed(model, sink, ts, ys);
+                    rows += row.elapsed();
+                } else {
+                    feed(model, sink, ts, ys);
+                }
+            },
+        );
+        self.cost.max_rhs_evals = self.cost.max_rhs_evals.max(self.integrator.stats().rhs_evals - evals);
+        if let Some(tet) = self.cost.tet.as_mut() {
+            let end = Instant::now();
+            let ns = |d: Duration| d.as_nanos() as u64;
+            tet.record(
+                k,
+                TickTime {
+                    command_ns: ns(commanded - tick_start),
+                    integration_ns: ns((end - integrating).saturating_sub(rows)),
+                    tick_ns: ns(end - tick_start),
+                    contact: touching || self::touching(&self.model, &self.y),
+                },
+            );
+        }
+        self.t = t1;
+        self.tick += 1;
+        if let Err(e) = step.map_err(RunError::from).and_then(|()| self.guards.check(&self.model, t1, &self.y)) {
+            // The run reached the failure, not the end of its macro step (an integration error
+            // stops inside it).
+            self.t = e.time();
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    fn record(&self, sink: &mut dyn Sink) {
+        feed(&self.model, sink, self.t, &self.y);
+    }
+
+    fn position(&self) -> Position {
+        Position { tick: self.tick, t: self.t, ticks: self.ticks }
+    }
+
+    fn planes(&self) -> usize {
+        M::PLANES
+    }
+
+    fn state(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn stats(&self) -> Stats {
+        self.integrator.stats()
+    }
+
+    fn parked_steps(&self) -> u64 {
+        self.parked_steps
+    }
+
+    fn voltage_saturation(&self) -> Option<f64> {
+        self.model.voltage_saturation(&self.y)
+    }
+
+    fn take_cost(&mut self) -> TickCost {
+        std::mem::take(&mut self.cost)
+    }
+
+    fn time_ticks(&mut self) {
+        if self.cost.tet.is_none() {
+            self.cost.tet = Some(Box::new(Tet::new(self.ticks)));
+        }
+    }
+
+    fn snapshot(&self, fingerprint: Fingerprint) -> Snapshot {
+        let stats = self.integrator.stats();
+        Snapshot {
+            format: crate::snapshot::FORMAT,
+            fingerprint,
+            tick: self.tick,
+            t_s: self.t,
+            state: self.y.to_vec(),
+            adaptive: self.integrator.adaptive_state(),
+            substeps: self.integrator.settings().substeps,
+            steps: stats.steps,
+            rejected: stats.rejected,
+            rhs_evals: stats.rhs_evals,
+            max_rhs_evals: self.cost.max_rhs_evals,
+            next_output: self.next_out,
+            parked: (0..M::PLANES).map(|i| self.model.parked(i)).collect(),
+            parked_steps: self.parked_steps,
+            sensor_rng: self.sensor_at_tick.rng_state(),
+            digital: None,
+        }
+    }
+
+    fn restore(&mut self, s: &Snapshot) -> Result<(), SnapshotError> {
+        let y: [f64; N] = s.state.as_slice().try_into().map_err(|_| SnapshotError::Layout {
+            what: "state",
+            expected: N,
+            found: s.state.len(),
+        })?;
+        if s.parked.len() != M::PLANES {
+            return Err(SnapshotError::Layout { what: "parked races", expected: M::PLANES, found: s.parked.len() });
+        }
+        if let Some(bad) = s.state.iter().position(|v| !v.is_finite()) {
+            return Err(SnapshotError::NonFinite { index: bad, value: s.state[bad] });
+        }
+        if !(s.t_s.is_finite() && (s.t_s - s.tick as f64 * self.period).abs() <= 1e-9 * self.period.max(s.t_s)) {
+            return Err(SnapshotError::Time { tick: s.tick, t_s: s.t_s, period_s: self.period });
+        }
+        if s.substeps == 0 || !(s.adaptive.h.is_finite() && s.adaptive.h >= 0.0 && s.adaptive.err_old.is_finite()) {
+            return Err(SnapshotError::Integrator(format!(
+                "substeps = {}, step-size memory h = {} s, err_old = {}",
+                s.substeps, s.adaptive.h, s.adaptive.err_old
+            )));
+        }
+        self.y = y;
+        self.tick = s.tick;
+        self.t = s.t_s;
+        self.integrator.set_adaptive_state(AdaptiveState { h: s.adaptive.h, err_old: s.adaptive.err_old });
+        self.integrator.set_substeps(s.substeps);
+        self.integrator.set_stats(Stats { steps: s.steps, rejected: s.rejected, rhs_evals: s.rhs_evals });
+        self.cost.max_rhs_evals = s.max_rhs_evals;
+        self.next_out = s.next_output;
+        for (i, &parked) in s.parked.iter().enumerate() {
+            self.model.set_parked(i, parked);
+        }
+        self.parked_steps = s.parked_steps;
+        self.sensor.set_rng_state(s.sensor_rng);
+        // The breakpoints passed are those of this scene's programme before the snapshot's time
+        // (the programme may be another than the one that ran up to it).
+        let tiny = 1e-9 * self.period;
+        self.next_breakpoint = self.breakpoints.partition_point(|b| *b < s.t_s - tiny);
+        Ok(())
+    }
+}
+
+/// The model's tolerances `atol` with the hardware's after them ([`crate::hardware::atol`]).
+fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
+    let mut a = [0.0; NA];
+    a[..N].copy_from_slice(&atol);
+    a[N..].copy_from_slice(&crate::hardware::atol(p, v)[..NA - N]);
+    a
+}
+
+/// Hands the output sample of state `y` at time `t` to `sink` (and its state: on the planar
+/// model [`Sink::planar_state`], on the two-plane rotor [`Sink::two_plane_state`]).
+#[inline]
+fn feed<const N: usize, M: Machine<N>>(model: &M, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
+    sink.sample(&model.record(t, y));
+    if let (Some(planar), Ok(state)) = (model.planar(), <&crate::model::State>::try_from(&y[..])) {
+        sink.planar_state(planar, t, state);
+    } else if let (Some(m), Ok(state)) = (model.two_plane(), <&plant_physics::two_plane::State>::try_from(&y[..])) {
+        sink.two_plane_state(m, t, state);
+    }
+}
+
+/// The rotor touches one of its races (the rotor – race contact force is not zero).
+fn touching<const N: usize, M: Machine<N>>(model: &M, y: &[f64; N]) -> bool {
+    (0..M::PLANES).any(|i| model.touching(y, i))
+}
+
+/// Advances over `[t0, t1]`, ending a step at every breakpoint of the base motion inside it
+/// (where the housing acceleration or its slope jumps): a step across such a kink has an
+/// O(h²) local error whatever the method's order. `breakpoints` is sorted; `next` is the index
+/// of the first one not yet passed. Samples at `times` go to `sample`.
+fn advance_across_breakpoints<const N: usize, S: System<N>, F: FnMut(f64, &[f64; N])>(
+    integrator: &mut Integrator<N>,
+    model: &S,
+    (t0, t1): (f64, f64),
+    y: &mut [f64; N],
+    times: &[f64],
+    (breakpoints, next): (&[f64], &mut usize),
+    mut sample: F,
+) -> Result<(), IntegrationError> {
+    let tiny = 1e-9 * (t1 - t0);
+    let mut from = t0;
+    let mut done = 0;
+    while *next < breakpoints.len() && breakpoints[*next] < t1 - tiny {
+        let b = breakpoints[*next];
+        *next += 1;
+        if b <= from + tiny {
+            continue;
+        }
+        let upto = done + times[done..].partition_point(|t| *t <= b);
+        integrator.advance_dense(model, from, b, y, &times[done..upto], &mut sample)?;
+        done = upto;
+        from = b;
+    }
+    integrator.advance_dense(model, from, t1, y, &times[done..], sample)
+}
+
+/// Radius limits beyond which the contact model has failed, per bearing plane.
+struct Guards {
+    /// (rotor, race) limits of each plane (m).
+    limits: Vec<(f64, f64)>,
+}
+
+impl Guards {
+    fn new<const N: usize, M: Machine<N>>(scene: &Scene, model: &M) -> Self {
+        let g = scene.integrator.radius_guard;
+        let limits = (0..M::PLANES)
+            .map(|i| {
+                let p = model.bearing(i);
+                (p.contact.gap + p.balls.clearance + g, p.balls.clearance + g)
+            })
+            .collect();
+        Self { limits }
+    }
+
+    fn check<const N: usize, M: Machine<N>>(&self, model: &M, t: f64, y: &[f64; N]) -> Result<(), RunError> {
+        const NAMES: [[&str; 2]; 2] =
+            [["rotor radius at bearing A", "race A radius"], ["rotor radius at bearing B", "race B radius"]];
+        for (i, &(rotor_limit, race_limit)) in self.limits.iter().enumerate() {
+            let (rotor, race) = model.radii(y, i);
+            let [rotor_name, race_name] = if M::PLANES == 1 { ["rotor radius", "race radius"] } else { NAMES[i] };
+            let fail = |what, value_m, limit_m| RunError::RadiusGuard { t, what, value_m, limit_m, state: y.to_vec() };
+            if rotor > rotor_limit {
+                return Err(fail(rotor_name, rotor, rotor_limit));
+            }
+            if race > race_limit {
+                return Err(fail(race_name, race, race_limit));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::{run_into_from, Hooks, Quiet};
+    use crate::snapshot::Snapshot;
+    use crate::trace::Trace;
+    use std::path::Path;
+
+    fn scene(file: &str, sets: &[&str]) -> Scene {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut all: Vec<String> =
+            ["scene.duration_s=0.03", "shock[0].start_s=0.005", "output.plots=false"].map(String::from).to_vec();
+        all.extend(sets.iter().map(|s| s.to_string()));
+        crate::config::load_scene(&root.join("config").join(file), &all).unwrap()
+    }
+
+    /// Hooks that save the state at the given times.
+    struct Saving {
+        at: Vec<f64>,
+        saved: Vec<Snapshot>,
+    }
+
+    impl Hooks for Saving {
+        fn save_state_at(&self) -> &[f64] {
+            &self.at
+        }
+        fn state_saved(&mut self, _at: f64, snapshot: Snapshot) {
+            self.saved.push(snapshot);
+        }
+    }
+
+    fn rows(trace: &Trace) -> Vec<Vec<u64>> {
+        trace.records().map(|r| r.a.iter().chain(r.b.iter().flatten()).map(|v| v.to_bits()).collect()).collect()
+    }
+
+    /// The run loop restored at a tick writes the rows of the run that never stopped, bit for
+    /// bit, with the digital loop's delay line carried over: on the planar model, the two-plane
+    /// rotor, a scene with amplifiers and a sensor front end, a noisy sensor and a parked race
+    /// under the fixed-step integrator.
+    #[test]
+    fn a_run_restored_at_a_tick_writes_the_rows_of_the_run_that_never_stopped() {
+        let cases = [
+            scene("cosim-10g.toml", &["controller.mode=\"sampled\"", "sensor.noise_v_rms=0.01", "sensor.adc_bits=14"]),
+            scene("two-plane-asymmetric-10g.toml", &["controller.mode=\"sampled\""]),
+            scene("realistic-10g.toml", &[]),
+            scene(
+                "paper-10g.toml",
+                &[
+                    "integrator.method=\"rk4\"",
+                    "integrator.substeps=1",
+                    "integrator.contact_substeps=3",
+                    "touchdown.race_when_clear=\"parked\"",
+                    "touchdown.race_release=\"equilibrium\"",
+                    "controller.mode=\"sampled\"",
+                    "controller.delay_samples=2",
+                ],
+            ),
+            scene("paper-10g.toml", &[]),
+        ];
+        for s in &cases {
+            let mut hooks = Saving { at: vec![0.004, 0.0123], saved: Vec::new() };
+            let mut whole = Trace::with_capacity(1000);
+            let run = run_into_from(s, &Default::default(), &mut hooks, &mut whole, None).unwrap();
+            assert_eq!(run.outcome, crate::run::Outcome::Completed, "{}", s.name);
+            assert_eq!(hooks.saved.len(), 2);
+            for snap in &hooks.saved {
+                let mut rest = Trace::with_capacity(1000);
+                let resumed = run_into_from(s, &Default::default(), &mut Quiet, &mut rest, Some(snap)).unwrap();
+                let (all, tail) = (rows(&whole), rows(&rest));
+                assert!(!tail.is_empty() && tail.len() < all.len(), "{}: {} of {} rows", s.name, tail.len(), all.len());
+                let from = all.len() - tail.len();
+                let differ = (0..tail.len()).find(|&i| all[from + i] != tail[i]);
+                assert_eq!(
+                    differ, None,
+                    "{}: resumed at {} s, the rows differ from row {from} + this",
+                    s.name, snap.t_s
+                );
+                assert_eq!(
+                    resumed.final_state.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    run.final_state.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+                );
+                assert_eq!(resumed.stats, run.stats, "{}: the integrator's counters go on", s.name);
+            }
+        }
+    }
+
+    /// A `Plant` stepped by hand is the run loop: the same rows as `plant run`'s sampled mode.
+    #[test]
+    fn a_plant_stepped_by_hand_gives_the_run_loops_rows() {
+        let s = scene("cosim-10g.toml", &["controller.mode=\"sampled\"", "controller.delay_samples=0"]);
+        let mut loop_trace = Trace::with_capacity(1000);
+        run_into_from(&s, &Default::default(), &mut Quiet, &mut loop_trace, None).unwrap();
+        let design = s.rotor_design();
+        let mut law = controller::build_rotor_law("pd", &design, &s.controller.params).unwrap();
+        let limits = design.current_limits();
+        let bias = crate::run::bias_of(&s, &crate::run::plane_gains(&s).unwrap());
+        let mut plant = Plant::new(&s, &Command::Held(bias)).unwrap();
+        let mut mine = Trace::with_capacity(1000);
+        plant.record(&mut mine);
+        while !plant.finished() {
+            let command = controller::saturate_axes(law.update(plant.sample()), limits);
+            plant.step(&Command::Held(command), &mut mine).unwrap();
+        }
+        assert_eq!(rows(&mine), rows(&loop_trace));
+    }
+
+    /// A snapshot goes to a file and back to the same bits; a snapshot of another rotor, another
+    /// state layout or integrator is refused naming the first difference, and the plant is left
+    /// as it was.
+    #[test]
+    fn snapshots_round_trip_and_refuse_another_scene() {
+        let s = scene("cosim-10g.toml", &["controller.mode=\"sampled\""]);
+        let bias = crate::run::bias_of(&s, &crate::run::plane_gains(&s).unwrap());
+        let mut plant = Plant::new(&s, &Command::Held(bias)).unwrap();
+        for _ in 0..37 {
+            plant.step(&Command::Held(bias), &mut Trace::with_capacity(4)).unwrap();
+        }
+        let snap = plant.snapshot();
+        let dir = std::env::temp_dir().join(format!("plant-snapshot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(Snapshot::file_name(0.5));
+        snap.write(&path).unwrap();
+        let back = Snapshot::read(&path).unwrap();
+        assert_eq!(back, snap);
+        assert!(back.state.iter().zip(&snap.state).all(|(a, b)| a.to_bits() == b.to_bits()));
+
+        let refused = |other: &Scene| {
+            let mut p = Plant::new(other, &Command::Held(bias)).unwrap();
+            let before = p.state().to_vec();
+            let e = p.restore(&snap).unwrap_err().to_string();
+            assert_eq!(p.state(), &before[..], "a refused restore leaves the plant as it was");
+            e
+        };
+        let e = refused(&scene("two-plane-asymmetric-10g.toml", &[]));
+        assert!(e.contains("state.length is 12 in the snapshot, 22 in the scene"), "{e}");
+        let e = refused(&scene("cosim-10g.toml", &["rotor.mass_kg=3.0"]));
+        assert!(e.contains("rotor.mass_kg"), "{e}");
+        let e = refused(&scene("cosim-10g.toml", &["amb.amplifier=true"]));
+        assert!(e.contains("state.length"), "{e}");
+        let e = refused(&scene("cosim-10g.toml", &["integrator.method=\"dop853\""]));
+        assert!(e.contains("integrator.method"), "{e}");
+        let e = refused(&scene("cosim-10g.toml", &["controller.rate_hz=10000.0"]));
+        assert!(e.contains("controller.rate_hz"), "{e}");
+        // The controller, its gains and the shock may differ.
+        for other in [
+            scene("cosim-10g.toml", &["controller.stiffness_n_per_m=2e6", "controller.law=\"relev\""]),
+            scene("cosim-10g.toml", &["shock[0].peak_g=3.0", "scene.duration_s=0.5"]),
+        ] {
+            Plant::new(&other, &Command::Held(bias)).unwrap().restore(&snap).unwrap();
+        }
+
+        // Files that are not a snapshot of this format.
+        let text = std::fs::read_to_string(&path).unwrap();
+        let bad = |name: &str, body: &str| {
+            let p = dir.join(name);
+            std::fs::write(&p, body).unwrap();
+            let e = Snapshot::read(&p).unwrap_err().to_string();
+            assert!(e.contains(name), "{e}");
+            e
+        };
+        let e = bad("truncated.json", &text[..text.len() / 2]);
+        assert!(e.contains("truncated"), "{e}");
+        let e = bad("format.json", &text.replacen("\"format\": 1", "\"format\": 99", 1));
+        assert!(e.contains("format 99"), "{e}");
+        let e = bad("trace.csv", "t_s,dx_m\n0,0\n");
+        assert!(e.contains("not a snapshot"), "{e}");
+        let e = bad("empty.json", "{}");
+        assert!(e.contains("not a snapshot"), "{e}");
+        let e = Snapshot::read(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("not a regular file"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
