@@ -338,6 +338,28 @@ fn recovered(seconds: f64) -> String {
 mod tests {
     use super::*;
 
+    fn scene(file: &str, sets: &[&str]) -> Scene {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
+        load_scene(&root, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap()
+    }
+
+    /// A chart of a two-plane rotor names each plane's gap and draws each plane's radius (it
+    /// used plane A's gap for the whole rotor).
+    #[test]
+    fn charts_name_each_planes_gap_and_radius() {
+        let planar = scene("paper-10g.toml", &[]);
+        assert_eq!(gap_words(&planar), format!("air gap {:.0} µm", planar.plane(0).contact.gap * 1e6));
+        let two = scene("two-plane-asymmetric-10g.toml", &["scene.duration_s=0.002", "output.plots=false"]);
+        let (a, b) = (two.plane(0).contact.gap * 1e6, two.plane(1).contact.gap * 1e6);
+        assert_ne!(a.round(), b.round(), "the asymmetric scene's gaps differ");
+        assert_eq!(gap_words(&two), format!("air gaps A {a:.0} µm, B {b:.0} µm"));
+        let run = crate::run::run(&two, &mut Quiet).unwrap();
+        let planes = plane_traces("pd", &run.trace);
+        assert_eq!(planes.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>(), ["pd A", "pd B"]);
+        assert_eq!(planes[1].1.radius(), run.trace.plane(1).radius());
+        assert_eq!(plane_traces("pd", &run.trace.plane(0)).len(), 1);
+    }
+
     #[test]
     fn rates_with_k_suffix() {
         assert_eq!(parse_rates("5k,10K, 20000").unwrap(), vec![5e3, 1e4, 2e4]);

@@ -437,3 +437,47 @@ impl FailureState {
         None
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stepper::{Command, Plant};
+
+    /// Every state layout a run can fail in (bare, with amplifiers or a sensor front end, with
+    /// unipolar amplifiers; planar and two-plane) gives its failing state: the model's part of
+    /// the state, whatever follows it (the length check gave none with hardware).
+    #[test]
+    fn every_layout_of_the_state_gives_its_failure_state() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config");
+        let hw = ["amb.amplifier=true"];
+        let uni = ["amb.amplifier=true", "amb.amplifier_topology=\"unipolar\"", "amb.force_law=\"nonlinear\""];
+        let front = ["sensor.bandwidth_hz=5000.0"];
+        let cases: [(&str, &[&str], bool); 7] = [
+            ("paper-10g.toml", &[], false),
+            ("realistic-10g.toml", &[], false),
+            ("paper-10g.toml", &front, false),
+            ("realistic-10g.toml", &uni, false),
+            ("two-plane-asymmetric-10g.toml", &[], true),
+            ("two-plane-asymmetric-10g.toml", &hw, true),
+            ("two-plane-asymmetric-10g.toml", &uni, true),
+        ];
+        let mut lengths = Vec::new();
+        for (file, sets, two) in cases {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            let scene =
+                crate::config::load_scene(&root.join(file), &sets).unwrap_or_else(|e| panic!("{file} {sets:?}: {e}"));
+            let plant = Plant::new(&scene, &Command::Continuous(None)).unwrap();
+            let state = plant.state().to_vec();
+            lengths.push(state.len());
+            let e = RunError::RadiusGuard { t: 0.25, what: "rotor radius", value_m: 1.0, limit_m: 0.5, state };
+            match (FailureState::of(&scene, &e), two) {
+                (Some(FailureState::Planar(f)), false) => assert_eq!(f.t_s, 0.25),
+                (Some(FailureState::TwoPlane(f)), true) => assert_eq!(f.t_s, 0.25),
+                (other, _) => panic!("{file} {sets:?}: {other:?}"),
+            }
+        }
+        lengths.sort_unstable();
+        lengths.dedup();
+        assert!(lengths.len() >= 5, "the cases cover the layouts: {lengths:?}");
+    }
+}

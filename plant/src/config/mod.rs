@@ -505,3 +505,35 @@ fn flatten(prefix: &str, table: &toml::Table, out: &mut Vec<(String, String)>) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(file: &str, sets: &[&str]) -> Scene {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
+        load_scene(&root, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap()
+    }
+
+    /// The fixed-step setting sizes the contact substeps for the bearing plane that needs the
+    /// most (it read plane A's alone), whichever plane that is.
+    #[test]
+    fn the_fixed_step_setting_holds_every_planes_contact_stable() {
+        for stiff in ["a", "b"] {
+            let s = scene(
+                "two-plane-asymmetric-10g.toml",
+                &[&format!("contact.{stiff}.rotor_race_stiffness_n_per_m10_9=4e11")],
+            );
+            let need: Vec<u32> = (0..2)
+                .map(|i| plant_physics::stability::safe_contact_substeps(s.plane(i), Method::Rk4, s.controller.period))
+                .collect();
+            assert_ne!(need[0], need[1], "the planes need different substeps");
+            let most = need.iter().max().unwrap();
+            assert!(
+                s.fixed_step_overrides().contains(&format!("integrator.contact_substeps={most}")),
+                "{stiff}: {:?}, planes need {need:?}",
+                s.fixed_step_overrides()
+            );
+        }
+    }
+}

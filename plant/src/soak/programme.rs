@@ -465,6 +465,31 @@ fn check_criteria(c: &Criteria) -> Result<(), ConfigError> {
 mod tests {
     use super::*;
 
+    /// Each bearing plane's clear radius is the fraction of its own air gap (it was plane A's
+    /// gap for the whole rotor).
+    #[test]
+    fn each_plane_is_clear_within_its_own_gap() {
+        let dir = std::env::temp_dir().join(format!("plant-soak-gaps-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
+        let file = dir.join("p.toml");
+        std::fs::write(
+            &file,
+            format!(
+                "name = \"gaps\"\nscene = {:?}\nmode = \"lockstep\"\nsettle_s = 0.2\nrss_every_s = 0.05\n\
+                 [recovery]\nhold_s = 0.1\nradius_fraction = 0.5\n\
+                 [[shock]]\nkind = \"double_half_sine\"\nstart_s = 0.02\npeak_g = 2.0\nf1_hz = 10.0\nf2_hz = 80.0\n",
+                scene.display().to_string()
+            ),
+        )
+        .unwrap();
+        let p = load(&file, &[]).unwrap();
+        let gaps: Vec<f64> = (0..2).map(|i| p.scene.plane(i).contact.gap).collect();
+        assert_ne!(gaps[0], gaps[1]);
+        assert_eq!(p.clear_radius, vec![0.5 * gaps[0], 0.5 * gaps[1]]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn random_programme_is_deterministic_and_in_range() {
         let r = RawRandom {

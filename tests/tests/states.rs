@@ -1,0 +1,147 @@
+//! `plant run --save-state-at` and `--from-state`: a run continued from a saved state writes
+//! the rows of the run that never stopped, with the controller in the plant's process and in a
+//! controller process (lockstep); another controller may take over from the same state; bad
+//! snapshots and bad times are refused naming the file or the flag, exit 2, nothing written.
+
+mod common;
+
+use common::*;
+use std::path::Path;
+
+/// The data lines of a `trace.csv` (the header dropped).
+fn rows(dir: &Path) -> Vec<String> {
+    read_text(&dir.join("trace.csv")).lines().skip(1).map(str::to_owned).collect()
+}
+
+fn header(dir: &Path) -> String {
+    read_text(&dir.join("trace.csv")).lines().next().unwrap_or_default().to_owned()
+}
+
+/// A lockstep run killed at any point can be continued from its last snapshot: the
+/// continuation's rows are the uninterrupted run's after the snapshot, byte for byte, and the
+/// snapshot names its own time; a sampled run on the two-plane rotor likewise.
+#[test]
+fn a_run_continued_from_a_saved_state_writes_the_rows_of_the_run_that_never_stopped() {
+    let tmp = TempDir::new("states-continue");
+    for (scene, sets) in [
+        ("cosim-10g.toml", vec!["scene.duration_s=0.06", "shock[0].start_s=0.01", "output.plots=false"]),
+        (
+            "two-plane-asymmetric-10g.toml",
+            vec!["scene.duration_s=0.05", "shock[0].start_s=0.01", "output.plots=false", "controller.mode=\"sampled\""],
+        ),
+    ] {
+        let whole = tmp.join(&format!("{scene}-whole"));
+        let mut cmd = plant_run(&scene_path(scene), &whole, &sets);
+        cmd.args(["--save-state-at", "0.02,0.0301"]);
+        let out = output(&mut cmd);
+        assert_exit(&out, 0);
+        for (t, file) in [(0.02, "state-0.02.json"), (0.0301, "state-0.0301.json")] {
+            let snap = read_json(&whole.join(file));
+            let at = num(&snap, "t_s");
+            assert!(at >= t && at < t + 5e-5 + 1e-12, "{file}: saved at {at} s for {t} s");
+            let rest = tmp.join(&format!("{scene}-from-{t}"));
+            let mut cmd = plant_run(&scene_path(scene), &rest, &sets);
+            cmd.arg("--from-state").arg(whole.join(file));
+            let out = output(&mut cmd);
+            assert_exit(&out, 0);
+            let (all, tail) = (rows(&whole), rows(&rest));
+            assert_eq!(header(&whole), header(&rest));
+            assert!(!tail.is_empty() && tail.len() < all.len());
+            assert_eq!(&all[all.len() - tail.len()..], &tail[..], "{scene} from {file}");
+            let first_t: f64 = tail[0].split(',').next().unwrap().parse().unwrap();
+            assert!(first_t > at, "the continuation starts after the state's time");
+        }
+    }
+}
+
+fn scene_path(name: &str) -> std::path::PathBuf {
+    workspace_root().join("config").join(name)
+}
+
+/// From one saved state, another law and other gains take over (the re-levitation question);
+/// the rows before the state's time are not written again.
+#[test]
+fn another_controller_takes_over_from_a_saved_state() {
+    let tmp = TempDir::new("states-takeover");
+    let sets = ["scene.duration_s=0.04", "shock[0].start_s=0.005", "output.plots=false", "controller.mode=\"sampled\""];
+    let whole = tmp.join("whole");
+    let mut cmd = plant_run(&scene_path("relev-10g.toml"), &whole, &sets);
+    cmd.args(["--save-state-at", "0.02"]);
+    assert_exit(&output(&mut cmd), 0);
+    let state = whole.join("state-0.02.json");
+    let mut tails = Vec::new();
+    for extra in [&["controller.law=\"relev\""][..], &["controller.law=\"pd\"", "controller.stiffness_n_per_m=2e6"][..]]
+    {
+        let out_dir = tmp.join(&format!("from-{}", tails.len()));
+        let mut all = sets.to_vec();
+        all.extend_from_slice(extra);
+        let mut cmd = plant_run(&scene_path("relev-10g.toml"), &out_dir, &all);
+        cmd.arg("--from-state").arg(&state);
+        assert_exit(&output(&mut cmd), 0);
+        let summary = read_json(&out_dir.join("summary.json"));
+        assert_eq!(summary["status"], "completed");
+        tails.push(rows(&out_dir));
+    }
+    assert_eq!(tails[0].len(), tails[1].len());
+    assert_ne!(tails[0], tails[1], "another law gives another continuation");
+}
+
+/// Bad snapshots and bad times: exit 2, the message names the file or the flag and the
+/// difference, and the output folder is not created.
+#[test]
+fn bad_states_and_times_are_refused_before_anything_is_written() {
+    let tmp = TempDir::new("states-bad");
+    let sets = ["scene.duration_s=0.03", "shock[0].start_s=0.005", "output.plots=false", "controller.mode=\"sampled\""];
+    let good = tmp.join("good");
+    let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &good, &sets);
+    cmd.args(["--save-state-at", "0.01"]);
+    assert_exit(&output(&mut cmd), 0);
+    let state = good.join("state-0.01.json");
+    let text = read_text(&state);
+    let write = |name: &str, body: &str| {
+        let p = tmp.join(name);
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    let two_plane = scene_path("two-plane-asymmetric-10g.toml");
+    let cases: Vec<(std::path::PathBuf, Vec<String>, &str)> = vec![
+        (write("truncated.json", &text[..text.len() / 3]), vec![], "truncated.json"),
+        (write("v99.json", &text.replacen("\"format\": 1", "\"format\": 99", 1)), vec![], "format 99"),
+        (write("notes.txt", "hello"), vec![], "not a snapshot"),
+        (state.clone(), vec!["rotor.mass_kg=12.0".into()], "rotor.mass_kg"),
+        (state.clone(), vec!["scene.duration_s=0.005".into()], "nothing to run"),
+    ];
+    for (i, (file, extra, needle)) in cases.iter().enumerate() {
+        let out_dir = tmp.join(&format!("refused-{i}"));
+        let mut all: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        all.extend(extra.iter().cloned());
+        let all: Vec<&str> = all.iter().map(String::as_str).collect();
+        let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &out_dir, &all);
+        cmd.arg("--from-state").arg(file);
+        let out = output(&mut cmd);
+        assert_exit(&out, 2);
+        let err = stderr(&out);
+        assert!(err.contains(needle), "case {i}: {err}");
+        assert!(!out_dir.exists(), "case {i}: nothing written");
+    }
+    // Another rotor model.
+    let out_dir = tmp.join("refused-two-plane");
+    let mut cmd = plant_run(&two_plane, &out_dir, &["output.plots=false"]);
+    cmd.arg("--from-state").arg(&state);
+    let out = output(&mut cmd);
+    assert_exit(&out, 2);
+    assert!(stderr(&out).contains("state.length is 12 in the snapshot, 22 in the scene"), "{}", stderr(&out));
+    assert!(!out_dir.exists());
+    // Times outside the run, or not ascending.
+    for (times, needle) in
+        [("0.5", "outside the run"), ("0.02,0.01", "ascending"), ("-1", "outside the run"), ("nan", "outside")]
+    {
+        let out_dir = tmp.join("refused-times");
+        let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &out_dir, &sets);
+        cmd.arg(format!("--save-state-at={times}"));
+        let out = output(&mut cmd);
+        assert_exit(&out, 2);
+        assert!(stderr(&out).contains("--save-state-at") && stderr(&out).contains(needle), "{times}: {}", stderr(&out));
+        assert!(!out_dir.exists());
+    }
+}
