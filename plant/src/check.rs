@@ -36,13 +36,12 @@
 //! ```
 
 use crate::config::{ConfigError, ControlMode, Scene};
+use crate::digital::CommandPath;
 use crate::hooks::Hooks;
-use crate::invalid::InvalidCommands;
 use crate::run::{RunResult, SetupError};
 use crate::sensor::Sensor;
 use crate::trace::{col, Trace, TraceError};
-use controller::{saturate, ControlLaw, LawEntry, LawError, Sample};
-use std::collections::VecDeque;
+use controller::{ControlLaw, LawEntry, LawError, RotorLaw, RotorSample, ROTOR_AXES};
 use std::path::Path;
 
 /// Runs `scene` with `law` (built from the scene's design and `[controller.params]`) in this
@@ -81,6 +80,8 @@ pub struct Difference {
     pub t_s: f64,
     /// The trace row that holds it (from 0, the header not counted).
     pub row: usize,
+    /// The bearing plane whose currents differ (0: A, the planar model's; 1: B).
+    pub plane: usize,
     /// The currents the trace applied (A).
     pub trace_a: [f64; 2],
     /// The law's (A).
@@ -121,25 +122,73 @@ impl std::fmt::Display for Replay {
 }
 
 /// Replays the run folder `dir` through `law`, built from the folder's design and
-/// `[controller.params]` (see the module doc).
+/// `[controller.params]` (see the module doc): once per bearing plane, or the whole rotor's.
 pub fn replay(dir: &Path, law: &LawEntry) -> Result<Replay, ReplayError> {
     let scene = crate::config::load_scene(&dir.join("scene.toml"), &[])?;
-    let mut built = (law.build)(&scene.design(), &scene.controller.params)?;
-    replay_trace(&scene, &dir.join("trace.csv"), built.as_mut())
+    let mut built = controller::AnyLaw::from(*law).build(&scene.rotor_design(), &scene.controller.params)?;
+    replay_rotor_trace(&scene, &dir.join("trace.csv"), built.as_mut())
 }
 
-/// Replays `trace` (a `trace.csv` of a run of `scene`) through `law`, as it is (not reset).
+/// Replays `trace` (a `trace.csv` of a run of `scene`, planar) through the per-plane `law`, as
+/// it is (not reset). A two-plane run needs a law per plane: [`replay`] or
+/// [`replay_rotor_trace`].
 pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Result<Replay, ReplayError> {
-    let c = &scene.controller;
-    if scene.two_plane.is_some() {
+    if scene.planes() != 1 {
         return Err(ReplayError::Layout(
-            "replay reads plane A's columns (dx_m, dy_m, ix_a, iy_a): a two-plane run cannot be replayed yet".into(),
+            "one per-plane law cannot serve both planes of a two-plane run: replay it with plant::check::replay \
+             or replay_rotor_trace (a law per plane)"
+                .into(),
         ));
     }
+    replay_rotor_trace(scene, trace, &mut OnePlane(law))
+}
+
+/// A per-plane law on the planar model's one plane, as a law of the rotor.
+struct OnePlane<'a>(&'a mut dyn ControlLaw);
+
+impl RotorLaw for OnePlane<'_> {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn update(&mut self, sample: &RotorSample) -> [f64; ROTOR_AXES] {
+        let [x, y] = self.0.update(&sample.plane(0));
+        let mut out = [0.0; ROTOR_AXES];
+        out[..2].copy_from_slice(&[x, y]);
+        out
+    }
+    fn reset(&mut self) {
+        self.0.reset();
+    }
+}
+
+/// Replays `trace` (a `trace.csv` of a run of `scene`, planar or two-plane) through `law`, a
+/// law of the whole rotor, as it is (not reset): every axis's sensor sample rebuilt from the
+/// trace through the scene's sensor (one noise sequence, the planes in order, as the plant
+/// reads them), the answer through the digital loop's own command path
+/// ([`crate::digital::CommandPath`]: saturation, held non-finite answers, the delay line), and
+/// the applied currents compared with every plane's current columns.
+pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -> Result<Replay, ReplayError> {
+    let c = &scene.controller;
     if c.mode == ControlMode::Continuous {
         return Err(ReplayError::Layout(
             "a continuous run has no controller ticks (its PD acts inside the derivative): nothing to replay".into(),
         ));
+    }
+    if scene.hardware.front_end.is_on() {
+        return Err(ReplayError::Layout(
+            "the run's sensor has a front end (sensor.bandwidth_hz, runout or range): what the controller read is not \
+             in the trace's displacements"
+                .into(),
+        ));
+    }
+    if let Some(m) = &scene.two_plane {
+        if let Some(p) = m.planes.iter().position(|p| p.sensor != p.station) {
+            return Err(ReplayError::Layout(format!(
+                "plane {}'s sensor is not at its bearing: the trace holds the displacement at the bearing, not what \
+                 the sensor read",
+                ["A", "B"][p]
+            )));
+        }
     }
     let (period, out_dt) = (c.period, scene.output_interval);
     // Rows per tick; a row at a tick time is the state the controller read there.
@@ -152,30 +201,31 @@ pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Re
         )));
     }
     let per_tick = per_tick as u64;
-    let gains = crate::run::design_gains(scene)?;
-    let limit = scene.params.current_limit;
-    let bias = saturate(gains.bias_a, limit);
+    let planes = scene.planes();
+    let bias = crate::run::bias_of(scene, &crate::run::plane_gains(scene)?);
+    let limits = scene.rotor_design().current_limits();
     let delay = c.delay_samples as usize;
     let mut sensor = Sensor::new(scene.sensor);
-    let mut held = InvalidCommands::new(bias, u64::MAX, 1.0);
-    // The commands not yet applied, oldest first (the run's delay line).
-    let mut line: VecDeque<[f64; 2]> = std::iter::repeat_n(bias, delay).collect();
+    let mut path = CommandPath::new(bias, limits, delay, u64::MAX, 1.0);
     let mut applied = bias;
     let mut report = Replay { compared: 0, differing: 0, first: None, largest_a: 0.0 };
     let mut row: u64 = 0;
     let mut bad_time = None;
-    crate::trace::read_rows(trace, |r| {
-        let r = &r.a;
+    crate::trace::read_rows(trace, |record| {
+        let t_row = record.a[col::T_S];
         // Row `row` closes the step of tick `(row − 1) / per_tick`; the command of that tick was
         // pushed when its sample (the row at its start) was read.
         if row > 0 {
-            let compared = applied;
-            let (ix, iy) = (r[col::IX_A], r[col::IY_A]);
-            let same = ix.to_bits() == compared[0].to_bits() && iy.to_bits() == compared[1].to_bits();
             report.compared += 1;
-            if !same {
-                report.differing += 1;
-                let gap = (ix - compared[0]).abs().max((iy - compared[1]).abs());
+            let mut differs = false;
+            for p in 0..planes {
+                let r = record.plane(p);
+                let (trace_a, law_a) = ([r[col::IX_A], r[col::IY_A]], [applied[2 * p], applied[2 * p + 1]]);
+                if trace_a.iter().zip(&law_a).all(|(t, l)| t.to_bits() == l.to_bits()) {
+                    continue;
+                }
+                differs = true;
+                let gap = (trace_a[0] - law_a[0]).abs().max((trace_a[1] - law_a[1]).abs());
                 report.largest_a = report.largest_a.max(if gap.is_nan() { f64::INFINITY } else { gap });
                 let tick = (row - 1) / per_tick;
                 let from = tick.checked_sub(delay as u64);
@@ -183,29 +233,40 @@ pub fn replay_trace(scene: &Scene, trace: &Path, law: &mut dyn ControlLaw) -> Re
                     seq: from.unwrap_or(0),
                     t_s: from.map_or(0.0, |k| k as f64 * period),
                     row: row as usize,
-                    trace_a: [ix, iy],
-                    law_a: compared,
+                    plane: p,
+                    trace_a,
+                    law_a,
                 });
             }
+            report.differing += u64::from(differs);
         }
         if row.is_multiple_of(per_tick) {
             let k = row / per_tick;
             let t_s = k as f64 * period;
-            if (r[col::T_S] - t_s).abs() > 1e-6 * period + 4.0 * f64::EPSILON * t_s.abs() {
-                bad_time = Some((row, r[col::T_S], t_s));
+            if (t_row - t_s).abs() > 1e-6 * period + 4.0 * f64::EPSILON * t_s.abs() {
+                bad_time = Some((row, t_row, t_s));
                 return false;
             }
-            let sample = Sample {
+            let a = &record.a;
+            let mut sample = RotorSample {
                 seq: k,
                 t_s,
-                sensor_v: sensor.read([r[col::DX_M], r[col::DY_M]]),
-                speed_rad_s: r[col::ROTOR_SPEED_RAD_S],
-                angle_rad: controller::wrap_angle(r[col::ROTOR_ANGLE_RAD]),
+                axes: 2 * planes as u32,
+                speed_rad_s: a[col::ROTOR_SPEED_RAD_S],
+                angle_rad: controller::wrap_angle(a[col::ROTOR_ANGLE_RAD]),
+                ..Default::default()
             };
-            let command = saturate(law.update(&sample), limit);
-            let command = held.check(command, &sample).map(|h| h.command).unwrap_or(command);
-            line.push_back(command);
-            applied = line.pop_front().unwrap_or(command);
+            for p in 0..planes {
+                let r = record.plane(p);
+                let gain = scene.plane(p).loop_constants.sensor_gain_v_per_m;
+                let v = sensor.read_with_gain([r[col::DX_M], r[col::DY_M]], gain);
+                sample.sensor_v[2 * p..2 * p + 2].copy_from_slice(&v);
+            }
+            let answer = path.saturate(law.update(&sample));
+            // The budget is not judged here (it cannot end a replay): u64::MAX in a row.
+            if let Ok(pushed) = path.push(answer, &sample) {
+                applied = pushed.applied;
+            }
         }
         row += 1;
         true

@@ -14,7 +14,8 @@
 #![warn(missing_docs)]
 
 pub use plant_physics::{force, integrate, model, park};
-pub use stepper::Plant;
+pub use run::stepper::Plant;
+pub use run::{digital, stepper};
 
 pub mod analysis;
 pub mod assess;
@@ -27,7 +28,6 @@ pub mod claim;
 pub mod compare;
 pub mod config;
 pub mod cosim;
-pub mod digital;
 pub mod ensemble;
 pub mod exit;
 pub mod figures;
@@ -50,7 +50,6 @@ pub mod snapshot;
 pub mod soak;
 pub mod stability;
 pub mod status;
-pub mod stepper;
 pub mod summary;
 pub mod sweep;
 pub mod table;

@@ -612,6 +612,7 @@ mod tests {
         let run = SinkRun {
             stats: Stats::default(),
             simulated: scene.controller.period,
+            started: 0.0,
             wall_time: 0.0,
             outcome: Outcome::Diverged(RunError::Integration(IntegrationError::NonFinite { t: 0.0, state })),
             final_state: vec![0.0; crate::model::N],

@@ -126,6 +126,10 @@ pub struct Summary {
     pub failure_state: Option<FailureState>,
     /// Simulated time reached (s).
     pub simulated_s: f64,
+    /// The time of the saved state the run started from (s), `plant run --from-state`; absent
+    /// for a run from t = 0. Its trace and figures cover the time after it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub started_s: Option<f64>,
     /// Largest rotor radius relative to the housing (m), over the rows before a failure;
     /// `null` when there is no such row (a run that failed at its first row).
     pub max_radius_m: Option<f64>,
@@ -281,6 +285,7 @@ impl Summary {
             failure_time_s: run.outcome.failure_time(),
             failure_state: failure.and_then(|e| FailureState::of(scene, e)),
             simulated_s: run.simulated,
+            started_s: (run.started > 0.0).then_some(run.started),
             max_radius_m: figures.max_radius_m,
             contact_fraction: analysis.steady_contact_fraction,
             steady_window_start_s: analysis.steady_window_s[0],

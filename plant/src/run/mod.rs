@@ -9,6 +9,9 @@
 //! integrator restarts at every tick. The trace is recorded at the output
 //! rate (dense output inside macro steps).
 
+pub mod digital;
+pub mod stepper;
+
 use crate::config::{ControlMode, Scene};
 use crate::cosim::stats::Tet;
 use crate::cosim::{CosimError, CosimReport, Launch, Session};
@@ -198,6 +201,8 @@ pub struct SinkRun {
     pub stats: Stats,
     /// Simulated time reached (s).
     pub simulated: f64,
+    /// Where the run started (s): 0, or a saved state's time (`plant run --from-state`).
+    pub started: f64,
     /// Wall time of the loop (s).
     pub wall_time: f64,
     /// How it ended.
@@ -357,6 +362,7 @@ fn drive(
     }
     let saves = hooks.save_state_at().to_vec();
     let mut next_save = saves.partition_point(|t| *t < plant.time() - 1e-9 * scene.controller.period);
+    let started = plant.time();
     let start = Instant::now();
     let mut outcome = primed.err().unwrap_or(Outcome::Completed);
     while outcome == Outcome::Completed && !plant.finished() {
@@ -398,6 +404,7 @@ fn drive(
     SinkRun {
         stats: plant.stats(),
         simulated: t,
+        started,
         wall_time,
         outcome,
         final_state: plant.state().to_vec(),
