@@ -215,6 +215,15 @@ pub enum CosimError {
     /// The controller's handshake answer is malformed, or of another protocol version.
     #[error("the controller's handshake answer is malformed: {0}")]
     Protocol(String),
+    /// The controller's handshake overrides change what is not the controller's to change
+    /// ([`crate::config::CONTROLLER_OVERRIDE_KEYS`], a current limit above the scene's).
+    #[error("the controller {controller} sent back {why}: refused, nothing of it applied")]
+    Overrides {
+        /// The controller: its program, its description and pid.
+        controller: String,
+        /// The key, its value and the rule.
+        why: String,
+    },
 }
 
 /// What an early exit code of a controller says (the codes of `controller::serve`).

@@ -304,7 +304,21 @@ impl Session {
                         return Some(Err(CosimError::Refused { reason: Refusal::describe(ack.status), message }));
                     }
                     match controller_overrides(&ack) {
-                        Ok(o) => self.overrides = o,
+                        Ok(o) => {
+                            // The controller is untrusted input: it may run its own law and design,
+                            // never change the run it serves. Refused whole, nothing applied.
+                            let allowed = o.as_ref().map_or(Ok(()), |t| {
+                                crate::config::check_controller_overrides(t, self.hello.current_limit_a)
+                            });
+                            if let Err(why) = allowed {
+                                let controller = match &self.program {
+                                    Some(p) => format!("{} ({message}, pid {})", p.describe(), ack.controller_pid),
+                                    None => format!("the external controller ({message}, pid {})", ack.controller_pid),
+                                };
+                                return Some(Err(CosimError::Overrides { controller, why }));
+                            }
+                            self.overrides = o;
+                        }
                         Err(why) => return Some(Err(CosimError::Protocol(why))),
                     }
                     self.controller = format!("{message} (pid {})", ack.controller_pid);
