@@ -42,12 +42,16 @@
 //! plant treats it as a lost controller (fallback, reconnection, else
 //! `peer_lost`, exit code 4).
 //!
-//! A lockstep plant waiting on a controller that is alive but silent (stopped
-//! with SIGSTOP, hung, answering another session) gives up after
-//! `controller.lockstep_timeout_ms`, says what it saw in the meantime
+//! A plant (lockstep or realtime) waiting on a controller that is alive but
+//! silent (stopped with SIGSTOP, hung, answering another session) gives up
+//! after `controller.lockstep_timeout_ms`, says what it saw in the meantime
 //! (nothing, replies of another session, frames of another run) and treats
-//! the controller as lost. A realtime run whose deadline-miss fraction
-//! exceeds `controller.max_miss_fraction` ends as `miss_budget` (exit 6).
+//! the controller as lost. A realtime run whose share of ticks without the
+//! controller's reply (deadline misses, fallback ticks) exceeds
+//! `controller.max_miss_fraction` (default 1 %) ends as `miss_budget` (exit
+//! 6), one whose plant overruns exceed `controller.max_overrun_fraction`
+//! (default 5 %) as `overrun_budget` (exit 10): a realtime run that is
+//! `completed` ran the scene's loop within those budgets.
 //!
 //! # Isolation
 //!

@@ -216,6 +216,7 @@ impl Session {
             woke: None,
             sent_ns: [0; RING],
             last_heard: Instant::now(),
+            silent: Default::default(),
             next_check: Duration::from_secs_f64(settings.reply_timeout),
             wall_start: Instant::now(),
             overrides: None,
@@ -326,6 +327,7 @@ impl Session {
                     self.connected = true;
                     self.lost_since = None;
                     self.last_heard = Instant::now();
+                    self.silent = Default::default();
                     self.next_check = Duration::from_secs_f64(self.settings.reply_timeout);
                     self.schedule_controller(ack.controller_pid, hooks);
                     return Some(Ok(()));
