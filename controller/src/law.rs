@@ -276,24 +276,42 @@ impl RotorLaw for Decentralised {
     }
 }
 
-/// Clamps each axis current to `|i| ≤ limit` (A).
+/// One axis current saturated at `|i| ≤ limit` (A); a non-finite current (NaN, ±∞) is no
+/// current at all and becomes NaN, never the limit: the plant counts it as an invalid command,
+/// whichever side (the plant, or a controller process) saturates it.
+#[inline]
+fn saturate_one(i: f64, limit: f64) -> f64 {
+    if i.is_finite() {
+        i.clamp(-limit, limit)
+    } else {
+        f64::NAN
+    }
+}
+
+/// Clamps each axis current to `|i| ≤ limit` (A); a non-finite one (NaN, ±∞) becomes NaN, which
+/// the plant holds, counts and judges as an invalid command (`controller.max_invalid_burst`),
+/// where a clamp would have made +∞ a valid full-scale current.
 ///
 /// ```
 /// assert_eq!(controller::saturate([3.0, -0.5], 2.0), [2.0, -0.5]);
+/// let [x, y] = controller::saturate([f64::INFINITY, f64::NEG_INFINITY], 2.0);
+/// assert!(x.is_nan() && y.is_nan());
 /// ```
 #[inline]
 pub fn saturate(i: [f64; 2], limit: f64) -> [f64; 2] {
-    [i[0].clamp(-limit, limit), i[1].clamp(-limit, limit)]
+    [saturate_one(i[0], limit), saturate_one(i[1], limit)]
 }
 
-/// Clamps each axis current to its own limit (A) ([`RotorDesign::current_limits`]).
+/// Clamps each axis current to its own limit (A) ([`RotorDesign::current_limits`]); a
+/// non-finite one becomes NaN, as in [`saturate`].
 ///
 /// ```
 /// assert_eq!(controller::saturate_axes([3.0, -0.5, -4.0, 1.0], [2.0, 2.0, 1.5, 1.5]), [2.0, -0.5, -1.5, 1.0]);
+/// assert!(controller::saturate_axes([0.0, 0.0, f64::INFINITY, 0.0], [2.0; 4])[2].is_nan());
 /// ```
 #[inline]
 pub fn saturate_axes(i: [f64; ROTOR_AXES], limits: [f64; ROTOR_AXES]) -> [f64; ROTOR_AXES] {
-    std::array::from_fn(|k| i[k].clamp(-limits[k], limits[k]))
+    std::array::from_fn(|k| saturate_one(i[k], limits[k]))
 }
 
 /// A rotor angle wrapped into [0, 2π) (rad), as the keyphasor reports it; a non-finite

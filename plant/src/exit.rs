@@ -184,6 +184,7 @@ impl HasExitCode for CosimError {
             | CosimError::Pin(_)
             | CosimError::Params(_)
             | CosimError::Protocol(_)
+            | CosimError::Overrides { .. }
             | CosimError::Command { .. }
             | CosimError::Lock(LockError::InUse { .. })
             | CosimError::Link(LinkError::Incompatible { .. }) => Code::BadInput,
@@ -310,6 +311,7 @@ mod tests {
             (stopped(StopKind::OverrunBudget), 10),
             (CosimError::Command { argv0: "c".into(), why: "w".into() }.into(), 2),
             (CosimError::Protocol("version 4".into()).into(), 2),
+            (CosimError::Overrides { controller: "c".into(), why: "controller.rate_hz = 1000".into() }.into(), 2),
             (
                 CosimError::Lock(controller::lock::LockError::InUse {
                     run_id: "r".into(),

@@ -116,6 +116,7 @@ impl CosimError {
                 | CosimError::Pin(_)
                 | CosimError::Params(_)
                 | CosimError::Protocol(_)
+                | CosimError::Overrides { .. }
                 | CosimError::Lock(LockError::InUse { .. })
                 | CosimError::Link(LinkError::Incompatible { .. })
                 | CosimError::ControllerExited { code: Some(2), .. }

@@ -357,5 +357,15 @@ class Params:
 
 
 def saturate(i: float, limit: float) -> float:
-    """Clamps a current to ``|i| <= limit`` (A); NaN stays NaN, as Rust's ``f64::clamp``."""
+    """Clamps a current to ``|i| <= limit`` (A); a non-finite one (NaN, ±inf) becomes NaN, as
+    Rust's ``controller::saturate``: no current at all, which the plant holds, counts and judges
+    as an invalid command (never +inf clamped into a valid full-scale current).
+
+    >>> saturate(3.0, 2.0), saturate(-0.5, 2.0)
+    (2.0, -0.5)
+    >>> saturate(float("inf"), 2.0), saturate(float("-inf"), 2.0), saturate(float("nan"), 2.0)
+    (nan, nan, nan)
+    """
+    if i - i != 0.0:  # NaN or ±inf (inf - inf is NaN), without a call in the frame loop
+        return math.nan
     return limit if i > limit else -limit if i < -limit else i

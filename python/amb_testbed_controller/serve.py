@@ -11,7 +11,9 @@ code  meaning
 0     the plant ended the run (a STOP frame)
 1     an IPC failure
 2     bad input: a bad argument, a run id held by another live controller, a
-      refused hello (it was told why), a plant of another protocol version
+      refused hello (it was told why), a plant of another protocol version, a
+      law that answers a sample with the wrong number of currents (not one per
+      axis: the frame would drop some or feed another plane)
 4     the plant is gone (its node died or vanished), or no hello came in time
 130   SIGINT or SIGTERM (the plant is told with a STOPPING frame)
 ====  =====================================================================
@@ -65,6 +67,24 @@ class BadInput(Ending):
 
 class PlantLost(Ending):
     code = PLANT_LOST
+
+
+class WrongCount(BadInput):
+    """A law answered a sample with another number of currents than it drives (exit 2): never
+    sent, since a frame of the wrong count would drop currents or feed one plane another's."""
+
+
+def _count(law: str, got: Any, want: int, what: str, seq: int, t_s: float) -> None:
+    """Raises :class:`WrongCount` unless ``got`` holds ``want`` currents."""
+    try:
+        if len(got) == want:
+            return
+        n = len(got)
+    except TypeError:
+        raise WrongCount(f"law {law} answered sample {seq} (t = {t_s} s) with {got!r}, not a sequence of "
+                         f"{want} currents ({what})") from None
+    raise WrongCount(f"law {law} answered sample {seq} (t = {t_s} s) with {n} currents, {list(got)!r} A; "
+                         f"it must answer {want} ({what}): refused, nothing sent")
 
 
 class Interrupted(Ending):
@@ -205,7 +225,9 @@ class _Decentralised:
     def update(self, sample: RotorSample) -> tuple[float, ...]:
         out: list[float] = []
         for p, law in enumerate(self.planes):
-            out.extend(law.update(sample.plane(p)))
+            currents = law.update(sample.plane(p))
+            _count(self.name, currents, 2, f"i_x, i_y of plane {'AB'[p]}", sample.seq, sample.t_s)
+            out.extend(currents)
         return tuple(out)
 
 
@@ -407,6 +429,8 @@ def _loop(law: Any, frames: link.Endpoint, session: int, token: int, axes: int, 
     current = reply.current_a
     update = law.update
     whole_rotor = getattr(law, "whole_rotor", False)
+    name = law.name
+    what = "one per axis: x_A, y_A, x_B, y_B" if axes == 4 else "i_x, i_y"
     limit = limits[0]
     stop_bit = wire.SensorFrame.STOP
     answered = 0
@@ -436,11 +460,14 @@ def _loop(law: Any, frames: link.Endpoint, session: int, token: int, axes: int, 
             if whole_rotor:
                 currents = update(RotorSample(frame.seq, frame.t_s, tuple(sensor[:axes]), frame.speed_rad_s,
                                               frame.angle_rad))
+                _count(name, currents, axes, what, frame.seq, frame.t_s)
                 for k in range(axes):
                     current[k] = saturate(currents[k], limits[k])
             else:
-                ix, iy = update(Sample(frame.seq, frame.t_s, (sensor[0], sensor[1]), frame.speed_rad_s,
-                                       frame.angle_rad))
+                currents = update(Sample(frame.seq, frame.t_s, (sensor[0], sensor[1]), frame.speed_rad_s,
+                                         frame.angle_rad))
+                _count(name, currents, 2, "i_x, i_y", frame.seq, frame.t_s)
+                ix, iy = currents
                 current[0] = saturate(ix, limit)
                 current[1] = saturate(iy, limit)
             reply.seq = frame.seq

@@ -1,12 +1,14 @@
 """The kit's handshake decisions, without a plant: which hellos it refuses with which code, and
 how a law is built for the hello's rotor (once per plane on 4 axes)."""
 
+import math
 from typing import ClassVar
 
+import pytest
 from conftest import hello
 
-from amb_testbed_controller import PD, Design, Params, RotorDesign, RotorSample, Sample, wire
-from amb_testbed_controller.serve import _build, _check_hello, _describe, _limits
+from amb_testbed_controller import PD, Design, Params, RotorDesign, RotorSample, Sample, saturate, wire
+from amb_testbed_controller.serve import WrongCount, _build, _check_hello, _count, _describe, _limits
 
 
 class PlanarOnly:
@@ -83,3 +85,34 @@ def test_unknown_laws_and_bad_designs_are_refused_with_code_5() -> None:
     h = hello()
     h.stiffness_n_per_m = -1.0
     assert _build([PD], h) == (None, (5, "law pd: controller.stiffness_n_per_m = -1 N/m: must be > 0"))
+
+
+class Three:
+    """A per-plane law that answers three currents (issue 31 item 7)."""
+
+    name: ClassVar[str] = "three"
+
+    def __init__(self, design: Design, params: Params) -> None:
+        pass
+
+    def update(self, sample: Sample) -> tuple[float, float, float]:
+        return (0.0, 0.0, 1.0)
+
+
+def test_a_wrong_number_of_currents_is_refused_naming_law_sample_and_count() -> None:
+    """A per-plane law lifted to 4 axes that answers 3 currents would feed plane B plane A's third."""
+    law, refusal = _build([Three], hello("three", axes=4))
+    assert refusal is None and law is not None
+    with pytest.raises(WrongCount, match=r"law three answered sample 7 \(t = 0.1 s\) with 3 currents.*i_x, i_y of plane A"):
+        law.update(RotorSample(7, 0.1, (0.0, 0.0, 0.0, 0.0), 0.0, 0.0))
+    for got in [(0.0,) * 3, (0.0,) * 5, [], 1.0]:
+        with pytest.raises(WrongCount, match="law sum answered sample 3"):
+            _count("sum", got, 4, "one per axis", 3, 0.0)
+    _count("sum", (0.0,) * 4, 4, "one per axis", 3, 0.0)
+    assert WrongCount.code == 2
+
+
+def test_every_non_finite_current_saturates_to_nan_never_to_the_limit() -> None:
+    for i in (math.nan, math.inf, -math.inf):
+        assert math.isnan(saturate(i, 2.0))
+    assert (saturate(3.0, 2.0), saturate(-3.0, 2.0), saturate(1.5, 2.0)) == (2.0, -2.0, 1.5)

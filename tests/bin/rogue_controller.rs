@@ -12,7 +12,14 @@
 //! - `other-session`: accepts the hello, then answers every sensor frame
 //!   with the run's token but another session;
 //! - `every-other`: answers only the sensor frames with an even `seq`;
-//! - `nan`: answers with the law's currents, but NaN on x from sample 100 on;
+//! - `nan`: answers with the law's currents, but NaN on x from sample 100 on (`--value V`: V
+//!   instead of NaN, e.g. `inf` or `-inf`, on x, and its negative on y);
+//! - `overrides`: acks with the overrides document `--overrides TEXT` (TOML), then answers
+//!   with the law's currents;
+//! - `late`: answers every frame `--late-us` µs (default 1000) after it came, too late for a
+//!   realtime tick: a collapsed schedule, whatever the machine;
+//! - `hang`: answers until sample `--die-at`, then sends nothing more while staying alive (a
+//!   hung controller), until the plant is gone or 60 s passed;
 //! - `die`: answers with the law's currents until sample `--die-at` (default 4000), then
 //!   kills itself with SIGKILL, as a controller killed in the middle of a run;
 //! - `no-wake`: answers every frame with the law's currents but never wakes
@@ -33,6 +40,8 @@ fn main() -> ExitCode {
     let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1)).cloned();
     let mode = value("--mode").unwrap_or_default();
     let die_at: u64 = value("--die-at").and_then(|v| v.parse().ok()).unwrap_or(4000);
+    let bad: f64 = value("--value").and_then(|v| v.parse().ok()).unwrap_or(f64::NAN);
+    let late = Duration::from_micros(value("--late-us").and_then(|v| v.parse().ok()).unwrap_or(1000));
     let Some(id) = value("--run-id").or_else(|| std::env::var("AMB_TESTBED_RUN_ID").ok()) else {
         eprintln!("rogue-controller: no run id");
         return ExitCode::from(2);
@@ -63,6 +72,10 @@ fn main() -> ExitCode {
         std::thread::sleep(Duration::from_millis(1));
     };
     let mut ack = Ack::new(hello.session, hello.token, 0, "pd", &format!("rogue controller, mode {mode}"));
+    if mode == "overrides" {
+        let text = value("--overrides").unwrap_or_default();
+        ack = ack.with_overrides(&text).expect("overrides within 4096 bytes");
+    }
     if mode == "two-axes" && hello.axes != wire::AXES {
         let why = format!("this controller runs {} axes, the plant asks for {}", wire::AXES, hello.axes);
         let refusal = Ack::new(hello.session, hello.token, wire::Refusal::Axes.code(), "pd", &why);
@@ -145,9 +158,20 @@ fn main() -> ExitCode {
         if mode == "die" && f.seq >= die_at {
             die();
         }
+        if mode == "hang" && f.seq >= die_at {
+            let until = Instant::now() + Duration::from_secs(60);
+            while Instant::now() < until && !plant_gone() {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            return ExitCode::from(4);
+        }
+        if mode == "late" {
+            std::thread::sleep(late);
+        }
         let mut r = reply(&mut law, &f);
         if mode == "nan" && f.seq >= 100 {
-            r.current_a[0] = f64::NAN;
+            r.current_a[0] = bad;
+            r.current_a[1] = -bad;
         }
         frames.send(r).expect("reply");
     }

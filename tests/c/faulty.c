@@ -2,6 +2,7 @@
  * faulty.c: a law of the C API that misbehaves on purpose, for tests/tests/c_api.rs. The
  * fault comes from the environment, AMB_FAULT (the plant passes its own to the controller):
  *   nan      update answers NaN from sample 100 on
+ *   inf      update answers +inf on x and -inf on y from sample 100 on
  *   abort    update aborts at sample 100 (after a line on stderr)
  *   null     the law's update pointer is NULL
  *   refuse   build refuses the design with a message
@@ -43,6 +44,11 @@ static void faulty_update(void *state, const amb_sample *s, double *current_a) {
         fprintf(stderr, "faulty: aborting at sample %llu\n", (unsigned long long)s->seq);
         fflush(stderr);
         abort();
+    }
+    if (s->seq >= 100 && strcmp(law->fault, "inf") == 0) {
+        current_a[0] = INFINITY;
+        current_a[1] = -INFINITY;
+        return;
     }
     double v = (s->seq >= 100 && strcmp(law->fault, "nan") == 0) ? NAN : 0.0;
     current_a[0] = v;

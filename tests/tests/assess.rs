@@ -192,6 +192,32 @@ fn a_controller_killed_during_the_measurement_is_reported_lost() {
     assert!(c["sensitivity"]["result"].is_null());
 }
 
+/// Issue 31 item 7: a controller answering +∞ was graded as a mere "unstable loop" (exit 0): its
+/// ∞ currents were clamped to the limit and counted valid. It follows the invalid-command rule
+/// now, as one answering NaN: every part fails as `invalid_commands`, exit 8, the report written.
+#[test]
+fn a_controller_answering_infinite_currents_is_not_graded() {
+    let dir = TempDir::new("assess-inf");
+    let command = format!(
+        "controller.command=[{:?}, \"--mode\", \"nan\", \"--value\", \"inf\"]",
+        rogue_bin().display().to_string()
+    );
+    let controllers = format!(
+        "[[controller]]\nlabel = \"infinite\"\nset = [\"controller.mode=\\\"lockstep\\\"\", \"controller.law=\\\"pd_delay\\\"\", {:?}]\n",
+        command
+    );
+    let out = dir.join("out");
+    let o = assess(&file(&dir.join("assess.toml"), &controllers, ""), &out);
+    assert_exit(&o, 8);
+    assert!(stderr(&o).contains("non-finite"), "{}", stderr(&o));
+    let r = read_json(&out.join("report.json"));
+    let c = &r["controllers"][0];
+    for part in ["sensitivity", "vibration", "ladder"] {
+        assert_eq!(c[part]["status"], "failed", "{part}: {}", c[part]);
+        assert_eq!(c[part]["failure"], "invalid_commands", "{part}: {}", c[part]);
+    }
+}
+
 /// SIGINT once the ladder has started: the sensitivity and the vibration measured before it
 /// are in the report, the ladder is marked interrupted, exit 130.
 #[cfg(unix)]

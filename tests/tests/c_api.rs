@@ -246,6 +246,16 @@ fn faults_of_a_c_law_are_named_with_their_exit_codes() {
             "invalid_commands",
             vec!["non-finite for 11 samples in a row, from sample 100"],
         ),
+        // Issue 31 item 7: ±∞ were clamped to the limit and counted valid.
+        (
+            "inf",
+            &faulty,
+            "inf",
+            vec![],
+            8,
+            "invalid_commands",
+            vec!["non-finite for 11 samples in a row, from sample 100"],
+        ),
         (
             "abort",
             &faulty,
@@ -315,4 +325,6 @@ fn faults_of_a_c_law_are_named_with_their_exit_codes() {
     // The controller side said the NaN itself, in controller.log.
     let log = std::fs::read_to_string(dir.join("nan").join("controller.log")).unwrap();
     assert!(log.contains("law `faulty` returned a non-finite current [NaN, NaN] A for sample 100"), "{log}");
+    let log = std::fs::read_to_string(dir.join("inf").join("controller.log")).unwrap();
+    assert!(log.contains("law `faulty` returned a non-finite current [inf, -inf] A for sample 100"), "{log}");
 }

@@ -141,7 +141,11 @@ fn realtime_run_completes_and_reports_misses() {
     controller_bin();
     let dir = TempDir::new("cosim-realtime");
     let out = dir.join("run");
-    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&["controller.mode=realtime"])));
+    let run = output(&mut plant_run(
+        &scene("paper-10g.toml"),
+        &out,
+        &sets(&["controller.mode=realtime", NO_BUDGET[0], NO_BUDGET[1]]),
+    ));
     assert_exit(&run, 0);
     let s = read_json(&out.join("summary.json"));
     let c = &s["cosim"];
@@ -194,7 +198,14 @@ fn assert_tet(c: &serde_json::Value, ticks: u64) {
 fn a_realtime_plant_that_cannot_keep_up_is_said_and_ends_past_its_overrun_budget() {
     controller_bin();
     let dir = TempDir::new("cosim-overruns");
-    let fast = ["controller.mode=realtime", "controller.rate_hz=1e7", "scene.duration_s=2e-4", "output.plots=false"];
+    let fast = [
+        "controller.mode=realtime",
+        "controller.rate_hz=1e7",
+        "scene.duration_s=2e-4",
+        "output.plots=false",
+        "controller.max_miss_fraction=1",
+        "controller.max_overrun_fraction=1",
+    ];
     let out = dir.join("warned");
     let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &fast));
     assert_exit(&run, 0);
@@ -488,7 +499,13 @@ fn realtime_controller_killed_is_respawned() {
     let mut cmd = plant_run(
         &scene("paper-10g.toml"),
         &out,
-        &sets(&["controller.mode=realtime", "controller.reconnect_timeout_ms=20000", "scene.duration_s=0.5"]),
+        &sets(&[
+            "controller.mode=realtime",
+            "controller.reconnect_timeout_ms=20000",
+            "scene.duration_s=0.5",
+            NO_BUDGET[0],
+            NO_BUDGET[1],
+        ]),
     );
     cmd.env("AMB_CONTROLLER_CRASH_AT_SEQ", CRASH_AT.to_string());
     let run = output(&mut cmd);
@@ -792,7 +809,14 @@ fn the_controller_serves_a_four_axis_rotor_with_modal_and_refuses_modal_on_two_a
 
 /// `--set` overrides giving a scene the rogue controller in `mode` as its command.
 fn rogue(mode: &str) -> String {
-    format!("controller.command=[{:?}, \"--mode\", {mode:?}]", common::rogue_bin().display().to_string())
+    rogue_with(mode, &[])
+}
+
+/// As [`rogue`], with more arguments for the rogue controller.
+fn rogue_with(mode: &str, args: &[&str]) -> String {
+    let mut argv = vec![common::rogue_bin().display().to_string(), "--mode".into(), mode.into()];
+    argv.extend(args.iter().map(|a| a.to_string()));
+    format!("controller.command={}", toml::Value::from(argv))
 }
 
 /// Issue 11 item 1: two runs under one run id exchanged each other's frames. A run id in use
@@ -952,8 +976,12 @@ fn replies_of_another_session_are_named_at_the_deadline() {
 fn a_realtime_run_past_its_miss_budget_exits_6() {
     let dir = TempDir::new("cosim-miss-budget");
     let out = dir.join("run");
-    let extra =
-        ["controller.mode=realtime".to_string(), "controller.max_miss_fraction=0.1".into(), rogue("every-other")];
+    let extra = [
+        "controller.mode=realtime".to_string(),
+        "controller.max_miss_fraction=0.1".into(),
+        "controller.max_overrun_fraction=1".into(),
+        rogue("every-other"),
+    ];
     let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
     let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
     assert_exit(&run, 6);
@@ -977,7 +1005,13 @@ fn a_sleeping_realtime_run_shares_one_core() {
     let run = output(&mut plant_run(
         &scene("paper-10g.toml"),
         &out,
-        &sets(&["controller.mode=realtime", "controller.pacing=\"sleep\"", "controller.pin_cores=[0, 0]"]),
+        &sets(&[
+            "controller.mode=realtime",
+            "controller.pacing=\"sleep\"",
+            "controller.pin_cores=[0, 0]",
+            NO_BUDGET[0],
+            NO_BUDGET[1],
+        ]),
     ));
     assert_exit(&run, 0);
     let c = &read_json(&out.join("summary.json"))["cosim"];
@@ -1006,7 +1040,7 @@ fn realtime_priority_is_applied_or_refused_with_a_warning() {
     let run = output(&mut plant_run(
         &scene("paper-10g.toml"),
         &out,
-        &sets(&["controller.mode=realtime", "controller.realtime_priority=10"]),
+        &sets(&["controller.mode=realtime", "controller.realtime_priority=10", NO_BUDGET[0], NO_BUDGET[1]]),
     ));
     assert_exit(&run, 0);
     let sched = &read_json(&out.join("summary.json"))["cosim"]["scheduling"];
@@ -1034,6 +1068,8 @@ fn on_a_shared_core_the_controller_runs_above_the_plant() {
         "controller.pin_cores=[0, 0]",
         "controller.pacing=\"sleep\"",
         "scene.duration_s=0.05",
+        NO_BUDGET[0],
+        NO_BUDGET[1],
     ];
     let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&shared)));
     assert_exit(&run, 0);
@@ -1133,4 +1169,163 @@ fn non_finite_currents_are_held_counted_and_said_once() {
     assert!(s["error"].as_str().unwrap_or_default().contains("max_invalid_burst"), "{s:#}");
     assert_eq!(num(&s, "invalid_commands"), 11.0, "{s:#}");
     assert!(out.join("trace.csv").is_file() && out.join("scene.toml").is_file());
+}
+
+/// Issue 31 item 5: a controller's handshake overrides are untrusted input. One that sends back
+/// any `[controller]` key the protocol does not give it (the budget of non-finite commands, the
+/// rate, the mode, the delay, another budget, a program for the run folder to replay) or a
+/// current limit above the scene's is refused on `config/cosim-10g.toml`: exit 2, status
+/// `refused`, the message naming the controller's program and the key; nothing of it reaches
+/// the run folder's `scene.toml`. What the protocol allows (its design) is still taken.
+#[test]
+fn a_controller_cannot_change_the_run_it_serves() {
+    let dir = TempDir::new("cosim-overrides");
+    let cases = [
+        ("burst", "max_invalid_burst = 1000000000", "controller.max_invalid_burst = 1000000000"),
+        ("rate", "rate_hz = 1000.0", "controller.rate_hz = 1000.0"),
+        ("mode", "mode = \"continuous\"", "controller.mode = \"continuous\""),
+        ("delay", "delay_samples = 1000", "controller.delay_samples = 1000"),
+        ("budget", "max_miss_fraction = 1.0", "controller.max_miss_fraction = 1.0"),
+        ("command", "command = [\"/bin/sh\", \"-c\", \"touch owned\"]", "controller.command = [\"/bin/sh\""),
+        ("limit", "current_limit_a = 1000.0", "controller.current_limit_a = 1000.0 A: a controller may lower"),
+        ("mixed", "damping_ratio = 0.05\nfallback = \"bias\"", "controller.fallback = \"bias\""),
+    ];
+    for (name, keys, needle) in cases {
+        let out = dir.join(name);
+        let overrides = format!("[controller]\n{keys}\n");
+        let extra = [
+            "controller.mode=lockstep".to_string(),
+            "scene.duration_s=0.01".into(),
+            rogue_with("overrides", &["--overrides", &overrides]),
+        ];
+        let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+        let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+        assert_exit(&run, 2);
+        let err = stderr(&run);
+        let rule = if name == "limit" { "never raise it above the scene's" } else { "may change only" };
+        for n in [needle, rule, "rogue-controller", "(controller.command)", "refused, nothing of it applied"] {
+            assert!(err.contains(n), "{name}: no {n:?} in\n{err}");
+        }
+        let s = read_json(&out.join("summary.json"));
+        assert_eq!(s["status"], "refused", "{name}: {s:#}");
+        assert!(!out.join("trace.csv").exists(), "{name}: a refused run wrote a trace");
+        let recorded = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+        let recorded: toml::Table = recorded.parse().unwrap();
+        let c = recorded["controller"].as_table().unwrap();
+        assert_eq!(c["mode"].as_str(), Some("lockstep"), "{name}");
+        assert!(c["command"].as_array().unwrap()[0].as_str().unwrap().ends_with("rogue-controller"), "{name}");
+        assert_eq!(c["damping_ratio"].as_float(), Some(0.026), "{name}: a refused table was applied in part");
+        assert!(!dir.join("owned").exists() && !out.join("owned").exists());
+    }
+    // Its design alone is the controller's: taken, and recorded for the folder to replay.
+    let out = dir.join("design");
+    let extra = [
+        "controller.mode=lockstep".to_string(),
+        "scene.duration_s=0.01".into(),
+        rogue_with("overrides", &["--overrides", "[controller]\ndamping_ratio = 0.05\ncurrent_limit_a = 1.5\n"]),
+    ];
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 0);
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(num(&s["cosim"]["controller_overrides"], "damping_ratio"), 0.05, "{s:#}");
+    let recorded: toml::Table = std::fs::read_to_string(out.join("scene.toml")).unwrap().parse().unwrap();
+    assert_eq!(recorded["controller"]["current_limit_a"].as_float(), Some(1.5));
+}
+
+/// Issue 31 item 7: ±∞ currents were clamped to the limit and counted valid (exit 0,
+/// `invalid_commands = 0`). Every non-finite current over the wire (NaN, +∞, −∞) is an invalid
+/// command: with the default budget the run ends at the 11th in a row, exit 8.
+#[test]
+fn every_non_finite_current_over_the_wire_is_invalid() {
+    let dir = TempDir::new("cosim-non-finite");
+    for value in ["nan", "inf", "-inf"] {
+        let out = dir.join(value.trim_start_matches('-'));
+        let extra = [
+            "controller.mode=lockstep".to_string(),
+            "scene.duration_s=0.01".into(),
+            rogue_with("nan", &["--value", value]),
+        ];
+        let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+        let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+        assert_exit(&run, 8);
+        let err = stderr(&run);
+        assert!(err.contains("non-finite for 11 samples in a row, from sample 100"), "{value}: {err}");
+        let s = read_json(&out.join("summary.json"));
+        assert_eq!(s["status"], "invalid_commands", "{value}: {s:#}");
+        assert_eq!(num(&s, "invalid_commands"), 11.0, "{value}: {s:#}");
+        assert_eq!(num(&s["cosim"], "invalid_replies"), 11.0, "{value}: {s:#}");
+    }
+}
+
+/// The no-limit choice, for the realtime tests that are about something else than the budgets:
+/// a loaded test machine may miss any share of its deadlines.
+const NO_BUDGET: [&str; 2] = ["controller.max_miss_fraction=1", "controller.max_overrun_fraction=1"];
+
+/// Issue 31 item 1: with the old defaults (no limit) a realtime run whose schedule collapsed
+/// (85–99 % of the deadlines missed) exited 0, `completed`. A controller that answers every
+/// frame 1 ms late (every reply after its tick, whatever the machine) now ends with the
+/// defaults as not `completed`, with a budget's exit code; with the overrun budget lifted,
+/// exactly the miss budget's (6, `miss_budget`); with both lifted (1: no limit, asked for) it
+/// completes and says the schedule did not hold.
+#[test]
+fn a_collapsed_realtime_schedule_never_passes_by_default() {
+    let dir = TempDir::new("cosim-collapse");
+    let late = rogue_with("late", &["--late-us", "1000"]);
+    let run_with = |name: &str, more: &[&str]| {
+        let out = dir.join(name);
+        let mut extra = vec!["controller.mode=realtime", "scene.duration_s=0.2", late.as_str()];
+        extra.extend_from_slice(more);
+        let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+        (run, read_json(&out.join("summary.json")))
+    };
+    let (run, s) = run_with("defaults", &[]);
+    let code = run.status.code();
+    assert!(matches!(code, Some(6) | Some(10)), "{code:?}: {}", stderr(&run));
+    let status = s["status"].as_str().unwrap();
+    assert!(["miss_budget", "overrun_budget"].contains(&status), "{s:#}");
+    assert!(stderr(&run).contains("(1 is no limit)"), "{}", stderr(&run));
+
+    let (run, s) = run_with("misses", &["controller.max_overrun_fraction=1"]);
+    assert_exit(&run, 6);
+    assert_eq!(s["status"], "miss_budget", "{s:#}");
+    let err = stderr(&run);
+    assert!(err.contains("exceed controller.max_miss_fraction = 0.01") && err.contains("not the scene's"), "{err}");
+    assert!(num(&s["cosim"], "deadline_miss_fraction") > 0.01, "{s:#}");
+
+    let (run, s) = run_with("no-limit", &NO_BUDGET);
+    assert_exit(&run, 0);
+    assert_eq!(s["status"], "completed", "{s:#}");
+    assert_eq!(s["cosim"]["schedule_held"].as_bool(), Some(false), "{s:#}");
+    assert!(stderr(&run).contains("the realtime schedule did not hold"), "{}", stderr(&run));
+}
+
+/// Issue 31 item 9: in realtime a live controller that stopped answering (hung) or answers
+/// another session ended `completed`. With the defaults such a run ends past the miss budget
+/// (exit 6); with no budget, after `controller.lockstep_timeout_ms` the controller is lost,
+/// named as in lockstep (exit 4, `peer_lost`), as docs/guide/controllers.md says.
+#[test]
+fn a_silent_realtime_controller_is_lost_or_past_the_budget() {
+    let dir = TempDir::new("cosim-rt-silent");
+    let hang = rogue_with("hang", &["--die-at", "1500"]);
+    let other = rogue("other-session");
+    for (name, program, said) in [("hang", hang.as_str(), "sent nothing"), ("other", other.as_str(), "another session")]
+    {
+        let out = dir.join(&format!("{name}-budget"));
+        let extra = ["controller.mode=realtime", "scene.duration_s=0.5", "controller.max_overrun_fraction=1", program];
+        let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+        assert_exit(&run, 6);
+        assert_eq!(read_json(&out.join("summary.json"))["status"], "miss_budget", "{name}");
+
+        let out = dir.join(&format!("{name}-lost"));
+        let mut extra = vec!["controller.mode=realtime", "scene.duration_s=0.5", "controller.lockstep_timeout_ms=200"];
+        extra.extend_from_slice(&NO_BUDGET);
+        extra.push(program);
+        let run = output(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets(&extra)));
+        assert_exit(&run, 4);
+        let err = stderr(&run);
+        assert!(err.contains("lockstep_timeout_ms = 200 ms") && err.contains(said), "{name}: {err}");
+        let s = read_json(&out.join("summary.json"));
+        assert_eq!(s["status"], "peer_lost", "{name}: {s:#}");
+    }
 }

@@ -278,3 +278,50 @@ fn scene_toml_of_a_run_with_controller_overrides_reproduces_the_run() {
     assert_exit(&o, 0);
     assert!(std::fs::read(plain.join("trace.csv")).unwrap() != a, "the overrides did not change the run");
 }
+
+/// Issue 31 item 7: a law in this process answering ±∞ had them clamped to the limit and
+/// counted valid (exit 0, `invalid_commands = 0`). Every non-finite current (NaN, +∞, −∞, on
+/// either axis) is an invalid command: held, counted, and past `controller.max_invalid_burst`
+/// (10 in a row) the run ends as `invalid_commands`.
+#[test]
+fn every_non_finite_current_of_a_law_in_process_is_invalid() {
+    use controller::{ControlLaw, Design, LawEntry, LawError, Params, Sample};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    const VALUES: [[f64; 2]; 4] =
+        [[f64::NAN, 0.0], [f64::INFINITY, 0.0], [0.0, f64::NEG_INFINITY], [f64::INFINITY, f64::NEG_INFINITY]];
+    static CASE: AtomicUsize = AtomicUsize::new(0);
+    struct Bad([f64; 2]);
+    impl ControlLaw for Bad {
+        fn name(&self) -> &'static str {
+            "bad_after_100"
+        }
+        fn update(&mut self, s: &Sample) -> [f64; 2] {
+            if s.seq >= 100 {
+                self.0
+            } else {
+                [0.0, 0.5]
+            }
+        }
+        fn reset(&mut self) {}
+    }
+    fn build(_: &Design, _: &Params) -> Result<Box<dyn ControlLaw>, LawError> {
+        Ok(Box::new(Bad(VALUES[CASE.load(Ordering::SeqCst)])))
+    }
+    const LAW: LawEntry = LawEntry { name: "bad_after_100", summary: "", build };
+    let scene = plant::config::load_scene(
+        &scene("paper-10g.toml"),
+        &sets(&["controller.mode=\"sampled\""]).iter().map(|s| s.to_string()).collect::<Vec<_>>(),
+    )
+    .unwrap();
+    for (i, value) in VALUES.iter().enumerate() {
+        CASE.store(i, Ordering::SeqCst);
+        let run = plant::check::run_law(&scene, &LAW, &mut plant::run::Quiet).unwrap();
+        let outcome = &run.run.outcome;
+        assert!(
+            matches!(outcome, plant::run::Outcome::InvalidCommands(w) if w.contains("11 samples in a row, from sample 100")),
+            "{value:?}: {outcome:?}"
+        );
+        assert_eq!(run.run.invalid_commands, 11, "{value:?}");
+        assert!(run.trace.ix_a.iter().chain(&run.trace.iy_a).all(|i| i.is_finite()), "{value:?}");
+    }
+}

@@ -2,8 +2,8 @@
 //! the scene format, set to values a careless operator or a hostile input
 //! would give (NaN, ±infinity, zero, negative, huge, tiny, the wrong type,
 //! and seeded random values around its default), makes `plant run` end
-//! within a time bound with exit 0, 2 or 3, never a signal death, never a
-//! panic; a value refused is refused at load with a message that names the
+//! within a time bound with exit 0, 2 or 3 (a realtime run also 6 or 10, its
+//! budgets), never a signal death, never a panic; a value refused is refused at load with a message that names the
 //! key.
 //!
 //! The keys come from the format itself, so a new key is covered without
@@ -410,7 +410,12 @@ fn every_scene_key_with_hostile_values_ends_in_time_with_exit_0_2_or_3() {
     sample.truncate(REFUSED_SAMPLE);
     let jobs: Vec<(Case, &[i32])> = runs
         .iter()
-        .map(|c| (c.clone(), &[0, 2, 3][..]))
+        // A realtime run on this loaded machine may end past its deadline-miss or overrun budget
+        // (exit 6 or 10, by default 1 % and 5 % of the ticks): the budget doing its work.
+        .map(|c| match (c.key.as_str(), c.value.as_str()) {
+            ("controller.mode", "\"realtime\"") => (c.clone(), &[0, 2, 3, 6, 10][..]),
+            _ => (c.clone(), &[0, 2, 3][..]),
+        })
         .chain(sample.iter().map(|c| (c.clone(), &[2][..])))
         .filter(|_| std::env::var_os("PROPERTIES_LOAD_ONLY").is_none())
         .collect();

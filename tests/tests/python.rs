@@ -774,3 +774,105 @@ fn the_python_relevitation_scene_runs_through_controller_command_and_recovers() 
     assert!(c["controller"].as_str().unwrap().starts_with("relev_py"), "{c:#}");
     assert_eq!(num(c, "invalid_replies"), 0.0, "{c:#}");
 }
+
+/// Laws that answer wrongly on purpose, for [`python_laws_that_answer_wrongly_are_refused`]:
+/// each answers correctly (zero currents) before sample 100, then as its name says.
+const BAD_LAWS: &str = r#"
+import sys
+from amb_testbed_controller import serve
+
+class PlaneLaw:
+    answer = (0.0, 0.0)
+    def __init__(self, design, params):
+        pass
+    def update(self, sample):
+        return self.answer if sample.seq >= 100 else (0.0, 0.0)
+
+class Inf(PlaneLaw):
+    name = "inf"
+    answer = (float("inf"), float("-inf"))
+
+class Three(PlaneLaw):
+    name = "three"
+    answer = (0.0, 0.0, 1.0)
+
+class RotorLaw:
+    whole_rotor = True
+    count = 4
+    def __init__(self, design, params):
+        self.axes = design.axes
+    def update(self, sample):
+        return tuple(0.0 for _ in range(self.count if sample.seq >= 100 else self.axes))
+
+class Short(RotorLaw):
+    name = "short"
+    count = 3
+
+class Long(RotorLaw):
+    name = "long"
+    count = 5
+
+serve(Inf, Three, Short, Long)
+"#;
+
+/// Issue 31 item 7, the Python kit: a law answering ±∞ had them clamped to its limit and
+/// counted valid; a law of the whole rotor answering the wrong number of currents had the
+/// extras dropped or plane B fed other values (exit 0). ±∞ is an invalid command (exit 8, as
+/// NaN); a wrong count is refused at once, naming the law, the sample and the count (the kit
+/// exits 2, nothing sent; the plant: the controller lost, its message quoted, exit 4).
+#[test]
+fn python_laws_that_answer_wrongly_are_refused() {
+    let dir = TempDir::new("py-bad-laws");
+    let script = dir.join("bad_laws.py");
+    std::fs::write(&script, BAD_LAWS).unwrap();
+    let command = format!(
+        "controller.command={}",
+        toml::Value::from(vec![python().display().to_string(), script.display().to_string()])
+    );
+    // (law, scene, plant's exit code, status, what stderr names)
+    let cases: [(&str, &str, i32, &str, &[&str]); 5] = [
+        ("inf", "cosim-10g.toml", 8, "invalid_commands", &["non-finite for 11 samples in a row, from sample 100"]),
+        (
+            "three",
+            "cosim-10g.toml",
+            4,
+            "peer_lost",
+            &["law three answered sample 100", "with 3 currents", "it must answer 2"],
+        ),
+        (
+            "three",
+            "two-plane-asymmetric-10g.toml",
+            4,
+            "peer_lost",
+            &["law three answered sample 100", "with 3 currents", "i_x, i_y of plane A"],
+        ),
+        (
+            "short",
+            "two-plane-asymmetric-10g.toml",
+            4,
+            "peer_lost",
+            &["law short answered sample 100", "with 3 currents", "it must answer 4"],
+        ),
+        ("long", "two-plane-asymmetric-10g.toml", 4, "peer_lost", &["law long answered sample 100", "with 5 currents"]),
+    ];
+    for (law, scene_file, code, status, needles) in cases {
+        let name = format!("{law}-{}", scene_file.split('-').next().unwrap());
+        let out = dir.join(&name);
+        let law_set = format!("controller.law=\"{law}\"");
+        let sets = [
+            "scene.duration_s=0.02",
+            "output.plots=false",
+            "controller.mode=\"lockstep\"",
+            law_set.as_str(),
+            command.as_str(),
+        ];
+        let run = output_within(&mut plant_run(&scene(scene_file), &out, &sets), LIMIT);
+        assert_exit(&run, code);
+        let err = stderr(&run);
+        for n in needles {
+            assert!(err.contains(n), "{name}: no {n:?} in\n{err}");
+        }
+        let s = read_json(&out.join("summary.json"));
+        assert_eq!(s["status"], status, "{name}: {s:#}");
+    }
+}

@@ -438,8 +438,12 @@ impl Scene {
 
     /// The same scene with what an external controller ran differently (the `[controller]`
     /// table of its handshake's overrides: `params` replaces the scene's whole, other keys
-    /// are set), validated again: the scene the run actually had.
+    /// are set), validated again: the scene the run actually had. Only what a controller may
+    /// change ([`check_controller_overrides`]); anything else is refused, never written into a
+    /// scene that a run folder would replay.
     pub fn with_controller_overrides(&self, controller: &toml::Table) -> Result<Scene, ConfigError> {
+        check_controller_overrides(controller, self.params.current_limit)
+            .map_err(|why| ConfigError::Parse { path: "the controller's handshake overrides".into(), message: why })?;
         let mut table = self.table()?;
         let section = table
             .entry("controller")
@@ -466,6 +470,44 @@ impl Scene {
             .map_err(|e| ConfigError::Parse { path: blame.to_string(), message: e.to_string() })?;
         validate(raw, base_dir)
     }
+}
+
+/// The `[controller]` keys a controller may send back in its handshake's overrides
+/// (docs/wire-protocol.md, "The overrides document"): the law it runs, its design and its
+/// parameters. The rest of the run (its program, mode, rate, delay, budgets, timeouts,
+/// scheduling) is the scene's, never the controller's.
+pub const CONTROLLER_OVERRIDE_KEYS: [&str; 6] =
+    ["law", "stiffness_n_per_m", "damping_ratio", "current_limit_a", "gravity_bias", "params"];
+
+/// Checks the `[controller]` table of a controller's handshake overrides: every key one of
+/// [`CONTROLLER_OVERRIDE_KEYS`], and `current_limit_a` (the amplifier's limit, a property of
+/// the plant) not above the scene's `scene_limit_a` (a controller may saturate lower, never
+/// drive the coils harder than the scene's amplifier). `Err` names the key and its value.
+pub fn check_controller_overrides(controller: &toml::Table, scene_limit_a: f64) -> Result<(), String> {
+    for (key, value) in controller {
+        if !CONTROLLER_OVERRIDE_KEYS.contains(&key.as_str()) {
+            return Err(format!(
+                "controller.{key} = {value}: a controller may change only {} (docs/wire-protocol.md, \
+                 \"The overrides document\"); the rest of the run is the scene's",
+                CONTROLLER_OVERRIDE_KEYS
+                    .map(|k| if k == "params" { "[controller.params]".into() } else { format!("`{k}`") })
+                    .join(", ")
+            ));
+        }
+    }
+    if let Some(v) = controller.get("current_limit_a") {
+        let limit = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+        match limit {
+            Some(a) if a.is_finite() && a > 0.0 && a <= scene_limit_a => {}
+            _ => {
+                return Err(format!(
+                    "controller.current_limit_a = {v} A: a controller may lower the current limit, never raise it \
+                     above the scene's controller.current_limit_a = {scene_limit_a} A (the amplifier's)"
+                ))
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Reads a scene file, applies `--set` overrides, validates.
@@ -535,5 +577,51 @@ mod tests {
                 s.fixed_step_overrides()
             );
         }
+    }
+
+    /// Issue 31 item 5: of every `[controller]` key of the scene format, a controller may send
+    /// back only those of the protocol; each other one is refused, naming it and its value.
+    /// A current limit above the scene's (or not a positive number) is refused too.
+    #[test]
+    fn a_controller_may_override_only_its_law_design_and_parameters() {
+        let raw = toml::Value::try_from(RawController::default()).unwrap();
+        let keys = raw.as_table().unwrap();
+        assert!(keys.len() > CONTROLLER_OVERRIDE_KEYS.len() + 10, "{keys:?}");
+        for (key, value) in keys {
+            let table = toml::Table::from_iter([(key.clone(), value.clone())]);
+            let checked = check_controller_overrides(&table, 2.0);
+            if CONTROLLER_OVERRIDE_KEYS.contains(&key.as_str()) {
+                assert_eq!(checked, Ok(()), "{key}");
+            } else {
+                let why = checked.expect_err(key);
+                assert!(why.starts_with(&format!("controller.{key} = ")) && why.contains("may change only"), "{why}");
+            }
+        }
+        let command = toml::Value::Array(vec!["/bin/sh".into(), "-c".into(), "touch /tmp/owned".into()]);
+        let why = check_controller_overrides(&toml::Table::from_iter([("command".to_string(), command)]), 2.0);
+        assert!(why.unwrap_err().contains("controller.command = [\"/bin/sh\""));
+        for (limit, ok) in
+            [(1.5, true), (2.0, true), (2.0000001, false), (1000.0, false), (0.0, false), (f64::NAN, false)]
+        {
+            let table = toml::Table::from_iter([("current_limit_a".to_string(), toml::Value::Float(limit))]);
+            let checked = check_controller_overrides(&table, 2.0);
+            assert_eq!(checked.is_ok(), ok, "{limit}: {checked:?}");
+            if !ok {
+                assert!(checked.unwrap_err().contains("scene's controller.current_limit_a = 2 A"), "{limit}");
+            }
+        }
+        let text = toml::Table::from_iter([("current_limit_a".to_string(), toml::Value::String("big".into()))]);
+        assert!(check_controller_overrides(&text, 2.0).is_err());
+        // The scene a run folder records refuses them too: nothing of a refused table is set.
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/cosim-10g.toml");
+        let scene = load_scene(&path, &[]).unwrap();
+        let mode = toml::Table::from_iter([
+            ("damping_ratio".to_string(), toml::Value::Float(0.05)),
+            ("mode".to_string(), toml::Value::String("continuous".into())),
+        ]);
+        let e = scene.with_controller_overrides(&mode).unwrap_err().to_string();
+        assert!(e.contains("controller.mode = \"continuous\""), "{e}");
+        let design = toml::Table::from_iter([("damping_ratio".to_string(), toml::Value::Float(0.05))]);
+        assert_eq!(scene.with_controller_overrides(&design).unwrap().controller.damping_ratio, 0.05);
     }
 }

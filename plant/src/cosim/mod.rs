@@ -42,12 +42,16 @@
 //! plant treats it as a lost controller (fallback, reconnection, else
 //! `peer_lost`, exit code 4).
 //!
-//! A lockstep plant waiting on a controller that is alive but silent (stopped
-//! with SIGSTOP, hung, answering another session) gives up after
-//! `controller.lockstep_timeout_ms`, says what it saw in the meantime
+//! A plant (lockstep or realtime) waiting on a controller that is alive but
+//! silent (stopped with SIGSTOP, hung, answering another session) gives up
+//! after `controller.lockstep_timeout_ms`, says what it saw in the meantime
 //! (nothing, replies of another session, frames of another run) and treats
-//! the controller as lost. A realtime run whose deadline-miss fraction
-//! exceeds `controller.max_miss_fraction` ends as `miss_budget` (exit 6).
+//! the controller as lost. A realtime run whose share of ticks without the
+//! controller's reply (deadline misses, fallback ticks) exceeds
+//! `controller.max_miss_fraction` (default 1 %) ends as `miss_budget` (exit
+//! 6), one whose plant overruns exceed `controller.max_overrun_fraction`
+//! (default 5 %) as `overrun_budget` (exit 10): a realtime run that is
+//! `completed` ran the scene's loop within those budgets.
 //!
 //! # Isolation
 //!
@@ -215,6 +219,15 @@ pub enum CosimError {
     /// The controller's handshake answer is malformed, or of another protocol version.
     #[error("the controller's handshake answer is malformed: {0}")]
     Protocol(String),
+    /// The controller's handshake overrides change what is not the controller's to change
+    /// ([`crate::config::CONTROLLER_OVERRIDE_KEYS`], a current limit above the scene's).
+    #[error("the controller {controller} sent back {why}: refused, nothing of it applied")]
+    Overrides {
+        /// The controller: its program, its description and pid.
+        controller: String,
+        /// The key, its value and the rule.
+        why: String,
+    },
 }
 
 /// What an early exit code of a controller says (the codes of `controller::serve`).

@@ -58,6 +58,14 @@ struct Seen {
 }
 
 impl Seen {
+    /// A reply of another session.
+    fn note_session(&mut self, session: u32) {
+        self.other_session += 1;
+        if !self.sessions.contains(&session) && self.sessions.len() < 8 {
+            self.sessions.push(session);
+        }
+    }
+
     /// What the controller sent, in words.
     fn describe(&self) -> String {
         let mut parts = Vec::new();
@@ -122,6 +130,9 @@ pub struct Session {
     woke: Option<Instant>,
     sent_ns: [u64; RING],
     last_heard: Instant,
+    /// Realtime: what the controller sent since its last reply of this session (for the
+    /// message when it is silent past `controller.lockstep_timeout_ms`).
+    silent: Seen,
     next_check: Duration,
     wall_start: Instant,
     /// What the controller runs differently from the hello (its ack's `[controller]` table).
@@ -175,20 +186,15 @@ impl Session {
         }
     }
 
-    /// Realtime: `Some(why)` if the deadline-miss fraction of the run so far exceeds
-    /// `controller.max_miss_fraction` (checked over at least `min_due` ticks with a reply due).
+    /// Realtime: `Some(why)` if the share of the run's ticks so far that went without the
+    /// controller's reply exceeds `controller.max_miss_fraction` (checked over at least
+    /// `min_due` such ticks): the deadline misses, and the fallback ticks while no controller was
+    /// connected. Either way the loop that ran was not the scene's.
     pub fn miss_budget_exceeded(&self, min_due: u64) -> Option<String> {
-        let f = &self.figures;
-        let budget = self.settings.max_miss_fraction;
-        let over = self.mode == ControlMode::Realtime && f.due >= min_due.max(1) && f.miss_fraction() > budget;
-        over.then(|| {
-            format!(
-                "realtime: {} deadline misses in {} ticks ({:.3} %) exceed controller.max_miss_fraction = {budget}",
-                f.misses.total,
-                f.due,
-                100.0 * f.miss_fraction()
-            )
-        })
+        if self.mode != ControlMode::Realtime {
+            return None;
+        }
+        self.figures.miss_budget(self.settings.max_miss_fraction, min_due)
     }
 
     /// Realtime: `Some(why)` if the share of ticks started more than a period late so far
@@ -200,7 +206,7 @@ impl Session {
         over.then(|| {
             format!(
                 "realtime: {} plant overruns (ticks started more than a period late) in {} ticks ({:.3} %) exceed \
-                 controller.max_overrun_fraction = {budget}",
+                 controller.max_overrun_fraction = {budget} (1 is no limit)",
                 f.overruns,
                 f.ticks,
                 100.0 * f.overrun_fraction()
@@ -309,10 +315,7 @@ impl Session {
                 seen.foreign += 1;
                 false
             } else if reply.session != session {
-                seen.other_session += 1;
-                if !seen.sessions.contains(&reply.session) && seen.sessions.len() < 8 {
-                    seen.sessions.push(reply.session);
-                }
+                seen.note_session(reply.session);
                 false
             } else if reply.status & CommandFrame::STOPPING != 0 {
                 return self.on_lost(sample, STOPPED_BY_SIGNAL.into(), hooks);
@@ -369,12 +372,21 @@ impl Session {
         hooks: &mut dyn Hooks,
     ) -> Result<[f64; ROTOR_AXES], Halt> {
         let pid = self.controller_pid.map(|p| format!(" (pid {p})")).unwrap_or_default();
-        let why = format!(
-            "no reply to sample {} within controller.lockstep_timeout_ms = {} ms although the controller{pid} is alive: {}",
-            sample.seq,
-            self.settings.lockstep_timeout * 1e3,
-            seen.describe()
-        );
+        let why = match self.mode {
+            ControlMode::Realtime => format!(
+                "no reply for controller.lockstep_timeout_ms = {} ms (up to sample {}) although the controller{pid} is \
+                 alive: {}",
+                self.settings.lockstep_timeout * 1e3,
+                sample.seq,
+                seen.describe()
+            ),
+            _ => format!(
+                "no reply to sample {} within controller.lockstep_timeout_ms = {} ms although the controller{pid} is alive: {}",
+                sample.seq,
+                self.settings.lockstep_timeout * 1e3,
+                seen.describe()
+            ),
+        };
         self.on_lost(sample, why, hooks)
     }
 
@@ -456,9 +468,13 @@ impl Session {
             };
             if reply.token != self.hello.token {
                 self.figures.foreign += 1;
+                self.silent.foreign += 1;
                 continue;
             }
             if reply.session != session || !self.connected {
+                if self.connected {
+                    self.silent.note_session(reply.session);
+                }
                 continue;
             }
             if reply.status & CommandFrame::STOPPING != 0 {
@@ -466,6 +482,7 @@ impl Session {
             }
             self.figures.received += 1;
             self.last_heard = Instant::now();
+            self.silent = Seen::default();
             self.next_check = Duration::from_secs_f64(self.settings.reply_timeout);
             self.figures.note_reply_seq(reply.seq);
             if reply.seq + (RING as u64) > k && reply.seq < k {
@@ -480,6 +497,9 @@ impl Session {
 
         let cmd = if !self.connected {
             self.figures.fallback_ticks += 1;
+            if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
+                return Err(Halt::MissBudget(why));
+            }
             match self.poll_handshake(hooks) {
                 Some(Ok(())) => {
                     self.first_seq = k;
@@ -526,6 +546,12 @@ impl Session {
                             if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
                                 return self.on_lost(sample, why, hooks);
                             }
+                        }
+                        // Alive but silent (stopped, hung, answering another session) for
+                        // controller.lockstep_timeout_ms: lost, as in lockstep.
+                        if self.last_heard.elapsed().as_secs_f64() >= self.settings.lockstep_timeout {
+                            let seen = std::mem::take(&mut self.silent);
+                            return self.on_silent(sample, &seen, hooks);
                         }
                     }
                     self.last_cmd

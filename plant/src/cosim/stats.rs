@@ -274,6 +274,39 @@ pub struct Figures {
 }
 
 impl Figures {
+    /// `Some(why)` if the share of ticks without the controller's reply (the deadline misses,
+    /// and the fallback ticks while no controller was connected: either way not the scene's
+    /// loop) exceeds `budget` (`controller.max_miss_fraction`), judged over at least `min_due`
+    /// such ticks.
+    ///
+    /// ```
+    /// let mut f = plant::cosim::stats::Figures::default();
+    /// (f.due, f.fallback_ticks) = (1000, 0);
+    /// (0..5).for_each(|_| f.misses.record(true));
+    /// assert_eq!(f.miss_budget(0.01, 1000), None); // 5 in 1000
+    /// f.fallback_ticks = 20;                          // the controller lost, a new one awaited
+    /// let why = f.miss_budget(0.01, 1000).unwrap();   // 25 in 1020
+    /// assert!(why.contains("5 deadline misses and 20 fallback ticks without a controller in 1020 ticks"), "{why}");
+    /// assert_eq!(f.miss_budget(1.0, 1000), None);   // 1: no limit
+    /// assert_eq!(f.miss_budget(0.01, 2000), None);  // not yet judged
+    /// ```
+    pub fn miss_budget(&self, budget: f64, min_due: u64) -> Option<String> {
+        let (without, ticks) = (self.misses.total + self.fallback_ticks, self.due + self.fallback_ticks);
+        let share = without as f64 / ticks.max(1) as f64;
+        (ticks >= min_due.max(1) && share > budget).then(|| {
+            let fallback = match self.fallback_ticks {
+                0 => String::new(),
+                n => format!(" and {n} fallback ticks without a controller"),
+            };
+            format!(
+                "realtime: {} deadline misses{fallback} in {ticks} ticks ({:.3} %) exceed controller.max_miss_fraction \
+                 = {budget}: the loop that ran is not the scene's (1 is no limit)",
+                self.misses.total,
+                100.0 * share
+            )
+        })
+    }
+
     /// Notes a reply's `seq`, counting the samples skipped since the last one.
     ///
     /// ```

@@ -216,6 +216,7 @@ impl Session {
             woke: None,
             sent_ns: [0; RING],
             last_heard: Instant::now(),
+            silent: Default::default(),
             next_check: Duration::from_secs_f64(settings.reply_timeout),
             wall_start: Instant::now(),
             overrides: None,
@@ -304,7 +305,21 @@ impl Session {
                         return Some(Err(CosimError::Refused { reason: Refusal::describe(ack.status), message }));
                     }
                     match controller_overrides(&ack) {
-                        Ok(o) => self.overrides = o,
+                        Ok(o) => {
+                            // The controller is untrusted input: it may run its own law and design,
+                            // never change the run it serves. Refused whole, nothing applied.
+                            let allowed = o.as_ref().map_or(Ok(()), |t| {
+                                crate::config::check_controller_overrides(t, self.hello.current_limit_a)
+                            });
+                            if let Err(why) = allowed {
+                                let controller = match &self.program {
+                                    Some(p) => format!("{} ({message}, pid {})", p.describe(), ack.controller_pid),
+                                    None => format!("the external controller ({message}, pid {})", ack.controller_pid),
+                                };
+                                return Some(Err(CosimError::Overrides { controller, why }));
+                            }
+                            self.overrides = o;
+                        }
                         Err(why) => return Some(Err(CosimError::Protocol(why))),
                     }
                     self.controller = format!("{message} (pid {})", ack.controller_pid);
@@ -312,6 +327,7 @@ impl Session {
                     self.connected = true;
                     self.lost_since = None;
                     self.last_heard = Instant::now();
+                    self.silent = Default::default();
                     self.next_check = Duration::from_secs_f64(self.settings.reply_timeout);
                     self.schedule_controller(ack.controller_pid, hooks);
                     return Some(Ok(()));
