@@ -283,6 +283,7 @@ pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -
 #[cfg(test)]
 mod tests {
     use super::*;
+    use controller::Sample;
 
     fn scene(sets: &[&str]) -> Scene {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -314,6 +315,36 @@ mod tests {
         assert_eq!(same.compared, 200);
         let other = replay(&dir, &controller::pd_delay::LAW).unwrap();
         assert!(!other.identical() && other.first.is_some_and(|d| d.seq == 0 && d.row == 2), "{other}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The replay covers the two-plane rotor: a sampled two-plane run (a noisy sensor, one
+    /// sample of delay) replays bit for bit through the law it ran, once per plane, and another
+    /// law differs; a per-plane law handed to `replay_trace` is refused naming the way.
+    #[test]
+    fn a_two_plane_run_replays_through_the_digital_loops_command_path() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let sets: Vec<String> = [
+            "scene.duration_s=0.01",
+            "shock[0].start_s=0.002",
+            "output.plots=false",
+            "controller.mode=\"sampled\"",
+            "sensor.noise_v_rms=0.01",
+        ]
+        .map(String::from)
+        .to_vec();
+        let s = crate::config::load_scene(&root.join("config").join("two-plane-asymmetric-10g.toml"), &sets).unwrap();
+        let run = crate::run::run(&s, &mut crate::run::Quiet).unwrap();
+        let dir = scratch("two-plane");
+        crate::output::write_run(&dir, &s, &run).unwrap();
+        let same = replay(&dir, &controller::pd::LAW).unwrap();
+        assert!(same.identical(), "{same}");
+        assert_eq!(same.compared, 200);
+        let other = replay(&dir, &controller::pd_delay::LAW).unwrap();
+        assert!(!other.identical(), "{other}");
+        let mut law = (controller::pd::LAW.build)(&s.design(), &s.controller.params).unwrap();
+        let e = replay_trace(&s, &dir.join("trace.csv"), law.as_mut()).unwrap_err().to_string();
+        assert!(e.contains("replay_rotor_trace"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
