@@ -265,8 +265,8 @@ impl Summary {
         let planes = match (&recorded.tilt, recorded.planes.as_slice()) {
             (Some(tilt), [a, b]) => Some(PlanesSummary {
                 governing: ["a", "b"][governing],
-                a: PlaneSummary::new(a, run.simulated),
-                b: PlaneSummary::new(b, run.simulated),
+                a: PlaneSummary::new(a, run.span()),
+                b: PlaneSummary::new(b, run.span()),
                 tilt: tilt.clone(),
             }),
             _ => None,
@@ -292,9 +292,9 @@ impl Summary {
             max_contact_force_n: figures.max_contact_force_n,
             max_race_speed_rpm: figures.max_race_speed_rpm,
             recovery_s: figures.recovery_s,
-            contact_time_s: figures.contact_share() * run.simulated,
+            contact_time_s: figures.contact_share() * run.span(),
             parked_fraction: {
-                let ticks = (run.simulated / c.period).round() * run.planes as f64;
+                let ticks = (run.span() / c.period).round() * run.planes as f64;
                 if ticks > 0.0 {
                     run.parked_steps as f64 / ticks
                 } else {
@@ -307,7 +307,7 @@ impl Summary {
             rejected_steps: run.stats.rejected,
             rhs_evals: run.stats.rhs_evals,
             wall_time_s: run.wall_time,
-            realtime_factor: if run.wall_time > 0.0 { run.simulated / run.wall_time } else { f64::INFINITY },
+            realtime_factor: if run.wall_time > 0.0 { run.span() / run.wall_time } else { f64::INFINITY },
             model: ModelInfo::new(scene),
             integrator: IntegratorInfo {
                 method: scene.integrator.method,

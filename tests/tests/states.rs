@@ -65,7 +65,7 @@ fn another_controller_takes_over_from_a_saved_state() {
     let tmp = TempDir::new("states-takeover");
     let sets = ["scene.duration_s=0.04", "shock[0].start_s=0.005", "output.plots=false", "controller.mode=\"sampled\""];
     let whole = tmp.join("whole");
-    let mut cmd = plant_run(&scene_path("relev-10g.toml"), &whole, &sets);
+    let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &whole, &sets);
     cmd.args(["--save-state-at", "0.02"]);
     assert_exit(&output(&mut cmd), 0);
     let state = whole.join("state-0.02.json");
@@ -75,11 +75,15 @@ fn another_controller_takes_over_from_a_saved_state() {
         let out_dir = tmp.join(&format!("from-{}", tails.len()));
         let mut all = sets.to_vec();
         all.extend_from_slice(extra);
-        let mut cmd = plant_run(&scene_path("relev-10g.toml"), &out_dir, &all);
+        let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &out_dir, &all);
         cmd.arg("--from-state").arg(&state);
         assert_exit(&output(&mut cmd), 0);
         let summary = read_json(&out_dir.join("summary.json"));
         assert_eq!(summary["status"], "completed");
+        let started = num(&summary, "started_s");
+        assert!((started - 0.02).abs() < 5e-5, "started_s {started}");
+        // The figures cover the time from the state on.
+        assert!(num(&summary, "contact_time_s") <= 0.04 - started + 1e-12);
         tails.push(rows(&out_dir));
     }
     assert_eq!(tails[0].len(), tails[1].len());

@@ -225,6 +225,14 @@ pub struct SinkRun {
     pub ticks: TickCost,
 }
 
+impl SinkRun {
+    /// The simulated time this run covered (s): from its start (0, or a saved state's time) to
+    /// where it ended.
+    pub fn span(&self) -> f64 {
+        self.simulated - self.started
+    }
+}
+
 /// What the ticks of a run cost.
 #[derive(Clone, Debug, Default)]
 pub struct TickCost {
