@@ -743,10 +743,8 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
     let a = spec::load(&args.file, &args.set, &args.laws)?;
     // Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2).
     let mut first = None;
-    let mut realtime = false;
     for c in &a.controllers {
         let scene = load_scene(&a.scene, &c.sets)?;
-        realtime |= scene.controller.mode == ControlMode::Realtime;
         if scene.hardware.is_on() {
             return Err(ConfigError::Range {
                 key: "amb.amplifier".into(),
@@ -813,45 +811,13 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         wall_s: 0.0,
         roots,
     };
-    // The controllers side by side: a co-simulated one mostly waits for its round trips, which
-    // leaves the cores to the others (each part's runs still go COSIM_JOBS or one per core at a
-    // time); the report keeps the file's order. One after the other when one runs in realtime.
-    let results: Vec<anyhow::Result<ControllerReport>> = if realtime {
-        let mut out = Vec::new();
-        for c in &a.controllers {
-            let r = assess_controller(&a, c, stop, &log);
-            if let Ok(r) = &r {
-                log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
-            }
-            let failed = r.is_err();
-            out.push(r);
-            if failed || stop.load(Ordering::Relaxed) {
-                break;
-            }
+    for c in &a.controllers {
+        let r = assess_controller(&a, c, stop, &log)?;
+        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
+        report.controllers.push(r);
+        if stop.load(Ordering::Relaxed) {
+            break;
         }
-        out
-    } else {
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = a
-                .controllers
-                .iter()
-                .map(|c| {
-                    let (a, log) = (&a, &log);
-                    scope.spawn(move || {
-                        let r = assess_controller(a, c, stop, log)?;
-                        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
-                        Ok(r)
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|_| Err(anyhow::anyhow!("an assessment thread panicked"))))
-                .collect()
-        })
-    };
-    for r in results {
-        report.controllers.push(r?);
     }
     for c in a.controllers.iter().skip(report.controllers.len()) {
         let mut r = ControllerReport {
