@@ -8,7 +8,7 @@
  *   cargo build --release
  *   cc -std=c11 -O2 -ffp-contract=off -Icontroller/include examples/c/pd.c \
  *      target/release/libamb_testbed_controller.a -lgcc_s -lutil -lrt -lpthread -lm -ldl -lc -o pd-c
- *   target/release/plant run config/cosim-10g.toml --set 'controller.command=["./pd-c"]'
+ *   target/release/plant run config/cosim-10g.toml --set controller.law='"pd"' --set 'controller.command=["./pd-c"]'
  *
  * One PD per bearing plane (the planar model: one; the two-plane rotor: two,
  * each from its own plane's design), as the registry's pd. It takes one

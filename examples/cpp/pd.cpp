@@ -7,7 +7,7 @@
 //   c++ -std=c++17 -O2 -ffp-contract=off -Icontroller/include examples/cpp/pd.cpp
 //       -Ltarget/release -lamb_testbed_controller -Wl,-rpath,$PWD/target/release -o pd-cpp
 //   (one command line)
-//   target/release/plant run config/cosim-10g.toml --set 'controller.command=["./pd-cpp"]'
+//   target/release/plant run config/cosim-10g.toml --set controller.law='"pd"' --set 'controller.command=["./pd-cpp"]'
 #include <array>
 #include <cmath>
 #include <cstdio>

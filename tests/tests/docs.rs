@@ -445,3 +445,140 @@ fn the_key_table_reader_reads_keys_notes_and_defaults() {
     let touchdown = &rows["touchdown"];
     assert!(!touchdown.iter().any(|(k, _)| k.contains('+')), "a code span inside a note is not a key");
 }
+
+/// The fenced code blocks of a page: `(line of the fence, info string, text)`.
+fn code_blocks(text: &str) -> Vec<(usize, String, String)> {
+    let mut out = Vec::new();
+    let mut open: Option<(usize, String, String)> = None;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if let Some(info) = t.strip_prefix("```") {
+            match open.take() {
+                Some(block) => out.push(block),
+                None => open = Some((i + 1, info.trim().to_string(), String::new())),
+            }
+        } else if let Some((_, _, body)) = open.as_mut() {
+            body.push_str(line);
+            body.push('\n');
+        }
+    }
+    out
+}
+
+/// The commands of a shell text: lines joined over a trailing `\`, comments dropped.
+fn shell_commands(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut current = String::new();
+    for line in text.lines() {
+        let line = line.split(" #").next().unwrap_or("");
+        if line.trim_start().starts_with('#') {
+            continue;
+        }
+        match line.trim_end().strip_suffix('\\') {
+            Some(head) => current.push_str(head),
+            None => {
+                current.push_str(line);
+                if !current.trim().is_empty() {
+                    out.push(std::mem::take(&mut current));
+                }
+                current.clear();
+            }
+        }
+    }
+    out
+}
+
+/// The tables of a TOML text by their header (`[controller]`, `[[controller]]`, …; the lines
+/// before the first header under `""`), each with its lines, comments dropped.
+fn toml_tables(text: &str) -> Vec<(String, String)> {
+    let mut out = vec![(String::new(), String::new())];
+    for line in text.lines() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.starts_with('[') && !line.contains('=') {
+            out.push((line.to_string(), String::new()));
+        } else if let Some((_, body)) = out.last_mut() {
+            body.push_str(line);
+            body.push('\n');
+        }
+    }
+    out
+}
+
+/// Where a TOML text runs a program of its own as the controller without naming its law: a
+/// `[controller]` table with `command` and no `law`, an assessment's `[[controller]]` whose
+/// `set` gives `controller.command` and no `controller.law`.
+fn commands_without_law(toml_text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (header, body) in toml_tables(toml_text) {
+        let keys: Vec<&str> = body.lines().filter_map(|l| l.split('=').next()).map(str::trim).collect();
+        if header == "[controller]" && keys.contains(&"command") && !keys.contains(&"law") {
+            out.push(format!("{header} with command and no law"));
+        }
+        if header == "[[controller]]" && body.contains("controller.command=") && !body.contains("controller.law=") {
+            out.push(format!("{header} {}", body.lines().next().unwrap_or("")));
+        }
+    }
+    out
+}
+
+/// Issue 31: every example that runs a program of its own as the controller
+/// (`controller.command`) names the law that program serves (`controller.law`): the plant asks
+/// the program for the scene's law, so a copied example whose program serves a law of another
+/// name is refused (exit 2) until its author guesses the key. Held for the shell commands and
+/// the TOML of every page's code blocks, and for every scene and assessment file under
+/// `config/` and `examples/`.
+#[test]
+fn every_example_that_runs_a_controller_program_names_its_law() {
+    let root = common::workspace_root();
+    let mut problems = Vec::new();
+    for page in pages() {
+        let text = fs::read_to_string(&page).unwrap();
+        for (line, info, body) in code_blocks(&text) {
+            if info.starts_with("toml") {
+                for p in commands_without_law(&body) {
+                    problems.push(format!("{}:{line}: {p}", rel(&page)));
+                }
+            } else if matches!(info.as_str(), "sh" | "bash" | "shell" | "console" | "") {
+                for c in shell_commands(&body) {
+                    if c.contains("controller.command=") && !c.contains("controller.law=") {
+                        problems.push(format!("{}:{line}: {}", rel(&page), c.trim()));
+                    }
+                }
+            }
+        }
+    }
+    let mut stack = vec![root.join("config"), root.join("examples")];
+    let mut files = 0;
+    while let Some(dir) = stack.pop() {
+        for entry in fs::read_dir(&dir).unwrap().flatten() {
+            let path = entry.path();
+            let name = entry.file_name().to_string_lossy().to_string();
+            if path.is_dir() {
+                if name != "target" && !name.starts_with('.') {
+                    stack.push(path);
+                }
+            } else if name.ends_with(".toml") && name != "Cargo.toml" && name != "pyproject.toml" {
+                files += 1;
+                for p in commands_without_law(&fs::read_to_string(&path).unwrap()) {
+                    problems.push(format!("{}: {p}", rel(&path)));
+                }
+            }
+        }
+    }
+    assert!(files > 20, "only {files} TOML files found under config/ and examples/");
+    assert!(problems.is_empty(), "a controller program without its law:\n  {}", problems.join("\n  "));
+}
+
+#[test]
+fn the_command_checker_finds_a_program_without_its_law() {
+    let assess = "scene = \"s.toml\"\n[[controller]]\nlabel = \"c\"\nset = [\"controller.command=[\\\"./c\\\"]\"]\n";
+    assert_eq!(commands_without_law(assess).len(), 1);
+    let named = assess.replace("set = [", "set = [\"controller.law=\\\"mine\\\"\", ");
+    assert!(commands_without_law(&named).is_empty(), "{named}");
+    assert_eq!(commands_without_law("[controller]\nmode = \"lockstep\"\ncommand = [\"./c\"]\n").len(), 1);
+    assert!(commands_without_law("[controller]\nlaw = \"mine\"   # served\ncommand = [\"./c\"]\n").is_empty());
+    let sh = "plant run x.toml \\\n    --set 'controller.command=[\"./c\"]'\nplant run y.toml --set controller.law=pd --set 'controller.command=[\"./c\"]'\n";
+    let commands = shell_commands(sh);
+    assert_eq!(commands.len(), 2, "{commands:?}");
+    assert!(!commands[0].contains("controller.law=") && commands[1].contains("controller.law="));
+}

@@ -181,6 +181,48 @@ fn the_kit_pins_the_iceoryx2_release_of_cargo_lock() {
     );
 }
 
+/// Issue 31: `pip install ./python` writes nothing into the checkout (setuptools left `build/`
+/// and `*.egg-info` there): a copy of the kit, installed by the venv's pip into a folder of its
+/// own, holds exactly the files it held before, and the installed package has its `py.typed`.
+#[test]
+fn installing_the_kit_writes_nothing_into_its_folder() {
+    fn files(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()) {
+            if e.file_name().is_some_and(|n| n == "__pycache__") {
+                continue;
+            }
+            out.push(e.clone());
+            if e.is_dir() {
+                files(&e, out);
+            }
+        }
+    }
+    let tmp = TempDir::new("py-install");
+    let kit = tmp.join("kit");
+    let copy = output_within(
+        Command::new("cp").arg("-r").arg(workspace_root().join("python")).arg(&kit),
+        Duration::from_secs(30),
+    );
+    assert_exit(&copy, 0);
+    let mut before = Vec::new();
+    files(&kit, &mut before);
+    let install = output_within(
+        Command::new(python())
+            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "--no-deps", "--target"])
+            .arg(tmp.join("site"))
+            .arg(&kit),
+        Duration::from_secs(300),
+    );
+    assert_exit(&install, 0);
+    let mut after = Vec::new();
+    files(&kit, &mut after);
+    before.sort();
+    after.sort();
+    let new: Vec<_> = after.iter().filter(|p| !before.contains(p)).collect();
+    assert!(new.is_empty(), "pip install wrote into the kit's folder: {new:?}");
+    assert!(tmp.join("site").join("amb_testbed_controller").join("py.typed").is_file(), "py.typed not installed");
+}
+
 /// Issue 20: the kit's wire constants and ctypes layouts come from the Rust definitions or
 /// this test fails naming the difference: `wire.describe()` (every constant of `wire.CONSTANTS`,
 /// every structure's type name, size, alignment and each field's offset and size as ctypes lays

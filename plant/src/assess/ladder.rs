@@ -311,8 +311,10 @@ pub fn ladder(
             work.len(),
             work.iter().map(|w| w.0).collect::<std::collections::BTreeSet<_>>().len()
         ));
-        let done: Vec<anyhow::Result<Option<Counted>>> =
-            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, stop)).collect();
+        // A co-simulated controller's members: more at once than cores (super::COSIM_JOBS).
+        let done: Vec<anyhow::Result<Option<Counted>>> = super::jobs_for(&base, || {
+            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, stop)).collect()
+        });
         for r in done {
             match r {
                 Ok(Some(c)) => {

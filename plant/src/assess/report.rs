@@ -13,32 +13,56 @@ use std::path::Path;
 /// The ISO 14839-3 zone boundaries of the peak sensitivity, in dB (3, 4, 5).
 const ZONE_DB: [(f64, &str); 3] = [(9.542, "A/B"), (12.041, "B/C"), (13.979, "C/D")];
 
+/// Peaks of `|S|` within this many dB of the worst one are named as its equals.
+pub const EQUAL_DB: f64 = 0.05;
+
+/// The worst measured axis (the worst zone, then the highest peak; of equals the first in the
+/// order measured: x, y, at standstill then at speed) and the others in its zone whose peak lies
+/// within [`EQUAL_DB`] of its own.
+pub fn worst_axis(
+    axes: &[super::sensitivity::AxisResult],
+) -> Option<(&super::sensitivity::AxisResult, Vec<&super::sensitivity::AxisResult>)> {
+    let rank = |a: &super::sensitivity::AxisResult| match a.zone.as_str() {
+        "A" => 0,
+        "B" => 1,
+        "C" => 2,
+        "D" => 3,
+        _ => 4,
+    };
+    let peak = |a: &super::sensitivity::AxisResult| a.peak.as_ref().map_or(f64::NEG_INFINITY, |p| p.s_db);
+    let mut worst: Option<&super::sensitivity::AxisResult> = None;
+    for a in axes {
+        let beats = worst.is_none_or(|w| rank(a).cmp(&rank(w)).then(peak(a).total_cmp(&peak(w))).is_gt());
+        if beats {
+            worst = Some(a);
+        }
+    }
+    let w = worst?;
+    let equals = axes
+        .iter()
+        .filter(|a| !std::ptr::eq(*a, w) && rank(a) == rank(w) && (peak(a) - peak(w)).abs() <= EQUAL_DB)
+        .collect();
+    Some((w, equals))
+}
+
 /// The verdict line of a controller: its worst zone, the vibration zone, the highest safe
 /// shock and the duty at the duty rung.
 pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
     let mut parts = Vec::new();
     match (&r.sensitivity.result, r.sensitivity.status) {
         (Some(s), _) => {
-            let worst = s
-                .axes
-                .iter()
-                // The worst zone, and within it the highest peak (of 2 or 4 axes).
-                .max_by(|a, b| {
-                    let rank = |a: &super::sensitivity::AxisResult| match a.zone.as_str() {
-                        "A" => 0,
-                        "B" => 1,
-                        "C" => 2,
-                        "D" => 3,
-                        _ => 4,
+            let worst = worst_axis(&s.axes)
+                .map(|(a, equals)| {
+                    let equal = if equals.is_empty() {
+                        String::new()
+                    } else {
+                        let names: Vec<String> =
+                            equals.iter().map(|e| format!("{} at {:.0} Hz", e.axis, e.speed_hz)).collect();
+                        format!("; equal within {EQUAL_DB} dB: {}", names.join(", "))
                     };
-                    let peak =
-                        |a: &super::sensitivity::AxisResult| a.peak.as_ref().map_or(f64::NEG_INFINITY, |p| p.s_db);
-                    rank(a).cmp(&rank(b)).then(peak(a).total_cmp(&peak(b)))
-                })
-                .map(|a| {
                     a.peak.as_ref().map_or(format!("{} ({} at {:.0} Hz)", a.zone, a.axis, a.speed_hz), |p| {
                         format!(
-                            "zone {} (|S| {:.1} dB at {:.1} Hz, {} at {:.0} Hz)",
+                            "zone {} (|S| {:.1} dB at {:.1} Hz, {} at {:.0} Hz{equal})",
                             a.zone, p.s_db, p.f_hz, a.axis, a.speed_hz
                         )
                     })
@@ -108,6 +132,23 @@ type ErrorBars = (RGBColor, Vec<(f64, f64, f64)>);
 fn chart(
     path: &Path,
     title: &str,
+    labels: (&str, &str),
+    x_log: bool,
+    lines: &[Line],
+    hlines: &[(f64, &str)],
+    bars: &[ErrorBars],
+) -> Result<(), PlotError> {
+    ensure_font(path)?;
+    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
+    let area = titled_root(&root, path, title)?;
+    panel(&area, path, labels, x_log, lines, hlines, bars)?;
+    finish(&root, path)
+}
+
+/// One x–y plot on `area` (the body of [`chart`]; a chart of several panels draws one each).
+fn panel(
+    area: &crate::plot::Area<'_>,
+    path: &Path,
     (x_label, y_label): (&str, &str),
     x_log: bool,
     lines: &[Line],
@@ -140,9 +181,6 @@ fn chart(
     }
     let pad = ((y1 - y0) * 0.06).max(1e-9);
     let (y0, y1) = (y0 - pad, y1 + pad);
-    ensure_font(path)?;
-    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
     let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
     macro_rules! body {
         ($chart:expr) => {{
@@ -188,25 +226,56 @@ fn chart(
     }
     if x_log {
         let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
-        let mut c = builder(&area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
+        let mut c = builder(area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
         let fmt_x = |v: &f64| format!("{v}");
         draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
         body!(c);
     } else {
-        let mut c = builder(&area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
+        let mut c = builder(area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
         let fmt_x = |v: &f64| format!("{v}");
         draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
         body!(c);
     }
-    finish(&root, path)
+    Ok(())
 }
 
 /// The Bode magnitude chart of one controller: `|S|` and `|T|` of each axis and speed, the
 /// closed form where there is one, the zone boundaries.
 fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
     let Some(s) = &c.sensitivity.result else { return Ok(false) };
+    // One panel per rotor speed, side by side (standstill first): the curves at standstill and
+    // at speed often lie on one another, and one panel would show only the last drawn.
+    let mut speeds: Vec<f64> = s.axes.iter().filter(|a| !a.points.is_empty()).map(|a| a.speed_hz).collect();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup();
+    let panels: Vec<(f64, Vec<Line>)> = speeds.iter().map(|sp| (*sp, sensitivity_lines(s, Some(*sp)))).collect();
+    if panels.iter().all(|(_, lines)| lines.iter().all(|l| l.points.is_empty())) {
+        return Ok(false);
+    }
+    let zones: Vec<(f64, &str)> = ZONE_DB.to_vec();
+    ensure_font(path)?;
+    let size = if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1) } else { WIDE_SIZE };
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    let area = titled_root(&root, path, &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label))?;
+    let areas = area.split_evenly((1, panels.len().max(1)));
+    for ((speed, lines), sub) in panels.iter().zip(&areas) {
+        let x = if *speed > 0.0 {
+            format!("frequency (Hz); rotor at {speed:.0} Hz")
+        } else {
+            "frequency (Hz); rotor at standstill".into()
+        };
+        panel(sub, path, (&x, "magnitude (dB)"), true, lines, &zones, &[])?;
+    }
+    finish(&root, path)?;
+    Ok(true)
+}
+
+/// The lines of the sensitivity chart: `|S|` and `|T|` of each axis measured at `speed` (Hz;
+/// `None`: every speed), and the closed form where there is one.
+fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line> {
     let mut lines = Vec::new();
-    for (i, a) in s.axes.iter().filter(|a| !a.points.is_empty()).enumerate() {
+    let at = |a: &&super::sensitivity::AxisResult| speed.is_none_or(|sp| a.speed_hz == sp);
+    for (i, a) in s.axes.iter().filter(|a| !a.points.is_empty()).filter(at).enumerate() {
         let name = format!("{} at {:.0} Hz", a.axis, a.speed_hz);
         lines.push(Line {
             label: format!("|S| {name}"),
@@ -231,20 +300,7 @@ fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotErro
         let label = if s.closed_form_planes.is_empty() { "|S| closed form" } else { "|S| closed form, plane A alone" };
         lines.push(Line { label: label.into(), points: cf.curve.clone(), colour: BLACK, dashed: true, width: 2 });
     }
-    if lines.iter().all(|l| l.points.is_empty()) {
-        return Ok(false);
-    }
-    let zones: Vec<(f64, &str)> = ZONE_DB.to_vec();
-    chart(
-        path,
-        &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label),
-        ("frequency (Hz)", "magnitude (dB)"),
-        true,
-        &lines,
-        &zones,
-        &[],
-    )?;
-    Ok(true)
+    lines
 }
 
 /// The ladder's charts over all controllers: probability with its interval, recovery times,
@@ -338,6 +394,91 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
     Ok(out)
 }
 
+/// The class (colour) of a highest safe shock of `g` (G): `ok` (green) from the duty rung
+/// `duty_g` up, `low` (amber) below it; none at all is `bad` (red).
+pub fn safe_class(g: f64, duty_g: f64) -> &'static str {
+    if g + 1e-9 >= duty_g {
+        "ok"
+    } else {
+        "low"
+    }
+}
+
+/// What the report's words, abbreviations and colours mean: the page reads without the guide.
+fn legend(r: &Report) -> String {
+    let min_p = r.ladder_settings.min_p;
+    let duty_g = r.ladder_settings.duty_g;
+    let mut h = String::from("<h2>How to read this report</h2>\n<dl class=\"note\">\n");
+    let mut item = |term: &str, text: String| {
+        let _ = writeln!(h, "<dt>{term}</dt><dd>{text}</dd>");
+    };
+    item(
+        "Stability margin (ISO 14839-3), zones A–D",
+        format!(
+            "The plant adds a sine E to the sensor signal the controller reads, one axis at a time; \
+             S = (what the controller read) / E is the sensitivity function, T = S − 1. The peak of |S| \
+             over frequency grades the axis: zone <b>A</b> |S| &lt; 3 ({:.1} dB), <b>B</b> 3 to 4 ({:.1} dB), \
+             <b>C</b> 4 to 5 ({:.1} dB), <b>D</b> 5 or more. <b>unstable</b>: the free decay after an offset grows, \
+             so there is no margin to grade. Each axis (x, y; on a two-plane rotor x_A, y_A, x_B, y_B) is \
+             measured at standstill and at the rotor's speed (“x at 500 Hz”: axis x, rotor at 500 Hz).",
+            ZONE_DB[0].0, ZONE_DB[1].0, ZONE_DB[2].0
+        ),
+    );
+    item(
+        "The worst axis in the verdict",
+        format!(
+            "The worst zone over every axis and speed, then within it the highest peak of |S|; of exactly \
+             equal peaks the first measured (x before y, standstill before speed). Axes whose peak lies \
+             within {EQUAL_DB} dB of it in the same zone are named after it as its equals (a machine that is \
+             the same in x and y, or whose margin does not change with speed, has several)."
+        ),
+    );
+    item(
+        "Closed form",
+        "|S| computed from the law's equations and the linearised bearing, where the law has them \
+         (pd, pd_delay, relev's nominal design, the continuous PD); a controller process is a black box \
+         and has none. On a two-plane rotor: plane A's load share as a planar rotor, not the coupled loop."
+            .into(),
+    );
+    item(
+        "Vibration (ISO 14839-2), zones A–D",
+        "The levitated rotor at its speed, no shock: the peak of the orbit at the sensor against \
+         C<sub>min</sub>, the minimum radial clearance (the touchdown bearing's air gap): zone <b>A</b> below \
+         0.3 C<sub>min</sub>, <b>B</b> 0.3 to 0.4, <b>C</b> 0.4 to 0.5, <b>D</b> 0.5 or more. The coil current: \
+         its largest swing about the mean and the RMS of the swing, per axis, against the amplifier's limit."
+            .into(),
+    );
+    item(
+        "Highest safe shock",
+        format!(
+            "The ladder runs the scene's shock scaled to each rung's peak (G) over many draws of the rotor's \
+             angle; P(recovered) is the share of draws that end back on the orbit, with its Wilson 95 % \
+             interval [lower, upper]. The highest safe shock is the highest rung up to which every rung's \
+             lower bound is at least {min_p}. Colours: <b class=\"ok\">green</b> at or above the {duty_g} G \
+             rung whose duty the verdict gives, <b class=\"low\">amber</b> below it, <b class=\"bad\">red</b> \
+             none (not even the first rung)."
+        ),
+    );
+    item(
+        "Motion modes (the ladder's counts)",
+        "How each draw ends, read over the run's last part: <b>recovered</b> back on its small unbalance \
+         orbit, no contact; <b>dry whirl</b> continuous contact, whirling around the clearance circle; \
+         <b>rebound</b> repeated impacts; <b>diverged</b> the run failed numerically (also at the \
+         reference setting)."
+            .into(),
+    );
+    item(
+        "Duty",
+        "Per shock, median [90th percentile, p90] over the rung's counted draws: time in contact, peak \
+         rotor–race force and its Hertz pressure, the most loaded ball's load and pressure, the friction \
+         energy, the race's peak speed and acceleration, and the ball-load cycles whose range reaches the \
+         given share of Q₀, one ball's static capacity (the basis is at the end of the page)."
+            .into(),
+    );
+    h.push_str("</dl>\n");
+    h
+}
+
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
@@ -358,8 +499,9 @@ fn image(dir: &Path, name: &str, alt: &str) -> anyhow::Result<String> {
 /// Writes `report.json`, the charts and `report.html` into `dir`.
 pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let json = serde_json::to_vec_pretty(r)?;
-    crate::atomic::write(&dir.join("report.json"), &json)?;
+    // No folder of this machine in the report: each is shown relative to where the command ran.
+    let json = super::relative_text(&serde_json::to_string_pretty(r)?, &r.roots);
+    crate::atomic::write(&dir.join("report.json"), json.as_bytes())?;
     let mut charts: Vec<(usize, String)> = Vec::new();
     for (i, c) in r.controllers.iter().enumerate() {
         let name = format!("sensitivity_{}.png", i + 1);
@@ -377,15 +519,17 @@ body{{font-family:sans-serif;max-width:1250px;margin:1.5em auto;padding:0 1em;co
 table{{border-collapse:collapse;margin:.8em 0;font-size:.92em}}td,th{{border:1px solid #bbb;padding:.3em .55em;text-align:left;vertical-align:top}}\
 th{{background:#f1f1f1}}.verdict td{{font-weight:600}}.bad{{color:#b00020}}.ok{{color:#126b12}}\
 figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{font-size:.9em;color:#555}}code{{font-size:.92em}}\
-.note{{font-size:.9em;color:#444}}</style></head><body>\n<h1>{}</h1>\n",
+.note{{font-size:.9em;color:#444}}.low{{color:#a65c00}}dt{{font-weight:600;margin-top:.4em}}dd{{margin-left:1.5em}}</style></head><body>\n<h1>{}</h1>\n",
         esc(&title),
         esc(&title)
     );
     let _ = writeln!(
         h,
-        "<p class=\"note\">{} · file <code>{}</code> · parts: {} · {:.0} s{}</p>",
+        "<p class=\"note\">{} · file <code>{}</code> · scene <code>{}</code> · written to <code>{}</code> (paths relative to where the command ran) · parts: {} · {:.0} s{}</p>",
         esc(&r.program),
         esc(&r.file),
+        esc(&r.scene),
+        esc(&r.out),
         r.parts.join(", "),
         r.wall_s,
         if r.interrupted {
@@ -498,7 +642,12 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
         ),
         Some(l) => match l.safe_up_to_g {
             Some(g) => {
-                format!("<b class=\"ok\">{g} G</b> (every rung up to it: lower bound ≥ {})", r.ladder_settings.min_p)
+                // Coloured by its value: green only from the duty rung (the design shock) up.
+                let class = safe_class(g, r.ladder_settings.duty_g);
+                format!(
+                    "<b class=\"{class}\">{g} G</b> (every rung up to it: lower bound ≥ {})",
+                    r.ladder_settings.min_p
+                )
             }
             None => {
                 format!("<b class=\"bad\">none</b> (the first rung's lower bound is below {})", r.ladder_settings.min_p)
@@ -515,6 +664,7 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
         )
     });
     let _ = writeln!(h, "</table>");
+    h.push_str(&legend(r));
     // The ladder table.
     if r.controllers.iter().any(|c| c.ladder.result.is_some()) {
         let _ = writeln!(h, "<h2>Shock ladder and the touchdown bearing's duty</h2>");
@@ -522,7 +672,7 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             esc(&r.controllers.iter().find_map(|c| c.ladder.result.as_ref().map(|l| l.member_setting.clone())).unwrap_or_default()));
         for c in r.controllers.iter() {
             let Some(l) = &c.ladder.result else { continue };
-            let _ = writeln!(h, "<h3>{}</h3><table><tr><th>peak (G)</th><th>members</th><th>P(recovered) [95 %]</th><th>modes R/W/B/D</th><th>recovery median / p90 (ms)</th><th>contact (ms)</th><th>peak force (N)</th><th>rotor–race pressure (MPa)</th><th>most loaded ball (N / MPa)</th><th>friction energy (J)</th><th>race peak speed (rpm)</th><th>race peak accel. (krad/s²)</th><th>ball-load cycles ≥ {:.0} % Q₀</th></tr>",
+            let _ = writeln!(h, "<h3>{}</h3><table><tr><th>peak (G)</th><th>members</th><th>P(recovered) [95 %]</th><th>recovered / dry whirl / rebound / diverged</th><th>recovery median / p90 (ms)</th><th>contact (ms)</th><th>peak force (N)</th><th>rotor–race pressure (MPa)</th><th>most loaded ball (N / MPa)</th><th>friction energy (J)</th><th>race peak speed (rpm)</th><th>race peak accel. (krad/s²)</th><th>ball-load cycles ≥ {:.0} % Q₀</th></tr>",
                 esc(&c.label), r.bearing.map_or(50.0, |b| b.capacity_fraction * 100.0));
             let mp = |s: &super::ladder::Spread, k: f64, dig: usize| {
                 format!("{} [{}]", num(s.median.map(|v| v * k), dig), num(s.p90.map(|v| v * k), dig))
@@ -588,6 +738,58 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             b.width_m * 1e3, b.materials.youngs_modulus_pa * 1e-9, b.materials.poisson, b.ball_diameter_m * 1e3, b.pitch_diameter_m * 1e3, b.materials.groove_conformity, b.ball_static_load_n, b.materials.static_pressure_pa * 1e-6, b.capacity_fraction * 100.0);
     }
     let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
+    let h = super::relative_text(&h, &r.roots);
     crate::atomic::write(&dir.join("report.html"), h.as_bytes())?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::sensitivity::{AxisResult, Peak};
+    use super::{safe_class, worst_axis};
+
+    fn axis(name: &str, speed_hz: f64, zone: &str, s_db: Option<f64>) -> AxisResult {
+        AxisResult {
+            axis: name.into(),
+            speed_hz,
+            stable: s_db.is_some(),
+            decay_per_s: 1.0,
+            probe_hz: 47.0,
+            note: None,
+            points: Vec::new(),
+            peak: s_db.map(|s_db| Peak { f_hz: 47.0, s_abs: 10f64.powf(s_db / 20.0), s_db, spacing: 0.002 }),
+            zone: zone.into(),
+            simulated_s: 1.0,
+        }
+    }
+
+    /// The worst axis: the worst zone, then the highest peak, of exact equals the first; the
+    /// others of its zone within `EQUAL_DB` are its equals, a lower zone never is.
+    #[test]
+    fn the_worst_axis_and_its_equals() {
+        let axes = [
+            axis("x", 0.0, "D", Some(37.10)),
+            axis("y", 0.0, "D", Some(37.12)),
+            axis("x", 500.0, "D", Some(37.12)),
+            axis("y", 500.0, "D", Some(36.0)),
+            axis("x_B", 0.0, "C", Some(37.11)),
+        ];
+        let (w, equals) = worst_axis(&axes).expect("worst");
+        assert_eq!((w.axis.as_str(), w.speed_hz), ("y", 0.0));
+        let names: Vec<(&str, f64)> = equals.iter().map(|a| (a.axis.as_str(), a.speed_hz)).collect();
+        assert_eq!(names, [("x", 0.0), ("x", 500.0)]);
+        // A higher zone wins over a higher peak.
+        let axes = [axis("x", 0.0, "B", Some(11.0)), axis("y", 0.0, "C", Some(12.5))];
+        assert_eq!(worst_axis(&axes).expect("worst").0.axis, "y");
+        assert!(worst_axis(&[]).is_none());
+    }
+
+    /// Green only from the duty rung up: 1 G against a 10 G duty rung is not green.
+    #[test]
+    fn the_highest_safe_shock_is_coloured_by_its_value() {
+        assert_eq!(safe_class(1.0, 10.0), "low");
+        assert_eq!(safe_class(7.0, 10.0), "low");
+        assert_eq!(safe_class(10.0, 10.0), "ok");
+        assert_eq!(safe_class(20.0, 10.0), "ok");
+    }
 }

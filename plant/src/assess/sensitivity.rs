@@ -19,6 +19,16 @@
 //! agree within `tolerance` (at most 6 windows; a point that never agrees is marked
 //! `settled = false`).
 //!
+//! *Multisine* (a sampled or co-simulated loop with `auto_level`, `excitation = "multisine"`):
+//! before the stepped sine, the whole log grid at once, each frequency on the nearest bin of one
+//! window (`min_cycles` periods of the lowest, at speed 4 periods of each one's distance from Ω):
+//! one settling, then windows fitted on every tone (the tones by their correlation sums, the
+//! rotation's line by the Schur complement) until each tone agrees with its previous window;
+//! a tone that does not is measured again by the stepped sine. The loop reads the sum at its
+//! ticks, as it reads a single sine; the grid then costs one settling and a few windows of its
+//! lowest frequency instead of a settling and two windows at each of its frequencies (over the
+//! wire, each tick a round trip: the difference between minutes and seconds).
+//!
 //! **Level.** The amplitude `a` is at most `excitation_um` (as a displacement at the sensor,
 //! `A_s · excitation_um` volts) and is lowered so that the expected response `|T| a` stays near
 //! `response_um` (`|T|` from the previous point). If the rotor's displacement still passes
@@ -27,10 +37,11 @@
 //! ends the measurement with an error naming the frequency and the amplitude.
 //!
 //! **Frequencies and resolution near a peak.** A log grid of `points` frequencies from `f_min`
-//! to `f_max` (below the Nyquist frequency of a sampled loop), then around the largest `|S|`
-//! the two intervals beside it are halved (in log f) until the points around the peak are at
-//! most `resolution` apart (relative; 0.2 % by default); the peak is the vertex of the parabola
-//! through the three points around it in (log f, dB). For a resonance of damping ratio ζ the
+//! to `f_max` (below the Nyquist frequency of a sampled loop), then frequencies are added around
+//! the largest `|S|` (at the vertex of the parabola through it and its neighbours, then one
+//! `resolution` either side) until the points around the peak are at most `resolution` apart
+//! (relative; 0.2 % by default); the peak is the vertex of the parabola through the three
+//! points around it in (log f, dB). For a resonance of damping ratio ζ the
 //! half-power width is `2ζ f`: at 0.2 % spacing the nearest point of a peak with ζ = 0.004 is
 //! within 0.1 % of it, 0.3 dB below it, and the parabola's vertex closer.
 
@@ -76,6 +87,32 @@ pub struct Settings {
     pub probe_s: f64,
     /// Periods per window, at least.
     pub min_cycles: f64,
+    /// How the grid's frequencies are excited: all at once (a multisine, discrete loops with
+    /// `auto_level`), or one after the other (a stepped sine).
+    pub excitation: Signal,
+}
+
+/// How the log grid's frequencies are excited (`sensitivity.excitation`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Signal {
+    /// The whole grid in one multisine (its tones on the bins of one window, Schroeder
+    /// phases), settled once and fitted window by window; a tone that does not settle is
+    /// measured again by the stepped sine. Used for sampled and co-simulated loops with
+    /// `auto_level`; the continuous PD and a fixed level take the stepped sine.
+    Multisine,
+    /// One frequency after the other.
+    Stepped,
+}
+
+impl Signal {
+    /// The key's value as written.
+    pub fn name(self) -> &'static str {
+        match self {
+            Signal::Multisine => "multisine",
+            Signal::Stepped => "stepped",
+        }
+    }
 }
 
 impl Settings {
@@ -96,6 +133,7 @@ impl Settings {
             probe_um: 0.1 * gap_m * 1e6,
             probe_s: 1.0,
             min_cycles: 8.0,
+            excitation: Signal::Multisine,
         }
     }
 }
@@ -196,6 +234,24 @@ pub enum MeasureError {
         /// Last amplitude (µm).
         amplitude_um: f64,
     },
+    /// The multisine drove the rotor into the touchdown bearing.
+    #[error("axis {axis} at {speed_hz} Hz rotor speed: the multisine of {tones} tones from {f_lo_hz:.2} to {f_hi_hz:.2} Hz, {amplitude_um:.3} µm each, drove the rotor into the touchdown bearing (t = {t_s:.3} s); lower sensitivity.response_um or set sensitivity.excitation = \"stepped\"")]
+    TouchedMulti {
+        /// Axis.
+        axis: String,
+        /// Speed (Hz).
+        speed_hz: f64,
+        /// Tones.
+        tones: usize,
+        /// Lowest tone (Hz).
+        f_lo_hz: f64,
+        /// Highest tone (Hz).
+        f_hi_hz: f64,
+        /// Each tone's amplitude as displacement (µm).
+        amplitude_um: f64,
+        /// Time (s).
+        t_s: f64,
+    },
     /// Stopped because another axis of the same part failed.
     #[error("not finished: another axis failed")]
     Abandoned,
@@ -212,8 +268,143 @@ pub enum MeasureError {
 /// Where the measurement stands.
 enum Phase {
     Probe,
+    Multi(Box<Multi>),
     Step(Box<Step>),
     Done,
+}
+
+/// One tone of the multisine.
+struct Tone {
+    f_hz: f64,
+    omega: f64,
+    phase: f64,
+    /// Σ cos θ·v, Σ sin θ·v over the window.
+    rv: [f64; 2],
+    /// Σ cos²θ, Σ sin²θ.
+    d: [f64; 2],
+    /// Σ cos θ·[cos Ωt, sin Ωt], Σ sin θ·[cos Ωt, sin Ωt] (at speed).
+    b: [[f64; 2]; 2],
+    estimates: Vec<Complex<f64>>,
+    /// The estimate once two consecutive windows agreed.
+    settled: Option<Complex<f64>>,
+}
+
+/// The whole coarse grid at once: `E = a Σ sin(ω_j (t − t0) + φ_j)`, each `ω_j` a whole number
+/// of periods in the window (the tones are orthogonal over it), fitted per window on
+/// `[1, cos θ_j, sin θ_j, cos Ωt, sin Ωt]`, the tones and the constant by their correlation
+/// sums and the rotation's line by the Schur complement (it is not on the window's bins).
+struct Multi {
+    tones: Vec<Tone>,
+    /// Each tone's amplitude (V).
+    amplitude: f64,
+    t0: f64,
+    settle_left: u64,
+    window_ticks: u64,
+    in_window: u64,
+    windows: u32,
+    /// Σ 1, Σ v, Σ [cos Ωt, sin Ωt], Σ v [cos Ωt, sin Ωt], Σ cos²Ωt, Σ cos Ωt sin Ωt, Σ sin²Ωt.
+    n: f64,
+    sv: f64,
+    su: [f64; 2],
+    uv: [f64; 2],
+    uu: [f64; 3],
+    /// The last `E(t)` and its time.
+    e_now: f64,
+    e_at: f64,
+}
+
+/// Windows of a multisine before its unsettled tones go to the stepped sine.
+const MULTI_WINDOWS: u32 = 6;
+
+impl Multi {
+    /// `E(t)` (V), kept for the tick: the fit and the loop read the same value.
+    fn value(&mut self, t: f64) -> f64 {
+        if self.e_at != t {
+            self.e_now =
+                self.amplitude * self.tones.iter().map(|k| (k.omega * (t - self.t0) + k.phase).sin()).sum::<f64>();
+            self.e_at = t;
+        }
+        self.e_now
+    }
+
+    fn clear(&mut self) {
+        for k in &mut self.tones {
+            k.rv = [0.0; 2];
+            k.d = [0.0; 2];
+            k.b = [[0.0; 2]; 2];
+        }
+        self.in_window = 0;
+        self.n = 0.0;
+        self.sv = 0.0;
+        self.su = [0.0; 2];
+        self.uv = [0.0; 2];
+        self.uu = [0.0; 3];
+    }
+
+    /// Adds one tick: `v` what the controller read, `rot` `[cos Ωt, sin Ωt]` (zero at standstill).
+    fn add(&mut self, t: f64, v: f64, rot: [f64; 2]) {
+        for k in &mut self.tones {
+            let (sn, cs) = (k.omega * (t - self.t0) + k.phase).sin_cos();
+            k.rv[0] += cs * v;
+            k.rv[1] += sn * v;
+            k.d[0] += cs * cs;
+            k.d[1] += sn * sn;
+            k.b[0][0] += cs * rot[0];
+            k.b[0][1] += cs * rot[1];
+            k.b[1][0] += sn * rot[0];
+            k.b[1][1] += sn * rot[1];
+        }
+        self.n += 1.0;
+        self.sv += v;
+        self.su[0] += rot[0];
+        self.su[1] += rot[1];
+        self.uv[0] += rot[0] * v;
+        self.uv[1] += rot[1] * v;
+        self.uu[0] += rot[0] * rot[0];
+        self.uu[1] += rot[0] * rot[1];
+        self.uu[2] += rot[1] * rot[1];
+        self.in_window += 1;
+    }
+
+    /// Each tone's `S` over the window just ended (`at_speed`: with the rotation's line).
+    fn fit(&self, at_speed: bool) -> Vec<Complex<f64>> {
+        // The rotation's line [p, q] from the Schur complement of the orthogonal block.
+        let y = if at_speed {
+            let mut m = [self.uu[0], self.uu[1], self.uu[2]];
+            let mut w = self.uv;
+            let mut eliminate = |b: [f64; 2], d: f64, r: f64| {
+                if d > 0.0 {
+                    m[0] -= b[0] * b[0] / d;
+                    m[1] -= b[0] * b[1] / d;
+                    m[2] -= b[1] * b[1] / d;
+                    w[0] -= b[0] * r / d;
+                    w[1] -= b[1] * r / d;
+                }
+            };
+            eliminate(self.su, self.n, self.sv);
+            for k in &self.tones {
+                eliminate(k.b[0], k.d[0], k.rv[0]);
+                eliminate(k.b[1], k.d[1], k.rv[1]);
+            }
+            let det = m[0] * m[2] - m[1] * m[1];
+            if det.abs() > 0.0 {
+                [(m[2] * w[0] - m[1] * w[1]) / det, (m[0] * w[1] - m[1] * w[0]) / det]
+            } else {
+                [0.0; 2]
+            }
+        } else {
+            [0.0; 2]
+        };
+        self.tones
+            .iter()
+            .map(|k| {
+                let c = (k.rv[0] - k.b[0][0] * y[0] - k.b[0][1] * y[1]) / k.d[0];
+                let s = (k.rv[1] - k.b[1][0] * y[0] - k.b[1][1] * y[1]) / k.d[1];
+                // v = c cos θ + s sin θ = Re((c − i s) e^{iθ}); E = a sin θ = Re(−i a e^{iθ}).
+                Complex::new(c, -s) / Complex::new(0.0, -self.amplitude)
+            })
+            .collect()
+    }
 }
 
 /// One frequency being measured.
@@ -241,6 +432,8 @@ pub struct Measure<'a> {
     axis: usize,
     axis_name: String,
     period: f64,
+    /// A sampled or co-simulated loop (the excitation is read at the ticks only).
+    discrete: bool,
     sensor_gain: f64,
     gap: f64,
     speed_hz: f64,
@@ -254,6 +447,8 @@ pub struct Measure<'a> {
     sigma: f64,
     probe_hz: f64,
     queue: VecDeque<f64>,
+    /// Frequencies added around the peak so far.
+    refined: usize,
     coarse_left: bool,
     points: Vec<Point>,
     error: Option<MeasureError>,
@@ -292,6 +487,7 @@ impl<'a> Measure<'a> {
             axis,
             axis_name: axis_name.to_string(),
             period,
+            discrete: sampled,
             sensor_gain,
             gap,
             speed_hz,
@@ -304,6 +500,7 @@ impl<'a> Measure<'a> {
             sigma: f64::NAN,
             probe_hz: f64::NAN,
             queue: grid,
+            refined: 0,
             coarse_left: true,
             points: Vec::new(),
             error: None,
@@ -380,7 +577,150 @@ impl<'a> Measure<'a> {
         }
         self.stable = Some(true);
         self.t_now = t;
-        self.next_step(t);
+        let multi = self.discrete && self.settings.auto_level && self.settings.excitation == Signal::Multisine;
+        if multi && self.queue.len() >= 2 {
+            let tones: Vec<f64> = self.queue.drain(..).collect();
+            let a = self.settings.excitation_um.min(self.settings.response_um) * 1e-6 * self.sensor_gain
+                / (tones.len() as f64).sqrt();
+            self.start_multi(tones, a, t);
+        } else {
+            self.next_step(t);
+        }
+    }
+
+    /// Starts the multisine of `tones` (Hz, ascending), each of amplitude `amplitude` (V), at
+    /// `t`: the window holds `min_cycles` periods of the lowest tone (at speed also 4 periods of
+    /// each tone's distance from the rotation), and each tone moves to the nearest free bin of
+    /// that window (a whole number of periods in it).
+    fn start_multi(&mut self, tones: Vec<f64>, amplitude: f64, t: f64) {
+        let s = &self.settings;
+        let lowest = tones[0];
+        let mut window = s.min_cycles / lowest;
+        if self.speed_hz > 0.0 {
+            for f in &tones {
+                window = window.max(4.0 / (f - self.speed_hz).abs());
+            }
+        }
+        let ticks = (window / self.period).ceil().max(8.0) as u64;
+        let bin = 1.0 / (ticks as f64 * self.period);
+        let mut bins: Vec<u64> = Vec::with_capacity(tones.len());
+        for f in &tones {
+            let k = ((f / bin).round() as u64).max(1).max(bins.last().map_or(1, |b| b + 1));
+            let f_k = k as f64 * bin;
+            if 2 * k < ticks && !near_rotation(f_k, self.speed_hz) && f_k <= self.f_max {
+                bins.push(k);
+            }
+        }
+        let n = bins.len();
+        let tones: Vec<Tone> = bins
+            .iter()
+            .enumerate()
+            .map(|(j, k)| Tone {
+                f_hz: *k as f64 * bin,
+                omega: TAU * *k as f64 * bin,
+                // Schroeder's phases: a low crest factor.
+                phase: -std::f64::consts::PI * (j * (j + 1)) as f64 / n as f64,
+                rv: [0.0; 2],
+                d: [0.0; 2],
+                b: [[0.0; 2]; 2],
+                estimates: Vec::with_capacity(MULTI_WINDOWS as usize),
+                settled: None,
+            })
+            .collect();
+        let settle = self.settle_time(lowest);
+        self.phase = Phase::Multi(Box::new(Multi {
+            tones,
+            amplitude,
+            t0: t,
+            settle_left: (settle / self.period).ceil() as u64,
+            window_ticks: ticks,
+            in_window: 0,
+            windows: 0,
+            n: 0.0,
+            sv: 0.0,
+            su: [0.0; 2],
+            uv: [0.0; 2],
+            uu: [0.0; 3],
+            e_now: 0.0,
+            e_at: f64::NAN,
+        }));
+    }
+
+    /// One tick of the multisine.
+    fn tick_multi(&mut self, t: f64, u: f64) -> Option<Excitation> {
+        let limit_v = self.settings.limit * self.gap * self.sensor_gain;
+        let tolerance = self.settings.tolerance;
+        let at_speed = self.speed_hz > 0.0;
+        let Phase::Multi(m) = &mut self.phase else { return None };
+        let e = m.value(t);
+        if u.abs() > limit_v && t >= self.grace_until {
+            // Too strong a response: a quarter of the level, twice at most; then the stepped
+            // sine, frequency by frequency, with its own levels.
+            let floor = self.settings.excitation_um.min(self.settings.response_um) * 1e-6 * self.sensor_gain / 20.0;
+            let tones: Vec<f64> = m.tones.iter().map(|k| k.f_hz).collect();
+            let a = m.amplitude / 4.0;
+            self.grace_until = t + (self.settle_time(tones[0]) * 0.5).min(2.0);
+            if a >= floor / (tones.len() as f64).sqrt() {
+                self.start_multi(tones, a, t);
+                return self.sine();
+            }
+            self.queue.extend(tones);
+            self.theta_now = 0.0;
+            self.next_step(t);
+            return self.sine();
+        }
+        if m.settle_left > 0 {
+            m.settle_left -= 1;
+            return self.sine();
+        }
+        let rot = if at_speed {
+            let (sn, cs) = (TAU * self.speed_hz * t).sin_cos();
+            [cs, sn]
+        } else {
+            [0.0; 2]
+        };
+        m.add(t, u + e, rot);
+        if m.in_window < m.window_ticks {
+            return self.sine();
+        }
+        let fit = m.fit(at_speed);
+        m.clear();
+        m.windows += 1;
+        for (k, s_est) in m.tones.iter_mut().zip(fit) {
+            if k.settled.is_some() {
+                continue;
+            }
+            k.estimates.push(s_est);
+            let n = k.estimates.len();
+            if n >= 2 && (k.estimates[n - 1] - k.estimates[n - 2]).norm() <= tolerance * s_est.norm() {
+                k.settled = Some(s_est);
+            }
+        }
+        if m.tones.iter().all(|k| k.settled.is_some()) || m.windows >= MULTI_WINDOWS {
+            let amplitude = m.amplitude;
+            let tones = std::mem::take(&mut m.tones);
+            for k in tones {
+                match k.settled {
+                    Some(s_est) => {
+                        let tt = s_est - 1.0;
+                        self.points.push(Point {
+                            f_hz: k.f_hz,
+                            s: [s_est.re, s_est.im],
+                            s_db: 20.0 * s_est.norm().log10(),
+                            t_db: 20.0 * tt.norm().log10(),
+                            amplitude_v: amplitude,
+                            windows: k.estimates.len() as u32,
+                            settled: true,
+                        });
+                    }
+                    // Not settled in the multisine's windows: measured again on its own.
+                    None => self.queue.push_back(k.f_hz),
+                }
+            }
+            self.theta_now = 0.0;
+            self.next_step(t);
+        }
+        self.sine()
     }
 
     /// The amplitude (V) for frequency `f` from the points measured so far.
@@ -442,27 +782,61 @@ impl<'a> Measure<'a> {
         }));
     }
 
-    /// Adds the midpoints around the largest `|S|` until its neighbours are within the resolution.
+    /// Adds a frequency near the largest `|S|` until its neighbours are within the resolution:
+    /// the vertex of the parabola through it and its neighbours (in ln f, dB) while that lies
+    /// half a resolution or more from it, then the points one resolution either side of it. At
+    /// an end of the grid, the interval beside it is halved.
     fn refine(&mut self) {
-        let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz, p.s_db)).collect();
+        let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz.ln(), p.s_db)).collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let Some(i) = (0..pts.len()).max_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1)) else { return };
-        // The intervals on either side of the peak (none below the first point).
-        for j in [i.checked_sub(1), Some(i)].into_iter().flatten() {
-            if j + 1 >= pts.len() {
-                continue;
+        let res = self.settings.resolution;
+        // Points added around one peak, at most: a guard, the rule ends long before.
+        if self.refined >= 64 {
+            return;
+        }
+        let add = |x: f64, me: &mut Self| {
+            let f = x.exp();
+            let clear = pts.iter().all(|p| (p.0 - x).abs() > 0.25 * res);
+            let ok = clear && !near_rotation(f, me.speed_hz) && f <= me.f_max;
+            if ok {
+                me.queue.push_back(f);
             }
-            let (a, b) = (pts[j].0, pts[j + 1].0);
-            if (b / a).ln() > self.settings.resolution {
-                let mid = (a * b).sqrt();
-                if !near_rotation(mid, self.speed_hz) && mid <= self.f_max {
-                    self.queue.push_back(mid);
+            ok
+        };
+        if i == 0 || i + 1 == pts.len() {
+            let j = if i == 0 { 1 } else { i - 1 };
+            if let Some(n) = pts.get(j) {
+                if (n.0 - pts[i].0).abs() > res {
+                    add(0.5 * (n.0 + pts[i].0), self);
                 }
             }
+            self.refined += self.queue.len();
+            return;
         }
+        let ((x0, y0), (x1, y1), (x2, y2)) = (pts[i - 1], pts[i], pts[i + 1]);
+        let (left, right) = (x1 - x0, x2 - x1);
+        if left <= res * (1.0 + 1e-9) && right <= res * (1.0 + 1e-9) {
+            return;
+        }
+        let d0 = (y1 - y0) / left;
+        let d1 = (y2 - y1) / right;
+        let curv = (d1 - d0) / (x2 - x0);
+        let vertex = (curv < 0.0).then(|| (0.5 * (x0 + x1) - d0 / (2.0 * curv)).clamp(x0, x2));
+        let at_vertex = vertex.is_some_and(|xv| (xv - x1).abs() >= 0.5 * res && add(xv, self));
+        if !at_vertex {
+            if left > res * (1.0 + 1e-9) {
+                add(x1 - res.min(0.5 * left), self);
+            }
+            if right > res * (1.0 + 1e-9) {
+                add(x1 + res.min(0.5 * right), self);
+            }
+        }
+        self.refined += self.queue.len();
     }
 
     fn tick(&mut self, t: f64, u: f64) -> Option<Excitation> {
+        self.t_now = t;
         if let Phase::Probe = self.phase {
             self.probe.push((t, u));
             if t + 0.5 * self.period >= self.settings.probe_s {
@@ -470,6 +844,13 @@ impl<'a> Measure<'a> {
             } else {
                 return None;
             }
+            // The excitation starts at the next tick.
+            if let Phase::Multi(_) = self.phase {
+                return self.sine();
+            }
+        }
+        if let Phase::Multi(_) = self.phase {
+            return self.tick_multi(t, u);
         }
         let speed = self.speed_hz;
         let limit_v = self.settings.limit * self.gap * self.sensor_gain;
@@ -545,7 +926,16 @@ impl<'a> Measure<'a> {
     }
 
     /// The sine in force now, on the axis' plane (axes 0, 1: plane A's x, y; 2, 3: plane B's).
-    fn sine(&self) -> Option<Excitation> {
+    fn sine(&mut self) -> Option<Excitation> {
+        let t_now = self.t_now;
+        if let Phase::Multi(m) = &mut self.phase {
+            // The multisine's value at this tick, held: the loop adds it to the tick's sample
+            // (a sampled or co-simulated law reads the sensor at the ticks only).
+            let mut amplitude_v = [0.0; 2];
+            amplitude_v[self.axis % 2] = m.value(t_now);
+            let held = SensorSine { amplitude_v, omega_rad_s: 0.0, phase_rad: std::f64::consts::FRAC_PI_2 };
+            return Some(Excitation { plane: self.axis / 2, sine: held });
+        }
         let Phase::Step(step) = &self.phase else { return None };
         let mut amplitude_v = [0.0; 2];
         amplitude_v[self.axis % 2] = step.amplitude;
@@ -572,6 +962,17 @@ impl Hooks for Measure<'_> {
                             speed_hz: self.speed_hz,
                             amplitude_um: step.amplitude / self.sensor_gain * 1e6,
                             f_hz: step.f_hz,
+                            t_s: t_touch,
+                        });
+                    }
+                    Phase::Multi(m) => {
+                        self.error = Some(MeasureError::TouchedMulti {
+                            axis: self.axis_name.clone(),
+                            speed_hz: self.speed_hz,
+                            tones: m.tones.len(),
+                            f_lo_hz: m.tones.first().map_or(f64::NAN, |k| k.f_hz),
+                            f_hi_hz: m.tones.last().map_or(f64::NAN, |k| k.f_hz),
+                            amplitude_um: m.amplitude / self.sensor_gain * 1e6,
                             t_s: t_touch,
                         });
                     }

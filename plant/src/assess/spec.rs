@@ -134,6 +134,7 @@ struct RawSensitivity {
     probe_um: Option<f64>,
     probe_s: Option<f64>,
     min_cycles: Option<f64>,
+    excitation: Option<String>,
     speeds: Option<Vec<String>>,
 }
 
@@ -287,6 +288,14 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         probe_um: number(&k("probe_um"), s.probe_um, d.probe_um, "µm", 0.0, gap_um)?,
         probe_s: number(&k("probe_s"), s.probe_s, d.probe_s, "s", 0.0, 100.0)?,
         min_cycles: number(&k("min_cycles"), s.min_cycles, d.min_cycles, "periods", 0.99, 1000.0)?,
+        excitation: match s.excitation.as_deref() {
+            None => d.excitation,
+            Some("multisine") => sensitivity::Signal::Multisine,
+            Some("stepped") => sensitivity::Signal::Stepped,
+            Some(other) => {
+                return Err(bad(&k("excitation"), format!("{other:?}"), "", "must be \"multisine\" or \"stepped\""))
+            }
+        },
     };
     if sens.f_min_hz >= sens.f_max_hz {
         return Err(bad(&k("f_min_hz"), sens.f_min_hz, "Hz", "must be below sensitivity.f_max_hz"));
