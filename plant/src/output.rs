@@ -86,7 +86,7 @@ pub fn prepare(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
 /// Writes `scene.toml`: the scene as resolved.
 fn prepare_scene_toml(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
     let resolved = scene.to_toml().context("serialising the resolved scene")?;
-    crate::atomic::write(&dir.join("scene.toml"), resolved.as_bytes())
+    crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes())
 }
 
 /// The record of a run that did not start (the controller refused it or could not be
@@ -278,7 +278,7 @@ pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Resul
 /// Writes a value as pretty JSON, atomically ([`crate::atomic::write`]).
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     let text = serde_json::to_string_pretty(value).context("serialising JSON")?;
-    crate::atomic::write(path, (text + "\n").as_bytes())
+    crate::outfile::write(path, (text + "\n").as_bytes())
 }
 
 /// The run's own charts; a chart with nothing to draw is not written. Returns those not written.

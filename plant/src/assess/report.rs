@@ -3,7 +3,7 @@
 //! network) with the verdict line of each controller at the top, one column each.
 
 use super::{ControllerReport, Report};
-use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, finish, titled_root, PlotError, WIDE_SIZE};
+use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
 use anyhow::Context;
 use base64::Engine;
 use plotters::prelude::*;
@@ -141,64 +141,69 @@ fn chart(
     let pad = ((y1 - y0) * 0.06).max(1e-9);
     let (y0, y1) = (y0 - pad, y1 + pad);
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
-    macro_rules! body {
-        ($chart:expr) => {{
-            let mut c = $chart;
-            for (y, label) in hlines {
-                c.draw_series(std::iter::once(PathElement::new(
-                    vec![(x0, *y), (x1, *y)],
-                    RGBColor(120, 120, 120).stroke_width(1),
-                )))
-                .map_err(draw_err(path))?;
-                c.draw_series(std::iter::once(Text::new(label.to_string(), (x0, *y), crate::plot::font(16))))
+    crate::plot::draw_png(path, WIDE_SIZE, |root| {
+        let area = titled_root(root, path, title)?;
+        let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
+        macro_rules! body {
+            ($chart:expr) => {{
+                let mut c = $chart;
+                for (y, label) in hlines {
+                    c.draw_series(std::iter::once(PathElement::new(
+                        vec![(x0, *y), (x1, *y)],
+                        RGBColor(120, 120, 120).stroke_width(1),
+                    )))
                     .map_err(draw_err(path))?;
-            }
-            for (col, b) in bars {
-                for (x, lo, hi) in b {
-                    c.draw_series(std::iter::once(PathElement::new(vec![(*x, *lo), (*x, *hi)], col.stroke_width(2))))
+                    c.draw_series(std::iter::once(Text::new(label.to_string(), (x0, *y), crate::plot::font(16))))
                         .map_err(draw_err(path))?;
                 }
-            }
-            for l in lines {
-                let style = l.colour.stroke_width(l.width);
-                let pts: Vec<(f64, f64)> =
-                    l.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
-                if l.dashed {
-                    c.draw_series(DashedLineSeries::new(pts.clone(), 8, 6, style)).map_err(draw_err(path))?
-                } else {
-                    c.draw_series(LineSeries::new(pts.clone(), style)).map_err(draw_err(path))?
+                for (col, b) in bars {
+                    for (x, lo, hi) in b {
+                        c.draw_series(std::iter::once(PathElement::new(
+                            vec![(*x, *lo), (*x, *hi)],
+                            col.stroke_width(2),
+                        )))
+                        .map_err(draw_err(path))?;
+                    }
                 }
-                .label(l.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
-                if !l.dashed && pts.len() < 40 {
-                    c.draw_series(pts.iter().map(|p| Circle::new(*p, 3, l.colour.filled()))).map_err(draw_err(path))?;
+                for l in lines {
+                    let style = l.colour.stroke_width(l.width);
+                    let pts: Vec<(f64, f64)> =
+                        l.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+                    if l.dashed {
+                        c.draw_series(DashedLineSeries::new(pts.clone(), 8, 6, style)).map_err(draw_err(path))?
+                    } else {
+                        c.draw_series(LineSeries::new(pts.clone(), style)).map_err(draw_err(path))?
+                    }
+                    .label(l.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+                    if !l.dashed && pts.len() < 40 {
+                        c.draw_series(pts.iter().map(|p| Circle::new(*p, 3, l.colour.filled())))
+                            .map_err(draw_err(path))?;
+                    }
                 }
-            }
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(crate::plot::font(16))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(draw_err(path))?;
-        }};
-    }
-    if x_log {
-        let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
-        let mut c = builder(&area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
-        let fmt_x = |v: &f64| format!("{v}");
-        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
-        body!(c);
-    } else {
-        let mut c = builder(&area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
-        let fmt_x = |v: &f64| format!("{v}");
-        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
-        body!(c);
-    }
-    finish(&root, path)
+                c.configure_series_labels()
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font(crate::plot::font(16))
+                    .position(SeriesLabelPosition::UpperRight)
+                    .draw()
+                    .map_err(draw_err(path))?;
+            }};
+        }
+        if x_log {
+            let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
+            let mut c = builder(&area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
+            let fmt_x = |v: &f64| format!("{v}");
+            draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+            body!(c);
+        } else {
+            let mut c = builder(&area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
+            let fmt_x = |v: &f64| format!("{v}");
+            draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+            body!(c);
+        }
+        Ok(())
+    })
 }
 
 /// The Bode magnitude chart of one controller: `|S|` and `|T|` of each axis and speed, the
@@ -350,7 +355,8 @@ fn num(v: Option<f64>, digits: usize) -> String {
 }
 
 fn image(dir: &Path, name: &str, alt: &str) -> anyhow::Result<String> {
-    let bytes = std::fs::read(dir.join(name)).with_context(|| format!("reading {name}"))?;
+    let bytes = crate::input::read_bytes(&dir.join(name), crate::input::MAX_JSON_BYTES)
+        .with_context(|| format!("reading {name}"))?;
     let data = base64::engine::general_purpose::STANDARD.encode(bytes);
     Ok(format!("<figure><img alt=\"{}\" src=\"data:image/png;base64,{data}\"><figcaption>{} (<code>{name}</code>)</figcaption></figure>\n", esc(alt), esc(alt)))
 }
@@ -359,7 +365,7 @@ fn image(dir: &Path, name: &str, alt: &str) -> anyhow::Result<String> {
 pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let json = serde_json::to_vec_pretty(r)?;
-    crate::atomic::write(&dir.join("report.json"), &json)?;
+    crate::outfile::write(&dir.join("report.json"), &json)?;
     let mut charts: Vec<(usize, String)> = Vec::new();
     for (i, c) in r.controllers.iter().enumerate() {
         let name = format!("sensitivity_{}.png", i + 1);
@@ -588,6 +594,6 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             b.width_m * 1e3, b.materials.youngs_modulus_pa * 1e-9, b.materials.poisson, b.ball_diameter_m * 1e3, b.pitch_diameter_m * 1e3, b.materials.groove_conformity, b.ball_static_load_n, b.materials.static_pressure_pa * 1e-6, b.capacity_fraction * 100.0);
     }
     let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
-    crate::atomic::write(&dir.join("report.html"), h.as_bytes())?;
+    crate::outfile::write(&dir.join("report.html"), h.as_bytes())?;
     Ok(())
 }
