@@ -139,6 +139,10 @@ pub enum Ending {
     /// `plant soak` completed, but criteria failed (each was named above).
     #[error("{0} soak criterion (criteria) failed")]
     CriteriaFailed(usize),
+    /// A command of several runs or loops (`compare`, `bench host`, `bench tick`, `assess`)
+    /// stopped by SIGINT/SIGTERM: what it had finished was written, as the text says.
+    #[error("interrupted: {0}")]
+    Interrupted(String),
 }
 
 /// How a run stopped early.
@@ -169,6 +173,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::OverrunBudget, .. } => Code::OverrunBudget,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
+            Ending::Interrupted(_) => Code::Interrupted,
         }
     }
 }
@@ -280,6 +285,7 @@ mod tests {
             (stopped(StopKind::PeerLost), 4),
             (stopped(StopKind::Interrupted), 130),
             (Ending::CriteriaFailed(1).into(), 5),
+            (Ending::Interrupted("2 of 5 runs written".into()).into(), 130),
             (Ending::BadArgument("diverged".into()).into(), 2),
             (anyhow::Error::from(crate::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
             (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),

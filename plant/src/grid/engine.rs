@@ -159,7 +159,8 @@ pub fn execute<W: Work>(grid: &Grid, work: &W, dir: &Path, args: &RunArgs) -> an
             (Err(_), n) => format!("{n} point(s) wait for other shards' units"),
         }
     );
-    if outcome.interrupted {
+    // Also a signal that came while the merged outputs were written (each whole): exit 130.
+    if outcome.interrupted || stop.load(Ordering::Relaxed) {
         return Err(GridError::Interrupted.into());
     }
     if !outcome.failed.is_empty() {
