@@ -496,12 +496,32 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     let mut recorder = Recorder::new(&scene, true);
     let mut rows = 0;
     let mut planes = None;
+    // A trace past the scene's end is another run's (issue 31 item 11): its rows would be
+    // analysed against this scene's shocks and duration. A sample may sit on the end itself,
+    // give or take the rounding of the output times.
+    let end = scene.duration + 1e-9 * scene.duration.max(scene.output_interval);
+    let mut beyond = None;
     let whole = crate::trace::read_rows(&trace_path, |r| {
+        let t = r.a[crate::trace::col::T_S];
+        if t > end {
+            beyond = Some((rows as u64 + 2, t));
+            return false;
+        }
         planes.get_or_insert(r.planes());
         recorder.push(r);
         rows += 1;
         !stopped()
     })?;
+    if let Some((line, t)) = beyond {
+        let what = format!(
+            "time {t:e} s is past the end of the scene ({} in {}: scene.duration_s = {} s): the trace is longer \
+             than its scene, not this scene's run",
+            scene.name,
+            dir.join("scene.toml").display(),
+            scene.duration
+        );
+        return Err(TraceError::Malformed { path: trace_path, line, column: Some("t_s".into()), what }.into());
+    }
     if !whole {
         return Err(AnalyzeError::Interrupted(NOTHING));
     }
