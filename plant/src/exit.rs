@@ -114,6 +114,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         controller::ParamsError,
         shock_table::ShockError,
         crate::bench::BadArgument,
+        crate::bench::Interrupted,
         AnalyzeError,
         AssessError,
     );
@@ -139,8 +140,7 @@ pub enum Ending {
     /// `plant soak` completed, but criteria failed (each was named above).
     #[error("{0} soak criterion (criteria) failed")]
     CriteriaFailed(usize),
-    /// A command of several runs or loops (`compare`, `bench host`, `bench tick`, `assess`)
-    /// stopped by SIGINT/SIGTERM: what it had finished was written, as the text says.
+    /// A command of several runs (`compare`) stopped by SIGINT/SIGTERM: what it had finished was written, as the text says.
     #[error("interrupted: {0}")]
     Interrupted(String),
 }
@@ -263,6 +263,12 @@ bad_input!(
     crate::bench::BadArgument
 );
 
+impl HasExitCode for crate::bench::Interrupted {
+    fn exit_code(&self) -> Code {
+        Code::Interrupted
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,6 +292,7 @@ mod tests {
             (stopped(StopKind::Interrupted), 130),
             (Ending::CriteriaFailed(1).into(), 5),
             (Ending::Interrupted("2 of 5 runs written".into()).into(), 130),
+            (crate::bench::Interrupted("1 of 2 loops finished".into()).into(), 130),
             (Ending::BadArgument("diverged".into()).into(), 2),
             (anyhow::Error::from(crate::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
             (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),

@@ -203,7 +203,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     crate::table::write_with_header(&path, HOST_HEADER, &rows)?;
     if stop.load(Ordering::Relaxed) {
         let why = format!("{} of 2 loops finished, written to {}", rows.len(), path.display());
-        return Err(crate::exit::Ending::Interrupted(why).into());
+        return Err(super::Interrupted(why).into());
     }
     Ok(path)
 }

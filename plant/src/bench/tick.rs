@@ -363,7 +363,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     if stopped() {
         let planned = settings.len() * req.repeats;
         let why = format!("{} of {planned} runs finished, written to {}", rows.len(), path.display());
-        return Err(crate::exit::Ending::Interrupted(why).into());
+        return Err(super::Interrupted(why).into());
     }
 
     let (label, fixed) = &settings[0];
