@@ -148,12 +148,14 @@ int amb_serve(const amb_law *laws, size_t count, int argc, char **argv);
 uint32_t amb_abi_version(void);
 
 /* In build: the number at key (unit: "" or NULL when dimensionless) into *value, default_value
- * when absent, checked (AMB_CHECK_*; lo, hi for AMB_CHECK_BETWEEN). 0, or -1 when refused
- * (return NULL from build: the refusal names the law, the key, the value and the unit). A key
+ * when absent, checked (AMB_CHECK_*; lo, hi for AMB_CHECK_BETWEEN; a default_value that fails
+ * the check is refused too, as the law's fault). 0, or -1 when refused (return NULL from build:
+ * the refusal names the law, the key, the value and the unit); a NULL value is refused. A key
  * build does not read is refused as unknown. */
 int amb_params_number(amb_params *params, const char *key, const char *unit, double default_value,
                       uint32_t check, double lo, double hi, double *value);
-/* In build: the boolean at key into *value (1 or 0), default_value when absent. 0 or -1. */
+/* In build: the boolean at key into *value (1 or 0), default_value when absent. 0 or -1 (also
+ * for a NULL value). */
 int amb_params_flag(amb_params *params, const char *key, int default_value, int *value);
 /* In build: the parameters as TOML text (NUL-terminated, valid during build). */
 const char *amb_params_text(amb_params *params);

@@ -145,7 +145,9 @@ impl ParamReader<'_> {
         LawError::Param { law: self.law, key: key.to_string(), value: value.to_string(), unit, why: why.into() }
     }
 
-    /// The number at `key` (an integer is taken as a float), or `default` when absent; checked.
+    /// The number at `key` (an integer is taken as a float), or `default` when absent; both
+    /// checked (a default that fails the check is the law's fault, and said so: issue 31
+    /// item 11, the C API's laws passed any default through).
     pub fn number(
         &mut self,
         key: &'static str,
@@ -153,7 +155,16 @@ impl ParamReader<'_> {
         default: f64,
         check: Check,
     ) -> Result<f64, LawError> {
-        Ok(self.optional_number(key, unit, check)?.unwrap_or(default))
+        match self.optional_number(key, unit, check)? {
+            Some(v) => Ok(v),
+            None if check.holds(default) => Ok(default),
+            None => Err(self.error(
+                key,
+                default,
+                unit,
+                format!("the law's own default (the key is not set) {}: a fault of the law", check.why()),
+            )),
+        }
     }
 
     /// The number at `key`, if given; checked.
@@ -249,6 +260,31 @@ mod tests {
         assert_eq!(r.number("n", "", 1.0, Check::Positive).unwrap(), 3.0);
         assert_eq!(r.number("m", "", 1.5, Check::Positive).unwrap(), 1.5);
         assert!(r.finish().is_ok());
+    }
+
+    /// Issue 31 item 11: a default was never checked. Every check refuses a default that
+    /// fails it (NaN and the infinities included), naming the law, the key and the value.
+    #[test]
+    fn a_default_that_fails_its_check_is_the_laws_fault() {
+        let cases = [
+            (Check::Finite, f64::NAN),
+            (Check::Finite, f64::INFINITY),
+            (Check::Positive, 0.0),
+            (Check::NonNegative, -1.0),
+            (Check::Between(0.0, 1.0), 1.0),
+            (Check::Between(0.0, 1.0), f64::NEG_INFINITY),
+        ];
+        for (check, default) in cases {
+            let p = Params::parse("").unwrap();
+            let e = p.reader("mylaw").number("gain", "A/m", default, check).unwrap_err().to_string();
+            assert!(
+                e.contains("law mylaw") && e.contains("controller.params.gain") && e.contains(&default.to_string())
+            );
+            assert!(e.contains("the law's own default") && e.contains(&check.why()), "{e}");
+            // A value given in the scene is checked as before, whatever the default.
+            let p = Params::parse("gain = 0.5").unwrap();
+            assert_eq!(p.reader("mylaw").number("gain", "A/m", default, check).unwrap(), 0.5);
+        }
     }
 
     #[test]

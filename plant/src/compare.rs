@@ -17,14 +17,17 @@
 
 use crate::analysis::classify::MotionMode;
 use crate::config::{load_scene, ControlMode, Scene};
+use crate::exit::Ending;
+use crate::hooks::Cancel;
 use crate::plot::{self, PointGroup, Scale, Series};
-use crate::run::{run, Outcome, Quiet, RunResult};
+use crate::run::{run, Outcome, RunResult};
 use crate::status::Status;
 use crate::summary::{recovery_time, snake_name, Summary};
 use crate::table::{plain, sci};
 use anyhow::Context;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Window after the shock for the deviation (s).
 pub const WINDOW: f64 = 0.1;
@@ -107,7 +110,8 @@ fn free_decay(
     base: &[String],
     extra: &[String],
     shocks: usize,
-) -> anyhow::Result<(f64, bool, bool)> {
+    stop: &AtomicBool,
+) -> anyhow::Result<Option<(f64, bool, bool)>> {
     let mut sets = extra.to_vec();
     sets.extend([
         "rotor.eccentricity_um=0.0".to_string(),
@@ -115,10 +119,43 @@ fn free_decay(
         "scene.duration_s=0.6".to_string(),
     ]);
     sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
-    let r = run(&with(scene_path, base, &sets)?, &mut Quiet)?;
+    let Some(r) = finished(&with(scene_path, base, &sets)?, stop)? else { return Ok(None) };
     let tr = &r.trace;
     let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
-    Ok((damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]), free < tr.len(), r.run.outcome == Outcome::Completed))
+    Ok(Some((
+        damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]),
+        free < tr.len(),
+        r.run.outcome == Outcome::Completed,
+    )))
+}
+
+/// One run of a comparison, stopped by `stop` (SIGINT/SIGTERM): `None` once the flag is set
+/// (a run it stopped part-way is not kept), so that the comparison writes the runs it finished.
+fn finished(scene: &Scene, stop: &AtomicBool) -> anyhow::Result<Option<RunResult>> {
+    if stop.load(Ordering::Relaxed) {
+        return Ok(None);
+    }
+    match run(scene, &mut Cancel(stop)) {
+        Ok(r) if r.run.outcome == Outcome::Interrupted => Ok(None),
+        Ok(r) => Ok(Some(r)),
+        // A co-simulated run interrupted while it waited for its controller.
+        Err(_) if stop.load(Ordering::Relaxed) => Ok(None),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// `Err` (exit 130) when `stop` was set, also while the outputs were written: `what`
+/// says what was written.
+fn interrupted(stop: &AtomicBool, what: impl FnOnce() -> String) -> anyhow::Result<()> {
+    if stop.load(Ordering::Relaxed) {
+        return Err(Ending::Interrupted(what()).into());
+    }
+    Ok(())
+}
+
+/// The error of a comparison interrupted before its first run finished: nothing written.
+fn nothing_finished() -> anyhow::Error {
+    Ending::Interrupted("before the first run finished; nothing was written".into()).into()
 }
 
 /// Runs the comparison and writes `compare.csv` and the plots into `out`.
@@ -129,15 +166,16 @@ pub fn compare(
     cosim: bool,
     out: &Path,
     log: &mut dyn FnMut(&str),
+    stop: &AtomicBool,
 ) -> anyhow::Result<Vec<RateRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
     let continuous = with(scene_path, &base, &["controller.mode=\"continuous\"".into()])?;
     let start = continuous.first_shock_start();
     // All traces on the same grid: the output rate of the scene.
-    let reference = run(&continuous, &mut Quiet)?;
+    let reference = finished(&continuous, stop)?.ok_or_else(nothing_finished)?;
     let shocks = continuous.shock_count();
-    let decay = |extra: &[String]| free_decay(scene_path, &base, extra, shocks).map(|(xi, _, _)| xi);
+    let decay = |extra: &[String]| free_decay(scene_path, &base, extra, shocks, stop).map(|d| d.map(|(xi, _, _)| xi));
     let row = |rate: f64, mode: ControlMode, r: &RunResult, scene: &Scene, xi: f64| {
         let (rms, max) = if mode == ControlMode::Continuous { (0.0, 0.0) } else { deviation(r, &reference, start) };
         let s = Summary::new(scene, r);
@@ -152,24 +190,20 @@ pub fn compare(
             post_shock_mode: s.analysis.post_shock_mode,
         }
     };
-    let mut rows = vec![row(
-        0.0,
-        ControlMode::Continuous,
-        &reference,
-        &continuous,
-        decay(&["controller.mode=\"continuous\"".into()])?,
-    )];
+    let Some(xi) = decay(&["controller.mode=\"continuous\"".into()])? else { return Err(nothing_finished()) };
+    let mut rows = vec![row(0.0, ControlMode::Continuous, &reference, &continuous, xi)];
     log(&format!("continuous: damping ratio {:.4}", rows[0].damping_ratio));
     let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone())];
     let modes = if cosim { vec![ControlMode::Sampled, ControlMode::Lockstep] } else { vec![ControlMode::Sampled] };
-    for &rate in rates {
+    'rates: for &rate in rates {
         for &mode in &modes {
             let name = snake_name(&mode);
             let extra = vec![format!("controller.mode=\"{name}\""), format!("controller.rate_hz={rate:?}")];
             let scene = with(scene_path, &base, &extra)?;
-            let r = run(&scene, &mut Quiet)?;
+            let Some(r) = finished(&scene, stop)? else { break 'rates };
             let xi = if mode == ControlMode::Sampled {
-                decay(&extra)?
+                let Some(xi) = decay(&extra)? else { break 'rates };
+                xi
             } else {
                 rows.last().map_or(f64::NAN, |r| r.damping_ratio)
             };
@@ -191,6 +225,8 @@ pub fn compare(
     }
     crate::table::write_with_header(&out.join("compare.csv"), COMPARE_HEADER, &rows)?;
     plots(out, &traces, start, &continuous)?;
+    let planned = 1 + rates.len() * modes.len();
+    interrupted(stop, || format!("{} of {planned} configurations finished, written to compare.csv", rows.len()))?;
     Ok(rows)
 }
 
@@ -291,18 +327,19 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&s
     let stem = req.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = req.out.map_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")), Path::to_path_buf);
     let _claim = crate::claim::claim(&dir, true)?;
+    let stop = crate::interrupt::stop_flag();
     if let Some(runs) = req.realtime {
-        compare_realtime(req.scene, req.set, runs, &dir, log)?;
+        compare_realtime(req.scene, req.set, runs, &dir, log, &stop)?;
         return Ok(dir.join("realtime.csv"));
     }
     if req.laws.is_empty() {
-        compare(req.scene, req.set, req.rates, req.cosim, &dir, log)?;
+        compare(req.scene, req.set, req.rates, req.cosim, &dir, log, &stop)?;
         if req.maps {
-            stability_maps(req.scene, req.set, req.rates, &dir, log)?;
+            stability_maps(req.scene, req.set, req.rates, &dir, log, &stop)?;
         }
         Ok(dir.join("compare.csv"))
     } else {
-        compare_laws(req.scene, req.set, req.laws, &dir, log)?;
+        compare_laws(req.scene, req.set, req.laws, &dir, log, &stop)?;
         Ok(dir.join("laws.csv"))
     }
 }
@@ -353,7 +390,7 @@ mod tests {
         let (a, b) = (two.plane(0).contact.gap * 1e6, two.plane(1).contact.gap * 1e6);
         assert_ne!(a.round(), b.round(), "the asymmetric scene's gaps differ");
         assert_eq!(gap_words(&two), format!("air gaps A {a:.0} µm, B {b:.0} µm"));
-        let run = crate::run::run(&two, &mut Quiet).unwrap();
+        let run = crate::run::run(&two, &mut crate::run::Quiet).unwrap();
         let planes = plane_traces("pd", &run.trace);
         assert_eq!(planes.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>(), ["pd A", "pd B"]);
         assert_eq!(planes[1].1.radius(), run.trace.plane(1).radius());
@@ -407,6 +444,7 @@ pub fn stability_maps(
     rates: &[f64],
     out: &Path,
     log: &mut dyn FnMut(&str),
+    stop: &AtomicBool,
 ) -> anyhow::Result<Vec<MapPoint>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
@@ -417,7 +455,8 @@ pub fn stability_maps(
         ("rate_damping", "controller.damping_ratio", vec![0.005, 0.01, 0.02, 0.03, 0.05, 0.1]),
         ("rate_delay", "controller.delay_samples", vec![0.0, 1.0, 2.0, 3.0]),
     ];
-    for (map, key, values) in grids {
+    let planned: usize = grids.iter().map(|g| g.2.len() * rates.len()).sum();
+    'maps: for (map, key, values) in grids {
         for &rate in rates {
             for &v in &values {
                 let value = if key.ends_with("delay_samples") { format!("{}", v as u32) } else { format!("{v:?}") };
@@ -426,13 +465,15 @@ pub fn stability_maps(
                     format!("controller.rate_hz={rate:?}"),
                     format!("{key}={value}"),
                 ];
-                let (decay_xi, touched, completed) = free_decay(scene_path, &base, &extra, shocks)?;
+                let Some((decay_xi, touched, completed)) = free_decay(scene_path, &base, &extra, shocks, stop)? else {
+                    break 'maps;
+                };
                 let xi = if completed || touched { decay_xi } else { f64::NAN };
                 let class = if xi.is_nan() || xi <= 0.0 || touched {
                     "unstable".to_string()
                 } else {
                     let scene = with(scene_path, &base, &extra)?;
-                    let r = run(&scene, &mut Quiet)?;
+                    let Some(r) = finished(&scene, stop)? else { break 'maps };
                     let s = Summary::new(&scene, &r);
                     if r.run.outcome == Outcome::Completed {
                         format!("stable ({})", snake_name(&s.analysis.post_shock_mode))
@@ -466,8 +507,14 @@ pub fn stability_maps(
             ylabel,
             &groups,
             false,
-        )?;
+        )
+        .or_else(|e| match e {
+            // A map interrupted before its first point has nothing to draw.
+            plot::PlotError::NoData { .. } if stop.load(Ordering::Relaxed) => Ok(()),
+            e => Err(e),
+        })?;
     }
+    interrupted(stop, || format!("{} of {planned} map points finished, written to stability_map.csv", points.len()))?;
     Ok(points)
 }
 
@@ -513,6 +560,7 @@ pub fn compare_laws(
     laws: &[String],
     out: &Path,
     log: &mut dyn FnMut(&str),
+    stop: &AtomicBool,
 ) -> anyhow::Result<Vec<LawRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
@@ -527,7 +575,7 @@ pub fn compare_laws(
             extra.push("controller.params={}".to_string());
         }
         let scene = with(scene_path, &base, &extra)?;
-        let r = run(&scene, &mut Quiet)?;
+        let Some(r) = finished(&scene, stop)? else { break };
         let s = Summary::new(&scene, &r);
         let row = LawRow {
             law: law.clone(),
@@ -554,10 +602,14 @@ pub fn compare_laws(
         runs.push((law.clone(), r));
         probe = Some(scene);
     }
+    if rows.is_empty() {
+        return Err(nothing_finished());
+    }
     crate::table::write_with_header(&out.join("laws.csv"), LAWS_HEADER, &rows)?;
     if let Some(scene) = probe {
         law_plots(out, &runs, &scene)?;
     }
+    interrupted(stop, || format!("{} of {} laws finished, written to laws.csv", rows.len(), laws.len()))?;
     Ok(rows)
 }
 
@@ -681,6 +733,7 @@ pub fn compare_realtime(
     runs: usize,
     out: &Path,
     log: &mut dyn FnMut(&str),
+    stop: &AtomicBool,
 ) -> anyhow::Result<Vec<RealtimeRow>> {
     if !(1..=1000).contains(&runs) {
         return Err(crate::bench::BadArgument(format!("--runs {runs}: must be between 1 and 1000")).into());
@@ -690,7 +743,7 @@ pub fn compare_realtime(
     let realtime = with(scene_path, &base, &["controller.mode=\"realtime\"".into()])?;
     // The realtime scene as resolved holds its integrator setting: the lockstep twin keeps it.
     let lockstep = realtime.reload(&["controller.mode=\"lockstep\"".into()])?;
-    let reference = run(&lockstep, &mut Quiet)?;
+    let reference = finished(&lockstep, stop)?.ok_or_else(nothing_finished)?;
     let start = lockstep.first_shock_start();
     let row = |n: usize, scene: &Scene, r: &RunResult| {
         let s = Summary::new(scene, r);
@@ -748,7 +801,7 @@ pub fn compare_realtime(
     log(&say(&rows[0]));
     let mut traces: Vec<(String, RunResult)> = Vec::new();
     for n in 1..=runs {
-        let r = run(&realtime, &mut Quiet)?;
+        let Some(r) = finished(&realtime, stop)? else { break };
         let rw = row(n, &realtime, &r);
         log(&say(&rw));
         rows.push(rw);
@@ -772,6 +825,7 @@ pub fn compare_realtime(
         &series,
         Scale::Linear,
     )?;
+    interrupted(stop, || format!("{} of {} runs finished, written to realtime.csv", rows.len(), runs + 1))?;
     Ok(rows)
 }
 

@@ -114,6 +114,7 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         controller::ParamsError,
         shock_table::ShockError,
         crate::bench::BadArgument,
+        crate::bench::Interrupted,
         AnalyzeError,
         AssessError,
         crate::snapshot::SnapshotError,
@@ -140,6 +141,9 @@ pub enum Ending {
     /// `plant soak` completed, but criteria failed (each was named above).
     #[error("{0} soak criterion (criteria) failed")]
     CriteriaFailed(usize),
+    /// A command of several runs (`compare`) stopped by SIGINT/SIGTERM: what it had finished was written, as the text says.
+    #[error("interrupted: {0}")]
+    Interrupted(String),
 }
 
 /// How a run stopped early.
@@ -170,6 +174,7 @@ impl HasExitCode for Ending {
             Ending::Stopped { kind: StopKind::OverrunBudget, .. } => Code::OverrunBudget,
             Ending::Stopped { kind: StopKind::Interrupted, .. } => Code::Interrupted,
             Ending::CriteriaFailed(_) => Code::CriterionFailed,
+            Ending::Interrupted(_) => Code::Interrupted,
         }
     }
 }
@@ -269,6 +274,12 @@ bad_input!(
     crate::bench::BadArgument
 );
 
+impl HasExitCode for crate::bench::Interrupted {
+    fn exit_code(&self) -> Code {
+        Code::Interrupted
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,6 +302,8 @@ mod tests {
             (stopped(StopKind::PeerLost), 4),
             (stopped(StopKind::Interrupted), 130),
             (Ending::CriteriaFailed(1).into(), 5),
+            (Ending::Interrupted("2 of 5 runs written".into()).into(), 130),
+            (crate::bench::Interrupted("1 of 2 loops finished".into()).into(), 130),
             (Ending::BadArgument("diverged".into()).into(), 2),
             (anyhow::Error::from(crate::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
             (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),

@@ -189,7 +189,33 @@ fn load_checked(scene: &Scene) -> anyhow::Result<()> {
     }
 }
 
-/// Progress on stderr about once a second, and the Ctrl-C flag.
+/// Wall time (s) after which a run's pace is judged ([`pace_warning`]).
+const PACE_AFTER_S: f64 = 10.0;
+/// Projected wall time (s) past which a run's pace is said.
+const SLOW_RUN_S: f64 = 600.0;
+
+/// A warning when a run, at the pace of its first [`PACE_AFTER_S`] of wall time or more, would
+/// take longer than [`SLOW_RUN_S`]: legal values can make a run practically endless (issue 31
+/// item 11: `contact.friction_static = 0` about 18 min for 1.5 s), and the user should learn
+/// it from the run, not from the clock. `t` simulated of `duration` s in `wall` s.
+fn pace_warning(t: f64, duration: f64, wall: f64) -> Option<String> {
+    if wall < PACE_AFTER_S || t.is_nan() || t <= 0.0 || duration.is_nan() || duration <= t {
+        return None;
+    }
+    let projected = wall * duration / t;
+    (projected > SLOW_RUN_S).then(|| {
+        format!(
+            "at its pace so far ({t:.4} of {duration} s simulated in {wall:.0} s, {:.2e} of real time) this run \
+             takes about {:.0} min; a stiff setting makes a run slow (contact.friction_static = 0, a fast \
+             sensor.bandwidth_hz or amb.current_loop_hz under an adaptive integrator, a tight \
+             integrator.rtol); Ctrl-C stops it and keeps what was computed",
+            t / wall,
+            projected / 60.0
+        )
+    })
+}
+
+/// Progress on stderr about once a second, a warning when the run is slow, and the Ctrl-C flag.
 struct CliHooks {
     stop: Arc<AtomicBool>,
     duration: f64,
@@ -197,6 +223,8 @@ struct CliHooks {
     last: Instant,
     quiet: bool,
     terminal: bool,
+    /// The pace warning was given.
+    pace_said: bool,
     /// `--save-state-at`, and the run folder the snapshots go to.
     save_at: Vec<f64>,
     dir: PathBuf,
@@ -258,11 +286,23 @@ impl States {
 
 impl Hooks for CliHooks {
     fn progress(&mut self, t: f64) {
-        if self.quiet || self.last.elapsed() < Duration::from_secs(1) {
+        if self.last.elapsed() < Duration::from_secs(1) {
             return;
         }
         self.last = Instant::now();
         let wall = self.started.elapsed().as_secs_f64();
+        if !self.pace_said {
+            if let Some(w) = pace_warning(t, self.duration, wall) {
+                self.pace_said = true;
+                if self.terminal && !self.quiet {
+                    eprintln!();
+                }
+                warn(&w);
+            }
+        }
+        if self.quiet {
+            return;
+        }
         let line = format!(
             "plant: t = {t:.3}/{:.3} s ({:.0} %), {:.2}x real time",
             self.duration,
@@ -327,6 +367,7 @@ fn run_scene(
         save_at: states.save_at,
         dir: dir.clone(),
         save_error: None,
+        pace_said: false,
     };
     let written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
         Ok(w) => w,
@@ -472,6 +513,7 @@ fn bench_ipc(
         save_at: Vec::new(),
         dir: PathBuf::new(),
         save_error: None,
+        pace_said: true,
     };
     let started = Instant::now();
     let launch = controller.launch(run_id);
@@ -496,6 +538,19 @@ fn bench_ipc(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 31 item 11: a run slowed to a crawl by legal values said nothing. Past 10 s of
+    /// wall time, a projected wall time over 10 min is said with the estimate; a fast run, an
+    /// early judgement and a run at its end say nothing.
+    #[test]
+    fn a_slow_run_is_told_its_projected_cost() {
+        let w = pace_warning(0.01, 1.5, 12.0).expect("30 min projected");
+        assert!(w.contains("about 30 min") && w.contains("0.0100 of 1.5 s") && w.contains("Ctrl-C"), "{w}");
+        assert_eq!(pace_warning(0.5, 1.5, 12.0), None, "36 s projected");
+        assert_eq!(pace_warning(0.0001, 1.5, 5.0), None, "judged too early");
+        assert_eq!(pace_warning(0.0, 1.5, 60.0), None, "no simulated time yet");
+        assert_eq!(pace_warning(1.5, 1.5, 900.0), None, "at its end");
+    }
 
     #[test]
     fn each_cause_is_said_once() {

@@ -86,7 +86,7 @@ pub fn prepare(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
 /// Writes `scene.toml`: the scene as resolved.
 fn prepare_scene_toml(dir: &Path, scene: &Scene) -> anyhow::Result<()> {
     let resolved = scene.to_toml().context("serialising the resolved scene")?;
-    crate::atomic::write(&dir.join("scene.toml"), resolved.as_bytes())
+    crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes())
 }
 
 /// The record of a run that did not start (the controller refused it or could not be
@@ -297,7 +297,7 @@ pub fn write_run(dir: &Path, scene: &Scene, result: &RunResult) -> anyhow::Resul
 /// Writes a value as pretty JSON, atomically ([`crate::atomic::write`]).
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     let text = serde_json::to_string_pretty(value).context("serialising JSON")?;
-    crate::atomic::write(path, (text + "\n").as_bytes())
+    crate::outfile::write(path, (text + "\n").as_bytes())
 }
 
 /// The run's own charts; a chart with nothing to draw is not written. Returns those not written.
@@ -515,12 +515,32 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     let mut recorder = Recorder::new(&scene, true);
     let mut rows = 0;
     let mut planes = None;
+    // A trace past the scene's end is another run's (issue 31 item 11): its rows would be
+    // analysed against this scene's shocks and duration. A sample may sit on the end itself,
+    // give or take the rounding of the output times.
+    let end = scene.duration + 1e-9 * scene.duration.max(scene.output_interval);
+    let mut beyond = None;
     let whole = crate::trace::read_rows(&trace_path, |r| {
+        let t = r.a[crate::trace::col::T_S];
+        if t > end {
+            beyond = Some((rows as u64 + 2, t));
+            return false;
+        }
         planes.get_or_insert(r.planes());
         recorder.push(r);
         rows += 1;
         !stopped()
     })?;
+    if let Some((line, t)) = beyond {
+        let what = format!(
+            "time {t:e} s is past the end of the scene ({} in {}: scene.duration_s = {} s): the trace is longer \
+             than its scene, not this scene's run",
+            scene.name,
+            dir.join("scene.toml").display(),
+            scene.duration
+        );
+        return Err(TraceError::Malformed { path: trace_path, line, column: Some("t_s".into()), what }.into());
+    }
     if !whole {
         return Err(AnalyzeError::Interrupted(NOTHING));
     }

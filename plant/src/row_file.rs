@@ -52,7 +52,7 @@ impl Write for Pending {
 impl RowFile {
     /// Creates (truncates) `path` with its header row.
     pub fn create(path: &Path, header: &[&str]) -> std::io::Result<Self> {
-        let file = File::create(path)?;
+        let file = crate::outfile::create(path)?;
         let pending = Pending::default();
         let csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(pending.clone());
         let mut f = Self { file, csv, pending };

@@ -230,20 +230,14 @@ impl Snapshot {
     pub fn write(&self, path: &Path) -> Result<(), SnapshotError> {
         let fail = |message: String| SnapshotError::Write { path: path.display().to_string(), message };
         let text = serde_json::to_string_pretty(self).map_err(|e| fail(e.to_string()))?;
-        crate::atomic::write(path, text.as_bytes()).map_err(|e| fail(format!("{e:#}")))
+        crate::outfile::write(path, text.as_bytes()).map_err(|e| fail(format!("{e:#}")))
     }
 
     /// Reads a snapshot file: a regular file of at most [`MAX_FILE_BYTES`], of this format.
     pub fn read(path: &Path) -> Result<Snapshot, SnapshotError> {
         let fail = |message: String| SnapshotError::Read { path: path.display().to_string(), message };
-        let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-        if !meta.is_file() {
-            return Err(fail("not a regular file (a snapshot is a state-T.json a run wrote)".into()));
-        }
-        if meta.len() > MAX_FILE_BYTES {
-            return Err(fail(format!("{} bytes: not a snapshot (at most {MAX_FILE_BYTES} bytes)", meta.len())));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+        // A regular file of at most MAX_FILE_BYTES (a device, a FIFO or a folder refused at once).
+        let text = crate::input::read_text(path, MAX_FILE_BYTES).map_err(|e| fail(format!("{e:#}")))?;
         // The format first, so that another version is named as such rather than as a field
         // this build does not know.
         #[derive(Deserialize)]

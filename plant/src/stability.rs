@@ -42,9 +42,64 @@ pub enum StepVerdict {
     Refuse(String),
 }
 
-/// Checks a fixed-step scene's step against the estimated limits.
+/// Derivative evaluations past which a run's cost is said before it starts (about two minutes
+/// at 1 µs per evaluation).
+pub const COSTLY_EVALUATIONS: f64 = 1e8;
+
+/// The fastest pole of the scene's hardware (rad/s) and the key that sets it: the sensor's
+/// low-pass corner, a current loop's bandwidth (or its coil's R/L); `None` without hardware.
+fn fastest_hardware_pole(scene: &Scene) -> Option<(f64, &'static str)> {
+    use crate::sensor::LowPass;
+    let sensor = scene.hardware.front_end.low_pass.map(|lp| match lp {
+        LowPass::First { corner } | LowPass::Second { corner } => (corner, "sensor.bandwidth_hz"),
+    });
+    let coils = scene
+        .hardware
+        .amplifiers
+        .iter()
+        .flatten()
+        .map(|a| (a.bandwidth.max(a.resistance / a.inductance), "amb.current_loop_hz"));
+    sensor.into_iter().chain(coils).max_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// What an adaptive method costs on a scene whose hardware has a fast pole (issue 31 item 11:
+/// `sensor.bandwidth_hz = 1e9` with `dp5` took about 3 h for a 1.5 s scene): an explicit
+/// method's step stays within its stability bound on the negative real axis, `ω h ≤ c`
+/// (DP5 about 3.3, DOP853 about 6.0), whatever the tolerances, so the run takes at least
+/// `duration · ω / c` steps. `Some(warning)` with that estimate when it passes
+/// [`COSTLY_EVALUATIONS`] evaluations of the derivative.
+pub fn hardware_cost(scene: &Scene) -> Option<String> {
+    let m = scene.integrator.method;
+    let (c, stages) = match m {
+        Method::Dp5 => (3.3, 6.0),
+        Method::Dop853 => (6.0, 12.0),
+        _ => return None,
+    };
+    let (omega, key) = fastest_hardware_pole(scene)?;
+    let h = c / omega;
+    let steps = scene.duration / h;
+    let evaluations = steps * stages;
+    if evaluations.is_nan() || evaluations <= COSTLY_EVALUATIONS {
+        return None;
+    }
+    let hours = evaluations * 1e-6 / 3600.0;
+    Some(format!(
+        "{key} puts a pole at {omega:.3e} rad/s that integrator.method = \"{}\" must resolve: its step stays \
+         below {h:.2e} s, at least {steps:.2e} steps ({evaluations:.2e} evaluations of the derivative) for \
+         scene.duration_s = {} s, about {hours:.1} h at 1 µs per evaluation; the run goes on (Ctrl-C keeps \
+         what it computed): a {key} near the real hardware's keeps it short",
+        crate::summary::snake_name(&m),
+        scene.duration
+    ))
+}
+
+/// Checks a fixed-step scene's step against the estimated limits, and an adaptive one's cost
+/// on fast hardware ([`hardware_cost`]).
 pub fn check(scene: &Scene) -> StepVerdict {
     let m = scene.integrator.method;
+    if let Some(w) = hardware_cost(scene) {
+        return StepVerdict::Warn(w);
+    }
     if !matches!(m, Method::ExplicitEuler | Method::SymplecticEuler | Method::Rk4) {
         return StepVerdict::Fine;
     }
@@ -83,4 +138,33 @@ pub fn check(scene: &Scene) -> StepVerdict {
         ));
     }
     StepVerdict::Fine
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(sets: &[&str]) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/paper-10g.toml");
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        crate::config::load_scene(&path, &sets).unwrap()
+    }
+
+    /// Issue 31 item 11: a legal sensor bandwidth (1 GHz) with an adaptive method ran for
+    /// hours without a word. The cost is said before the run, with the estimate, for either
+    /// adaptive method and either fast pole (the sensor's corner, a current loop); a bandwidth
+    /// a real sensor has says nothing.
+    #[test]
+    fn a_fast_hardware_pole_under_an_adaptive_method_is_warned_with_its_cost() {
+        for method in ["dp5", "dop853"] {
+            let m = format!("integrator.method=\"{method}\"");
+            let w = hardware_cost(&scene(&[&m, "sensor.bandwidth_hz=1e9"])).expect("a warning");
+            assert!(w.contains("sensor.bandwidth_hz") && w.contains("steps") && w.contains(" h at 1 µs"), "{w}");
+            assert!(matches!(check(&scene(&[&m, "sensor.bandwidth_hz=1e9"])), StepVerdict::Warn(_)));
+            let w = hardware_cost(&scene(&[&m, "amb.amplifier=true", "amb.current_loop_hz=1e9"])).expect("a warning");
+            assert!(w.contains("amb.current_loop_hz"), "{w}");
+            assert_eq!(hardware_cost(&scene(&[&m, "sensor.bandwidth_hz=5000"])), None);
+            assert_eq!(hardware_cost(&scene(&[&m])), None);
+        }
+    }
 }

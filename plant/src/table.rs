@@ -58,18 +58,20 @@ pub fn to_bytes_with_header<T: Serialize>(header: &str, rows: &[T]) -> anyhow::R
 /// Writes the rows to `path` (whole or not at all, [`crate::atomic::write`]).
 pub fn write<T: Serialize>(path: &Path, rows: &[T]) -> anyhow::Result<()> {
     let bytes = to_bytes(rows).with_context(|| format!("formatting {}", path.display()))?;
-    crate::atomic::write(path, &bytes)
+    crate::outfile::write(path, &bytes)
 }
 
 /// Writes the rows to `path` under `header`, which is written even when there are no rows.
 pub fn write_with_header<T: Serialize>(path: &Path, header: &str, rows: &[T]) -> anyhow::Result<()> {
     let bytes = to_bytes_with_header(header, rows).with_context(|| format!("formatting {}", path.display()))?;
-    crate::atomic::write(path, &bytes)
+    crate::outfile::write(path, &bytes)
 }
 
 /// Reads every row of a CSV file with a header row, matching fields to columns by name.
 pub fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<Vec<T>> {
-    let mut r = csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
+    let file = crate::input::open_bounded(path, crate::input::MAX_TABLE_BYTES)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let mut r = csv::Reader::from_reader(file);
     let header = r.headers().with_context(|| format!("reading {}", path.display()))?.clone();
     let mut rows = Vec::new();
     for (i, record) in r.records().enumerate() {

@@ -43,19 +43,45 @@ pub fn open_regular(path: &Path) -> std::io::Result<File> {
 
 /// Reads a regular file of at most `max` bytes as UTF-8 text.
 pub fn read_text(path: &Path, max: u64) -> std::io::Result<String> {
+    String::from_utf8(read_bytes(path, max)?).map_err(|e| Error::new(ErrorKind::InvalidData, e.utf8_error()))
+}
+
+/// Reads a regular file of at most `max` bytes.
+pub fn read_bytes(path: &Path, max: u64) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    open_bounded(path, max)?.read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+/// Opens a regular file of at most `max` bytes for reading as a stream (a CSV table): its
+/// reads fail (`InvalidInput`) once more than `max` bytes came, should it grow while read.
+pub fn open_bounded(path: &Path, max: u64) -> std::io::Result<impl Read> {
     let file = open_regular(path)?;
-    let too_long = |len: u64| {
-        Error::new(ErrorKind::InvalidInput, format!("{len} bytes: an input file may have at most {max} bytes"))
-    };
     let len = file.metadata()?.len();
     if len > max {
-        return Err(too_long(len));
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            format!("{len} bytes: an input file may have at most {max} bytes"),
+        ));
     }
-    // At most one byte past the bound, in case the file grows while it is read.
-    let mut text = String::new();
-    file.take(max + 1).read_to_string(&mut text)?;
-    if text.len() as u64 > max {
-        return Err(Error::new(ErrorKind::InvalidInput, format!("grew past {max} bytes while it was read")));
+    Ok(Bounded { inner: file, left: max })
+}
+
+/// A reader that fails once it has given more than `left` bytes.
+struct Bounded<R> {
+    inner: R,
+    left: u64,
+}
+
+impl<R: Read> Read for Bounded<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        // At most one byte past the bound, to tell a file that grew from one that ended.
+        let room = usize::try_from(self.left.saturating_add(1)).unwrap_or(usize::MAX).min(buf.len());
+        let n = self.inner.read(&mut buf[..room])?;
+        if n as u64 > self.left {
+            return Err(Error::new(ErrorKind::InvalidInput, "grew past its bound while it was read"));
+        }
+        self.left -= n as u64;
+        Ok(n)
     }
-    Ok(text)
 }

@@ -240,3 +240,44 @@ fn keys_of_a_choice_not_made_and_absurd_stiffness_are_refused_at_load() {
         refused(&format!("choice-{}", set.split('=').next().unwrap()), &paper, &sets(&[set]), needles);
     }
 }
+
+/// Issue 31 item 8: `plant assess` read its file without a bound (`/dev/zero` grew without
+/// end, a FIFO blocked for ever, both deaf to SIGTERM), and a sweep its unit files likewise.
+/// Every file a command reads goes through the one bounded reader: what is not a regular
+/// file is refused at once (exit 2), naming it.
+#[cfg(target_os = "linux")]
+#[test]
+fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
+    let dir = TempDir::new("bounds-inputs");
+    let fifo = dir.join("fifo.toml");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    for input in [Path::new("/dev/zero"), fifo.as_path()] {
+        for command in ["assess", "sweep"] {
+            let out = dir.join("out");
+            let o = output_within(Command::new(plant_bin()).arg(command).arg(input).arg("--out").arg(&out), QUICK);
+            assert_exit(&o, 2);
+            let err = stderr(&o);
+            assert!(
+                err.contains(&input.display().to_string()) && err.contains("not a regular file"),
+                "{command}: {err}"
+            );
+        }
+    }
+    // A sweep folder whose unit file is a FIFO: named as unreadable, nothing run, no hang.
+    let sweep = dir.join("sweep.toml");
+    std::fs::write(
+        &sweep,
+        format!(
+            "scene = {:?}\nset = [\"scene.duration_s=0.02\", \"shock[0].start_s=0.005\"]\nkey = \"shock[0].peak_g\"\nfrom = 1.0\nto = 2.0\npoints = 2\n",
+            scene("paper-10g.toml").display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("sweep");
+    std::fs::create_dir_all(out.join("points")).unwrap();
+    assert!(Command::new("mkfifo").arg(out.join("points").join("00000.json")).status().unwrap().success());
+    let o = output_within(Command::new(plant_bin()).arg("sweep").arg(&sweep).arg("--out").arg(&out), QUICK);
+    assert_exit(&o, 2);
+    let err = stderr(&o);
+    assert!(err.contains("00000.json") && err.contains("not a regular file"), "{err}");
+}

@@ -1329,3 +1329,27 @@ fn a_silent_realtime_controller_is_lost_or_past_the_budget() {
         assert_eq!(s["status"], "peer_lost", "{name}: {s:#}");
     }
 }
+
+/// Issue 31 item 8: with `controller.reconnect_timeout_ms > 0`, a controller that died on
+/// each start was respawned at every tick (about 145 ms each: an hour for the 1.5 s scene,
+/// `summary.json` growing by a peer event each time). The respawns are bounded: the ninth loss
+/// ends the run with exit 4, `peer_lost`, naming the bound, after eight reconnections.
+#[test]
+fn a_controller_that_dies_on_each_start_is_respawned_a_bounded_number_of_times() {
+    let dir = TempDir::new("cosim-respawn");
+    let out = dir.join("run");
+    let command = format!(
+        "controller.command=[{:?}, \"--mode\", \"die\", \"--die-at\", \"0\"]",
+        common::rogue_bin().display().to_string()
+    );
+    let extra = ["controller.mode=lockstep", "controller.reconnect_timeout_ms=20000", command.as_str()];
+    let run = output(&mut plant_run(&scene("paper-10g.toml"), &out, &sets(&extra)));
+    assert_exit(&run, 4);
+    let err = stderr(&run);
+    assert!(err.contains("lost 9 times") && err.contains("at most 8 per run"), "{err}");
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "peer_lost", "{s:#}");
+    let kinds = event_kinds(&s);
+    assert_eq!(kinds.iter().filter(|k| *k == "lost").count(), 9, "{kinds:?}");
+    assert_eq!(kinds.iter().filter(|k| *k == "reconnected").count(), 8, "{kinds:?}");
+}

@@ -119,6 +119,36 @@ fn analyze_refuses_corrupt_traces_naming_file_line_and_column_and_writes_nothing
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 
+/// Issue 31 item 11: `plant analyze` took a trace longer than its scene (another run's, or a
+/// `scene.toml` edited since) and analysed it against this scene's duration. A row past the
+/// scene's end is refused (exit 2), naming the file, the line, its time and the scene's
+/// duration; nothing is written. The trace of the scene's own length still reads.
+#[test]
+fn analyze_refuses_a_trace_longer_than_its_scene() {
+    let dir = TempDir::new("outputs-analyze-longer");
+    let out = dir.join("run");
+    short_run(&out, false);
+    let scene_text = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+    let at = scene_text.lines().filter(|l| l.trim_start().starts_with("duration_s = ")).count();
+    assert_eq!(at, 1, "scene.toml has one duration_s:\n{scene_text}");
+    let line = scene_text.lines().find(|l| l.trim_start().starts_with("duration_s = ")).unwrap();
+    assert_eq!(line.trim(), "duration_s = 0.05", "{scene_text}");
+    std::fs::write(out.join("scene.toml"), scene_text.replace(line, "duration_s = 0.03")).unwrap();
+    // The first row past 0.03 s, counted from the trace itself (header on line 1).
+    let times = Csv::read(&out.join("trace.csv")).column("t_s");
+    let first = times.iter().position(|t| *t > 0.03 + 1e-9).expect("rows past 0.03 s");
+    let summary = std::fs::read(out.join("summary.json")).unwrap();
+    let o = analyze(&out);
+    assert_exit(&o, 2);
+    let err = stderr(&o);
+    assert!(err.contains("trace.csv") && err.contains(&format!("line {}, column t_s", first + 2)), "{err}");
+    assert!(err.contains("past the end of the scene") && err.contains("scene.duration_s = 0.03 s"), "{err}");
+    assert!(err.contains(&format!("{:e}", times[first])), "{err}");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), summary, "summary.json rewritten");
+    std::fs::write(out.join("scene.toml"), &scene_text).unwrap();
+    assert_exit(&analyze(&out), 0);
+}
+
 #[test]
 fn a_reused_out_folder_keeps_no_file_of_the_previous_run() {
     let dir = TempDir::new("outputs-reuse");

@@ -552,7 +552,8 @@ unsafe fn handle<'a>(params: *mut Params) -> Option<&'a mut ParamsHandle<'a>> {
 
 /// Reads the number at `key` of the law's parameters (unit `unit`, may be NULL) into
 /// `*value`, `default_value` when absent, checked (`AMB_CHECK_*`; `lo`, `hi` for
-/// `AMB_CHECK_BETWEEN`). Returns 0, or -1 when refused (the law's `build` should then return
+/// `AMB_CHECK_BETWEEN`; the default too). A NULL `value` is refused. Returns 0, or -1 when
+/// refused (the law's `build` should then return
 /// NULL: the hello is refused with the message naming the law, the key, the value and the
 /// unit). Call it from `build` only.
 ///
@@ -596,12 +597,16 @@ pub unsafe extern "C" fn amb_params_number(
             return -1;
         }
     };
+    if value.is_null() {
+        // The value would be lost: the law would run on whatever its variable held.
+        h.error = Some(h.reader.error(key, "?", unit, "amb_params_number: a NULL value pointer"));
+        return -1;
+    }
+    // The default is checked too (`ParamReader::number`).
     match h.reader.number(key, unit, default_value, check) {
         Ok(v) => {
-            if !value.is_null() {
-                // SAFETY: the caller's promise.
-                unsafe { *value = v };
-            }
+            // SAFETY: the caller's promise; not NULL (checked above).
+            unsafe { *value = v };
             0
         }
         Err(e) => {
@@ -634,12 +639,15 @@ pub unsafe extern "C" fn amb_params_flag(
             Some(LawError::Refused { law: h.reader.law(), why: "amb_params_flag: a NULL or non-UTF-8 key".into() });
         return -1;
     };
-    match h.reader.flag(intern(key), default_value != 0) {
+    let key = intern(key);
+    if value.is_null() {
+        h.error = Some(h.reader.error(key, "?", "", "amb_params_flag: a NULL value pointer"));
+        return -1;
+    }
+    match h.reader.flag(key, default_value != 0) {
         Ok(b) => {
-            if !value.is_null() {
-                // SAFETY: the caller's promise.
-                unsafe { *value = c_int::from(b) };
-            }
+            // SAFETY: the caller's promise; not NULL (checked above).
+            unsafe { *value = c_int::from(b) };
             0
         }
         Err(e) => {
@@ -759,6 +767,63 @@ mod tests {
         assert_eq!(e, "law echo: controller.params.scale = -1.0: must be a finite number > 0");
         let e = BUILDERS[0](&rotor, &controller::Params::parse("sclae = 1.0").unwrap()).err().unwrap().to_string();
         assert!(e.contains("unknown parameter controller.params.sclae"), "{e}");
+    }
+
+    /// Issue 31 item 11: the getters took a NULL output pointer (the value was dropped and the
+    /// law ran on whatever its variable held) and never checked the law's default. Each is
+    /// refused now, naming the law and the key, and the refusal sticks (later getters fail).
+    #[test]
+    fn a_null_output_or_a_default_that_fails_its_check_is_refused() {
+        let params = controller::Params::parse("").unwrap();
+        let fresh = || ParamsHandle { reader: params.reader("mylaw"), error: None, text: std::ffi::CString::default() };
+        let number = |h: &mut ParamsHandle, default: f64, check: u32, out: *mut f64| {
+            // SAFETY: a live handle; a key and unit with their NULs; `out` NULL or valid.
+            unsafe {
+                amb_params_number(
+                    (h as *mut ParamsHandle).cast(),
+                    c"gain".as_ptr(),
+                    c"A".as_ptr(),
+                    default,
+                    check,
+                    0.0,
+                    1.0,
+                    out,
+                )
+            }
+        };
+        let mut h = fresh();
+        assert_eq!(number(&mut h, 1.0, check::FINITE, std::ptr::null_mut()), -1);
+        let e = h.error.take().unwrap().to_string();
+        assert!(
+            e.contains("law mylaw") && e.contains("controller.params.gain") && e.contains("NULL value pointer"),
+            "{e}"
+        );
+        let mut h = fresh();
+        let mut flag: c_int = 7;
+        // SAFETY: as above.
+        let f = |h: &mut ParamsHandle, out: *mut c_int| unsafe {
+            amb_params_flag((h as *mut ParamsHandle).cast(), c"on".as_ptr(), 1, out)
+        };
+        assert_eq!(f(&mut h, std::ptr::null_mut()), -1);
+        assert!(h.error.take().unwrap().to_string().contains("NULL value pointer"));
+        assert_eq!(f(&mut h, &mut flag), 0);
+        assert_eq!(flag, 1);
+        for (default, c) in
+            [(f64::NAN, check::FINITE), (0.0, check::POSITIVE), (-1.0, check::NON_NEGATIVE), (1.0, check::BETWEEN)]
+        {
+            let mut h = fresh();
+            let mut v = 42.0;
+            assert_eq!(number(&mut h, default, c, &mut v), -1, "default {default} passed check {c}");
+            assert_eq!(v, 42.0, "nothing written on a refusal");
+            let e = h.error.as_ref().unwrap().to_string();
+            assert!(e.contains("controller.params.gain") && e.contains("the law's own default"), "{e}");
+            // The refusal sticks: a later good read fails too.
+            assert_eq!(number(&mut h, 0.5, check::FINITE, &mut v), -1);
+        }
+        let mut h = fresh();
+        let mut v = 0.0;
+        assert_eq!(number(&mut h, 0.5, check::BETWEEN, &mut v), 0);
+        assert_eq!(v, 0.5);
     }
 
     #[test]

@@ -862,6 +862,12 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         };
         return Err(AssessError { kind: worst, message, dir: dir.display().to_string() }.into());
     }
+    // A signal while the report was written: every part was measured and the report is whole,
+    // but the command was asked to stop (exit 130, as `run` and `soak` do).
+    if stop.load(Ordering::Relaxed) {
+        let message = "interrupted while the report was written (every part was measured)".to_string();
+        return Err(AssessError { kind: Failure::Interrupted, message, dir: dir.display().to_string() }.into());
+    }
     Ok(dir)
 }
 

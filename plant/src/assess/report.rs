@@ -3,7 +3,7 @@
 //! network) with the verdict line of each controller at the top, one column each.
 
 use super::{ControllerReport, Report};
-use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, finish, titled_root, PlotError, WIDE_SIZE};
+use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
 use anyhow::Context;
 use base64::Engine;
 use plotters::prelude::*;
@@ -139,10 +139,10 @@ fn chart(
     bars: &[ErrorBars],
 ) -> Result<(), PlotError> {
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    panel(&area, path, labels, x_log, lines, hlines, bars)?;
-    finish(&root, path)
+    crate::plot::draw_png(path, WIDE_SIZE, |root| {
+        let area = titled_root(root, path, title)?;
+        panel(&area, path, labels, x_log, lines, hlines, bars)
+    })
 }
 
 /// One x–y plot on `area` (the body of [`chart`]; a chart of several panels draws one each).
@@ -255,18 +255,19 @@ fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotErro
     let zones: Vec<(f64, &str)> = ZONE_DB.to_vec();
     ensure_font(path)?;
     let size = if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1) } else { WIDE_SIZE };
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    let area = titled_root(&root, path, &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label))?;
-    let areas = area.split_evenly((1, panels.len().max(1)));
-    for ((speed, lines), sub) in panels.iter().zip(&areas) {
-        let x = if *speed > 0.0 {
-            format!("frequency (Hz); rotor at {speed:.0} Hz")
-        } else {
-            "frequency (Hz); rotor at standstill".into()
-        };
-        panel(sub, path, (&x, "magnitude (dB)"), true, lines, &zones, &[])?;
-    }
-    finish(&root, path)?;
+    crate::plot::draw_png(path, size, |root| {
+        let area = titled_root(root, path, &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label))?;
+        let areas = area.split_evenly((1, panels.len().max(1)));
+        for ((speed, lines), sub) in panels.iter().zip(&areas) {
+            let x = if *speed > 0.0 {
+                format!("frequency (Hz); rotor at {speed:.0} Hz")
+            } else {
+                "frequency (Hz); rotor at standstill".into()
+            };
+            panel(sub, path, (&x, "magnitude (dB)"), true, lines, &zones, &[])?;
+        }
+        Ok::<(), PlotError>(())
+    })?;
     Ok(true)
 }
 
@@ -491,7 +492,8 @@ fn num(v: Option<f64>, digits: usize) -> String {
 }
 
 fn image(dir: &Path, name: &str, alt: &str) -> anyhow::Result<String> {
-    let bytes = std::fs::read(dir.join(name)).with_context(|| format!("reading {name}"))?;
+    let bytes = crate::input::read_bytes(&dir.join(name), crate::input::MAX_JSON_BYTES)
+        .with_context(|| format!("reading {name}"))?;
     let data = base64::engine::general_purpose::STANDARD.encode(bytes);
     Ok(format!("<figure><img alt=\"{}\" src=\"data:image/png;base64,{data}\"><figcaption>{} (<code>{name}</code>)</figcaption></figure>\n", esc(alt), esc(alt)))
 }
@@ -501,7 +503,7 @@ pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     // No folder of this machine in the report: each is shown relative to where the command ran.
     let json = super::relative_text(&serde_json::to_string_pretty(r)?, &r.roots);
-    crate::atomic::write(&dir.join("report.json"), json.as_bytes())?;
+    crate::outfile::write(&dir.join("report.json"), json.as_bytes())?;
     let mut charts: Vec<(usize, String)> = Vec::new();
     for (i, c) in r.controllers.iter().enumerate() {
         let name = format!("sensitivity_{}.png", i + 1);
@@ -739,7 +741,7 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
     }
     let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
     let h = super::relative_text(&h, &r.roots);
-    crate::atomic::write(&dir.join("report.html"), h.as_bytes())?;
+    crate::outfile::write(&dir.join("report.html"), h.as_bytes())?;
     Ok(())
 }
 

@@ -185,7 +185,8 @@ fn count(key: &str, v: Option<i64>, default: usize, lo: i64, hi: i64) -> Result<
 /// Loads an assessment file, or a scene file as an assessment of its own controller (or of
 /// `laws`), with `set` for every controller.
 pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, ConfigError> {
-    let text = std::fs::read_to_string(file).map_err(|source| ConfigError::Read { path: file.into(), source })?;
+    let text = crate::input::read_text(file, crate::input::MAX_TOML_BYTES)
+        .map_err(|source| ConfigError::Read { path: file.into(), source })?;
     let table: toml::Table = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: file.display().to_string(), message: e.to_string() })?;
     let parse_err =

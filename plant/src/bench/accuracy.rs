@@ -129,8 +129,7 @@ pub struct Peer {
 fn run_peer(peer: &Peer, b: &BenchScene, out: &Path, quick: bool, repeats: usize) -> anyhow::Result<Vec<AccuracyRow>> {
     let spec_path = out.join(format!("spec_{}.json", b.name));
     let spec = super::peer::spec(&b.scene, 0, 1, Some(atol_scale(&b.scene)))?;
-    std::fs::write(&spec_path, serde_json::to_string(&spec)?)
-        .with_context(|| format!("writing {}", spec_path.display()))?;
+    crate::outfile::write(&spec_path, serde_json::to_string(&spec)?.as_bytes())?;
     let csv = out.join(format!("peer_{}.csv", b.name));
     let rtols = if quick { "1e-4,1e-7" } else { "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10" };
     let status = std::process::Command::new(&peer.python)
@@ -215,7 +214,7 @@ pub fn accuracy(
             b.name, reference.floor.0, reference.floor.1, reference.peak_contact_force
         ));
         write_reference(&out.join(format!("reference_{}.csv", b.name)), &reference.trace, t0, t1)?;
-        std::fs::write(out.join(format!("scene_{}.toml", b.name)), b.scene.to_toml()?)?;
+        crate::outfile::write(&out.join(format!("scene_{}.toml", b.name)), b.scene.to_toml()?.as_bytes())?;
         for (method, settings) in grid(quick) {
             for setting in settings {
                 let s = with_integrator(&b.scene, method, setting);

@@ -23,6 +23,7 @@ use crate::table::sci;
 use controller::wire::monotonic_ns;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Header of `host.csv`.
 pub const HOST_HEADER: &str =
@@ -88,10 +89,11 @@ pub enum Wait {
 }
 
 /// The lateness of `ticks` ticks of `period_ns`, the first due `lead_ns` from now, waiting as
-/// `wait` says; and how many started more than a period late.
-pub fn lateness(ticks: u64, period_ns: u64, lead_ns: u64, wait: Wait) -> (Percentiles, u64) {
+/// `wait` says; and how many started more than a period late. Ends early, with fewer ticks,
+/// once `stop` is set (SIGINT/SIGTERM).
+pub fn lateness(ticks: u64, period_ns: u64, lead_ns: u64, wait: Wait, stop: &AtomicBool) -> (Percentiles, u64) {
     let start = monotonic_ns() + lead_ns;
-    tally(ticks, period_ns, start, |due| match wait {
+    tally(ticks, period_ns, start, stop, |due| match wait {
         Wait::Sleep => {
             controller::link::sleep_until_ns(due);
             monotonic_ns()
@@ -108,10 +110,19 @@ pub fn lateness(ticks: u64, period_ns: u64, lead_ns: u64, wait: Wait) -> (Percen
 
 /// Ticks `k` due at `start + k·period_ns`, each started when `wait_until(due)` returns (the
 /// clock then, ns): their lateness, and how many started more than a period late.
-fn tally(ticks: u64, period_ns: u64, start: u64, mut wait_until: impl FnMut(u64) -> u64) -> (Percentiles, u64) {
+fn tally(
+    ticks: u64,
+    period_ns: u64,
+    start: u64,
+    stop: &AtomicBool,
+    mut wait_until: impl FnMut(u64) -> u64,
+) -> (Percentiles, u64) {
     let mut late = Latencies::new();
     let mut over = 0;
     for k in 0..ticks {
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
         let due = start + k * period_ns;
         let by = wait_until(due).saturating_sub(due);
         late.record(by);
@@ -150,9 +161,14 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     let _idle = (req.realtime_priority > 0)
         .then(controller::link::hold_zero_idle_latency)
         .and_then(|r| r.map_err(|e| log(&format!("warning: cannot hold the idle latency at 0 ({e})"))).ok());
+    let stop = crate::interrupt::stop_flag();
     let mut rows = Vec::new();
     for (pacing, wait) in [("sleep", Wait::Sleep), ("spin", Wait::Spin)] {
-        let (p, over) = lateness(ticks, period_ns, 1_000_000, wait);
+        let (p, over) = lateness(ticks, period_ns, 1_000_000, wait, &stop);
+        if stop.load(Ordering::Relaxed) {
+            // A loop stopped part-way is not a measurement of the rate.
+            break;
+        }
         let row = HostRow {
             pacing,
             rate_hz: req.rate_hz,
@@ -185,6 +201,10 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     }
     let path = dir.join("host.csv");
     crate::table::write_with_header(&path, HOST_HEADER, &rows)?;
+    if stop.load(Ordering::Relaxed) {
+        let why = format!("{} of 2 loops finished, written to {}", rows.len(), path.display());
+        return Err(super::Interrupted(why).into());
+    }
     Ok(path)
 }
 
@@ -195,7 +215,7 @@ mod tests {
     #[test]
     fn every_tick_is_measured_on_either_wait() {
         for wait in [Wait::Sleep, Wait::Spin] {
-            let (p, over) = lateness(50, 200_000, 0, wait);
+            let (p, over) = lateness(50, 200_000, 0, wait, &AtomicBool::new(false));
             assert_eq!(p.count, 50, "{wait:?}");
             assert!(p.max >= p.p999 && p.p999 >= p.p50, "{wait:?}: {p:?}");
             assert!(over <= 50);
@@ -209,7 +229,7 @@ mod tests {
         // back.
         let period = 50_000;
         let mut clock = 0u64;
-        let (p, over) = tally(100, period, 0, |due| {
+        let (p, over) = tally(100, period, 0, &AtomicBool::new(false), |due| {
             if due == 10 * period {
                 clock = due + 230_000;
             } else {

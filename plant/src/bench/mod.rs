@@ -188,6 +188,12 @@ pub fn method_name(m: Method) -> String {
 #[error("{0}")]
 pub struct BadArgument(pub String);
 
+/// A bench stopped by SIGINT/SIGTERM (exit 130): what it had finished was written, as the
+/// text says.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted: {0}")]
+pub struct Interrupted(pub String);
+
 /// The output folder of a bench: `out`, or `runs/<default>`.
 pub fn out_dir(out: Option<&Path>, default: &str) -> std::path::PathBuf {
     out.map_or_else(|| Path::new("runs").join(default), Path::to_path_buf)

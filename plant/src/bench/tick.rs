@@ -266,11 +266,15 @@ pub struct Request<'a> {
     pub realtime_priority: u32,
 }
 
-/// Hooks that ask the loop to time every tick.
-struct Timed;
-impl Hooks for Timed {
+/// Hooks that ask the loop to time every tick, and stop it on SIGINT/SIGTERM.
+struct Timed<'a>(&'a std::sync::atomic::AtomicBool);
+impl Hooks for Timed<'_> {
     fn time_ticks(&self) -> bool {
         true
+    }
+
+    fn cancelled(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
     }
 }
 
@@ -299,10 +303,16 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     let dir = super::out_dir(req.out, "bench-tick");
     let _claim = crate::claim::claim(&dir, true)?;
     let scheduling = schedule(req.pin_core, req.realtime_priority, log)?;
+    let stop = crate::interrupt::stop_flag();
+    let stopped = || stop.load(std::sync::atomic::Ordering::Relaxed);
     let mut rows = Vec::new();
-    for (label, scene) in &settings {
+    'settings: for (label, scene) in &settings {
         for run in 1..=req.repeats {
-            let result = crate::run::run_with(scene, &Launch::default(), &mut Timed)?;
+            let result = crate::run::run_with(scene, &Launch::default(), &mut Timed(&stop))?;
+            if stopped() && result.run.outcome == crate::run::Outcome::Interrupted {
+                // A run stopped part-way is not a measurement of the setting.
+                break 'settings;
+            }
             let s = Summary::new(scene, &result);
             let report = result.run.ticks.tet.as_ref().map(|t| t.report()).unwrap_or_default();
             let row = TickRow {
@@ -350,6 +360,11 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     }
     let path = dir.join("tick.csv");
     crate::table::write_with_header(&path, TICK_HEADER, &rows)?;
+    if stopped() {
+        let planned = settings.len() * req.repeats;
+        let why = format!("{} of {planned} runs finished, written to {}", rows.len(), path.display());
+        return Err(super::Interrupted(why).into());
+    }
 
     let (label, fixed) = &settings[0];
     let repeats = rows.first().map_or(1, |r| r.ticks.max(1));

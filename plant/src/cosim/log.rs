@@ -97,7 +97,7 @@ pub struct OutputLog {
 impl OutputLog {
     /// A log into `path` (created or truncated), or in memory only.
     pub fn create(path: Option<&Path>) -> std::io::Result<Self> {
-        let file = path.map(File::create).transpose()?;
+        let file = path.map(crate::outfile::create).transpose()?;
         Ok(Self {
             state: Arc::new(Mutex::new(State { file, head_left: HEAD_BYTES, ..Default::default() })),
             path: path.map(Path::to_path_buf),

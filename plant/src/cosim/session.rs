@@ -33,6 +33,11 @@ const UNWOKEN_WARNING: u64 = 50;
 /// Realtime ticks with a reply due (started, for overruns) before the miss (overrun) budget is
 /// checked during the run (it is checked again at the end, over the whole run).
 const MISS_BUDGET_MIN_DUE: u64 = 1000;
+/// Most controllers a run starts (or waits for) after losing one, with a positive
+/// `controller.reconnect_timeout_ms`: a controller lost more often than this is not recovering,
+/// and the run ends as `peer_lost`. Without the bound, one that dies on each start was
+/// respawned at every tick (about 145 ms each: an hour for a 1.5 s scene, issue 31 item 8).
+pub const MAX_RECONNECTIONS: u32 = 8;
 
 /// Why the loop must stop at this tick.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,6 +122,8 @@ pub struct Session {
     /// False while the controller is lost.
     connected: bool,
     lost_since: Option<Instant>,
+    /// Controllers lost so far in this run ([`MAX_RECONNECTIONS`]).
+    losses: u32,
     pending: Option<Pending>,
     /// First sample sent in the current session.
     first_seq: u64,
@@ -407,6 +414,14 @@ impl Session {
         }
         if self.settings.fallback == Fallback::Stop || self.settings.reconnect_timeout <= 0.0 {
             return Err(Halt::Lost(format!("controller lost at t = {} s (sample {}): {why}", sample.t_s, sample.seq)));
+        }
+        self.losses += 1;
+        if self.losses > MAX_RECONNECTIONS {
+            return Err(Halt::Lost(format!(
+                "controller lost at t = {} s (sample {}): {why}; lost {} times in this run: no further reconnection \
+                 (at most {MAX_RECONNECTIONS} per run)",
+                sample.t_s, sample.seq, self.losses
+            )));
         }
         self.last_cmd = cmd;
         if let Err(e) = self.spawn() {

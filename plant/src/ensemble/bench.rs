@@ -147,8 +147,8 @@ pub fn bench(args: &BenchArgs, log: &mut dyn FnMut(&str)) -> anyhow::Result<Benc
         })?;
     }
     let bytes = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
-    crate::atomic::write(&dir.join("bench.csv"), &bytes)?;
-    crate::atomic::write(&dir.join("bench.json"), (serde_json::to_string_pretty(&report)? + "\n").as_bytes())?;
+    crate::outfile::write(&dir.join("bench.csv"), &bytes)?;
+    crate::outfile::write(&dir.join("bench.json"), (serde_json::to_string_pretty(&report)? + "\n").as_bytes())?;
     log(&format!(
         "modes: fast = scene setting for {}/{} members; fast with verification = scene setting for {}/{} ({} verified)",
         report.agree, report.members, report.agree_verified, report.members, report.verified

@@ -169,11 +169,11 @@ pub fn sweep_charts(
     let key = &grid.axes[0].key;
     let path = dir.join("recovery_probability.png");
     {
-        let root = BitMapBackend::new(&path, (1200, 800)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_err(&path))?;
-        let title = format!("{scene}: probability of recovery against {key}");
-        band_panel(&root, &path, Some(&title), &x_label, (&x, xr), stats, &t)?;
-        root.present().map_err(draw_err(&path))?;
+        plot::draw_png(&path, (1200, 800), |root| {
+            root.fill(&WHITE).map_err(draw_err(&path))?;
+            let title = format!("{scene}: probability of recovery against {key}");
+            band_panel(root, &path, Some(&title), &x_label, (&x, xr), stats, &t)
+        })?;
     }
     for (coord, file) in [(0usize, "bifurcation_x.png"), (1, "bifurcation_y.png")] {
         let path = dir.join(file);
@@ -187,45 +187,45 @@ pub fn sweep_charts(
             }
         }
         let yr = range(groups.iter().flat_map(|g| g.2.iter().map(|p| p.1)));
-        let root = BitMapBackend::new(&path, (1200, 1000)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_err(&path))?;
-        let root = root
-            .titled(&format!("{scene}: bifurcation diagram, {c}(nT) against {key}"), (FONT, 26))
-            .map_err(draw_err(&path))?;
-        let (upper, lower) = root.split_vertically(560);
-        let mut chart = ChartBuilder::on(&upper)
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(80)
-            .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-            .map_err(draw_err(&path))?;
-        chart
-            .configure_mesh()
-            .y_desc(format!("{c}(nT) (µm), first {} members", crate::ensemble::member::POINCARE_MEMBERS))
-            .label_style((FONT, 18))
-            .axis_desc_style((FONT, 20))
-            .light_line_style(RGBColor(0xee, 0xee, 0xee))
-            .bold_line_style(RGBColor(0xc8, 0xc8, 0xc8))
-            .draw()
-            .map_err(draw_err(&path))?;
-        for (name, colour, pts) in groups.iter().filter(|g| !g.2.is_empty()) {
-            let colour = *colour;
+        plot::draw_png(&path, (1200, 1000), |root| -> anyhow::Result<()> {
+            root.fill(&WHITE).map_err(draw_err(&path))?;
+            let root = root
+                .titled(&format!("{scene}: bifurcation diagram, {c}(nT) against {key}"), (FONT, 26))
+                .map_err(draw_err(&path))?;
+            let (upper, lower) = root.split_vertically(560);
+            let mut chart = ChartBuilder::on(&upper)
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(80)
+                .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+                .map_err(draw_err(&path))?;
             chart
-                .draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled())))
-                .map_err(draw_err(&path))?
-                .label(name.name())
-                .legend(move |(x, y)| Circle::new((x + 11, y), 5, colour.filled()));
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 17))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(draw_err(&path))?;
-        band_panel(&lower, &path, None, &x_label, (&x, xr), stats, &t)?;
-        root.present().map_err(draw_err(&path))?;
+                .configure_mesh()
+                .y_desc(format!("{c}(nT) (µm), first {} members", crate::ensemble::member::POINCARE_MEMBERS))
+                .label_style((FONT, 18))
+                .axis_desc_style((FONT, 20))
+                .light_line_style(RGBColor(0xee, 0xee, 0xee))
+                .bold_line_style(RGBColor(0xc8, 0xc8, 0xc8))
+                .draw()
+                .map_err(draw_err(&path))?;
+            for (name, colour, pts) in groups.iter().filter(|g| !g.2.is_empty()) {
+                let colour = *colour;
+                chart
+                    .draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled())))
+                    .map_err(draw_err(&path))?
+                    .label(name.name())
+                    .legend(move |(x, y)| Circle::new((x + 11, y), 5, colour.filled()));
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font((FONT, 17))
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()
+                .map_err(draw_err(&path))?;
+            band_panel(&lower, &path, None, &x_label, (&x, xr), stats, &t)
+        })?;
     }
     Ok(())
 }
@@ -253,73 +253,73 @@ fn probability_map(
         }
     };
     let (xe, ye) = (edges(x), edges(y));
-    let root = BitMapBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE).map_err(draw_err(path))?;
-    let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
-    let root = root.titled(&title, (FONT, 26)).map_err(draw_err(path))?;
-    let (main, bar) = root.split_horizontally(1030);
-    let mut chart = ChartBuilder::on(&main)
-        .margin(12)
-        .x_label_area_size(55)
-        .y_label_area_size(90)
-        .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])
-        .map_err(draw_err(path))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .label_style((FONT, 18))
-        .axis_desc_style((FONT, 20))
-        .draw()
-        .map_err(draw_err(path))?;
-    let n1 = x.len();
-    chart
-        .draw_series(stats.iter().map(|s| {
-            let (c, r) = (s.index % n1, s.index / n1);
-            Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.p_recovered).filled())
-        }))
-        .map_err(draw_err(path))?;
-    let crossed: Vec<(f64, f64)> =
-        stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
-    if !crossed.is_empty() {
+    plot::draw_png(path, (1200, 800), |root| -> anyhow::Result<()> {
+        root.fill(&WHITE).map_err(draw_err(path))?;
+        let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
+        let root = root.titled(&title, (FONT, 26)).map_err(draw_err(path))?;
+        let (main, bar) = root.split_horizontally(1030);
+        let mut chart = ChartBuilder::on(&main)
+            .margin(12)
+            .x_label_area_size(55)
+            .y_label_area_size(90)
+            .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])
+            .map_err(draw_err(path))?;
         chart
-            .draw_series(crossed.iter().map(|p| Cross::new(*p, 6, SENSITIVE.stroke_width(2))))
-            .map_err(draw_err(path))?
-            .label("numerically sensitive members")
-            .legend(|(x, y)| Cross::new((x + 10, y), 6, SENSITIVE.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 17))
-            .position(SeriesLabelPosition::UpperRight)
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style((FONT, 18))
+            .axis_desc_style((FONT, 20))
             .draw()
             .map_err(draw_err(path))?;
-    }
-    let mut bc = ChartBuilder::on(&bar)
-        .margin_top(12)
-        .margin_bottom(67)
-        .margin_left(10)
-        .margin_right(10)
-        .right_y_label_area_size(100)
-        .build_cartesian_2d(0f64..1f64, 0f64..1f64)
+        let n1 = x.len();
+        chart
+            .draw_series(stats.iter().map(|s| {
+                let (c, r) = (s.index % n1, s.index / n1);
+                Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.p_recovered).filled())
+            }))
+            .map_err(draw_err(path))?;
+        let crossed: Vec<(f64, f64)> =
+            stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
+        if !crossed.is_empty() {
+            chart
+                .draw_series(crossed.iter().map(|p| Cross::new(*p, 6, SENSITIVE.stroke_width(2))))
+                .map_err(draw_err(path))?
+                .label("numerically sensitive members")
+                .legend(|(x, y)| Cross::new((x + 10, y), 6, SENSITIVE.stroke_width(2)));
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font((FONT, 17))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(draw_err(path))?;
+        }
+        let mut bc = ChartBuilder::on(&bar)
+            .margin_top(12)
+            .margin_bottom(67)
+            .margin_left(10)
+            .margin_right(10)
+            .right_y_label_area_size(100)
+            .build_cartesian_2d(0f64..1f64, 0f64..1f64)
+            .map_err(draw_err(path))?;
+        bc.draw_series((0..200).map(|k| {
+            let (a, b) = (k as f64 / 200.0, (k + 1) as f64 / 200.0);
+            Rectangle::new([(0.0, a), (1.0, b)], plot::viridis(0.5 * (a + b)).filled())
+        }))
         .map_err(draw_err(path))?;
-    bc.draw_series((0..200).map(|k| {
-        let (a, b) = (k as f64 / 200.0, (k + 1) as f64 / 200.0);
-        Rectangle::new([(0.0, a), (1.0, b)], plot::viridis(0.5 * (a + b)).filled())
-    }))
-    .map_err(draw_err(path))?;
-    bc.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc("P(recovered)")
-        .label_style((FONT, 18))
-        .axis_desc_style((FONT, 20))
-        .draw()
-        .map_err(draw_err(path))?;
-    root.present().map_err(draw_err(path))?;
-    Ok(())
+        bc.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("P(recovered)")
+            .label_style((FONT, 18))
+            .axis_desc_style((FONT, 20))
+            .draw()
+            .map_err(draw_err(path))?;
+        Ok(())
+    })
 }
 
 /// A single scene's members: recovery time against the rotor's angle at the shock's arrival

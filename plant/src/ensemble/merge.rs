@@ -179,7 +179,7 @@ pub fn write_ensemble(
         members_verified: stats.iter().map(|s| s.verified).sum(),
     };
     let json_name = if grid.kind == Kind::Ensemble { "ensemble.json" } else { "sweep.json" };
-    crate::atomic::write(&dir.join(json_name), (serde_json::to_string_pretty(&summary)? + "\n").as_bytes())?;
+    crate::outfile::write(&dir.join(json_name), (serde_json::to_string_pretty(&summary)? + "\n").as_bytes())?;
 
     if grid.kind == Kind::Ensemble {
         let mut w = csv::Writer::from_writer(Vec::new());

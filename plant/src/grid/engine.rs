@@ -79,7 +79,8 @@ pub fn execute<W: Work>(grid: &Grid, work: &W, dir: &Path, args: &RunArgs) -> an
             eprintln!("plant: warning: --jobs {n}: {e}");
         }
     }
-    std::fs::create_dir_all(dir.join("points")).with_context(|| format!("creating {}", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::outfile::folder(&dir.join("points"))?;
     let removed = store::remove_temporaries(dir);
     if !removed.is_empty() {
         eprintln!("plant: note: removed {} temporary file(s) of writes a kill interrupted", removed.len());
@@ -158,7 +159,8 @@ pub fn execute<W: Work>(grid: &Grid, work: &W, dir: &Path, args: &RunArgs) -> an
             (Err(_), n) => format!("{n} point(s) wait for other shards' units"),
         }
     );
-    if outcome.interrupted {
+    // Also a signal that came while the merged outputs were written (each whole): exit 130.
+    if outcome.interrupted || stop.load(Ordering::Relaxed) {
         return Err(GridError::Interrupted.into());
     }
     if !outcome.failed.is_empty() {

@@ -43,7 +43,7 @@ pub fn csv_writer() -> csv::Writer<Vec<u8>> {
 pub fn finish(w: csv::Writer<Vec<u8>>, path: &Path) -> anyhow::Result<()> {
     let bytes =
         w.into_inner().map_err(|e| anyhow::anyhow!("{e}")).with_context(|| format!("writing {}", path.display()))?;
-    crate::atomic::write(path, &bytes)
+    crate::outfile::write(path, &bytes)
 }
 
 /// The leading columns of a `points.csv` row, [`SINGLE_COLUMNS`] in their order: a single

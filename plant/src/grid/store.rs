@@ -84,11 +84,11 @@ struct Stored<'a> {
 pub fn write_unit<T: Serialize>(dir: &Path, unit: Unit, key: &str, result: &T) -> anyhow::Result<()> {
     let path = unit.path(dir);
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+        crate::outfile::folder(parent)?;
     }
     let text = serde_json::to_string(result)?;
     let body = format!("{{\"key\":\"{key}\",\"checksum\":\"{}\",\"result\":{text}}}\n", sha256_hex(text.as_bytes()));
-    crate::atomic::write(&path, body.as_bytes())
+    crate::outfile::write(&path, body.as_bytes())
 }
 
 /// What was found for a unit.
@@ -113,7 +113,7 @@ pub fn read_unit<T: DeserializeOwned>(
     indices: impl Fn(&T) -> Option<String>,
 ) -> Found<T> {
     let path = unit.path(dir);
-    let text = match std::fs::read_to_string(&path) {
+    let text = match crate::input::read_text(&path, crate::input::MAX_JSON_BYTES) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Found::Missing,
         Err(e) => return Found::Corrupt(format!("unreadable: {e}")),
@@ -251,7 +251,7 @@ impl Manifest {
 
     /// Reads `DIR/manifest.json`: `Ok(None)` if there is none, `Err` text if unreadable.
     pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
-        match std::fs::read_to_string(dir.join("manifest.json")) {
+        match crate::input::read_text(&dir.join("manifest.json"), crate::input::MAX_JSON_BYTES) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
             Err(e) => Err(e.to_string()),
             Ok(t) => serde_json::from_str(&t).map(Some).map_err(|e| e.to_string()),
@@ -260,6 +260,6 @@ impl Manifest {
 
     /// Writes `DIR/manifest.json`.
     pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
-        crate::atomic::write(&dir.join("manifest.json"), (serde_json::to_string_pretty(self)? + "\n").as_bytes())
+        crate::outfile::write(&dir.join("manifest.json"), (serde_json::to_string_pretty(self)? + "\n").as_bytes())
     }
 }

@@ -65,43 +65,45 @@ pub fn lines(
     let y_range = if log { log_padded(y0, y1) } else { padded(y0, y1) };
 
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    let (pw, ph) = plot_pixels(&area, path)?;
+    crate::plot::draw_png(path, WIDE_SIZE, |root| {
+        let area = titled_root(root, path, title)?;
+        let (pw, ph) = plot_pixels(&area, path)?;
 
-    // Only points inside the axes are drawn (plotters does not clip to the
-    // plotting area); this matters only for values beyond ±AXIS_LIMIT or
-    // more than MAX_DECADES below the top of a log axis.
-    let inside =
-        |x: f64, y: f64| (x_range.0..=x_range.1).contains(&x) && (y_range.0..=y_range.1).contains(&y) && keep_y(y);
-    let pieces: Vec<Vec<Vec<(f64, f64)>>> =
-        series.iter().map(|s| decimate_min_max(s.x, s.y, x_range.0, x_range.1, pw, inside)).collect();
+        // Only points inside the axes are drawn (plotters does not clip to the
+        // plotting area); this matters only for values beyond ±AXIS_LIMIT or
+        // more than MAX_DECADES below the top of a log axis.
+        let inside =
+            |x: f64, y: f64| (x_range.0..=x_range.1).contains(&x) && (y_range.0..=y_range.1).contains(&y) && keep_y(y);
+        let pieces: Vec<Vec<Vec<(f64, f64)>>> =
+            series.iter().map(|s| decimate_min_max(s.x, s.y, x_range.0, x_range.1, pw, inside)).collect();
 
-    let labels: Vec<String> = series.iter().map(|s| s.label.to_string()).collect();
-    let legend_pos = if series.len() > 1 {
-        let (lw, lh) = legend_size(&area, &labels);
-        let xm = AxisMap { lo: x_range.0, hi: x_range.1, log: false };
-        let ym = AxisMap { lo: y_range.0, hi: y_range.1, log };
-        let pts = pieces.iter().flatten().flatten().map(move |&(x, y)| (xm.frac(x), ym.frac(y)));
-        Some(quiet_corner(pts, (lw / pw as f64, lh / ph as f64)))
-    } else {
-        None
-    };
+        let labels: Vec<String> = series.iter().map(|s| s.label.to_string()).collect();
+        let legend_pos = if series.len() > 1 {
+            let (lw, lh) = legend_size(&area, &labels);
+            let xm = AxisMap { lo: x_range.0, hi: x_range.1, log: false };
+            let ym = AxisMap { lo: y_range.0, hi: y_range.1, log };
+            let pts = pieces.iter().flatten().flatten().map(move |&(x, y)| (xm.frac(x), ym.frac(y)));
+            Some(quiet_corner(pts, (lw / pw as f64, lh / ph as f64)))
+        } else {
+            None
+        };
 
-    let x_fmt = linear_ticks(x_range.0, x_range.1);
-    if log {
-        let y_coord: LogCoord<f64> = (y_range.0..y_range.1).log_scale().into();
-        let mut chart = builder(&area).build_cartesian_2d(x_range.0..x_range.1, y_coord).map_err(draw_err(path))?;
-        draw_mesh(&mut chart, x_label, y_label, &x_fmt, &log_ticks, path)?;
-        draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
-    } else {
-        let y_fmt = linear_ticks(y_range.0, y_range.1);
-        let mut chart =
-            builder(&area).build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1).map_err(draw_err(path))?;
-        draw_mesh(&mut chart, x_label, y_label, &x_fmt, &y_fmt, path)?;
-        draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
-    }
-    finish(&root, path)
+        let x_fmt = linear_ticks(x_range.0, x_range.1);
+        if log {
+            let y_coord: LogCoord<f64> = (y_range.0..y_range.1).log_scale().into();
+            let mut chart = builder(&area).build_cartesian_2d(x_range.0..x_range.1, y_coord).map_err(draw_err(path))?;
+            draw_mesh(&mut chart, x_label, y_label, &x_fmt, &log_ticks, path)?;
+            draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
+        } else {
+            let y_fmt = linear_ticks(y_range.0, y_range.1);
+            let mut chart = builder(&area)
+                .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+                .map_err(draw_err(path))?;
+            draw_mesh(&mut chart, x_label, y_label, &x_fmt, &y_fmt, path)?;
+            draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
+        }
+        Ok(())
+    })
 }
 
 pub(crate) fn draw_pieces<'a, Y>(

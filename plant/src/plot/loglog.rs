@@ -38,33 +38,34 @@ pub fn loglog(
     };
     let (xr, yr) = (log_padded(xb.0, xb.1), log_padded(yb.0, yb.1));
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, WIDE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    let x_coord: LogCoord<f64> = (xr.0..xr.1).log_scale().into();
-    let y_coord: LogCoord<f64> = (yr.0..yr.1).log_scale().into();
-    let mut chart = builder(&area).build_cartesian_2d(x_coord, y_coord).map_err(draw_err(path))?;
-    draw_mesh(&mut chart, x_label, y_label, &log_ticks, &log_ticks, path)?;
-    for (i, s) in series.iter().enumerate() {
-        let c = colour(i);
-        let p: Vec<(f64, f64)> = s.x.iter().zip(s.y).map(|(a, b)| (*a, *b)).filter(|p| ok(p.0, p.1)).collect();
-        chart
-            .draw_series(p.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))))
-            .map_err(draw_err(path))?;
-        chart
-            .draw_series(p.iter().map(|q| Circle::new(*q, 4, c.filled())))
-            .map_err(draw_err(path))?
-            .label(s.label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
-    }
-    for (j, g) in crosses.iter().enumerate() {
-        let c = colour(series.len() + j);
-        let p: Vec<(f64, f64)> = g.x.iter().zip(g.y).map(|(a, b)| (*a, *b)).filter(|p| ok(p.0, p.1)).collect();
-        chart
-            .draw_series(p.iter().map(|q| Cross::new(*q, 6, c.stroke_width(2))))
-            .map_err(draw_err(path))?
-            .label(g.label)
-            .legend(move |(x, y)| Cross::new((x + 12, y), 6, c.stroke_width(2)));
-    }
-    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, path)?;
-    finish(&root, path)
+    crate::plot::draw_png(path, WIDE_SIZE, |root| {
+        let area = titled_root(root, path, title)?;
+        let x_coord: LogCoord<f64> = (xr.0..xr.1).log_scale().into();
+        let y_coord: LogCoord<f64> = (yr.0..yr.1).log_scale().into();
+        let mut chart = builder(&area).build_cartesian_2d(x_coord, y_coord).map_err(draw_err(path))?;
+        draw_mesh(&mut chart, x_label, y_label, &log_ticks, &log_ticks, path)?;
+        for (i, s) in series.iter().enumerate() {
+            let c = colour(i);
+            let p: Vec<(f64, f64)> = s.x.iter().zip(s.y).map(|(a, b)| (*a, *b)).filter(|p| ok(p.0, p.1)).collect();
+            chart
+                .draw_series(p.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))))
+                .map_err(draw_err(path))?;
+            chart
+                .draw_series(p.iter().map(|q| Circle::new(*q, 4, c.filled())))
+                .map_err(draw_err(path))?
+                .label(s.label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+        }
+        for (j, g) in crosses.iter().enumerate() {
+            let c = colour(series.len() + j);
+            let p: Vec<(f64, f64)> = g.x.iter().zip(g.y).map(|(a, b)| (*a, *b)).filter(|p| ok(p.0, p.1)).collect();
+            chart
+                .draw_series(p.iter().map(|q| Cross::new(*q, 6, c.stroke_width(2))))
+                .map_err(draw_err(path))?
+                .label(g.label)
+                .legend(move |(x, y)| Cross::new((x + 12, y), 6, c.stroke_width(2)));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, path)?;
+        Ok(())
+    })
 }

@@ -290,7 +290,22 @@ where
         .map_err(draw_err(path))
 }
 
-/// Writes the finished bitmap to its file.
-pub(crate) fn finish(root: &Area<'_>, path: &Path) -> Result<(), PlotError> {
-    root.present().map_err(draw_err(path))
+/// Draws a chart of `size` pixels in memory with `draw`, then writes it to `path` as PNG
+/// through [`crate::outfile::png`]: never through a link at `path` (plotters' own
+/// `BitMapBackend::new(path)` opens the path and follows one). Nothing is written when
+/// `draw` fails.
+pub(crate) fn draw_png<E: From<PlotError>>(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw(&root)?;
+        root.present().map_err(draw_err(path))?;
+    }
+    crate::outfile::png(path, &rgb, size)
+        .map_err(|e| PlotError::Draw { path: path.to_path_buf(), message: format!("{e:#}") })?;
+    Ok(())
 }

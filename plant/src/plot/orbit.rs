@@ -78,42 +78,45 @@ pub fn orbit_with_circles(
     entries.push(("end".into(), Mark::Square(red)));
 
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, SQUARE_SIZE).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    // The legend goes in a strip above the chart: inside, it would hide
-    // part of a circle in any corner.
-    let area = legend_strip(&area, &entries, path)?;
-    let (pw, ph) = plot_pixels(&area, path)?;
-    let (xr, yr) = equalise((-half, half), (-half, half), pw, ph);
-    let um_per_px = (xr.1 - xr.0) / pw as f64;
+    crate::plot::draw_png(path, SQUARE_SIZE, |root| {
+        let area = titled_root(root, path, title)?;
+        // The legend goes in a strip above the chart: inside, it would hide
+        // part of a circle in any corner.
+        let area = legend_strip(&area, &entries, path)?;
+        let (pw, ph) = plot_pixels(&area, path)?;
+        let (xr, yr) = equalise((-half, half), (-half, half), pw, ph);
+        let um_per_px = (xr.1 - xr.0) / pw as f64;
 
-    let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
-    let (x_fmt, y_fmt) = (linear_ticks(xr.0, xr.1), linear_ticks(yr.0, yr.1));
-    draw_mesh(&mut chart, "x (µm)", "y (µm)", &x_fmt, &y_fmt, path)?;
+        let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
+        let (x_fmt, y_fmt) = (linear_ticks(xr.0, xr.1), linear_ticks(yr.0, yr.1));
+        draw_mesh(&mut chart, "x (µm)", "y (µm)", &x_fmt, &y_fmt, path)?;
 
-    chart
-        .draw_series(pieces.iter().filter(|p| p.len() > 1).map(|p| PathElement::new(p.clone(), line.stroke_width(1))))
-        .map_err(draw_err(path))?;
-    // Reference circles on top of the orbit, so that they stay visible
-    // where the rotor runs along them.
-    for (i, (_, r)) in circles.iter().enumerate() {
-        let style = circle_colour(i).stroke_width(2);
         chart
-            .draw_series(dashed_circle(*r, um_per_px).into_iter().map(|d| PathElement::new(d, style)))
+            .draw_series(
+                pieces.iter().filter(|p| p.len() > 1).map(|p| PathElement::new(p.clone(), line.stroke_width(1))),
+            )
             .map_err(draw_err(path))?;
-    }
-    let on_chart = |p: &(f64, f64)| (xr.0..=xr.1).contains(&p.0) && (yr.0..=yr.1).contains(&p.1);
-    chart
-        .draw_series(std::iter::once(start).filter(on_chart).map(|p| Circle::new(p, 7, green.filled())))
-        .map_err(draw_err(path))?;
-    chart
-        .draw_series(
-            std::iter::once(end)
-                .filter(on_chart)
-                .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], red.filled())),
-        )
-        .map_err(draw_err(path))?;
-    finish(&root, path)
+        // Reference circles on top of the orbit, so that they stay visible
+        // where the rotor runs along them.
+        for (i, (_, r)) in circles.iter().enumerate() {
+            let style = circle_colour(i).stroke_width(2);
+            chart
+                .draw_series(dashed_circle(*r, um_per_px).into_iter().map(|d| PathElement::new(d, style)))
+                .map_err(draw_err(path))?;
+        }
+        let on_chart = |p: &(f64, f64)| (xr.0..=xr.1).contains(&p.0) && (yr.0..=yr.1).contains(&p.1);
+        chart
+            .draw_series(std::iter::once(start).filter(on_chart).map(|p| Circle::new(p, 7, green.filled())))
+            .map_err(draw_err(path))?;
+        chart
+            .draw_series(
+                std::iter::once(end)
+                    .filter(on_chart)
+                    .map(|p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], red.filled())),
+            )
+            .map_err(draw_err(path))?;
+        Ok(())
+    })
 }
 
 pub(crate) fn circle_colour(i: usize) -> RGBColor {

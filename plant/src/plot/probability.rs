@@ -61,69 +61,73 @@ pub fn probability(
     let yr = (-0.04, 1.04);
 
     ensure_font(path)?;
-    let root = BitMapBackend::new(path, (1200, 900)).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    let entries: Vec<(String, Mark)> = curves
-        .iter()
-        .enumerate()
-        .map(|(k, c)| (c.label.to_string(), Mark::LineMarker(colour(k), Shape::ALL[k % Shape::ALL.len()])))
-        .collect();
-    let area = legend_strip(&area, &entries, path)?;
-    let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
-    draw_mesh(
-        &mut chart,
-        x_label,
-        "P(recovered), 95 % interval (Wilson)",
-        &linear_ticks(xr.0, xr.1),
-        &|v: &f64| format!("{v:.1}"),
-        path,
-    )?;
-    chart
-        .draw_series(DashedLineSeries::new(
-            [(xr.0, 0.5), (xr.1, 0.5)],
-            8,
-            6,
-            RGBColor(0x70, 0x70, 0x70).stroke_width(1),
-        ))
-        .map_err(draw_err(path))?;
-    for (k, c) in curves.iter().enumerate() {
-        let tint = colour(k);
-        let shape = Shape::ALL[k % Shape::ALL.len()];
-        let dx = shift(k);
-        let finite = |i: usize| c.x[i].is_finite() && c.p[i].is_finite();
-        let points: Vec<(f64, f64)> = (0..c.x.len()).filter(|&i| finite(i)).map(|i| (c.x[i] + dx, c.p[i])).collect();
-        chart.draw_series(LineSeries::new(points.iter().copied(), tint.stroke_width(2))).map_err(draw_err(path))?;
-        let style = tint.mix(0.8).stroke_width(1);
-        let bars: Vec<(f64, f64, f64)> = (0..c.x.len())
-            .filter(|&i| c.x[i].is_finite() && c.lo[i].is_finite() && c.hi[i].is_finite())
-            .map(|i| (c.x[i] + dx, c.lo[i].clamp(0.0, 1.0), c.hi[i].clamp(0.0, 1.0)))
+    crate::plot::draw_png(path, (1200, 900), |root| {
+        let area = titled_root(root, path, title)?;
+        let entries: Vec<(String, Mark)> = curves
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (c.label.to_string(), Mark::LineMarker(colour(k), Shape::ALL[k % Shape::ALL.len()])))
             .collect();
+        let area = legend_strip(&area, &entries, path)?;
+        let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
+        draw_mesh(
+            &mut chart,
+            x_label,
+            "P(recovered), 95 % interval (Wilson)",
+            &linear_ticks(xr.0, xr.1),
+            &|v: &f64| format!("{v:.1}"),
+            path,
+        )?;
         chart
-            .draw_series(bars.iter().map(|&(x, lo, hi)| PathElement::new(vec![(x, lo), (x, hi)], style)))
+            .draw_series(DashedLineSeries::new(
+                [(xr.0, 0.5), (xr.1, 0.5)],
+                8,
+                6,
+                RGBColor(0x70, 0x70, 0x70).stroke_width(1),
+            ))
             .map_err(draw_err(path))?;
-        chart
-            .draw_series(bars.iter().flat_map(|&(x, lo, hi)| {
-                [lo, hi].map(|y| EmptyElement::at((x, y)) + PathElement::new(vec![(-5, 0), (5, 0)], style))
-            }))
+        for (k, c) in curves.iter().enumerate() {
+            let tint = colour(k);
+            let shape = Shape::ALL[k % Shape::ALL.len()];
+            let dx = shift(k);
+            let finite = |i: usize| c.x[i].is_finite() && c.p[i].is_finite();
+            let points: Vec<(f64, f64)> =
+                (0..c.x.len()).filter(|&i| finite(i)).map(|i| (c.x[i] + dx, c.p[i])).collect();
+            chart.draw_series(LineSeries::new(points.iter().copied(), tint.stroke_width(2))).map_err(draw_err(path))?;
+            let style = tint.mix(0.8).stroke_width(1);
+            let bars: Vec<(f64, f64, f64)> = (0..c.x.len())
+                .filter(|&i| c.x[i].is_finite() && c.lo[i].is_finite() && c.hi[i].is_finite())
+                .map(|i| (c.x[i] + dx, c.lo[i].clamp(0.0, 1.0), c.hi[i].clamp(0.0, 1.0)))
+                .collect();
+            chart
+                .draw_series(bars.iter().map(|&(x, lo, hi)| PathElement::new(vec![(x, lo), (x, hi)], style)))
+                .map_err(draw_err(path))?;
+            chart
+                .draw_series(bars.iter().flat_map(|&(x, lo, hi)| {
+                    [lo, hi].map(|y| EmptyElement::at((x, y)) + PathElement::new(vec![(-5, 0), (5, 0)], style))
+                }))
+                .map_err(draw_err(path))?;
+            // The markers over the bars, one shape per curve.
+            let fill = tint.filled();
+            let at = |p: (f64, f64)| EmptyElement::at(p);
+            match shape {
+                Shape::Circle => {
+                    chart.draw_series(points.iter().map(|&p| at(p) + Circle::new((0, 0), 5, fill))).map(|_| ())
+                }
+                Shape::Square => chart
+                    .draw_series(points.iter().map(|&p| at(p) + Rectangle::new([(-5, -5), (5, 5)], fill)))
+                    .map(|_| ()),
+                Shape::Triangle => chart
+                    .draw_series(points.iter().map(|&p| at(p) + Polygon::new(vec![(0, -7), (6, 5), (-6, 5)], fill)))
+                    .map(|_| ()),
+                Shape::Diamond => chart
+                    .draw_series(
+                        points.iter().map(|&p| at(p) + Polygon::new(vec![(0, -7), (7, 0), (0, 7), (-7, 0)], fill)),
+                    )
+                    .map(|_| ()),
+            }
             .map_err(draw_err(path))?;
-        // The markers over the bars, one shape per curve.
-        let fill = tint.filled();
-        let at = |p: (f64, f64)| EmptyElement::at(p);
-        match shape {
-            Shape::Circle => {
-                chart.draw_series(points.iter().map(|&p| at(p) + Circle::new((0, 0), 5, fill))).map(|_| ())
-            }
-            Shape::Square => {
-                chart.draw_series(points.iter().map(|&p| at(p) + Rectangle::new([(-5, -5), (5, 5)], fill))).map(|_| ())
-            }
-            Shape::Triangle => chart
-                .draw_series(points.iter().map(|&p| at(p) + Polygon::new(vec![(0, -7), (6, 5), (-6, 5)], fill)))
-                .map(|_| ()),
-            Shape::Diamond => chart
-                .draw_series(points.iter().map(|&p| at(p) + Polygon::new(vec![(0, -7), (7, 0), (0, 7), (-7, 0)], fill)))
-                .map(|_| ()),
         }
-        .map_err(draw_err(path))?;
-    }
-    finish(&root, path)
+        Ok(())
+    })
 }

@@ -41,61 +41,62 @@ pub fn scatter(
 
     ensure_font(path)?;
     let size = if equal_axes { SQUARE_SIZE } else { WIDE_SIZE };
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    let area = titled_root(&root, path, title)?;
-    let (pw, ph) = plot_pixels(&area, path)?;
-    let (mut xr, mut yr) = (padded(xb.0, xb.1), padded(yb.0, yb.1));
-    if equal_axes {
-        // Both axes get the larger padded span, then the plotting area's
-        // aspect ratio, so that one unit is as long on both.
-        let s = (xr.1 - xr.0).max(yr.1 - yr.0);
-        (xr, yr) = equalise(centred(xr.0, xr.1, s), centred(yr.0, yr.1, s), pw, ph);
-    }
-
-    let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
-    let (x_fmt, y_fmt) = (linear_ticks(xr.0, xr.1), linear_ticks(yr.0, yr.1));
-    draw_mesh(&mut chart, x_label, y_label, &x_fmt, &y_fmt, path)?;
-
-    let xm = AxisMap { lo: xr.0, hi: xr.1, log: false };
-    let ym = AxisMap { lo: yr.0, hi: yr.1, log: false };
-    let mut occupied = vec![false; pw * ph];
-    let mut kept_all: Vec<(f64, f64)> = Vec::new();
-    // Marker size: smaller as the map gets denser.
-    let radius = match groups.iter().map(|g| g.x.len()).sum::<usize>() {
-        0..=2_000 => 3,
-        2_001..=20_000 => 2,
-        _ => 1,
-    };
-    for (i, g) in groups.iter().enumerate() {
-        occupied.iter_mut().for_each(|o| *o = false);
-        let mut kept = Vec::new();
-        for (&x, &y) in g.x.iter().zip(g.y) {
-            let (fx, fy) = (xm.frac(x), ym.frac(y));
-            // Also skips the non-finite, and anything beyond ±AXIS_LIMIT.
-            if !((0.0..=1.0).contains(&fx) && (0.0..=1.0).contains(&fy)) {
-                continue;
-            }
-            let px = ((fx * pw as f64) as usize).min(pw - 1);
-            let py = ((fy * ph as f64) as usize).min(ph - 1);
-            let cell = &mut occupied[py * pw + px];
-            if !*cell {
-                *cell = true;
-                kept.push((x, y));
-            }
+    crate::plot::draw_png(path, size, |root| {
+        let area = titled_root(root, path, title)?;
+        let (pw, ph) = plot_pixels(&area, path)?;
+        let (mut xr, mut yr) = (padded(xb.0, xb.1), padded(yb.0, yb.1));
+        if equal_axes {
+            // Both axes get the larger padded span, then the plotting area's
+            // aspect ratio, so that one unit is as long on both.
+            let s = (xr.1 - xr.0).max(yr.1 - yr.0);
+            (xr, yr) = equalise(centred(xr.0, xr.1, s), centred(yr.0, yr.1, s), pw, ph);
         }
-        let c = colour(i);
-        chart
-            .draw_series(kept.iter().map(|&p| Circle::new(p, radius, c.filled())))
-            .map_err(draw_err(path))?
-            .label(g.label)
-            .legend(move |(x, y)| Circle::new((x + 12, y), 5, c.filled()));
-        kept_all.extend(kept.iter().map(|&(x, y)| (xm.frac(x), ym.frac(y))));
-    }
-    if groups.len() > 1 {
-        let labels: Vec<String> = groups.iter().map(|g| g.label.to_string()).collect();
-        let (lw, lh) = legend_size(&area, &labels);
-        let pos = quiet_corner(kept_all.iter().copied(), (lw / pw as f64, lh / ph as f64));
-        draw_legend(&mut chart, pos, path)?;
-    }
-    finish(&root, path)
+
+        let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
+        let (x_fmt, y_fmt) = (linear_ticks(xr.0, xr.1), linear_ticks(yr.0, yr.1));
+        draw_mesh(&mut chart, x_label, y_label, &x_fmt, &y_fmt, path)?;
+
+        let xm = AxisMap { lo: xr.0, hi: xr.1, log: false };
+        let ym = AxisMap { lo: yr.0, hi: yr.1, log: false };
+        let mut occupied = vec![false; pw * ph];
+        let mut kept_all: Vec<(f64, f64)> = Vec::new();
+        // Marker size: smaller as the map gets denser.
+        let radius = match groups.iter().map(|g| g.x.len()).sum::<usize>() {
+            0..=2_000 => 3,
+            2_001..=20_000 => 2,
+            _ => 1,
+        };
+        for (i, g) in groups.iter().enumerate() {
+            occupied.iter_mut().for_each(|o| *o = false);
+            let mut kept = Vec::new();
+            for (&x, &y) in g.x.iter().zip(g.y) {
+                let (fx, fy) = (xm.frac(x), ym.frac(y));
+                // Also skips the non-finite, and anything beyond ±AXIS_LIMIT.
+                if !((0.0..=1.0).contains(&fx) && (0.0..=1.0).contains(&fy)) {
+                    continue;
+                }
+                let px = ((fx * pw as f64) as usize).min(pw - 1);
+                let py = ((fy * ph as f64) as usize).min(ph - 1);
+                let cell = &mut occupied[py * pw + px];
+                if !*cell {
+                    *cell = true;
+                    kept.push((x, y));
+                }
+            }
+            let c = colour(i);
+            chart
+                .draw_series(kept.iter().map(|&p| Circle::new(p, radius, c.filled())))
+                .map_err(draw_err(path))?
+                .label(g.label)
+                .legend(move |(x, y)| Circle::new((x + 12, y), 5, c.filled()));
+            kept_all.extend(kept.iter().map(|&(x, y)| (xm.frac(x), ym.frac(y))));
+        }
+        if groups.len() > 1 {
+            let labels: Vec<String> = groups.iter().map(|g| g.label.to_string()).collect();
+            let (lw, lh) = legend_size(&area, &labels);
+            let pos = quiet_corner(kept_all.iter().copied(), (lw / pw as f64, lh / ph as f64));
+            draw_legend(&mut chart, pos, path)?;
+        }
+        Ok(())
+    })
 }

@@ -7,7 +7,7 @@ pub fn rss_kib(pid: Option<u32>) -> Option<u64> {
         Some(pid) => format!("/proc/{pid}/status"),
         None => "/proc/self/status".to_string(),
     };
-    parse_vm_rss(&std::fs::read_to_string(path).ok()?)
+    parse_vm_rss(&std::fs::read_to_string(path).ok()?) // "/proc/…": the system's own file
 }
 
 /// The `VmRSS:` line of a `status` file, in KiB.

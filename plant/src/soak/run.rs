@@ -147,7 +147,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display())).map_err(io)?;
     let scene = &prog.scene;
     let resolved = scene.to_toml().context("serialising the resolved scene").map_err(io)?;
-    crate::atomic::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
+    crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
 
     let create = |name: &str, header: &[&str]| {
         let path = dir.join(name);

@@ -107,7 +107,8 @@ fn read_sweep(dir: &Path, label: String) -> anyhow::Result<Curve> {
         };
         return Err(bad(format!("{shown}: {why}")));
     }
-    let text = std::fs::read_to_string(&json).with_context(|| format!("reading {}", json.display()))?;
+    let text = crate::input::read_text(&json, crate::input::MAX_JSON_BYTES)
+        .map_err(|e| bad(format!("{}: {e}", json.display())))?;
     let s: SweepJson = serde_json::from_str(&text)
         .map_err(|e| bad(format!("{}: not the summary of an ensemble sweep: {e}", json.display())))?;
     if s.kind != "sweep" {
@@ -130,7 +131,7 @@ fn read_sweep(dir: &Path, label: String) -> anyhow::Result<Curve> {
         return Err(bad(format!("{shown}: a point without a finite value of {key} ({:?})", p.value)));
     }
     // The axis's spacing, from the sweep's definition (linear when the manifest does not say).
-    let log = std::fs::read_to_string(dir.join("manifest.json"))
+    let log = crate::input::read_text(&dir.join("manifest.json"), crate::input::MAX_JSON_BYTES)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .is_some_and(|m| m["definition"]["spacing"] == "log");

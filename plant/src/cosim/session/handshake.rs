@@ -207,6 +207,7 @@ impl Session {
             period,
             connected: false,
             lost_since: None,
+            losses: 0,
             pending: None,
             first_seq: 0,
             last_cmd: bias,

@@ -1,0 +1,211 @@
+//! The one way the plant creates a file in an output folder, so that no
+//! command writes through a link someone left in its `--out` (issue 31 item 6:
+//! `soak`, `compare`, `assess`, `campbell`, `ensemble`, `sweep`, `overlay` and
+//! `analyze` drew their charts, and `soak` its CSVs and log, through symlinks
+//! already in the folder, overwriting files elsewhere).
+//!
+//! * [`write`]: a file written whole (JSON, TOML, CSV tables, charts): through
+//!   a temporary created new in the same folder, renamed over the name
+//!   ([`crate::atomic::write`]). A rename replaces a link (symbolic or hard)
+//!   by the new file and never touches what it pointed to.
+//! * [`create`]: a file streamed as it is made (`trace.csv`, the soak's CSVs,
+//!   `controller.log`): whatever non-folder entry holds the name (a link, an
+//!   earlier file) is unlinked, and the file is created new (`O_CREAT |
+//!   O_EXCL`, which never follows a link), so it is always a fresh regular
+//!   file in the folder.
+//! * [`png`]: a chart, drawn in memory and handed to [`write`] (plotters'
+//!   own `BitMapBackend::new(path)` opens the path and follows a link).
+//! * [`folder`]: a folder the command makes inside its output folder
+//!   (`points/`): created if missing, refused when a link holds its name.
+//!
+//! Nothing else in `plant/src` opens a file for writing: a test
+//! (`no_writer_bypasses_the_shared_module`) fails on a `File::create`,
+//! `fs::write`, `OpenOptions`, `BitMapBackend::new` or `atomic::write` outside
+//! this module and `atomic.rs`.
+
+use anyhow::Context;
+use std::fs::{File, OpenOptions};
+use std::io::{Error, ErrorKind};
+use std::path::Path;
+
+/// Writes `bytes` to `path` whole or not at all, replacing whatever entry held the name
+/// (a link included) and never writing through it.
+pub fn write(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    crate::atomic::write(path, bytes)
+}
+
+/// Creates `path` as a new, empty regular file for writing: an entry already at the name
+/// (a file of an earlier run, a symbolic or hard link) is unlinked first, never followed;
+/// a folder at the name is an error.
+pub fn create(path: &Path) -> std::io::Result<File> {
+    // Another process may put an entry back between the unlink and the creation: try again.
+    for _ in 0..8 {
+        match std::fs::symlink_metadata(path) {
+            Ok(m) if m.is_dir() => {
+                return Err(Error::new(ErrorKind::AlreadyExists, format!("{} is a folder", path.display())))
+            }
+            Ok(_) => match std::fs::remove_file(path) {
+                Ok(()) => {}
+                Err(e) if e.kind() == ErrorKind::NotFound => {}
+                Err(e) => return Err(e),
+            },
+            Err(e) if e.kind() == ErrorKind::NotFound => {}
+            Err(e) => return Err(e),
+        }
+        match OpenOptions::new().write(true).create_new(true).open(path) {
+            Ok(file) => return Ok(file),
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(Error::new(ErrorKind::AlreadyExists, format!("{}: another process keeps creating it", path.display())))
+}
+
+/// Creates the folder `path` (and its parents) if missing; a symbolic link at `path` is
+/// refused, so that the files written into it stay inside the output folder.
+pub fn folder(path: &Path) -> anyhow::Result<()> {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        anyhow::bail!("{} is a symbolic link: a folder the command writes into must be a real folder", path.display());
+    }
+    std::fs::create_dir_all(path).with_context(|| format!("creating {}", path.display()))?;
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        anyhow::bail!("{} is a symbolic link: a folder the command writes into must be a real folder", path.display());
+    }
+    Ok(())
+}
+
+/// An RGB image of `size` pixels, `rgb` row by row, as PNG bytes (the encoding plotters'
+/// own file output uses).
+pub fn png_bytes(rgb: &[u8], size: (u32, u32)) -> anyhow::Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(rgb, size.0, size.1, image::ColorType::Rgb8)
+        .context("encoding PNG")?;
+    Ok(bytes)
+}
+
+/// Writes an RGB image as a PNG file through [`write`].
+pub fn png(path: &Path, rgb: &[u8], size: (u32, u32)) -> anyhow::Result<()> {
+    write(path, &png_bytes(rgb, size).with_context(|| format!("writing {}", path.display()))?)
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("plant-outfile-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Every way of writing replaces a symbolic or hard link at its name and leaves what it
+    /// pointed to as it was.
+    #[test]
+    fn no_write_goes_through_a_link() {
+        let dir = scratch("links");
+        let outside = dir.join("outside");
+        std::fs::create_dir_all(&outside).unwrap();
+        let victim = |n: &str| {
+            let p = outside.join(n);
+            std::fs::write(&p, b"precious").unwrap();
+            p
+        };
+        let out = dir.join("out");
+        std::fs::create_dir_all(&out).unwrap();
+        let names = ["a.json", "b.csv", "c.png", "d.json", "e.csv"];
+        for (i, n) in names.iter().enumerate() {
+            let target = victim(n);
+            if i < 3 {
+                std::os::unix::fs::symlink(&target, out.join(n)).unwrap();
+            } else {
+                std::fs::hard_link(&target, out.join(n)).unwrap();
+            }
+        }
+        // A dangling link: creating through it would make a file elsewhere.
+        std::os::unix::fs::symlink(outside.join("made.csv"), out.join("f.csv")).unwrap();
+        write(&out.join("a.json"), b"{}").unwrap();
+        std::io::Write::write_all(&mut create(&out.join("b.csv")).unwrap(), b"x\n").unwrap();
+        png(&out.join("c.png"), &[255; 12], (2, 2)).unwrap();
+        write(&out.join("d.json"), b"{}").unwrap();
+        std::io::Write::write_all(&mut create(&out.join("e.csv")).unwrap(), b"x\n").unwrap();
+        std::io::Write::write_all(&mut create(&out.join("f.csv")).unwrap(), b"x\n").unwrap();
+        for n in names {
+            assert_eq!(std::fs::read(outside.join(n)).unwrap(), b"precious", "{n} was written through");
+            let m = std::fs::symlink_metadata(out.join(n)).unwrap();
+            assert!(m.is_file(), "{n} is a regular file of its own now");
+        }
+        assert!(!outside.join("made.csv").exists(), "a dangling link was followed");
+        assert!(std::fs::symlink_metadata(out.join("f.csv")).unwrap().is_file());
+        // A folder at the name stays and is an error.
+        std::fs::create_dir_all(out.join("g.csv")).unwrap();
+        assert!(create(&out.join("g.csv")).is_err());
+        // A linked subfolder is refused.
+        std::os::unix::fs::symlink(&outside, out.join("points")).unwrap();
+        let e = folder(&out.join("points")).unwrap_err().to_string();
+        assert!(e.contains("symbolic link"), "{e}");
+        folder(&out.join("real")).unwrap();
+        assert!(out.join("real").is_dir());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The non-test code of `plant/src` up to its first `#[cfg(test)]`, per file.
+    pub(crate) fn sources() -> Vec<(PathBuf, String)> {
+        fn walk(dir: &Path, out: &mut Vec<(PathBuf, String)>) {
+            for e in std::fs::read_dir(dir).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    walk(&p, out);
+                } else if p.extension().is_some_and(|x| x == "rs") && p.file_name().is_some_and(|n| n != "tests.rs") {
+                    let text = std::fs::read_to_string(&p).unwrap();
+                    let code = text.split("#[cfg(test)]").next().unwrap_or_default().to_string();
+                    out.push((p, code));
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), &mut out);
+        assert!(out.len() > 50, "plant/src was not found");
+        out
+    }
+
+    /// The class of issue 31 item 6: a writer that opens its output itself can follow a link.
+    /// Every writer of `plant/src` goes through this module (`atomic.rs` is its mechanism);
+    /// a new one that does not fails here, named with its line.
+    #[test]
+    fn no_writer_bypasses_the_shared_module() {
+        const FORBIDDEN: &[&str] = &[
+            "File::create",
+            "fs::write(",
+            "OpenOptions::new",
+            "BitMapBackend::new(",
+            "atomic::write(",
+            "Writer::from_path",
+            "fs::copy(",
+            "fs::rename(",
+        ];
+        let mut found = Vec::new();
+        for (path, code) in sources() {
+            let name = path.file_name().unwrap().to_string_lossy();
+            if name == "outfile.rs" || name == "atomic.rs" {
+                continue;
+            }
+            for (i, line) in code.lines().enumerate() {
+                let line_code = line.split("//").next().unwrap_or_default();
+                // A whole name: `RowFile::create` is not `File::create`.
+                let whole = |f: &str| {
+                    line_code.match_indices(f).any(|(at, _)| {
+                        !line_code[..at].chars().next_back().is_some_and(|c| c.is_alphanumeric() || c == '_')
+                    })
+                };
+                if FORBIDDEN.iter().any(|f| whole(f)) {
+                    found.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
+                }
+            }
+        }
+        assert!(found.is_empty(), "writers that bypass plant::outfile:\n{}", found.join("\n"));
+    }
+}
