@@ -287,7 +287,7 @@ pub fn run_into_from(
 
 /// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
 /// limit (unused axes 0).
-pub(crate) fn bias_of(scene: &Scene, gains: &[PdGains]) -> [f64; ROTOR_AXES] {
+pub fn bias_of(scene: &Scene, gains: &[PdGains]) -> [f64; ROTOR_AXES] {
     let mut bias = [0.0; ROTOR_AXES];
     for (i, g) in gains.iter().enumerate() {
         let b = saturate(g.bias_a, scene.plane(i).current_limit);
