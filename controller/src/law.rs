@@ -55,7 +55,7 @@ pub struct Sample {
 /// let b = s.plane(1); // plane B's pair, with the keyphasor
 /// assert_eq!((b.sensor_v, b.speed_rad_s), ([0.3, 0.4], 100.0));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RotorSample {
     /// Sample index k (the tick it was taken at).
     pub seq: u64,

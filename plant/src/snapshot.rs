@@ -105,50 +105,7 @@ pub struct DigitalState {
     /// The samples the law read last, oldest first ([`crate::digital::RECENT`] at most): a law
     /// started from the snapshot reads them first ([`crate::digital::DigitalLoop::prime`]).
     #[serde(default)]
-    pub recent: Vec<SavedSample>,
-}
-
-/// A sample the law read ([`controller::RotorSample`]), as a snapshot keeps it.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SavedSample {
-    /// Sample index.
-    pub seq: u64,
-    /// Its time (s).
-    pub t_s: f64,
-    /// Axes in use.
-    pub axes: u32,
-    /// Sensor voltages (V) per axis.
-    pub sensor_v: [f64; ROTOR_AXES],
-    /// Keyphasor speed (rad/s).
-    pub speed_rad_s: f64,
-    /// Keyphasor angle (rad).
-    pub angle_rad: f64,
-}
-
-impl From<&controller::RotorSample> for SavedSample {
-    fn from(s: &controller::RotorSample) -> Self {
-        Self {
-            seq: s.seq,
-            t_s: s.t_s,
-            axes: s.axes,
-            sensor_v: s.sensor_v,
-            speed_rad_s: s.speed_rad_s,
-            angle_rad: s.angle_rad,
-        }
-    }
-}
-
-impl From<&SavedSample> for controller::RotorSample {
-    fn from(s: &SavedSample) -> Self {
-        Self {
-            seq: s.seq,
-            t_s: s.t_s,
-            axes: s.axes,
-            sensor_v: s.sensor_v,
-            speed_rad_s: s.speed_rad_s,
-            angle_rad: s.angle_rad,
-        }
-    }
+    pub recent: Vec<controller::RotorSample>,
 }
 
 /// Why a snapshot cannot be read or restored.

@@ -341,8 +341,7 @@ fn run_from(
         plant.restore(snapshot)?;
         if let Some(d) = &snapshot.digital {
             digital.path_mut().set_in_flight(&d.in_flight);
-            let recent: Vec<controller::RotorSample> = d.recent.iter().map(Into::into).collect();
-            primed = digital.prime(&recent, hooks);
+            primed = digital.prime(&d.recent, hooks);
         }
     }
     if digital.is_cosim() || hooks.time_ticks() {
@@ -391,8 +390,7 @@ fn drive(
         let t = plant.time();
         while next_save < saves.len() && saves[next_save] <= t + 1e-9 * scene.controller.period {
             let mut snapshot = plant.snapshot();
-            let recent = digital.recent().iter().map(Into::into).collect();
-            snapshot.digital = Some(DigitalState { in_flight: digital.path().in_flight(), recent });
+            snapshot.digital = Some(DigitalState { in_flight: digital.path().in_flight(), recent: digital.recent() });
             hooks.state_saved(saves[next_save], snapshot);
             next_save += 1;
         }
