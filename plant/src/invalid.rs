@@ -73,6 +73,11 @@ impl<const N: usize> InvalidCommands<N> {
         Self { max_burst, max_fraction, held: initial, ticks: 0, count: 0, burst: 0, burst_from: (0, 0.0) }
     }
 
+    /// `controller.max_invalid_burst`: the most non-finite commands in a row.
+    pub fn max_burst(&self) -> u64 {
+        self.max_burst
+    }
+
     /// Non-finite commands so far.
     pub fn count(&self) -> u64 {
         self.count

@@ -41,7 +41,6 @@ pub struct CommandPath {
     invalid: InvalidCommands<ROTOR_AXES>,
     /// The commands not yet applied, oldest first.
     line: VecDeque<[f64; ROTOR_AXES]>,
-    max_burst: u64,
 }
 
 /// What [`CommandPath::push`] makes of one answer.
@@ -66,7 +65,7 @@ impl CommandPath {
     ) -> Self {
         let mut line = VecDeque::with_capacity(delay + 1);
         line.extend(std::iter::repeat_n(bias, delay));
-        Self { limits, invalid: InvalidCommands::new(bias, max_burst, max_fraction), line, max_burst }
+        Self { limits, invalid: InvalidCommands::new(bias, max_burst, max_fraction), line }
     }
 
     /// A law's answer saturated at the limits.
@@ -112,7 +111,7 @@ impl CommandPath {
 
     /// `controller.max_invalid_burst`, for messages.
     pub fn max_burst(&self) -> u64 {
-        self.max_burst
+        self.invalid.max_burst()
     }
 }
 
@@ -125,8 +124,6 @@ pub const RECENT: usize = 32;
 pub struct DigitalLoop {
     source: Source,
     path: CommandPath,
-    /// Bearing planes of the rotor.
-    planes: usize,
     controller_pid: Option<u32>,
     /// The last [`RECENT`] samples the law read, a ring (`recent_next` the oldest once full).
     recent: [RotorSample; RECENT],
@@ -135,15 +132,9 @@ pub struct DigitalLoop {
 }
 
 impl DigitalLoop {
-    /// The loop of `scene` for a rotor of `planes` planes, its commands from `source`, `bias`
-    /// before any (A, per axis), saturated at `limits`.
-    pub fn new(
-        scene: &Scene,
-        source: Source,
-        planes: usize,
-        bias: [f64; ROTOR_AXES],
-        limits: [f64; ROTOR_AXES],
-    ) -> Self {
+    /// The loop of `scene`, its commands from `source`, `bias` before any (A, per axis),
+    /// saturated at `limits`.
+    pub fn new(scene: &Scene, source: Source, bias: [f64; ROTOR_AXES], limits: [f64; ROTOR_AXES]) -> Self {
         let inherent = match &source {
             Source::Cosim(session) => session.inherent_delay(),
             _ => 0,
@@ -155,15 +146,7 @@ impl DigitalLoop {
             _ => None,
         };
         let path = CommandPath::new(bias, limits, delay, c.max_invalid_burst, c.max_invalid_fraction);
-        Self {
-            source,
-            path,
-            planes,
-            controller_pid,
-            recent: [RotorSample::default(); RECENT],
-            recent_len: 0,
-            recent_next: 0,
-        }
+        Self { source, path, controller_pid, recent: [RotorSample::default(); RECENT], recent_len: 0, recent_next: 0 }
     }
 
     /// The samples the law read last, oldest first (at most [`RECENT`]; a snapshot's).
@@ -228,7 +211,8 @@ impl DigitalLoop {
 
     /// The command over the tick of `sample` (what the plant read), or how the run ends.
     pub fn command(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<Command, Outcome> {
-        let planes = self.planes;
+        // Bearing planes of the rotor: the sample's axes, two each.
+        let planes = sample.axes as usize / 2;
         let mut sample = *sample;
         // The summing point of a sensitivity measurement (one plane's axes): added to what a
         // law reads, handed to the plane's continuous PD, which reads it inside the derivative.
@@ -238,10 +222,6 @@ impl DigitalLoop {
             let axes = &mut sample.sensor_v[2 * e.plane..2 * e.plane + 2];
             axes.iter_mut().zip(e.sine.at(sample.t_s).0).for_each(|(v, e)| *v += e);
         }
-        if let Source::Continuous = self.source {
-            return Ok(Command::Continuous(excitation));
-        }
-        self.remember(&sample);
         let answer = match &mut self.source {
             Source::Continuous => return Ok(Command::Continuous(excitation)),
             Source::InProcess(law) => self.path.saturate(law.update(&sample)),
@@ -259,6 +239,7 @@ impl DigitalLoop {
                 Err(halt) => return Err(outcome_of(halt)),
             },
         };
+        self.remember(&sample);
         // (The session saturates what comes over the wire itself.)
         let pushed = self.path.push(answer, &sample).map_err(Outcome::InvalidCommands)?;
         if pushed.first_invalid {

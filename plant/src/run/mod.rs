@@ -335,7 +335,7 @@ fn run_from(
         _ => Command::Held(bias),
     };
     let mut plant = Plant::new(scene, &initial)?;
-    let mut digital = DigitalLoop::new(scene, source, plant.planes(), bias, limits);
+    let mut digital = DigitalLoop::new(scene, source, bias, limits);
     let mut primed = Ok(());
     if let Some(snapshot) = from {
         plant.restore(snapshot)?;

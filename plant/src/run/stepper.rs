@@ -307,8 +307,8 @@ struct Stepper<const N: usize, M: Machine<N>> {
     /// Each plane's continuous PD (`Command::Continuous`).
     gains: Vec<PdGains>,
     sensor: Sensor,
-    /// The sensor as it was before the current sample was read (what a snapshot keeps).
-    sensor_at_tick: Sensor,
+    /// The sensor's noise generator before the current sample was read (what a snapshot keeps).
+    rng_at_tick: u64,
     guards: Guards,
     breakpoints: Vec<f64>,
     next_breakpoint: usize,
@@ -340,7 +340,7 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
             y,
             integrator: Integrator::new(settings),
             gains,
-            sensor_at_tick: sensor.clone(),
+            rng_at_tick: sensor.rng_state(),
             sensor,
             breakpoints: scene.base.breakpoints(),
             next_breakpoint: 0,
@@ -373,7 +373,7 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
 
 impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
     fn read_sample(&mut self) -> RotorSample {
-        self.sensor_at_tick = self.sensor.clone();
+        self.rng_at_tick = self.sensor.rng_state();
         let planes = M::PLANES;
         let (model, y) = (&self.model, &self.y);
         // The rotor's speed and its angle wrapped to [0, 2π), from the state.
@@ -550,7 +550,7 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
             next_output: self.next_out,
             parked: (0..M::PLANES).map(|i| self.model.parked(i)).collect(),
             parked_steps: self.parked_steps,
-            sensor_rng: self.sensor_at_tick.rng_state(),
+            sensor_rng: self.rng_at_tick,
             digital: None,
         }
     }
