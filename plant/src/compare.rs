@@ -375,10 +375,7 @@ fn recovered(seconds: f64) -> String {
 mod tests {
     use super::*;
 
-    fn scene(file: &str, sets: &[&str]) -> Scene {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
-        load_scene(&root, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap()
-    }
+    use crate::config::shipped as scene;
 
     /// A chart of a two-plane rotor names each plane's gap and draws each plane's radius (it
     /// used plane A's gap for the whole rotor).

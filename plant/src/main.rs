@@ -246,9 +246,8 @@ impl States {
             None => None,
             Some(path) => {
                 let snapshot = plant::snapshot::Snapshot::read(path)?;
-                let initial = plant::stepper::Command::Continuous(None);
-                let mut plant = plant::Plant::new(scene, &initial).context("--from-state")?;
-                plant.restore(&snapshot).with_context(|| format!("--from-state {}", path.display()))?;
+                plant::run::check_start(scene, &snapshot)
+                    .with_context(|| format!("--from-state {}", path.display()))?;
                 if snapshot.t_s >= scene.duration {
                     return Err(Ending::BadArgument(format!(
                         "--from-state {}: the state is at t = {} s, not before the scene's end, \

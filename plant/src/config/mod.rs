@@ -548,14 +548,19 @@ fn flatten(prefix: &str, table: &toml::Table, out: &mut Vec<(String, String)>) {
     }
 }
 
+/// A shipped scene (`config/FILE`) with `sets` applied, for the library's tests.
+#[cfg(test)]
+pub(crate) fn shipped(file: &str, sets: &[&str]) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
+    load_scene(&path, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+        .unwrap_or_else(|e| panic!("config/{file} {sets:?}: {e}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn scene(file: &str, sets: &[&str]) -> Scene {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
-        load_scene(&root, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap()
-    }
+    use super::shipped as scene;
 
     /// The fixed-step setting sizes the contact substeps for the bearing plane that needs the
     /// most (it read plane A's alone), whichever plane that is.

@@ -105,7 +105,7 @@ pub enum SetupError {
     #[error("the controller's overrides: {0}")]
     Overrides(#[from] crate::config::ConfigError),
     /// The state to start from does not fit the scene, or could not be read.
-    #[error("--from-state: {0}")]
+    #[error("the state to start from: {0}")]
     State(#[from] SnapshotError),
     /// The thread that takes a realtime run's samples could not be started.
     #[error("starting the thread that takes the run's samples: {0}")]
@@ -265,7 +265,7 @@ pub fn run_into_from(
 ) -> Result<SinkRun, SetupError> {
     if let Some(snapshot) = from {
         // Refused before a controller process starts.
-        Plant::new(scene, &Command::Continuous(None))?.restore(snapshot)?;
+        check_start(scene, snapshot)?;
     }
     let params = &scene.controller.params;
     let source = match scene.controller.mode {
@@ -283,6 +283,13 @@ pub fn run_into_from(
         }
     };
     run_from(scene, source, hooks, sink, from)
+}
+
+/// Whether `scene`'s plant can start from `snapshot` ([`Plant::restore`] into a fresh one): the
+/// check made before anything starts or is written.
+pub fn check_start(scene: &Scene, snapshot: &Snapshot) -> Result<(), SetupError> {
+    Plant::new(scene, &Command::Continuous(None))?.restore(snapshot)?;
+    Ok(())
 }
 
 /// The bias currents per axis (A) of each plane's design `gains`, each within its plane's

@@ -696,12 +696,11 @@ mod tests {
     use crate::trace::Trace;
     use std::path::Path;
 
+    /// A shipped scene, 30 ms long with the shock at 5 ms, and `sets`.
     fn scene(file: &str, sets: &[&str]) -> Scene {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let mut all: Vec<String> =
-            ["scene.duration_s=0.03", "shock[0].start_s=0.005", "output.plots=false"].map(String::from).to_vec();
-        all.extend(sets.iter().map(|s| s.to_string()));
-        crate::config::load_scene(&root.join("config").join(file), &all).unwrap()
+        let mut all = vec!["scene.duration_s=0.03", "shock[0].start_s=0.005", "output.plots=false"];
+        all.extend_from_slice(sets);
+        crate::config::shipped(file, &all)
     }
 
     /// Hooks that save the state at the given times.
