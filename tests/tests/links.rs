@@ -179,14 +179,7 @@ fn compare_and_campbell_write_through_no_link() {
 #[test]
 fn assess_writes_through_no_link() {
     let dir = TempDir::new("links-assess");
-    let path = dir.join("assess.toml");
-    let text = format!(
-        "scene = {:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\nparts = [\"vibration\", \"ladder\"]\n\
-         [[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
-         [ladder]\npeaks_g = [3.0]\nduty_g = 3.0\nmembers = 2\nbatch = 2\nverify = false\n",
-        scene("paper-10g.toml").display().to_string()
-    );
-    std::fs::write(&path, text).unwrap();
+    let path = small_assessment(&dir);
     let args = os(&["assess", path.to_str().unwrap(), "--out", "{out}", "--quiet"]);
     let written = holds(&dir, "assess", &args, &[], &nothing);
     assert!(written.iter().any(|f| f.ends_with("report.html")), "{written:?}");
@@ -201,16 +194,7 @@ fn ensemble_sweep_and_overlay_write_through_no_link_and_refuse_a_linked_points_f
     let written = holds(&dir, "ensemble", &args, &[], &nothing);
     assert!(written.iter().any(|f| f.starts_with("points")), "{written:?}");
 
-    let file = dir.join("sweep.toml");
-    std::fs::write(
-        &file,
-        format!(
-            "scene = {:?}\nset = [\"scene.duration_s=0.06\", \"shock[0].start_s=0.005\"]\nkey = \"shock[0].peak_g\"\n\
-             from = 1.0\nto = 10.0\npoints = 2\n\n[ensemble]\nmembers = 2\nbatch = 2\nagree = 2\nseed = 3\nverify = false\n",
-            scene("paper-10g.toml").display().to_string()
-        ),
-    )
-    .unwrap();
+    let file = small_ensemble_sweep(&dir);
     let args = os(&["sweep", file.to_str().unwrap(), "--out", "{out}", "--quiet"]);
     let written = holds(&dir, "sweep", &args, &[], &nothing);
     assert!(written.iter().any(|f| f.ends_with("sweep.json")), "{written:?}");

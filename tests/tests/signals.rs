@@ -108,16 +108,7 @@ fn ensemble_and_sweep_exit_130_for_a_signal_while_they_write_their_outputs() {
     assert_eq!(code, Some(130), "{log}");
     assert!(out.join("ensemble.json").is_file(), "{log}");
 
-    let file = dir.join("sweep.toml");
-    std::fs::write(
-        &file,
-        format!(
-            "scene = {:?}\nset = [\"scene.duration_s=0.06\", \"shock[0].start_s=0.005\"]\nkey = \"shock[0].peak_g\"\n\
-             from = 1.0\nto = 10.0\npoints = 2\n\n[ensemble]\nmembers = 2\nbatch = 2\nagree = 2\nseed = 3\nverify = false\n",
-            scene("paper-10g.toml").display().to_string()
-        ),
-    )
-    .unwrap();
+    let file = small_ensemble_sweep(&dir);
     let out = dir.join("sweep");
     let p = Proc::spawn(&mut plant_sweep(&file, &out, &["--quiet"]));
     wait_for_file(&out.join("members.csv"));
@@ -132,14 +123,7 @@ fn ensemble_and_sweep_exit_130_for_a_signal_while_they_write_their_outputs() {
 #[test]
 fn assess_exits_130_for_a_signal_while_it_writes_the_report() {
     let dir = TempDir::new("signals-assess");
-    let path = dir.join("assess.toml");
-    let text = format!(
-        "scene = {:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\nparts = [\"vibration\", \"ladder\"]\n\
-         [[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
-         [ladder]\npeaks_g = [3.0]\nduty_g = 3.0\nmembers = 2\nbatch = 2\nverify = false\n",
-        scene("paper-10g.toml").display().to_string()
-    );
-    std::fs::write(&path, text).unwrap();
+    let path = small_assessment(&dir);
     let out = dir.join("out");
     let p = Proc::spawn(Command::new(plant_bin()).arg("assess").arg(&path).arg("--out").arg(&out).arg("--quiet"));
     wait_for_file(&out.join("report.json"));

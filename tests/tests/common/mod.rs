@@ -19,6 +19,36 @@ pub fn scene(name: &str) -> PathBuf {
     workspace_root().join("config").join(name)
 }
 
+/// Writes `assess.toml` into `dir`: a small assessment of the study's scene (0.3 s runs in
+/// process, a damped `pd_delay`, the vibration and a ladder of one 3 G rung with two members),
+/// and returns its path.
+#[allow(dead_code)] // not every test binary uses it
+pub fn small_assessment(dir: &TempDir) -> PathBuf {
+    let path = dir.join("assess.toml");
+    let text = format!(
+        "scene = {:?}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\nparts = [\"vibration\", \"ladder\"]\n\
+         [[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
+         [ladder]\npeaks_g = [3.0]\nduty_g = 3.0\nmembers = 2\nbatch = 2\nverify = false\n",
+        scene("paper-10g.toml").display().to_string()
+    );
+    std::fs::write(&path, text).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+    path
+}
+
+/// Writes `sweep.toml` into `dir`: an ensemble sweep of the study's scene over the shock's peak
+/// (2 points of 2 members, 60 ms runs), and returns its path.
+#[allow(dead_code)] // not every test binary uses it
+pub fn small_ensemble_sweep(dir: &TempDir) -> PathBuf {
+    let path = dir.join("sweep.toml");
+    let text = format!(
+        "scene = {:?}\nset = [\"scene.duration_s=0.06\", \"shock[0].start_s=0.005\"]\nkey = \"shock[0].peak_g\"\n\
+         from = 1.0\nto = 10.0\npoints = 2\n\n[ensemble]\nmembers = 2\nbatch = 2\nagree = 2\nseed = 3\nverify = false\n",
+        scene("paper-10g.toml").display().to_string()
+    );
+    std::fs::write(&path, text).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+    path
+}
+
 /// Builds `bin` of `package` in the profile these tests were built in and
 /// returns the executable's path.
 ///
