@@ -7,7 +7,8 @@ mod common;
 use common::{contact_state, model, two_plane_contact_state, two_plane_model};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use plant::integrate::{Integrator, Method, Settings};
-use plant::run::integrator_settings;
+use plant::machine::Machine;
+use plant::run::settings_with;
 
 fn derivative(c: &mut Criterion) {
     let (model, _) = model();
@@ -15,7 +16,7 @@ fn derivative(c: &mut Criterion) {
     let ev = model.evaluate(0.002, &y);
     assert!(ev.contact.normal > 0.0 && ev.balls.loaded >= 3, "bench state must load the contacts: {ev:?}");
     c.bench_function("derivative/contact_19_balls", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&y)).dy));
-    let levitated = plant::initial::initial_state(&model_scene());
+    let levitated = plant::initial::initial_state(&model_scene(), &model.params);
     c.bench_function("derivative/levitated", |b| b.iter(|| model.evaluate(black_box(0.002), black_box(&levitated)).dy));
     let (two, scene) = two_plane_model();
     let y = two_plane_contact_state();
@@ -24,7 +25,7 @@ fn derivative(c: &mut Criterion) {
     c.bench_function("derivative/two_plane_contact_2x19_balls", |b| {
         b.iter(|| two.evaluate(black_box(0.002), black_box(&y)).dy)
     });
-    let levitated = plant::initial::two_plane_initial_state(&scene, scene.two_plane.as_ref().expect("two-plane"));
+    let levitated = plant::initial::two_plane_initial_state(&scene, &two.params);
     c.bench_function("derivative/two_plane_levitated", |b| {
         b.iter(|| two.evaluate(black_box(0.002), black_box(&levitated)).dy)
     });
@@ -37,7 +38,9 @@ fn model_scene() -> plant::config::Scene {
 fn macro_step(c: &mut Criterion) {
     let (model, scene) = model();
     let period = scene.controller.period;
-    let levitated = plant::initial::initial_state(&scene);
+    let levitated = plant::initial::initial_state(&scene, &model.params);
+    let integrator_settings =
+        |scene: &plant::config::Scene| settings_with(scene, plant::model::Model::atol(scene.integrator.atol_groups));
     let cases: [(&str, Settings<{ plant::model::N }>); 3] = [
         ("dp5_rtol1e-6", integrator_settings(&scene)),
         ("rk4_16", Settings { substeps: 16, ..Settings::fixed(Method::Rk4, 16) }),

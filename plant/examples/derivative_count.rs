@@ -27,8 +27,11 @@ fn main() {
     match which.as_str() {
         "contact" | "levitated" => {
             let (model, scene) = common::model();
-            let y: State =
-                if which == "contact" { common::contact_state() } else { plant::initial::initial_state(&scene) };
+            let y: State = if which == "contact" {
+                common::contact_state()
+            } else {
+                plant::initial::initial_state(&scene, &model.params)
+            };
             for _ in 0..count {
                 let dy = model.evaluate(black_box(0.002), black_box(&y)).dy;
                 sum += black_box(dy)[ix::VYR];
@@ -39,7 +42,7 @@ fn main() {
             let y = if which == "two_plane_contact" {
                 common::two_plane_contact_state()
             } else {
-                plant::initial::two_plane_initial_state(&scene, scene.two_plane.as_ref().expect("two-plane"))
+                plant::initial::two_plane_initial_state(&scene, &model.params)
             };
             for _ in 0..count {
                 let dy = model.evaluate(black_box(0.002), black_box(&y)).dy;

@@ -15,7 +15,7 @@
 //! Writes `campbell.csv` (speed, mode, whirl, frequency, damping ratio), `campbell.png` and
 //! `decay.csv` (each decay mode against the linear one).
 
-use crate::config::{load_scene, Scene};
+use crate::config::{load_scene, Rotor, Scene};
 use crate::plot::{self, Scale, Series};
 use crate::run::{plane_gains, run, Outcome, Quiet};
 use crate::trace::{col, colb};
@@ -82,12 +82,14 @@ pub struct Request<'a> {
 
 /// The linearised rotor of a two-plane scene with its continuous PD at each plane.
 pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
-    let machine = scene.two_plane.as_ref().ok_or_else(|| {
-        crate::bench::BadArgument(format!(
-            "{}: plant campbell needs a two-plane scene (rotor.model = \"two_plane\"); this one is planar",
-            scene.name
+    let Rotor::TwoPlane(machine) = &scene.rotor else {
+        return Err(crate::bench::BadArgument(format!(
+            "{}: plant campbell needs a two-plane scene (rotor.model = \"two_plane\"); this one is {}",
+            scene.name,
+            scene.rotor.model().name()
         ))
-    })?;
+        .into());
+    };
     // The linearisation is the rotor on the ideal loop: an amplifier's coil and current loop
     // and a sensor's filter would add states it does not have, and runout forces the free
     // decays at 1× and 2× the spin. Refused rather than drawn wrong; the range does not act
@@ -192,7 +194,7 @@ pub fn matrix_pencil(signals: &[Vec<C64>], dt: f64, rel_threshold: f64, max_orde
 
 /// The free decay of `scene` at `speed_hz` (module doc): the fitted modes, or why there are none.
 pub fn free_decay(scene: &Scene, speed_hz: f64) -> anyhow::Result<Vec<Fitted>> {
-    let machine = scene.two_plane.as_ref().context("a two-plane scene")?;
+    let Rotor::TwoPlane(machine) = &scene.rotor else { anyhow::bail!("a two-plane scene") };
     let mut sets: Vec<String> = [
         format!("rotor.speed_hz={speed_hz:?}"),
         "rotor.eccentricity_um=0.0".into(),

@@ -181,14 +181,12 @@ pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -
                 .into(),
         ));
     }
-    if let Some(m) = &scene.two_plane {
-        if let Some(p) = m.planes.iter().position(|p| p.sensor != p.station) {
-            return Err(ReplayError::Layout(format!(
-                "plane {}'s sensor is not at its bearing: the trace holds the displacement at the bearing, not what \
-                 the sensor read",
-                ["A", "B"][p]
-            )));
-        }
+    if let Some(p) = scene.rotor.non_collocated_plane() {
+        return Err(ReplayError::Layout(format!(
+            "plane {}'s sensor is not at its bearing: the trace holds the displacement at the bearing, not what the \
+             sensor read",
+            ["A", "B"][p]
+        )));
     }
     let (period, out_dt) = (c.period, scene.output_interval);
     // Rows per tick; a row at a tick time is the state the controller read there.
@@ -342,7 +340,7 @@ mod tests {
         assert_eq!(same.compared, 200);
         let other = replay(&dir, &controller::pd_delay::LAW).unwrap();
         assert!(!other.identical(), "{other}");
-        let mut law = (controller::pd::LAW.build)(&s.design(), &s.controller.params).unwrap();
+        let mut law = (controller::pd::LAW.build)(&s.plane_design(0), &s.controller.params).unwrap();
         let e = replay_trace(&s, &dir.join("trace.csv"), law.as_mut()).unwrap_err().to_string();
         assert!(e.contains("replay_rotor_trace"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);

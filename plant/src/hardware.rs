@@ -29,7 +29,7 @@
 //! sampled controller's.
 
 pub use crate::config::hardware::Hardware;
-use crate::machine::Machine;
+use crate::machine::{FailureState, Machine, PlaneState};
 use crate::model::{Control, Params, Release};
 use crate::sensor::{runout, runout_rate};
 use crate::trace::{col, colb, Record, WIDTH_MAGNETS};
@@ -407,6 +407,25 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         r
     }
 
+    fn plane_states(&self, t: f64, y: &[f64; NA], visit: &mut dyn FnMut(usize, &PlaneState<'_>)) {
+        let (m, iy, _) = self.synced(y);
+        m.plane_states(t, &iy, visit);
+    }
+
+    /// The model's tolerances with the hardware's after them ([`atol`]).
+    fn atol(groups: [f64; 4]) -> [f64; NA] {
+        let [p, v, ..] = groups;
+        let mut a = [0.0; NA];
+        a[..N].copy_from_slice(&M::atol(groups));
+        a[N..].copy_from_slice(&atol(p, v)[..NA - N]);
+        a
+    }
+
+    /// The model's failing state (the hardware's states are not in it).
+    fn failure(t: f64, y: &[f64; NA]) -> FailureState {
+        M::failure(t, &split::<N, NA>(y).0)
+    }
+
     fn voltage_saturation(&self, y: &[f64; NA]) -> Option<f64> {
         self.hw.amplified().then(|| y[N + ex::SATURATED])
     }
@@ -427,7 +446,7 @@ mod tests {
 
     fn wired(scene: &crate::config::Scene) -> Wired<Model, { crate::model::N }, { crate::model::N + EXTRA }> {
         let model = Model {
-            params: scene.params.clone(),
+            params: scene.plane(0).clone(),
             base: scene.base.clone(),
             control: Control::Held([0.0; 2]),
             race_parked: false,
@@ -443,7 +462,7 @@ mod tests {
         let w = wired(&scene);
         let harmonics = &scene.hardware.front_end.runout;
         assert_eq!(harmonics.len(), 4);
-        let gain = scene.params.loop_constants.sensor_gain_v_per_m;
+        let gain = scene.plane(0).loop_constants.sensor_gain_v_per_m;
         let mut sensor = Sensor::new(scene.sensor);
         for k in 0..100 {
             let theta = 0.37 * k as f64;
@@ -477,7 +496,7 @@ mod tests {
         let bipolar = realistic(&sets);
         let unipolar = realistic(&[sets[0], sets[1], sets[2], "amb.amplifier_topology=unipolar"]);
         let model = |scene: &crate::config::Scene| Model {
-            params: scene.params.clone(),
+            params: scene.plane(0).clone(),
             base: scene.base.clone(),
             control: Control::Held([0.0; 2]),
             race_parked: false,
@@ -523,14 +542,16 @@ mod tests {
     #[test]
     fn the_continuous_pd_reads_the_sensors_front_end() {
         let pd = |scene: &crate::config::Scene, d: [f64; 2], rate: [f64; 2]| {
-            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
-            let a_s = scene.params.loop_constants.sensor_gain_v_per_m;
+            let g =
+                controller::PdGains::from_design(&scene.plane_design(0).pd(), &scene.plane(0).loop_constants).unwrap();
+            let a_s = scene.plane(0).loop_constants.sensor_gain_v_per_m;
             let i = |k: usize| g.bias_a[k] - g.amp_gain_a_per_v * (g.kp * a_s * d[k] + g.kd * a_s * rate[k]);
             [i(0).clamp(-2.0, 2.0), i(1).clamp(-2.0, 2.0)]
         };
         let continuous = |scene: &crate::config::Scene| {
             let mut w = wired(scene);
-            let g = controller::PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants).unwrap();
+            let g =
+                controller::PdGains::from_design(&scene.plane_design(0).pd(), &scene.plane(0).loop_constants).unwrap();
             w.set_control(0, Control::Continuous(g));
             (w, g)
         };

@@ -37,7 +37,7 @@ pub fn two_plane_initial_state(
     )
 }
 
-/// The initial state of a scene.
-pub fn initial_state(scene: &Scene) -> State {
-    plant_physics::initial::initial_state(&scene.params, &initial_conditions(scene))
+/// The initial state of a planar scene whose bearing is `params`.
+pub fn initial_state(scene: &Scene, params: &crate::model::Params) -> State {
+    plant_physics::initial::initial_state(params, &initial_conditions(scene))
 }

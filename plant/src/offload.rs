@@ -63,8 +63,8 @@ pub fn run_into_offloaded<S: Sink + Send>(
 /// The thread is an ordinary one (`SCHED_OTHER`, on any core the process may use but those
 /// in `avoid`, the loop's `controller.pin_cores`), whatever the caller's scheduling: a
 /// realtime loop puts its own thread under `SCHED_FIFO` and pins it. `sink` receives samples only:
-/// [`Sink::planar_state`] and [`Sink::two_plane_state`] are not handed over, so a sink that
-/// needs them must not be offloaded. A panic on the thread is passed on to the caller; a
+/// [`Sink::planes`] is not handed over, so a sink that
+/// needs the planes must not be offloaded. A panic on the thread is passed on to the caller; a
 /// thread that cannot be started (a process at its thread limit) is an error, before `body`
 /// runs.
 pub fn offload<S: Sink + Send, R>(

@@ -148,7 +148,7 @@ impl Recorder {
                 charts: charts.then(|| ChartData::new(scene.duration)),
             })
             .collect();
-        let tilt = scene.two_plane.as_ref().map(|_| {
+        let tilt = scene.rotor.tilts().then(|| {
             let bins = charts.then(|| MinMaxBins::new(0.0, scene.duration * 1e3, CHART_BINS));
             (TiltAnalyzer::new(analysis_spec(scene)), bins)
         });

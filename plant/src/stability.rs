@@ -105,7 +105,7 @@ pub fn check(scene: &Scene) -> StepVerdict {
     }
     // The stiff modes exist only while the race is free: with a parked race that is the step of
     // `contact_substeps`.
-    let (key, steps) = match scene.params.race_when_clear {
+    let (key, steps) = match scene.plane(0).race_when_clear {
         RaceWhenClear::Free => ("integrator.substeps", scene.integrator.substeps),
         RaceWhenClear::Parked(_) => ("integrator.contact_substeps", scene.integrator.contact_substeps),
     };

@@ -59,14 +59,11 @@ pub struct ModelInfo {
 impl ModelInfo {
     /// The model choices of a scene.
     pub fn new(scene: &Scene) -> Self {
-        let (p, c) = (&scene.params, &scene.controller);
+        // The model choices (`[touchdown]`, `rotor.spin`) are every plane's: plane A's say them.
+        let (p, c) = (scene.plane(0), &scene.controller);
         let (race_when_clear, race_release) = RaceWhenClearChoice::of(&p.race_when_clear);
         ModelInfo {
-            rotor: if scene.two_plane.is_some() {
-                crate::config::RotorModel::TwoPlane
-            } else {
-                crate::config::RotorModel::Planar
-            },
+            rotor: scene.rotor.model(),
             spin: SpinChoice::of(&p.spin),
             cage: p.cage,
             race_drag: DragChoice::of(&p.drag),
@@ -283,7 +280,7 @@ impl Summary {
             status: run.outcome.status(),
             error: run.outcome.error(),
             failure_time_s: run.outcome.failure_time(),
-            failure_state: failure.and_then(|e| FailureState::of(scene, e)),
+            failure_state: failure.and_then(|e| failure_state(scene, e)),
             simulated_s: run.simulated,
             started_s: (run.started > 0.0).then_some(run.started),
             max_radius_m: figures.max_radius_m,
@@ -312,10 +309,7 @@ impl Summary {
             integrator: IntegratorInfo {
                 method: scene.integrator.method,
                 rtol: scene.integrator.rtol,
-                atol: match scene.two_plane {
-                    None => scene.integrator.atol.to_vec(),
-                    Some(_) => scene.integrator.two_plane_atol().to_vec(),
-                },
+                atol: scene.rotor.atol(scene.integrator.atol_groups),
                 substeps: scene.integrator.substeps,
                 contact_substeps: scene.integrator.contact_substeps,
                 macro_step_s: c.period,
@@ -329,118 +323,14 @@ impl Summary {
     }
 }
 
-/// The state a diverged run failed in (`failure_state` in `summary.json`); non-finite
-/// values are written as `null`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum FailureState {
-    /// The planar model's.
-    Planar(PlanarFailure),
-    /// The two-plane rotor's.
-    TwoPlane(TwoPlaneFailure),
-}
+pub use crate::machine::{FailureState, PlanarFailure, RaceFailure, TwoPlaneFailure};
 
-/// The planar model's failing state.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct PlanarFailure {
-    /// Time of the failure (s).
-    pub t_s: f64,
-    /// Rotor radius relative to the housing (m).
-    pub rotor_radius_m: f64,
-    /// Race radius relative to the housing (m).
-    pub race_radius_m: f64,
-    /// Rotor x, y relative to the housing (m).
-    pub rotor_m: [f64; 2],
-    /// Rotor velocity relative to the housing (m/s).
-    pub rotor_velocity_m_s: [f64; 2],
-    /// Race x, y relative to the housing (m).
-    pub race_m: [f64; 2],
-    /// Race velocity relative to the housing (m/s).
-    pub race_velocity_m_s: [f64; 2],
-    /// Rotor spin angle (rad) and speed (rad/s).
-    pub rotor_spin: [f64; 2],
-    /// Race angle (rad) and speed (rad/s).
-    pub race_spin: [f64; 2],
-}
-
-/// One race of the two-plane rotor's failing state.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RaceFailure {
-    /// Race radius relative to the housing (m).
-    pub race_radius_m: f64,
-    /// Race x, y relative to the housing (m).
-    pub race_m: [f64; 2],
-    /// Race velocity relative to the housing (m/s).
-    pub race_velocity_m_s: [f64; 2],
-    /// Race angle (rad) and speed (rad/s).
-    pub race_spin: [f64; 2],
-}
-
-/// The two-plane rotor's failing state.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TwoPlaneFailure {
-    /// Time of the failure (s).
-    pub t_s: f64,
-    /// The rotor axis at the centre of mass's station, x, y relative to the housing (m).
-    pub rotor_m: [f64; 2],
-    /// Its velocity (m/s).
-    pub rotor_velocity_m_s: [f64; 2],
-    /// The slopes a, b of the axis (rad).
-    pub slopes_rad: [f64; 2],
-    /// Their rates (rad/s).
-    pub slope_rates_rad_s: [f64; 2],
-    /// Rotor spin angle (rad) and speed (rad/s).
-    pub rotor_spin: [f64; 2],
-    /// Race A.
-    pub race_a: RaceFailure,
-    /// Race B.
-    pub race_b: RaceFailure,
-}
-
-impl FailureState {
-    /// The failing state of a divergence of a run of `scene`: the rotor model's part of the
-    /// state (the hardware's states of a run with amplifiers or a sensor front end follow it,
-    /// [`crate::hardware`]); `None` if the error holds less than the model's state.
-    pub fn of(scene: &Scene, e: &RunError) -> Option<Self> {
-        let y = e.state();
-        if scene.two_plane.is_none() {
-            if y.len() < crate::model::N {
-                return None;
-            }
-            use crate::model::ix;
-            return Some(Self::Planar(PlanarFailure {
-                t_s: e.time(),
-                rotor_radius_m: y[ix::XR].hypot(y[ix::YR]),
-                race_radius_m: y[ix::XB].hypot(y[ix::YB]),
-                rotor_m: [y[ix::XR], y[ix::YR]],
-                rotor_velocity_m_s: [y[ix::VXR], y[ix::VYR]],
-                race_m: [y[ix::XB], y[ix::YB]],
-                race_velocity_m_s: [y[ix::VXB], y[ix::VYB]],
-                rotor_spin: [y[ix::TR], y[ix::WR]],
-                race_spin: [y[ix::TB], y[ix::WB]],
-            }));
-        }
-        if y.len() >= plant_physics::two_plane::N {
-            use plant_physics::two_plane::ix;
-            let race = |x: usize| RaceFailure {
-                race_radius_m: y[x].hypot(y[x + 1]),
-                race_m: [y[x], y[x + 1]],
-                race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
-                race_spin: [y[x + 2], y[x + 2 + ix::V]],
-            };
-            return Some(Self::TwoPlane(TwoPlaneFailure {
-                t_s: e.time(),
-                rotor_m: [y[ix::X], y[ix::Y]],
-                rotor_velocity_m_s: [y[ix::VX], y[ix::VY]],
-                slopes_rad: [y[ix::SX], y[ix::SY]],
-                slope_rates_rad_s: [y[ix::VSX], y[ix::VSY]],
-                rotor_spin: [y[ix::TR], y[ix::WR]],
-                race_a: race(ix::RACE_A),
-                race_b: race(ix::RACE_B),
-            }));
-        }
-        None
-    }
+/// The failing state of a divergence of a run of `scene` ([`crate::config::Rotor::failure`]):
+/// the rotor model's part of the state (the hardware's states of a run with amplifiers or a
+/// sensor front end follow it, [`crate::hardware`]); `None` if the error holds less than the
+/// model's state.
+pub fn failure_state(scene: &Scene, e: &RunError) -> Option<FailureState> {
+    scene.rotor.failure(e.time(), e.state())
 }
 
 #[cfg(test)]
@@ -475,7 +365,7 @@ mod tests {
             let state = plant.state().to_vec();
             lengths.push(state.len());
             let e = RunError::RadiusGuard { t: 0.25, what: "rotor radius", value_m: 1.0, limit_m: 0.5, state };
-            match (FailureState::of(&scene, &e), two) {
+            match (failure_state(&scene, &e), two) {
                 (Some(FailureState::Planar(f)), false) => assert_eq!(f.t_s, 0.25),
                 (Some(FailureState::TwoPlane(f)), true) => assert_eq!(f.t_s, 0.25),
                 (other, _) => panic!("{file} {sets:?}: {other:?}"),

@@ -23,8 +23,8 @@ fn settings(gap: f64) -> Settings {
 fn check(sets: &[&str], axis: usize, speed_hz: f64) {
     let s = scene(sets);
     let pd = closed_form_of(&s).expect("a law with a closed form");
-    let plant = AxisPlant::of(&s.params.loop_constants);
-    let set = settings(s.params.contact.gap);
+    let plant = AxisPlant::of(&s.plane(0).loop_constants);
+    let set = settings(s.plane(0).contact.gap);
     let stop = AtomicBool::new(false);
     let measured = measure_axis(&s, axis, speed_hz, &set, &stop).expect("measured");
     assert!(closed_form::stable(&plant, &pd), "{sets:?}");
@@ -70,10 +70,10 @@ fn delay_aware_pd_measured_against_its_closed_form() {
 fn an_unstable_sampled_pd_is_measured_unstable() {
     // The study's design, naively sampled at 20 kHz with one sample of delay: ξ ≈ −0.006.
     let s = scene(&["controller.mode=\"sampled\""]);
-    let plant = AxisPlant::of(&s.params.loop_constants);
+    let plant = AxisPlant::of(&s.plane(0).loop_constants);
     assert!(!closed_form::stable(&plant, &closed_form_of(&s).expect("pd")));
     let stop = AtomicBool::new(false);
-    let mut set = settings(s.params.contact.gap);
+    let mut set = settings(s.plane(0).contact.gap);
     set.probe_s = 1.0;
     let m = measure_axis(&s, 0, 0.0, &set, &stop).expect("measured");
     assert!(!m.stable && m.peak.is_none() && m.zone == "unstable", "{m:?}");

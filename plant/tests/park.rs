@@ -9,8 +9,8 @@ use std::path::Path;
 
 fn model() -> Model {
     let scene = load_scene(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/paper-3g.toml"), &[]).unwrap();
-    let gains = plant::run::design_gains(&scene).unwrap();
-    Model { params: scene.params, base: scene.base, control: Control::Continuous(gains), race_parked: false }
+    let gains = plant::run::plane_gains(&scene).unwrap()[0];
+    Model { params: scene.plane(0).clone(), base: scene.base, control: Control::Continuous(gains), race_parked: false }
 }
 
 /// Under gravity alone the rest position is the initial state's sag, straight down.

@@ -28,7 +28,7 @@ fn race_rests_on_the_lowest_ball_with_the_hertz_sag() {
     // m_b g = K_b δ^(3/2)  →  y_b = −(r_cl + (m_b g / K_b)^(2/3)).
     let s = scene(|_| {});
     let expected = -(1e-5 + (0.048 * 9.80665 / 7.81e9_f64).powf(2.0 / 3.0));
-    let sag = plant::initial::race_sag(&s.params);
+    let sag = plant::initial::race_sag(s.plane(0));
     assert!((sag - expected).abs() < 1e-12, "sag {sag} vs {expected}");
 
     // And the race stays there while the rotor is levitated.
@@ -137,7 +137,7 @@ fn energy_is_conserved_without_damping_friction_and_drive_work() {
         r.output.rate_hz = 200_000.0;
     });
     let tr = completed(&s).trace;
-    let p = &s.params;
+    let p = s.plane(0);
     let energy = |i: usize| {
         let (x, y, vx, vy) = (tr.dx_m[i], tr.dy_m[i], tr.vx_m_s[i], tr.vy_m_s[i]);
         let (xb, yb, vxb, vyb) = (tr.xb_m[i], tr.yb_m[i], tr.vxb_m_s[i], tr.vyb_m_s[i]);
@@ -427,9 +427,9 @@ fn levitation_scene_setting_is_within_1e4_of_the_full_model_and_passes_the_stabi
     assert_eq!(parked.run.parked_steps, ticks, "the race should stay parked: the 1 G shock leaves the gap clear");
 
     let mut full = shipped.clone();
-    full.params.race_when_clear = plant::model::RaceWhenClear::Free;
+    full.rotor.plane_mut(0).race_when_clear = plant::model::RaceWhenClear::Free;
     let reference = completed(&with_integrator(&full, Method::Dop853, IntegratorSetting::Rtol(1e-11)));
-    let (rms, max) = window_error(&parked.trace, &reference.trace, start, start + 0.05, shipped.params.contact.gap);
+    let (rms, max) = window_error(&parked.trace, &reference.trace, start, start + 0.05, shipped.plane(0).contact.gap);
     assert!(rms <= 1e-4 && max <= 1e-3, "error rms {rms:.2e}, max {max:.2e} of the gap");
 
     let mut one_step_in_contact = shipped.clone();

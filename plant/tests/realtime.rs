@@ -22,7 +22,7 @@ fn load(sets: &[&str]) -> Scene {
 #[test]
 fn a_realtime_scene_gets_the_fixed_step_setting_unless_it_asks_for_its_own() {
     let lockstep = load(&[]);
-    assert_eq!((lockstep.integrator.method, lockstep.params.race_when_clear), (Method::Dp5, RaceWhenClear::Free));
+    assert_eq!((lockstep.integrator.method, lockstep.plane(0).race_when_clear), (Method::Dp5, RaceWhenClear::Free));
     assert!(lockstep.warnings.is_empty(), "{:?}", lockstep.warnings);
 
     let realtime = load(&["controller.mode=\"realtime\""]);
@@ -31,7 +31,7 @@ fn a_realtime_scene_gets_the_fixed_step_setting_unless_it_asks_for_its_own() {
     // The stability estimate's substeps under a 10 kN contact at 20 kHz.
     assert_eq!(i.contact_substeps, plant::stability::safe_contact_substeps(&realtime, Method::Rk4));
     assert!(i.contact_substeps > 1, "{}", i.contact_substeps);
-    assert!(matches!(realtime.params.race_when_clear, RaceWhenClear::Parked(_)));
+    assert!(matches!(realtime.plane(0).race_when_clear, RaceWhenClear::Parked(_)));
     let said = realtime.warnings.join("\n");
     assert!(said.contains("fixed-step setting") && said.contains("dp5 rtol 1e-6"), "{said}");
     // What ran is what the run folder's scene.toml says: rerun, it is the same setting, unsaid.
@@ -42,7 +42,7 @@ fn a_realtime_scene_gets_the_fixed_step_setting_unless_it_asks_for_its_own() {
     assert!(again.warnings.is_empty(), "{:?}", again.warnings);
 
     let own = load(&["controller.mode=\"realtime\"", "integrator.realtime=\"scene\""]);
-    assert_eq!((own.integrator.method, own.params.race_when_clear), (Method::Dp5, RaceWhenClear::Free));
+    assert_eq!((own.integrator.method, own.plane(0).race_when_clear), (Method::Dp5, RaceWhenClear::Free));
     assert!(own.warnings.is_empty(), "{:?}", own.warnings);
     // The ensembles' fast setting is the same one.
     assert_eq!(

@@ -21,7 +21,7 @@ fn traces(file: &str, sets: &[&str]) -> (Trace, Trace) {
     let planar: Scene = load_scene(&shipped(file), &sets).unwrap();
     let two_sets: Vec<String> = sets.iter().cloned().chain(SYMMETRIC.iter().map(|s| s.to_string())).collect();
     let two: Scene = load_scene(&shipped(file), &two_sets).unwrap();
-    assert!(planar.two_plane.is_none() && two.two_plane.is_some());
+    assert!(planar.planes() == 1 && two.planes() == 2);
     let p = run(&planar, &mut Quiet).unwrap();
     let t = run(&two, &mut Quiet).unwrap();
     assert_eq!(p.run.outcome, Outcome::Completed);

@@ -100,7 +100,7 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     assert!(replayed.identical(), "{replayed}");
     assert_eq!(replayed.compared, 1000);
     let scene = plant::config::load_scene(&out.join("scene.toml"), &[]).expect("the run's scene");
-    let mut pd = controller::build_law("pd", &scene.design(), &controller::Params::default()).unwrap();
+    let mut pd = controller::build_law("pd", &scene.plane_design(0), &controller::Params::default()).unwrap();
     let pd = plant::check::replay_trace(&scene, &out.join("trace.csv"), pd.as_mut()).expect("the replay");
     assert!(!pd.identical() && pd.largest_a > 1e-3, "the notch changed nothing: {pd}");
     // And the same law run in the plant's process gives the same trace.

@@ -233,7 +233,7 @@ fn discover(dir: &Path) -> Vec<Key> {
         let mut scene = base.clone();
         scene["controller"].as_table_mut().unwrap().insert("law".into(), toml::Value::String(law.into()));
         let path = write(&format!("base-law-{law}.toml"), &scene);
-        let design = plant::config::validate(parses(&scene).unwrap(), dir).unwrap().design();
+        let design = plant::config::validate(parses(&scene).unwrap(), dir).unwrap().plane_design(0);
         let mut params = toml::Table::new();
         params.insert("__probe__".into(), toml::Value::Integer(0));
         match controller::build_law(law, &design, &controller::Params::new(params)) {

@@ -5,7 +5,6 @@
 
 use plant::config::{validate, RawScene};
 use plant::model::{ix, Control, Model, State};
-use plant::run::design_gains;
 use std::path::Path;
 
 /// The default scene under a 10 G shock starting at t = 0, with the continuous PD.
@@ -18,9 +17,9 @@ pub fn model() -> (Model, plant::config::Scene) {
         ..Default::default()
     };
     let scene = validate(raw, Path::new(".")).expect("scene");
-    let gains = design_gains(&scene).expect("gains");
+    let gains = plant::run::plane_gains(&scene).expect("gains")[0];
     let model = Model {
-        params: scene.params.clone(),
+        params: scene.plane(0).clone(),
         base: scene.base.clone(),
         control: Control::Continuous(gains),
         race_parked: false,
@@ -60,7 +59,10 @@ pub fn two_plane_model() -> (plant_physics::two_plane::Model, plant::config::Sce
     let scene = validate(raw, Path::new(".")).expect("scene");
     let gains = plant::run::plane_gains(&scene).expect("gains");
     let model = plant_physics::two_plane::Model {
-        params: scene.two_plane.clone().expect("two-plane"),
+        params: match &scene.rotor {
+            plant::config::Rotor::TwoPlane(p) => p.clone(),
+            other => panic!("a two-plane scene, not {:?}", other.model()),
+        },
         base: scene.base.clone(),
         control: [Control::Continuous(gains[0]), Control::Continuous(gains[1])],
         race_parked: [false; 2],

@@ -16,10 +16,10 @@
 
 use super::hertz::{self, Materials};
 use super::rainflow::Rainflow;
-use crate::model::{cage_angle, ix, Cage, Model, State, Support};
-use crate::run::Sink;
+use crate::machine::PlaneState;
+use crate::model::{cage_angle, Cage, Support};
+use crate::run::{PlaneStates, Sink};
 use nalgebra::Vector2;
-use plant_physics::two_plane;
 use serde::Serialize;
 
 /// The bearing's geometry and materials the duty needs beyond the model's parameters (SI).
@@ -82,23 +82,6 @@ pub struct Duty {
     pub planes: Vec<Duty>,
 }
 
-/// What one bearing plane's duty reads at an output sample (SI, relative to the housing).
-struct PlaneSample<'p> {
-    /// The plane's bearing parameters.
-    params: &'p crate::model::Params,
-    /// Rotor – race normal and tangential force (N).
-    normal: f64,
-    tangential: f64,
-    /// The rotor at the bearing, and the race: positions and velocities.
-    rotor: (Vector2<f64>, Vector2<f64>),
-    race: (Vector2<f64>, Vector2<f64>),
-    /// Rotor spin speed, race angle, spin speed and spin acceleration.
-    rotor_speed: f64,
-    race_angle: f64,
-    race_speed: f64,
-    race_accel: f64,
-}
-
 /// One touchdown bearing's duty, accumulated sample by sample.
 struct PlaneDuty {
     duty: Duty,
@@ -120,7 +103,7 @@ impl PlaneDuty {
         }
     }
 
-    fn push(&mut self, bearing: &Bearing, t: f64, s: &PlaneSample) {
+    fn push(&mut self, bearing: &Bearing, t: f64, s: &PlaneState) {
         let p = s.params;
         let d = &mut self.duty;
         let normal = s.normal;
@@ -254,43 +237,54 @@ impl Sink for DutySink<'_> {
         self.inner.sample(record);
     }
 
-    fn planar_state(&mut self, model: &Model, t: f64, y: &State) {
-        self.inner.planar_state(model, t, y);
-        let ev = model.evaluate(t, y);
-        let sample = PlaneSample {
-            params: &model.params,
-            normal: ev.contact.normal,
-            tangential: ev.contact.tangential,
-            rotor: (Vector2::new(y[ix::XR], y[ix::YR]), Vector2::new(y[ix::VXR], y[ix::VYR])),
-            race: (Vector2::new(y[ix::XB], y[ix::YB]), Vector2::new(y[ix::VXB], y[ix::VYB])),
-            rotor_speed: y[ix::WR],
-            race_angle: y[ix::TB],
-            race_speed: y[ix::WB],
-            race_accel: ev.dy[ix::WB],
-        };
-        let bearing = self.bearing;
-        self.plane(0).push(&bearing, t, &sample);
+    fn planes(&mut self, planes: &dyn PlaneStates) {
+        self.inner.planes(planes);
+        let (bearing, t) = (self.bearing, planes.time());
+        planes.visit(&mut |i, sample| self.plane(i).push(&bearing, t, sample));
     }
+}
 
-    fn two_plane_state(&mut self, model: &two_plane::Model, t: f64, y: &two_plane::State) {
-        self.inner.two_plane_state(model, t, y);
-        use two_plane::ix;
-        let ev = model.evaluate(t, y);
-        let bearing = self.bearing;
-        for (i, plane) in model.params.planes.iter().enumerate() {
-            let race = ix::RACE[i];
-            let sample = PlaneSample {
-                params: &plane.params,
-                normal: ev.planes[i].contact.normal,
-                tangential: ev.planes[i].contact.tangential,
-                rotor: two_plane::at_station(y, plane.station),
-                race: (Vector2::new(y[race], y[race + 1]), Vector2::new(y[race + ix::V], y[race + 1 + ix::V])),
-                rotor_speed: y[ix::WR],
-                race_angle: y[race + 2],
-                race_speed: y[race + 2 + ix::V],
-                race_accel: ev.dy[race + 2 + ix::V],
-            };
-            self.plane(i).push(&bearing, t, &sample);
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::shipped;
+    use crate::trace::Trace;
+
+    /// Every layout of the plant's state (bare, with amplifiers, with unipolar amplifiers; planar
+    /// and two-plane) hands the duty each of its planes in contact: the duty reads the planes
+    /// through the rotor model (`Machine::plane_states`), the hardware's wrapper included (before
+    /// the rotor seam, a run with amplifiers handed the duty nothing and its duty was all zeros).
+    #[test]
+    fn every_layout_of_the_state_hands_the_duty_its_planes() {
+        let hw = "amb.amplifier=true";
+        let uni = ["amb.amplifier=true", "amb.amplifier_topology=\"unipolar\"", "amb.force_law=\"nonlinear\""];
+        let cases: [(&str, &[&str]); 4] = [
+            ("realistic-10g.toml", &[]),
+            ("realistic-10g.toml", &uni),
+            ("two-plane-asymmetric-10g.toml", &[]),
+            ("two-plane-asymmetric-10g.toml", &[hw]),
+        ];
+        for (file, sets) in cases {
+            let mut sets = sets.to_vec();
+            sets.push("controller.mode=\"continuous\"");
+            let scene = shipped(file, &sets);
+            // Into contact: the shock's first 30 ms, at the fixed-step setting (fast).
+            let mut more = scene.fixed_step_overrides();
+            more.push(format!("scene.duration_s={:?}", scene.first_shock_start() + 0.03));
+            let scene = scene.reload(&more).unwrap();
+            let bearing = Bearing::new(Materials::default(), 6.35e-3, 50e-3, 10e-3, 0.1);
+            let mut trace = Trace::with_capacity(1024);
+            let mut sink = DutySink::new(&mut trace, bearing, scene.plane(0).balls.count());
+            let run = crate::run::run_into(&scene, &Default::default(), &mut crate::hooks::Quiet, &mut sink)
+                .unwrap_or_else(|e| panic!("{file} {sets:?}: {e}"));
+            assert_eq!(run.outcome, crate::run::Outcome::Completed, "{file} {sets:?}");
+            let duty = sink.finish();
+            // One plane's duty is the duty; two planes' are each in `planes`.
+            assert_eq!(duty.planes.len(), if scene.planes() == 1 { 0 } else { scene.planes() }, "{file} {sets:?}");
+            assert!(
+                duty.contact_time_s > 0.0 && duty.peak_contact_force_n > 0.0,
+                "{file} {sets:?}: the shock puts the rotor into a race: {duty:?}"
+            );
         }
     }
 }

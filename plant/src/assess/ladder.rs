@@ -217,7 +217,8 @@ fn run_counted(
 ) -> anyhow::Result<Option<Counted>> {
     let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty)>> {
         let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
-        let balls = scene.params.balls.count();
+        // Every plane's touchdown bearing has the scene's ball set (`[touchdown]`).
+        let balls = scene.plane(0).balls.count();
         let mut sink = DutySink::new(&mut trace, bearing, balls);
         let run = run_into(scene, &crate::cosim::Launch::default(), &mut Cancel(stop), &mut sink)?;
         let duty = sink.finish();

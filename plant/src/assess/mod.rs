@@ -189,26 +189,20 @@ pub struct ControllerReport {
 /// The axes a scene's loop has, by name: x then y (the planar model), x_A, y_A, x_B, y_B (the
 /// two-plane rotor, its planes in order).
 pub fn axis_names(scene: &Scene) -> Vec<&'static str> {
-    match scene.two_plane {
-        Some(_) => vec!["x_A", "y_A", "x_B", "y_B"],
-        None => vec!["x", "y"],
+    match scene.planes() {
+        1 => vec!["x", "y"],
+        _ => vec!["x_A", "y_A", "x_B", "y_B"],
     }
 }
 
 /// Each bearing plane's air gap (m).
 fn plane_gaps(scene: &Scene) -> Vec<f64> {
-    match &scene.two_plane {
-        Some(m) => m.planes.iter().map(|p| p.params.contact.gap).collect(),
-        None => vec![scene.params.contact.gap],
-    }
+    scene.rotor.bearings().map(|p| p.contact.gap).collect()
 }
 
 /// Each bearing plane's sensor gain (V/m).
 fn plane_sensor_gains(scene: &Scene) -> Vec<f64> {
-    match &scene.two_plane {
-        Some(m) => m.planes.iter().map(|p| p.params.loop_constants.sensor_gain_v_per_m).collect(),
-        None => vec![scene.params.loop_constants.sensor_gain_v_per_m],
-    }
+    scene.rotor.bearings().map(|p| p.loop_constants.sensor_gain_v_per_m).collect()
 }
 
 /// The initial offsets that put the rotor `offset_um` (µm) off on axis `axis` at its sensor:
@@ -216,16 +210,7 @@ fn plane_sensor_gains(scene: &Scene) -> Vec<f64> {
 /// axis' own plane's sensor by `offset_um` and leave the other plane's sensor where it was (both
 /// modes, translation and tilt, start to move).
 fn initial_offsets(scene: &Scene, axis: usize, offset_um: f64) -> Vec<String> {
-    let xy = ["x", "y"][axis % 2];
-    match &scene.two_plane {
-        None => vec![format!("initial.rotor_{xy}_um={offset_um:?}")],
-        Some(m) => {
-            let (own, other) = (m.planes[axis / 2].sensor, m.planes[1 - axis / 2].sensor);
-            // x(z) = x₀ + a z: offset_um at z = own, 0 at z = other (µm, µrad for z in m).
-            let slope = offset_um / (own - other);
-            vec![format!("initial.rotor_{xy}_um={:?}", -slope * other), format!("initial.slope_{xy}_urad={slope:?}")]
-        }
-    }
+    scene.rotor.sensor_offset(axis, offset_um)
 }
 
 /// Overrides of a measurement run without shocks: the shocks moved past `duration`, the fast
@@ -374,10 +359,7 @@ pub fn closed_form_of(scene: &Scene) -> Option<closed_form::PdLoop> {
 /// modes decouple into the plane's own (the cylindrical mode of a symmetric machine); the
 /// conical mode has another modal mass, and the measured sensitivity of an axis mixes both.
 pub fn closed_form_of_plane(scene: &Scene, plane: usize) -> Option<(closed_form::PdLoop, closed_form::AxisPlant)> {
-    let params = match &scene.two_plane {
-        Some(m) => &m.planes.get(plane)?.params,
-        None => &scene.params,
-    };
+    let params = scene.rotor.bearings().nth(plane)?;
     if !matches!(params.amb, crate::force::amb::AmbLaw::Linear { .. }) {
         return None;
     }
@@ -452,7 +434,7 @@ fn sensitivity_part(
     stop: &AtomicBool,
     log: &(dyn Fn(&str) + Sync),
 ) -> Result<SensitivityPart, PartialSensitivity> {
-    let speed = scene.params.speed / std::f64::consts::TAU;
+    let speed = scene.rotor.speed() / std::f64::consts::TAU;
     let speeds: Vec<f64> = a.speeds.iter().map(|s| if *s == spec::Speed::Rated { speed } else { 0.0 }).collect();
     let jobs: Vec<(usize, f64)> =
         speeds.iter().flat_map(|s| (0..axis_names(scene).len()).map(move |k| (k, *s))).collect();
@@ -491,8 +473,7 @@ fn sensitivity_part(
         .map(|i| closed_form_of_plane(scene, i).map(|(pd, axis)| closed_form_peak(&axis, &pd, &a.sensitivity)))
         .collect();
     let closed_form = closed.first().cloned().flatten();
-    let closed_form_planes =
-        if scene.two_plane.is_some() { closed.into_iter().flatten().collect() } else { Vec::new() };
+    let closed_form_planes = if scene.planes() > 1 { closed.into_iter().flatten().collect() } else { Vec::new() };
     let part = SensitivityPart { axes, closed_form, closed_form_planes, simulated_s, settings: a.sensitivity.clone() };
     if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
         // The axes often fail alike (one controller command, one interruption): each reason once.
@@ -528,7 +509,7 @@ fn vibration_part(
     decay_per_s: Option<f64>,
     stop: &AtomicBool,
 ) -> Result<vibration::Vibration, (Failure, String)> {
-    let speed_hz = scene.params.speed / std::f64::consts::TAU;
+    let speed_hz = scene.rotor.speed() / std::f64::consts::TAU;
     let settle = decay_per_s.filter(|s| *s > 0.0).map_or(1.0, |s| (1000f64.ln() / s).clamp(0.1, 5.0));
     let window = if speed_hz > 0.0 { (50.0 / speed_hz).max(0.2) } else { 0.2 };
     let sets = quiet_run_overrides(scene, settle + window, scene.controller.rate_hz.min(20_000.0), 1);
@@ -548,7 +529,8 @@ fn vibration_part(
     if run.outcome == Outcome::Interrupted {
         return Err((Failure::Interrupted, "interrupted".into()));
     }
-    Ok(sink.figures(scene.params.current_limit, speed_hz, settle, window))
+    // The report's one current limit is plane A's.
+    Ok(sink.figures(scene.plane(0).current_limit, speed_hz, settle, window))
 }
 
 /// A co-simulated controller started once, for one tick, before anything is measured: a
@@ -957,7 +939,7 @@ mod tests {
             ["rotor.model=\"two_plane\"", "rotor.mass_kg=23", "rotor.polar_inertia_kg_m2=0.01162"].map(String::from),
         );
         let scene = crate::config::load_scene(&path, &two_sets).expect("two-plane scene");
-        let m = scene.two_plane.as_ref().expect("two-plane");
+        let crate::config::Rotor::TwoPlane(m) = &scene.rotor else { panic!("two-plane") };
         let l = m.planes[1].station;
         assert!((m.planes[0].station + l).abs() < 1e-12 && m.planes.iter().all(|p| p.sensor == p.station));
         let (pd, cyl) = closed_form_of_plane(&scene, 0).expect("closed form");
@@ -965,7 +947,7 @@ mod tests {
         assert_eq!(Some((pd, cyl)), closed_form_of_plane(&planar, 0));
         let con = closed_form::AxisPlant { mass: m.rotor.transverse_inertia / (2.0 * l * l), ..cyl };
         let s_aa = |f: f64| 0.5 * (closed_form::sensitivity(&cyl, &pd, f) + closed_form::sensitivity(&con, &pd, f));
-        let mut settings = sensitivity::Settings::for_gap(scene.params.contact.gap);
+        let mut settings = sensitivity::Settings::for_gap(scene.plane(0).contact.gap);
         settings.f_min_hz = 20.0;
         settings.f_max_hz = 200.0;
         settings.points = 6;

@@ -269,7 +269,8 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             out
         }
     };
-    let gap = probe.params.contact.gap;
+    // Plane A's gap (the excitation's default amplitude).
+    let gap = probe.plane(0).contact.gap;
     let d = sensitivity::Settings::for_gap(gap);
     let s = &raw.sensitivity;
     let k = |name: &str| format!("sensitivity.{name}");

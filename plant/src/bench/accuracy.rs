@@ -70,7 +70,7 @@ pub fn reference(b: &BenchScene) -> anyhow::Result<Reference> {
     );
     let check = run(&with_integrator(&b.scene, Method::Dp5, IntegratorSetting::Rtol(1e-11)), &mut Quiet)?;
     let floor =
-        window_error(&check.trace, &r.trace, b.window_start, b.window_start + WINDOW, b.scene.params.contact.gap);
+        window_error(&check.trace, &r.trace, b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
     let peak = r.trace.contact_force_n.iter().copied().fold(0.0, f64::max);
     Ok(Reference { trace: r.trace, floor, peak_contact_force: peak })
 }
@@ -81,7 +81,8 @@ pub fn stability_limit(b: &BenchScene, method: Method, reference: &Trace) -> any
     let stable = |n: u32| -> anyhow::Result<bool> {
         let s = with_integrator(&b.scene, method, IntegratorSetting::Substeps(n));
         let r = run(&s, &mut Quiet)?;
-        let (_, max) = window_error(&r.trace, reference, b.window_start, b.window_start + WINDOW, s.params.contact.gap);
+        let (_, max) =
+            window_error(&r.trace, reference, b.window_start, b.window_start + WINDOW, s.plane(0).contact.gap);
         Ok(r.run.outcome == Outcome::Completed && max < 1.0)
     };
     // Double until stable, then bisect between the last unstable and the first stable count.
@@ -156,7 +157,7 @@ fn timed_row(
 ) -> anyhow::Result<AccuracyRow> {
     let (t0, t1) = (b.window_start, b.window_start + WINDOW);
     let m = measure(s, repeats)?;
-    let (rms, max) = window_error(&m.result.trace, reference, t0, t1, b.scene.params.contact.gap);
+    let (rms, max) = window_error(&m.result.trace, reference, t0, t1, b.scene.plane(0).contact.gap);
     let ok = m.result.run.outcome == Outcome::Completed && rms.is_finite();
     let (text, rtol, substeps) = AccuracyRow::setting_columns(setting);
     Ok(AccuracyRow {

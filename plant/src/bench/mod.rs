@@ -109,11 +109,17 @@ impl std::fmt::Display for IntegratorSetting {
     }
 }
 
-/// Per-component scale of the absolute tolerances (see the module doc).
+/// Scale of the absolute tolerances of positions, velocities, angles and angular speeds (see
+/// the module doc): plane A's gap, the gap times the spin speed, a turn, the spin speed.
+pub fn atol_scale_groups(scene: &Scene) -> [f64; 4] {
+    let (r0, w) = (scene.plane(0).contact.gap, scene.rotor.speed().max(1.0));
+    [r0, r0 * w, std::f64::consts::TAU, w]
+}
+
+/// Per-component scale of the planar model's absolute tolerances ([`atol_scale_groups`] laid
+/// out as [`crate::model::ix`]).
 pub fn atol_scale(scene: &Scene) -> [f64; N] {
-    let (r0, w) = (scene.params.contact.gap, scene.params.speed.max(1.0));
-    let tau = std::f64::consts::TAU;
-    [r0, r0, tau, r0, r0, tau, r0 * w, r0 * w, w, r0 * w, r0 * w, w]
+    <crate::model::Model as crate::machine::Machine<N>>::atol(atol_scale_groups(scene))
 }
 
 /// The scene with another integrator.
@@ -123,8 +129,7 @@ pub fn with_integrator(scene: &Scene, method: Method, setting: IntegratorSetting
     match setting {
         IntegratorSetting::Rtol(rtol) => {
             s.integrator.rtol = rtol;
-            let scale = atol_scale(scene);
-            s.integrator.atol = std::array::from_fn(|i| rtol * scale[i]);
+            s.integrator.atol_groups = atol_scale_groups(scene).map(|g| rtol * g);
         }
         IntegratorSetting::Substeps(n) => s.integrator.substeps = n,
     }
@@ -239,11 +244,12 @@ mod tests {
         let s = with_integrator(&scene, Method::Dop853, IntegratorSetting::Rtol(1e-8));
         assert_eq!(s.integrator.method, Method::Dop853);
         assert_eq!(s.integrator.rtol, 1e-8);
-        let (r0, w) = (scene.params.contact.gap, scene.params.speed);
-        assert_eq!(s.integrator.atol[0], 1e-8 * r0);
-        assert_eq!(s.integrator.atol[2], 1e-8 * std::f64::consts::TAU);
-        assert_eq!(s.integrator.atol[6], 1e-8 * r0 * w);
-        assert_eq!(s.integrator.atol[11], 1e-8 * w);
+        let (r0, w) = (scene.plane(0).contact.gap, scene.rotor.speed());
+        let atol = scene.rotor.atol(s.integrator.atol_groups);
+        assert_eq!(atol[0], 1e-8 * r0);
+        assert_eq!(atol[2], 1e-8 * std::f64::consts::TAU);
+        assert_eq!(atol[6], 1e-8 * (r0 * w));
+        assert_eq!(atol[11], 1e-8 * w);
         let f = with_integrator(&scene, Method::Rk4, IntegratorSetting::Substeps(7));
         assert_eq!((f.integrator.method, f.integrator.substeps), (Method::Rk4, 7));
         assert_eq!(IntegratorSetting::Rtol(1e-4).to_string(), "rtol=1e-4");

@@ -104,7 +104,7 @@ pub fn models(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut rows = Vec::new();
     for b in super::scenes(config_dir)? {
-        let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.params.contact.gap);
+        let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
         // Accurate runs for the error (model differences, not integration error).
         let accurate = |s: &Scene| run(&with_integrator(s, Method::Dp5, IntegratorSetting::Rtol(1e-10)), &mut Quiet);
         let full = overridden(&b, FULL)?;
@@ -172,7 +172,7 @@ pub fn models(
 /// (`planar study model`, speed-up 1), both run accurately for the error; the error is the
 /// larger of the two planes'.
 fn second_plane(b: &BenchScene, repeats: usize, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<ModelRow>> {
-    let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.params.contact.gap);
+    let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
     let accurate = |s: &Scene| run(&with_integrator(s, Method::Dp5, IntegratorSetting::Rtol(1e-10)), &mut Quiet);
     let planar = overridden(b, STUDY)?;
     let reference = accurate(&planar)?.trace;

@@ -7,11 +7,10 @@
 //! Only scenes whose shocks are all double half-sines are accepted (the peer
 //! implements that pulse only), with `controller.mode = "continuous"`.
 
-use crate::config::{ControlMode, Scene};
+use crate::config::{ControlMode, Rotor, Scene};
 use crate::initial::initial_state;
 use crate::model::{ix, Control, Model, State, N};
 use crate::rng::SplitMix64;
-use crate::run::design_gains;
 use anyhow::bail;
 use serde_json::{json, Value};
 use shock_table::Pulse;
@@ -53,7 +52,8 @@ impl Draw for SplitMix64 {
 /// Sample states: a mix of levitated, rotor on the race, race on several
 /// balls, slip and race speed near zero, saturated current, and anything.
 fn sample_states(scene: &Scene, y0: &State, n: usize, seed: u64) -> Vec<(String, f64, State)> {
-    let p = &scene.params;
+    // The planar model's bearing (spec refuses any other).
+    let p = scene.plane(0);
     let mut rng = SplitMix64::new(seed);
     let r0 = p.contact.gap;
     let rcl = p.balls.clearance;
@@ -174,7 +174,10 @@ pub fn spec(scene: &Scene, samples: usize, seed: u64, atol_scale: Option<[f64; N
     if scene.controller.mode != ControlMode::Continuous {
         bail!("peer spec: controller.mode must be \"continuous\" (the peer evaluates the PD inside the derivative)");
     }
-    let gains = design_gains(scene)?;
+    let Rotor::Planar(params) = &scene.rotor else {
+        bail!("peer spec: the peer implements the planar model (rotor.model = \"planar\")");
+    };
+    let gains = crate::run::plane_gains(scene)?[0];
     let mut shocks = Vec::new();
     for (i, s) in scene.base.shocks.iter().enumerate() {
         let Pulse::DoubleHalfSine(d) = s.pulse else {
@@ -194,9 +197,9 @@ pub fn spec(scene: &Scene, samples: usize, seed: u64, atol_scale: Option<[f64; N
             "t2": d.t2,
         }));
     }
-    let y0 = initial_state(scene);
+    let y0 = initial_state(scene, params);
     let model = Model {
-        params: scene.params.clone(),
+        params: params.clone(),
         base: scene.base.clone(),
         control: Control::Continuous(gains),
         race_parked: false,
@@ -223,15 +226,15 @@ pub fn spec(scene: &Scene, samples: usize, seed: u64, atol_scale: Option<[f64; N
         "state_names": STATE_NAMES,
         "duration_s": scene.duration,
         "controller_period_s": scene.controller.period,
-        "params": serde_json::to_value(&scene.params)?,
-        "ball_count": scene.params.balls.count(),
+        "params": serde_json::to_value(params)?,
+        "ball_count": params.balls.count(),
         "gains": {
             "kp": gains.kp,
             "kd": gains.kd,
             "amp_gain_a_per_v": gains.amp_gain_a_per_v,
             "bias_a": gains.bias_a,
         },
-        "current_limit_a": scene.params.current_limit,
+        "current_limit_a": params.current_limit,
         "shocks": shocks,
         "y0": y0,
         "samples_seed": seed,

@@ -21,9 +21,10 @@
 //! other processes. On a two-plane rotor both bearing planes are 2 µm into their races.
 
 use crate::analysis::classify::MotionMode;
-use crate::config::{load_scene, Scene};
+use crate::config::{load_scene, Rotor, Scene};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
+use crate::machine::Machine;
 use crate::status::Status;
 use crate::summary::Summary;
 use crate::table::sci;
@@ -124,7 +125,7 @@ fn repeat_two_plane_contact_tick(
         race_parked: [false; 2],
     };
     let y0 = two_plane_contact_state(scene, params);
-    let settings = crate::run::settings_with(scene, scene.integrator.two_plane_atol());
+    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
     time_repeated_tick(scene, &model, settings, y0, repeats)
 }
 
@@ -178,21 +179,22 @@ pub struct RepeatRow {
 
 /// Integrates one contact tick of `scene` (the realtime setting) `repeats` times from the same
 /// state, timing each: identical work, so the spread is the host's.
-fn repeat_contact_tick(scene: &Scene, repeats: u64) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+fn repeat_contact_tick(
+    scene: &Scene,
+    params: &crate::model::Params,
+    repeats: u64,
+) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
     use crate::model::{ix, Control, Model};
-    let gains = crate::run::design_gains(scene)?;
-    let bias = controller::saturate(gains.bias_a, scene.params.current_limit);
-    let model = Model {
-        params: scene.params.clone(),
-        base: scene.base.clone(),
-        control: Control::Held(bias),
-        race_parked: false,
-    };
-    let mut y0 = crate::initial::initial_state(scene);
+    let gains = crate::run::plane_gains(scene)?[0];
+    let bias = controller::saturate(gains.bias_a, params.current_limit);
+    let model =
+        Model { params: params.clone(), base: scene.base.clone(), control: Control::Held(bias), race_parked: false };
+    let mut y0 = crate::initial::initial_state(scene, params);
     // The rotor 2 µm into its race, straight down (about a kilonewton of contact).
     y0[ix::XR] = y0[ix::XB];
-    y0[ix::YR] = y0[ix::YB] - scene.params.contact.gap - 2e-6;
-    time_repeated_tick(scene, &model, crate::run::integrator_settings(scene), y0, repeats)
+    y0[ix::YR] = y0[ix::YB] - params.contact.gap - 2e-6;
+    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
+    time_repeated_tick(scene, &model, settings, y0, repeats)
 }
 
 /// Integrates one tick of `model` (the scene's period, its contact substeps) from `y0`
@@ -368,9 +370,9 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
 
     let (label, fixed) = &settings[0];
     let repeats = rows.first().map_or(1, |r| r.ticks.max(1));
-    let (p, rhs_evals) = match &fixed.two_plane {
-        None => repeat_contact_tick(fixed, repeats)?,
-        Some(params) => repeat_two_plane_contact_tick(fixed, params, repeats)?,
+    let (p, rhs_evals) = match &fixed.rotor {
+        Rotor::Planar(params) => repeat_contact_tick(fixed, params, repeats)?,
+        Rotor::TwoPlane(params) => repeat_two_plane_contact_tick(fixed, params, repeats)?,
     };
     let repeat = RepeatRow {
         setting: format!("one contact tick repeated, {label}"),
@@ -402,7 +404,6 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::machine::Machine;
 
     /// The repeated tick of a two-plane rotor starts with both planes in contact, each about
     /// 2 µm into its race (the asymmetric scene: gaps of 150 and 250 µm, so the rotor tilts).
@@ -410,7 +411,7 @@ mod tests {
     fn the_two_plane_contact_tick_starts_with_both_planes_in_their_races() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
         let scene = load_scene(&path, &[]).unwrap();
-        let params = scene.two_plane.as_ref().unwrap();
+        let Rotor::TwoPlane(params) = &scene.rotor else { panic!("a two-plane scene") };
         let y = two_plane_contact_state(&scene, params);
         let model = plant_physics::two_plane::Model {
             params: params.clone(),

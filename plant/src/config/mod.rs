@@ -14,6 +14,7 @@
 pub mod hardware;
 pub mod overrides;
 pub mod raw;
+pub mod rotor;
 pub mod validate;
 
 pub use overrides::apply_override;
@@ -21,6 +22,7 @@ pub use raw::{
     ControlMode, DragChoice, Fallback, ForceLaw, Pacing, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
     ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
+pub use rotor::Rotor;
 pub use validate::{finite, non_negative, positive, range, validate};
 
 use crate::integrate::Method;
@@ -158,8 +160,6 @@ pub struct IntegratorSettings {
     pub method: Method,
     /// Relative tolerance.
     pub rtol: f64,
-    /// Absolute tolerance per state component of the planar model.
-    pub atol: [f64; crate::model::N],
     /// Absolute tolerances of positions (m), velocities (m/s), angles (rad) and angular speeds
     /// (rad/s), from which each model's per-component tolerances are laid out.
     pub atol_groups: [f64; 4],
@@ -172,16 +172,6 @@ pub struct IntegratorSettings {
     /// The integrator of realtime runs (`integrator.realtime`); a realtime scene on `fixed`
     /// already holds the fixed-step setting here.
     pub realtime: RealtimeSetting,
-}
-
-impl IntegratorSettings {
-    /// Absolute tolerances per state component of the two-plane rotor
-    /// ([`plant_physics::two_plane::ix`]): the slopes and their rates count as angles and
-    /// angular speeds.
-    pub fn two_plane_atol(&self) -> [f64; plant_physics::two_plane::N] {
-        let [p, v, a, w] = self.atol_groups;
-        [p, p, a, a, a, p, p, a, p, p, a, v, v, w, w, w, v, v, w, v, v, w]
-    }
 }
 
 /// Initial-state settings.
@@ -206,11 +196,8 @@ pub struct Scene {
     pub description: String,
     /// Simulated time (s).
     pub duration: f64,
-    /// Physics: the planar model's parameters, or, for a two-plane rotor, bearing plane A's
-    /// (its share of the rotor; the whole machine is in `two_plane`).
-    pub params: Params,
-    /// The two-plane rotor (`rotor.model = "two_plane"`), or `None` for the planar model.
-    pub two_plane: Option<plant_physics::two_plane::Params>,
+    /// The rotor: its model and each bearing plane's physics ([`Rotor`]).
+    pub rotor: Rotor,
     /// Base motion.
     pub base: Programme,
     /// Controller.
@@ -257,59 +244,37 @@ impl Scene {
         self.source.shocks
     }
 
-    /// The common loop design the scene's law is built from: one conversion, scene to
-    /// [`controller::Design`] (plane A's, for a two-plane rotor).
-    pub fn design(&self) -> controller::Design {
-        self.design_of(&self.params)
-    }
-
     /// The design of each bearing plane (one for the planar model): the scene's closed loop
     /// with the plane's own loop constants, its load share as the mass (the damping design and
     /// the gravity bias act on it) and its own air gap.
     pub fn plane_designs(&self) -> Vec<controller::Design> {
-        match &self.two_plane {
-            None => vec![self.design()],
-            Some(machine) => machine.planes.iter().map(|p| self.design_of(&p.params)).collect(),
-        }
+        self.rotor.bearings().map(|p| self.design_of(p)).collect()
+    }
+
+    /// Plane `i`'s design ([`Scene::plane_designs`]).
+    pub fn plane_design(&self, i: usize) -> controller::Design {
+        self.design_of(self.plane(i))
     }
 
     /// The whole rotor's design a law is built from (`controller::build_rotor_law`) and the
     /// hello carries: the planar design, or each plane's with the rotor's geometry.
     pub fn rotor_design(&self) -> controller::RotorDesign {
-        match &self.two_plane {
-            None => controller::RotorDesign::Planar(self.design()),
-            Some(m) => {
-                let [a, b] = &m.planes;
-                controller::RotorDesign::TwoPlane {
-                    planes: [self.design_of(&a.params), self.design_of(&b.params)],
-                    geometry: controller::Geometry {
-                        mass_kg: m.rotor.mass,
-                        transverse_inertia_kg_m2: m.rotor.transverse_inertia,
-                        polar_inertia_kg_m2: m.rotor.polar_inertia,
-                        rated_speed_rad_s: m.rotor.speed,
-                        bearing_z_m: [a.station, b.station],
-                        sensor_z_m: [a.sensor, b.sensor],
-                    },
-                }
+        match self.rotor.geometry() {
+            None => controller::RotorDesign::Planar(self.plane_design(0)),
+            Some(geometry) => {
+                controller::RotorDesign::TwoPlane { planes: [self.plane_design(0), self.plane_design(1)], geometry }
             }
         }
     }
 
     /// Bearing planes: 1 (planar) or 2.
     pub fn planes(&self) -> usize {
-        if self.two_plane.is_some() {
-            2
-        } else {
-            1
-        }
+        self.rotor.planes()
     }
 
-    /// Plane `i`'s parameters (the planar model's for `i = 0` without a second plane).
+    /// Plane `i`'s parameters: its bearing and its share of the rotor ([`Rotor::plane`]).
     pub fn plane(&self, i: usize) -> &Params {
-        match &self.two_plane {
-            Some(machine) => &machine.planes[i].params,
-            None => &self.params,
-        }
+        self.rotor.plane(i)
     }
 
     fn design_of(&self, params: &Params) -> controller::Design {
@@ -442,8 +407,11 @@ impl Scene {
     /// change ([`check_controller_overrides`]); anything else is refused, never written into a
     /// scene that a run folder would replay.
     pub fn with_controller_overrides(&self, controller: &toml::Table) -> Result<Scene, ConfigError> {
-        check_controller_overrides(controller, self.params.current_limit)
-            .map_err(|why| ConfigError::Parse { path: "the controller's handshake overrides".into(), message: why })?;
+        check_controller_overrides(
+            controller,
+            self.rotor.bearings().map(|p| p.current_limit).fold(f64::INFINITY, f64::min),
+        )
+        .map_err(|why| ConfigError::Parse { path: "the controller's handshake overrides".into(), message: why })?;
         let mut table = self.table()?;
         let section = table
             .entry("controller")

@@ -23,7 +23,9 @@
 //! `touchdown.palmgren_f0` with the constant drag.
 
 use super::raw::*;
-use super::{ConfigError, ControllerSettings, CosimSettings, InitialSettings, IntegratorSettings, Scene, Source};
+use super::{
+    ConfigError, ControllerSettings, CosimSettings, InitialSettings, IntegratorSettings, Rotor, Scene, Source,
+};
 use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
 use crate::integrate::Method;
@@ -478,10 +480,6 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     }
     positive("housing.mass_kg", raw.housing.mass_kg, "kg")?;
     let unbalance_phase = finite("rotor.unbalance_phase_deg", r.unbalance_phase_deg, "deg")?.to_radians();
-    let two = r.model == RotorModel::TwoPlane;
-    if !two {
-        refuse_two_plane_keys(&raw)?;
-    }
     let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
     let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
     let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
@@ -495,13 +493,17 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     };
     let whole =
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
-    let (physics, two_plane) = if two {
-        let machine = two_plane_params(&raw, &whole)?;
-        (machine.planes[0].params.clone(), Some(machine))
-    } else {
-        (bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?, None)
+    // The rotor model: how each is built from the scene (a new model is an arm here).
+    let rotor = match r.model {
+        RotorModel::Planar => {
+            refuse_two_plane_keys(&raw)?;
+            Rotor::Planar(bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?)
+        }
+        RotorModel::TwoPlane => Rotor::TwoPlane(two_plane_params(&raw, &whole)?),
     };
-    let loop_constants = physics.loop_constants;
+    // The sensor's and the controller's loop constants are the scene's (`[amb]`,
+    // `[controller]`), the same on every plane.
+    let loop_constants = rotor.plane(0).loop_constants;
 
     let rate = positive("controller.rate_hz", ctl.rate_hz, "Hz")?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
@@ -589,7 +591,6 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let integrator = IntegratorSettings {
         method: int.method,
         rtol,
-        atol: [ap, ap, aa, ap, ap, aa, av, av, aw, av, av, aw],
         atol_groups: [ap, av, aa, aw],
         substeps: int.substeps,
         contact_substeps: if int.contact_substeps == 0 { int.substeps } else { int.contact_substeps },
@@ -635,27 +636,19 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         adc_bits: raw.sensor.adc_bits,
         adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
     };
-    let planes = if two { 2 } else { 1 };
-    let gaps: Vec<f64> = match &two_plane {
-        Some(m) => m.planes.iter().map(|p| p.params.contact.gap).collect(),
-        None => vec![physics.contact.gap],
-    };
-    let laws: Vec<AmbLaw> = match &two_plane {
-        Some(m) => m.planes.iter().map(|p| p.params.amb).collect(),
-        None => vec![physics.amb],
-    };
-    let hardware = hardware(&raw, planes, &gaps, &laws, &integrator, 1.0 / rate)?;
+    let gaps: Vec<f64> = rotor.bearings().map(|p| p.contact.gap).collect();
+    let laws: Vec<AmbLaw> = rotor.bearings().map(|p| p.amb).collect();
+    let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
     // The resolved scene states the two-plane rotor's defaults.
-    if two_plane.is_some() {
+    if let Rotor::TwoPlane(_) = rotor {
         record_two_plane(&mut raw);
     }
     let scene = Scene {
         name: raw.scene.name.clone(),
         description: raw.scene.description.clone(),
         duration,
-        params: physics,
-        two_plane,
+        rotor,
         base,
         controller,
         integrator,

@@ -153,14 +153,14 @@ pub fn setting_description(scene: &Scene, spec: &EnsembleSpec) -> String {
 
 /// `--set` overrides of the reference setting that verifies a member.
 pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
-    let scale = crate::bench::atol_scale(scene);
+    let [p, v, a, w] = crate::bench::atol_scale_groups(scene);
     vec![
         "integrator.method=\"dop853\"".into(),
         format!("integrator.rtol={rtol:?}"),
-        format!("integrator.atol_position_m={:?}", rtol * scale[0]),
-        format!("integrator.atol_angle_rad={:?}", rtol * scale[2]),
-        format!("integrator.atol_velocity_m_s={:?}", rtol * scale[6]),
-        format!("integrator.atol_angular_speed_rad_s={:?}", rtol * scale[8]),
+        format!("integrator.atol_position_m={:?}", rtol * p),
+        format!("integrator.atol_angle_rad={:?}", rtol * a),
+        format!("integrator.atol_velocity_m_s={:?}", rtol * v),
+        format!("integrator.atol_angular_speed_rad_s={:?}", rtol * w),
         "touchdown.race_when_clear=\"free\"".into(),
     ]
 }

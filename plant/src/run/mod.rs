@@ -121,20 +121,22 @@ pub trait Sink {
     /// The sample at one output time: the state's row(s) with the forces the model gives there.
     fn sample(&mut self, record: &Record);
 
-    /// The same sample as the planar model's state, after [`Sink::sample`] (planar runs only):
-    /// for a sink that needs what a row does not hold (the race's angle and acceleration, each
-    /// ball's load: the assessment's touchdown-bearing duty). The default ignores it.
-    fn planar_state(&mut self, _model: &crate::model::Model, _t: f64, _y: &crate::model::State) {}
+    /// The same sample's bearing planes, after [`Sink::sample`], for a sink that needs what a
+    /// row does not hold (the race's angle and acceleration, each ball's load: the
+    /// assessment's touchdown-bearing duty): `planes` hands each plane's
+    /// [`crate::machine::PlaneState`] to a visitor, computed only if the sink asks. The default
+    /// ignores it.
+    fn planes(&mut self, _planes: &dyn PlaneStates) {}
+}
 
-    /// The same for the two-plane rotor's state, after [`Sink::sample`] (two-plane runs only):
-    /// each touchdown bearing's duty. The default ignores it.
-    fn two_plane_state(
-        &mut self,
-        _model: &plant_physics::two_plane::Model,
-        _t: f64,
-        _y: &plant_physics::two_plane::State,
-    ) {
-    }
+/// The bearing planes of one output sample, as the rotor model gives them
+/// ([`crate::machine::Machine::plane_states`]).
+pub trait PlaneStates {
+    /// The sample's time (s).
+    fn time(&self) -> f64;
+
+    /// Hands each plane's state to `visit`, with the plane's index.
+    fn visit(&self, visit: &mut dyn FnMut(usize, &crate::machine::PlaneState<'_>));
 }
 
 impl Sink for Trace {
@@ -152,19 +154,9 @@ pub struct RunResult {
     pub run: SinkRun,
 }
 
-/// Continuous PD gains for a scene's controller design (plane A's, for a two-plane rotor).
-pub fn design_gains(scene: &Scene) -> Result<PdGains, controller::LawError> {
-    PdGains::from_design(&scene.design().pd(), &scene.params.loop_constants)
-}
-
 /// Continuous PD gains of each bearing plane's design (one for the planar model).
 pub fn plane_gains(scene: &Scene) -> Result<Vec<PdGains>, controller::LawError> {
     scene.plane_designs().iter().map(|d| PdGains::from_design(&d.pd(), &d.constants)).collect()
-}
-
-/// Integrator settings for a scene, with the macro step as the largest step.
-pub fn integrator_settings(scene: &Scene) -> Settings<{ crate::model::N }> {
-    settings_with(scene, scene.integrator.atol)
 }
 
 /// Integrator settings for a scene's model of `N` state components, absolute tolerances `atol`.

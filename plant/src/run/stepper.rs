@@ -40,7 +40,7 @@
 //! ([`crate::snapshot::Snapshot`]); a plant restored at any tick writes the same rows as the
 //! one that never stopped.
 
-use crate::config::Scene;
+use crate::config::{Rotor, Scene};
 use crate::cosim::stats::{Tet, TickTime};
 use crate::hardware::{Wired, EXTRA, EXTRA_UNIPOLAR};
 pub use crate::hooks::Excitation;
@@ -48,7 +48,7 @@ use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
 use crate::machine::Machine;
 use crate::model::{Control, Model, RaceWhenClear};
-use crate::run::{integrator_settings, plane_gains, settings_with, RunError, SetupError, Sink, TickCost};
+use crate::run::{plane_gains, settings_with, RunError, SetupError, Sink, TickCost};
 use crate::sensor::Sensor;
 use crate::snapshot::{Fingerprint, Snapshot, SnapshotError};
 use controller::{wrap_angle, PdGains, RotorSample, ROTOR_AXES};
@@ -80,6 +80,34 @@ impl std::fmt::Debug for Plant {
     }
 }
 
+/// The stepper of `model` (a [`Machine`] on `$n` states) from state `$y`, wrapped in the
+/// scene's hardware ([`Wired`]) when it has amplifiers or a sensor front end.
+macro_rules! stepper_of {
+    ($scene:expr, $model:expr, $y:expr, $n:expr, $controls:expr, $gains:expr, $timed:expr) => {{
+        const N: usize = $n;
+        let (scene, model, y) = ($scene, $model, $y);
+        let groups = scene.integrator.atol_groups;
+        let hw = &scene.hardware;
+        let core: Box<dyn Core> = if hw.is_unipolar() {
+            const NA: usize = N + EXTRA_UNIPOLAR;
+            let wired = Wired::<_, N, NA>::new(model, $controls, hw.clone());
+            let y = wired.initial(&y);
+            let settings = settings_with(scene, atol_of(&wired, groups));
+            Box::new(Stepper::new(scene, wired, y, settings, $gains, $timed))
+        } else if hw.is_on() {
+            const NA: usize = N + EXTRA;
+            let wired = Wired::<_, N, NA>::new(model, $controls, hw.clone());
+            let y = wired.initial(&y);
+            let settings = settings_with(scene, atol_of(&wired, groups));
+            Box::new(Stepper::new(scene, wired, y, settings, $gains, $timed))
+        } else {
+            let settings = settings_with(scene, atol_of(&model, groups));
+            Box::new(Stepper::new(scene, model, y, settings, $gains, $timed))
+        };
+        core
+    }};
+}
+
 impl Plant {
     /// The plant of `scene` at its initial state (levitated on the unbalance orbit, each race at
     /// rest), with `initial` applied: the command the row at t = 0 shows (the bias currents of a
@@ -97,60 +125,30 @@ impl Plant {
             Command::Continuous(_) => Control::Continuous(gains[i]),
             Command::Held(c) => Control::Held([c[2 * i], c[2 * i + 1]]),
         };
-        let hw = &scene.hardware;
-        let controls = if scene.two_plane.is_some() { [control(0), control(1)] } else { [control(0); 2] };
-        let [p, v, ..] = scene.integrator.atol_groups;
-        let core: Box<dyn Core> = match &scene.two_plane {
-            None => {
+        let last = scene.planes() - 1;
+        let controls: [Control; 2] = std::array::from_fn(|i| control(i.min(last)));
+        // The one place the plant tells the rotor models apart: each is built from the scene
+        // and wrapped in the hardware the scene has (the hardware's state length is a
+        // constant of the model's, hence a macro).
+        let core: Box<dyn Core> = match &scene.rotor {
+            Rotor::Planar(params) => {
                 let model = Model {
-                    params: scene.params.clone(),
+                    params: params.clone(),
                     base: scene.base.clone(),
-                    control: control(0),
+                    control: controls[0],
                     race_parked: false,
                 };
-                let y = initial_state(scene);
-                const N: usize = crate::model::N;
-                if hw.is_unipolar() {
-                    const NA: usize = N + EXTRA_UNIPOLAR;
-                    let wired = Wired::<Model, N, NA>::new(model, controls, hw.clone());
-                    let y = wired.initial(&y);
-                    let settings = settings_with(scene, extended::<N, NA>(scene.integrator.atol, p, v));
-                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
-                } else if hw.is_on() {
-                    const NA: usize = N + EXTRA;
-                    let wired = Wired::<Model, N, NA>::new(model, controls, hw.clone());
-                    let y = wired.initial(&y);
-                    let settings = settings_with(scene, extended::<N, NA>(scene.integrator.atol, p, v));
-                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
-                } else {
-                    Box::new(Stepper::new(scene, model, y, integrator_settings(scene), gains, timed))
-                }
+                stepper_of!(scene, model, initial_state(scene, params), crate::model::N, controls, gains, timed)
             }
-            Some(params) => {
+            Rotor::TwoPlane(params) => {
                 let model = two_plane::Model {
                     params: params.clone(),
                     base: scene.base.clone(),
-                    control: [control(0), control(1)],
+                    control: controls,
                     race_parked: [false; 2],
                 };
                 let y = crate::initial::two_plane_initial_state(scene, params);
-                const N: usize = two_plane::N;
-                let atol = scene.integrator.two_plane_atol();
-                if hw.is_unipolar() {
-                    const NA: usize = N + EXTRA_UNIPOLAR;
-                    let wired = Wired::<two_plane::Model, N, NA>::new(model, controls, hw.clone());
-                    let y = wired.initial(&y);
-                    let settings = settings_with(scene, extended::<N, NA>(atol, p, v));
-                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
-                } else if hw.is_on() {
-                    const NA: usize = N + EXTRA;
-                    let wired = Wired::<two_plane::Model, N, NA>::new(model, controls, hw.clone());
-                    let y = wired.initial(&y);
-                    let settings = settings_with(scene, extended::<N, NA>(atol, p, v));
-                    Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
-                } else {
-                    Box::new(Stepper::new(scene, model, y, settings_with(scene, atol), gains, timed))
-                }
+                stepper_of!(scene, model, y, two_plane::N, controls, gains, timed)
             }
         };
         let fingerprint = Fingerprint::of(scene, core.state().len());
@@ -597,23 +595,33 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
     }
 }
 
-/// The model's tolerances `atol` with the hardware's after them ([`crate::hardware::atol`]).
-fn extended<const N: usize, const NA: usize>(atol: [f64; N], p: f64, v: f64) -> [f64; NA] {
-    let mut a = [0.0; NA];
-    a[..N].copy_from_slice(&atol);
-    a[N..].copy_from_slice(&crate::hardware::atol(p, v)[..NA - N]);
-    a
+/// `model`'s absolute tolerances from the scene's groups ([`Machine::atol`]).
+fn atol_of<const N: usize, M: Machine<N>>(_model: &M, groups: [f64; 4]) -> [f64; N] {
+    M::atol(groups)
 }
 
-/// Hands the output sample of state `y` at time `t` to `sink` (and its state: on the planar
-/// model [`Sink::planar_state`], on the two-plane rotor [`Sink::two_plane_state`]).
+/// Hands the output sample of state `y` at time `t` to `sink`, then its bearing planes
+/// ([`Sink::planes`]).
 #[inline]
 fn feed<const N: usize, M: Machine<N>>(model: &M, sink: &mut dyn Sink, t: f64, y: &[f64; N]) {
     sink.sample(&model.record(t, y));
-    if let (Some(planar), Ok(state)) = (model.planar(), <&crate::model::State>::try_from(&y[..])) {
-        sink.planar_state(planar, t, state);
-    } else if let (Some(m), Ok(state)) = (model.two_plane(), <&plant_physics::two_plane::State>::try_from(&y[..])) {
-        sink.two_plane_state(m, t, state);
+    sink.planes(&At { model, t, y });
+}
+
+/// One output sample's bearing planes, computed when a sink asks ([`crate::run::PlaneStates`]).
+struct At<'a, M, const N: usize> {
+    model: &'a M,
+    t: f64,
+    y: &'a [f64; N],
+}
+
+impl<const N: usize, M: Machine<N>> crate::run::PlaneStates for At<'_, M, N> {
+    fn time(&self) -> f64 {
+        self.t
+    }
+
+    fn visit(&self, visit: &mut dyn FnMut(usize, &crate::machine::PlaneState<'_>)) {
+        self.model.plane_states(self.t, self.y, visit);
     }
 }
 

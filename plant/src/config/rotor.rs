@@ -1,0 +1,160 @@
+//! The scene's rotor: one value whose variant is the rotor model (`rotor.model`).
+//!
+//! This is the scene's side of the rotor seam. A `match` on [`Rotor`] is exhaustive, so a
+//! new rotor model is pointed to by the build wherever the scene must say something of it;
+//! everything else about a model (its state, tolerances, per-plane state, failure state, trace
+//! record) is answered by the model itself through [`crate::machine::Machine`].
+//! docs/ARCHITECTURE.md ("Adding a rotor model") lists what a new model touches.
+
+use super::RotorModel;
+use crate::model::Params;
+use plant_physics::two_plane;
+
+/// The rotor of a scene, validated (SI).
+#[derive(Clone, Debug)]
+pub enum Rotor {
+    /// One bearing plane (the study's model, `rotor.model = "planar"`): its parameters.
+    Planar(Params),
+    /// The whole rigid rotor on two bearing planes, A and B (`rotor.model = "two_plane"`).
+    TwoPlane(two_plane::Params),
+}
+
+impl Rotor {
+    /// The model's name as `rotor.model` writes it.
+    pub fn model(&self) -> RotorModel {
+        match self {
+            Rotor::Planar(_) => RotorModel::Planar,
+            Rotor::TwoPlane(_) => RotorModel::TwoPlane,
+        }
+    }
+
+    /// Bearing planes: each with its AMB, sensor and touchdown bearing.
+    pub fn planes(&self) -> usize {
+        match self {
+            Rotor::Planar(_) => 1,
+            Rotor::TwoPlane(m) => m.planes.len(),
+        }
+    }
+
+    /// Plane `i`'s bearing: its touchdown bearing, AMB, loop constants and its share of the
+    /// rotor (the planar model's whole parameters). Panics if `i` is not a plane.
+    pub fn plane(&self, i: usize) -> &Params {
+        match self {
+            Rotor::Planar(p) => {
+                assert_eq!(i, 0, "the planar rotor has one bearing plane");
+                p
+            }
+            Rotor::TwoPlane(m) => &m.planes[i].params,
+        }
+    }
+
+    /// Plane `i`'s bearing, mutable (a sweep or a test that moves one plane's value).
+    pub fn plane_mut(&mut self, i: usize) -> &mut Params {
+        match self {
+            Rotor::Planar(p) => {
+                assert_eq!(i, 0, "the planar rotor has one bearing plane");
+                p
+            }
+            Rotor::TwoPlane(m) => &mut m.planes[i].params,
+        }
+    }
+
+    /// Every plane's bearing, in order.
+    pub fn bearings(&self) -> impl Iterator<Item = &Params> {
+        (0..self.planes()).map(|i| self.plane(i))
+    }
+
+    /// The rotor's rated spin speed (rad/s); every plane's share carries it.
+    pub fn speed(&self) -> f64 {
+        self.plane(0).speed
+    }
+
+    /// The first plane whose sensor is not at its bearing (the sensor reads the rotor
+    /// elsewhere than where the AMB and the touchdown bearing act); `None` when collocated.
+    pub fn non_collocated_plane(&self) -> Option<usize> {
+        match self {
+            Rotor::Planar(_) => None,
+            Rotor::TwoPlane(m) => m.planes.iter().position(|p| p.sensor != p.station),
+        }
+    }
+
+    /// The `initial.*` overrides that put the rotor `offset_um` (µm) off on axis `axis` (x, y per
+    /// plane, in order) at its sensor: the planar model's x or y; on the two-plane rotor, a
+    /// translation and a slope that move the axis' own plane's sensor by `offset_um` and leave
+    /// the other plane's sensor where it was (both modes, translation and tilt, start to move).
+    pub fn sensor_offset(&self, axis: usize, offset_um: f64) -> Vec<String> {
+        let xy = ["x", "y"][axis % 2];
+        match self {
+            Rotor::Planar(_) => vec![format!("initial.rotor_{xy}_um={offset_um:?}")],
+            Rotor::TwoPlane(m) => {
+                let (own, other) = (m.planes[axis / 2].sensor, m.planes[1 - axis / 2].sensor);
+                // x(z) = x₀ + a z: offset_um at z = own, 0 at z = other (µm, µrad for z in m).
+                let slope = offset_um / (own - other);
+                vec![
+                    format!("initial.rotor_{xy}_um={:?}", -slope * other),
+                    format!("initial.slope_{xy}_urad={slope:?}"),
+                ]
+            }
+        }
+    }
+
+    /// Whether the rotor tilts (its trace and analysis have the tilt's columns and figures).
+    pub fn tilts(&self) -> bool {
+        match self {
+            Rotor::Planar(_) => false,
+            Rotor::TwoPlane(_) => true,
+        }
+    }
+
+    /// The whole rotor's geometry as a law sees it (`None` for the planar model, which has
+    /// one plane and no tilt).
+    pub fn geometry(&self) -> Option<controller::Geometry> {
+        match self {
+            Rotor::Planar(_) => None,
+            Rotor::TwoPlane(m) => {
+                let [a, b] = &m.planes;
+                Some(controller::Geometry {
+                    mass_kg: m.rotor.mass,
+                    transverse_inertia_kg_m2: m.rotor.transverse_inertia,
+                    polar_inertia_kg_m2: m.rotor.polar_inertia,
+                    rated_speed_rad_s: m.rotor.speed,
+                    bearing_z_m: [a.station, b.station],
+                    sensor_z_m: [a.sensor, b.sensor],
+                })
+            }
+        }
+    }
+
+    /// Absolute tolerances per state component of the model, laid out from those of
+    /// positions (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
+    /// ([`crate::machine::Machine::atol`]).
+    pub fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
+        use crate::machine::Machine;
+        match self {
+            Rotor::Planar(_) => crate::model::Model::atol(groups).to_vec(),
+            Rotor::TwoPlane(_) => two_plane::Model::atol(groups).to_vec(),
+        }
+    }
+
+    /// The failing state of a run that stopped at time `t` in state `y` (the model's part of
+    /// the state first, the hardware's after it); `None` if `y` holds less than the model's
+    /// state.
+    pub fn failure(&self, t: f64, y: &[f64]) -> Option<crate::machine::FailureState> {
+        use crate::machine::Machine;
+        match self {
+            Rotor::Planar(_) => crate::model::Model::failure(t, y.get(..crate::model::N)?.try_into().ok()?),
+            Rotor::TwoPlane(_) => two_plane::Model::failure(t, y.get(..two_plane::N)?.try_into().ok()?),
+        }
+        .into()
+    }
+}
+
+impl RotorModel {
+    /// The name `rotor.model` gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RotorModel::Planar => "planar",
+            RotorModel::TwoPlane => "two_plane",
+        }
+    }
+}

@@ -1,0 +1,141 @@
+//! The rotor models the run loop steps, behind one trait: the planar model (one bearing plane,
+//! the study's, [`planar`]) and the two-plane rotor (two bearing planes, tilt, [`two_plane`]).
+//! The loop ([`crate::run`]) is generic over it, so that the planar model runs the very code it
+//! ran before the second plane existed: its `trace.csv` is unchanged byte for byte.
+//!
+//! This is the model's side of the rotor seam (the scene's is [`crate::config::Rotor`]): what
+//! differs between rotor models (its tolerances, what it senses, parks and records, each
+//! plane's state for the touchdown bearing's duty, its failing state) is answered here, one
+//! file per model.
+
+mod planar;
+mod two_plane;
+
+pub use planar::PlanarFailure;
+pub use two_plane::{RaceFailure, TwoPlaneFailure};
+
+use crate::model::{Control, Params, Release};
+use crate::trace::Record;
+use controller::{saturate, PdGains};
+use nalgebra::Vector2;
+use plant_physics::integrate::System;
+use serde::Serialize;
+
+/// One bearing plane's state at an output time, for a sink that needs what a row does not hold
+/// (the race's angle and acceleration, each ball's load: the touchdown bearing's duty).
+#[derive(Clone, Copy, Debug)]
+pub struct PlaneState<'p> {
+    /// The plane's bearing parameters.
+    pub params: &'p Params,
+    /// Normal rotor – race contact force magnitude (N).
+    pub normal: f64,
+    /// Tangential (friction) rotor – race contact force (N).
+    pub tangential: f64,
+    /// The rotor at the plane's bearing: position and velocity relative to the housing.
+    pub rotor: (Vector2<f64>, Vector2<f64>),
+    /// The race: position and velocity relative to the housing.
+    pub race: (Vector2<f64>, Vector2<f64>),
+    /// Rotor spin speed (rad/s).
+    pub rotor_speed: f64,
+    /// Race angle (rad).
+    pub race_angle: f64,
+    /// Race speed (rad/s).
+    pub race_speed: f64,
+    /// Race angular acceleration (rad/s²).
+    pub race_accel: f64,
+}
+
+/// The state a diverged run failed in (`failure_state` in `summary.json`), as its rotor model
+/// lays it out ([`Machine::failure`]); non-finite values are written as `null`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum FailureState {
+    /// The planar model's.
+    Planar(PlanarFailure),
+    /// The two-plane rotor's.
+    TwoPlane(TwoPlaneFailure),
+}
+
+/// A rotor model on a state of `N` numbers with one or two bearing planes, each with its AMB,
+/// sensor and touchdown bearing.
+pub trait Machine<const N: usize>: System<N> {
+    /// Bearing planes: 1 (planar) or 2.
+    const PLANES: usize;
+
+    /// Plane `i`'s bearing: its touchdown bearing, AMB and loop constants (a planar model's
+    /// parameters; for the two-plane rotor, those of the plane's share).
+    fn bearing(&self, i: usize) -> &Params;
+
+    /// Sets plane `i`'s control for the coming macro step.
+    fn set_control(&mut self, i: usize, control: Control);
+
+    /// The rotor's displacement at plane `i`'s sensor, relative to the housing (m), x then y.
+    fn sensed(&self, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// Whether plane `i`'s race is parked.
+    fn parked(&self, i: usize) -> bool;
+
+    /// Parks (`true`) or frees plane `i`'s race for the coming macro step.
+    fn set_parked(&mut self, i: usize, parked: bool);
+
+    /// Whether the rotor stays clear of plane `i`'s race over `[t0, t0 + h]` ([`crate::park`]).
+    fn race_clear(&self, t0: f64, h: f64, y: &[f64; N], i: usize) -> bool;
+
+    /// Holds plane `i`'s race in the housing frame (its velocity set to zero).
+    fn park_race(&self, y: &mut [f64; N], i: usize);
+
+    /// Releases plane `i`'s race at time `t` as `release` says.
+    fn release_race(&self, t: f64, y: &mut [f64; N], i: usize, release: Release);
+
+    /// Plane `i`'s radii relative to the housing (m): the rotor at the bearing, and the race.
+    fn radii(&self, y: &[f64; N], i: usize) -> (f64, f64);
+
+    /// The rotor's spin angle (rad, unwrapped) and speed (rad/s) in state `y`: the keyphasor.
+    fn spin(&self, y: &[f64; N]) -> (f64, f64);
+
+    /// Whether the rotor touches plane `i`'s race (their distance exceeds the gap).
+    fn touching(&self, y: &[f64; N], i: usize) -> bool;
+
+    /// The output sample of state `y` at time `t`.
+    fn record(&self, t: f64, y: &[f64; N]) -> Record;
+
+    /// Each bearing plane's state at time `t` in state `y` ([`PlaneState`]), handed to `visit`
+    /// with the plane's index: what the touchdown bearing's duty reads
+    /// ([`crate::run::Sink::planes`]).
+    fn plane_states(&self, t: f64, y: &[f64; N], visit: &mut dyn FnMut(usize, &PlaneState<'_>));
+
+    /// Absolute tolerances per state component, laid out from those of positions (m),
+    /// velocities (m/s), angles (rad) and angular speeds (rad/s).
+    fn atol(groups: [f64; 4]) -> [f64; N]
+    where
+        Self: Sized;
+
+    /// The failing state of a run stopped at time `t` in state `y` (`failure_state` in
+    /// `summary.json`).
+    fn failure(t: f64, y: &[f64; N]) -> FailureState
+    where
+        Self: Sized;
+
+    /// The rate of [`Machine::sensed`] (m/s): the rotor's velocity at plane `i`'s sensor (through
+    /// a sensor's front end, the rate of what it reads, [`crate::hardware`]).
+    fn sensed_rate(&self, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// Plane `i`'s continuous PD current in state `y` (A): the PD on what the plane's sensor
+    /// reads ([`Machine::sensed`]) and its rate, saturated at the plane's limit. For the bare
+    /// models, what their `Control::Continuous(gains)` applies.
+    fn pd_current(&self, gains: &PdGains, y: &[f64; N], i: usize) -> [f64; 2] {
+        let p = self.bearing(i);
+        let a_s = p.loop_constants.sensor_gain_v_per_m;
+        let (d, v) = (self.sensed(y, i), self.sensed_rate(y, i));
+        saturate(gains.current([d[0] * a_s, d[1] * a_s], [v[0] * a_s, v[1] * a_s]), p.current_limit)
+    }
+
+    /// The rotor's velocity at plane `i`'s bearing, relative to the housing (m/s).
+    fn bearing_velocity(&self, y: &[f64; N], i: usize) -> [f64; 2];
+
+    /// Time spent with an amplifier at its voltage limit (s), for a model with amplifiers
+    /// ([`crate::hardware`]).
+    fn voltage_saturation(&self, _y: &[f64; N]) -> Option<f64> {
+        None
+    }
+}

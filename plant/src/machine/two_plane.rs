@@ -1,0 +1,166 @@
+//! The two-plane rotor (the whole rigid rotor on bearing planes A and B, with tilt and
+//! gyroscopics, MODEL.md §9) behind [`Machine`].
+
+use super::{FailureState, Machine, PlaneState};
+use crate::model::{Control, Params, Release};
+use crate::park::{self, GapMotion};
+use crate::trace::{self, Record};
+use nalgebra::Vector2;
+use plant_physics::two_plane::{self, ix, Model, State, N};
+use serde::Serialize;
+
+/// One race of the two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RaceFailure {
+    /// Race radius relative to the housing (m).
+    pub race_radius_m: f64,
+    /// Race x, y relative to the housing (m).
+    pub race_m: [f64; 2],
+    /// Race velocity relative to the housing (m/s).
+    pub race_velocity_m_s: [f64; 2],
+    /// Race angle (rad) and speed (rad/s).
+    pub race_spin: [f64; 2],
+}
+
+/// The two-plane rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TwoPlaneFailure {
+    /// Time of the failure (s).
+    pub t_s: f64,
+    /// The rotor axis at the centre of mass's station, x, y relative to the housing (m).
+    pub rotor_m: [f64; 2],
+    /// Its velocity (m/s).
+    pub rotor_velocity_m_s: [f64; 2],
+    /// The slopes a, b of the axis (rad).
+    pub slopes_rad: [f64; 2],
+    /// Their rates (rad/s).
+    pub slope_rates_rad_s: [f64; 2],
+    /// Rotor spin angle (rad) and speed (rad/s).
+    pub rotor_spin: [f64; 2],
+    /// Race A.
+    pub race_a: RaceFailure,
+    /// Race B.
+    pub race_b: RaceFailure,
+}
+
+impl Machine<N> for Model {
+    const PLANES: usize = 2;
+
+    fn bearing(&self, i: usize) -> &Params {
+        &self.params.planes[i].params
+    }
+
+    fn set_control(&mut self, i: usize, control: Control) {
+        self.control[i] = control;
+    }
+
+    fn sensed(&self, y: &State, i: usize) -> [f64; 2] {
+        two_plane::at_station(y, self.params.planes[i].sensor).0.into()
+    }
+
+    fn parked(&self, i: usize) -> bool {
+        self.race_parked[i]
+    }
+
+    fn set_parked(&mut self, i: usize, parked: bool) {
+        self.race_parked[i] = parked;
+    }
+
+    fn race_clear(&self, t0: f64, h: f64, y: &State, i: usize) -> bool {
+        use ix;
+        let plane = &self.params.planes[i];
+        let z = plane.station;
+        let dy = self.evaluate(t0, y).dy;
+        let (pos, vel) = two_plane::at_station(y, z);
+        let race = ix::RACE[i];
+        let motion = GapMotion {
+            distance: (pos.x - y[race]).hypot(pos.y - y[race + 1]),
+            speed: (vel.x - y[race + ix::V]).hypot(vel.y - y[race + 1 + ix::V]),
+            accel: (dy[ix::VX] + dy[ix::VSX] * z).hypot(dy[ix::VY] + dy[ix::VSY] * z),
+        };
+        park::stays_open(&plane.params, &self.base, t0, h, motion)
+    }
+
+    fn touching(&self, y: &State, i: usize) -> bool {
+        let plane = &self.params.planes[i];
+        let (pos, _) = two_plane::at_station(y, plane.station);
+        let race = ix::RACE[i];
+        (pos.x - y[race]).hypot(pos.y - y[race + 1]) > plane.params.contact.gap
+    }
+
+    fn park_race(&self, y: &mut State, i: usize) {
+        park::park_race(y, ix::RACE[i]);
+    }
+
+    fn release_race(&self, t: f64, y: &mut State, i: usize, release: Release) {
+        park::release_race(&self.params.planes[i].params, &self.base, t, y, ix::RACE[i], release);
+    }
+
+    fn radii(&self, y: &State, i: usize) -> (f64, f64) {
+        let (pos, _) = two_plane::at_station(y, self.params.planes[i].station);
+        let race = ix::RACE[i];
+        (pos.x.hypot(pos.y), y[race].hypot(y[race + 1]))
+    }
+
+    fn spin(&self, y: &State) -> (f64, f64) {
+        (y[ix::TR], y[ix::WR])
+    }
+
+    fn record(&self, t: f64, y: &State) -> Record {
+        trace::two_plane_record(self, t, y)
+    }
+
+    fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {
+        two_plane::at_station(y, self.params.planes[i].sensor).1.into()
+    }
+
+    fn bearing_velocity(&self, y: &State, i: usize) -> [f64; 2] {
+        two_plane::at_station(y, self.params.planes[i].station).1.into()
+    }
+
+    fn plane_states(&self, t: f64, y: &State, visit: &mut dyn FnMut(usize, &PlaneState<'_>)) {
+        let ev = self.evaluate(t, y);
+        for (i, plane) in self.params.planes.iter().enumerate() {
+            let race = ix::RACE[i];
+            visit(
+                i,
+                &PlaneState {
+                    params: &plane.params,
+                    normal: ev.planes[i].contact.normal,
+                    tangential: ev.planes[i].contact.tangential,
+                    rotor: two_plane::at_station(y, plane.station),
+                    race: (Vector2::new(y[race], y[race + 1]), Vector2::new(y[race + ix::V], y[race + 1 + ix::V])),
+                    rotor_speed: y[ix::WR],
+                    race_angle: y[race + 2],
+                    race_speed: y[race + 2 + ix::V],
+                    race_accel: ev.dy[race + 2 + ix::V],
+                },
+            );
+        }
+    }
+
+    /// The slopes and their rates count as angles and angular speeds.
+    fn atol(groups: [f64; 4]) -> [f64; N] {
+        let [p, v, a, w] = groups;
+        [p, p, a, a, a, p, p, a, p, p, a, v, v, w, w, w, v, v, w, v, v, w]
+    }
+
+    fn failure(t: f64, y: &State) -> FailureState {
+        let race = |x: usize| RaceFailure {
+            race_radius_m: y[x].hypot(y[x + 1]),
+            race_m: [y[x], y[x + 1]],
+            race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
+            race_spin: [y[x + 2], y[x + 2 + ix::V]],
+        };
+        FailureState::TwoPlane(TwoPlaneFailure {
+            t_s: t,
+            rotor_m: [y[ix::X], y[ix::Y]],
+            rotor_velocity_m_s: [y[ix::VX], y[ix::VY]],
+            slopes_rad: [y[ix::SX], y[ix::SY]],
+            slope_rates_rad_s: [y[ix::VSX], y[ix::VSY]],
+            rotor_spin: [y[ix::TR], y[ix::WR]],
+            race_a: race(ix::RACE_A),
+            race_b: race(ix::RACE_B),
+        })
+    }
+}
