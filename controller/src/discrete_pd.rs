@@ -168,6 +168,10 @@ impl ControlLaw for DelayPd {
     fn reset(&mut self) {
         self.rate.reset();
     }
+
+    fn linear_pd(&self) -> Option<PdGains> {
+        Some(self.gains.pd)
+    }
 }
 
 #[cfg(test)]

@@ -96,6 +96,13 @@ pub trait ControlLaw: Send {
     fn update(&mut self, sample: &Sample) -> [f64; 2];
     /// Forget all memory (back to the state before the first sample).
     fn reset(&mut self);
+    /// The PD this law is while the rotor levitates (read at each sample, the rate as the
+    /// backward difference, as `pd` does): what `plant assess` takes the sampled loop's closed
+    /// form of. `None` (the default) for a law that is no such PD; `plant assess` then grades
+    /// the law by measurement alone.
+    fn linear_pd(&self) -> Option<crate::pd::PdGains> {
+        None
+    }
 }
 
 /// A sampled control law of the whole rotor: every axis in, every current out, one call per

@@ -138,6 +138,10 @@ impl ControlLaw for SampledPd {
     fn reset(&mut self) {
         self.rate.reset();
     }
+
+    fn linear_pd(&self) -> Option<PdGains> {
+        Some(self.gains)
+    }
 }
 
 #[cfg(test)]

@@ -88,6 +88,30 @@ mod tests {
         }
     }
 
+    /// A law that says it is a PD around levitation ([`ControlLaw::linear_pd`], the closed form
+    /// `plant assess` grades it against) answers exactly as that PD does, the rate as the
+    /// backward difference, on small motions; `pid` (an integral) says it is none.
+    #[test]
+    fn a_law_that_says_it_is_a_pd_is_that_pd() {
+        let d = design();
+        let mut claimed = Vec::new();
+        for entry in LAWS {
+            let mut law = build_law(entry.name, &d, &Params::default()).unwrap();
+            let Some(g) = law.linear_pd() else { continue };
+            claimed.push(entry.name);
+            let mut prev: Option<[f64; 2]> = None;
+            for k in 0..20u64 {
+                let phase = k as f64 * 0.7;
+                let u = [1e-3 * phase.sin(), -2e-3 * phase.cos()];
+                let rate = prev.map_or([0.0; 2], |p| [(u[0] - p[0]) / d.period_s, (u[1] - p[1]) / d.period_s]);
+                prev = Some(u);
+                let sample = Sample { seq: k, t_s: k as f64 * d.period_s, sensor_v: u, ..Default::default() };
+                assert_eq!(law.update(&sample), g.current(u, rate), "{} at sample {k}", entry.name);
+            }
+        }
+        assert_eq!(claimed, ["pd", "pd_delay", "relev"]);
+    }
+
     #[test]
     fn every_registered_law_builds_and_reports_its_name() {
         assert!(LAWS.len() >= 4);

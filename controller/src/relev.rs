@@ -243,6 +243,11 @@ impl ControlLaw for Relev {
         self.phase = Phase::Nominal;
         self.switches = 0;
     }
+
+    /// The nominal loop (the recovery design acts only while the rotor touches).
+    fn linear_pd(&self) -> Option<crate::pd::PdGains> {
+        Some(self.nominal.pd)
+    }
 }
 
 #[cfg(test)]

@@ -369,28 +369,15 @@ pub fn closed_form_of_plane(scene: &Scene, plane: usize) -> Option<(closed_form:
     // A sampled law runs in the plant whatever `controller.command` says; co-simulated, the
     // built-in controller runs the registry's law, a command is a black box.
     let registry = c.mode == ControlMode::Sampled || c.cosim.command.is_none();
-    let pd_gains = || controller::PdGains::from_design(&design.pd(), &design.constants).ok();
-    let pd = match (c.mode, c.law.as_str()) {
-        (ControlMode::Continuous, _) => {
-            let g = pd_gains()?;
-            closed_form::PdLoop::Continuous { kp: g.kp, kd: g.kd }
-        }
-        (_, "pd") if registry => {
-            let g = pd_gains()?;
-            closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples }
-        }
-        (_, "pd_delay" | "relev") if registry => {
-            let g = controller::discrete_pd::DelayPdGains::from_design(
-                &design.pd(),
-                &design.constants,
-                c.period,
-                c.delay_samples,
-            )
-            .ok()?
-            .pd;
-            closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples }
-        }
-        _ => return None,
+    let pd = if c.mode == ControlMode::Continuous {
+        let g = controller::PdGains::from_design(&design.pd(), &design.constants).ok()?;
+        closed_form::PdLoop::Continuous { kp: g.kp, kd: g.kd }
+    } else if registry {
+        // The law says whether it is a PD around levitation ([`controller::ControlLaw::linear_pd`]).
+        let g = controller::build_law(&c.law, &design, &c.params).ok()?.linear_pd()?;
+        closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples }
+    } else {
+        return None;
     };
     Some((pd, axis))
 }
