@@ -1,0 +1,198 @@
+//! One bearing plane's physics: `[touchdown]`, `[contact]` and `[amb]` into a planar model's
+//! [`Params`], for the planar rotor or a plane's share of the two-plane rotor.
+
+use super::*;
+
+/// The rotor's values a bearing plane's planar parameters take: for the planar model the
+/// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
+pub(super) struct Share {
+    pub(super) gravity: f64,
+    pub(super) mass: f64,
+    pub(super) eccentricity: f64,
+    pub(super) inertia: f64,
+    pub(super) radius: f64,
+    pub(super) speed: f64,
+    pub(super) spin: Spin,
+}
+
+/// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`
+/// where plane B's table sets it.
+pub(super) struct Keys<'a> {
+    /// The plane's letter and its own tables of `[touchdown]`, `[contact]`, `[amb]`.
+    pub(super) plane: Option<(&'static str, [Option<&'a toml::Table>; 3])>,
+}
+
+impl Keys<'_> {
+    fn key(&self, table: usize, field: &str) -> String {
+        const TABLES: [&str; 3] = ["touchdown", "contact", "amb"];
+        match self.plane {
+            Some((plane, own)) if own[table].is_some_and(|t| t.contains_key(field)) => {
+                format!("{}.{plane}.{field}", TABLES[table])
+            }
+            _ => format!("{}.{field}", TABLES[table]),
+        }
+    }
+
+    fn td(&self, field: &str) -> String {
+        self.key(0, field)
+    }
+
+    fn ct(&self, field: &str) -> String {
+        self.key(1, field)
+    }
+
+    fn amb(&self, field: &str) -> String {
+        self.key(2, field)
+    }
+}
+
+/// One bearing plane's parameters, validated: its touchdown bearing (`[touchdown]`), contact
+/// laws (`[contact]`) and AMB (`[amb]`, `controller.current_limit_a`), with the rotor's `share`.
+pub(super) fn bearing(
+    td: &RawTouchdown,
+    ct: &RawContact,
+    amb: &RawAmb,
+    ctl: &RawController,
+    k: &Keys,
+    share: &Share,
+) -> Result<Params, ConfigError> {
+    let gap = positive(&k.td("air_gap_mm"), td.air_gap_mm, "mm")? * 1e-3;
+    let race_mass = positive(&k.td("race_mass_kg"), td.race_mass_kg, "kg")?;
+    let race_inertia = positive(&k.td("race_polar_inertia_kg_m2"), td.race_polar_inertia_kg_m2, "kg·m²")?;
+    let ball_d = positive(&k.td("ball_diameter_mm"), td.ball_diameter_mm, "mm")?;
+    let dm = positive(&k.td("pitch_diameter_mm"), td.pitch_diameter_mm, "mm")?;
+    if ball_d >= dm {
+        return Err(range(
+            &k.td("ball_diameter_mm"),
+            ball_d,
+            "mm",
+            &format!("must be smaller than {}", k.td("pitch_diameter_mm")),
+        ));
+    }
+    positive(&k.td("outer_diameter_mm"), td.outer_diameter_mm, "mm")?;
+    positive(&k.td("width_mm"), td.width_mm, "mm")?;
+    if !(3..=64).contains(&td.ball_count) {
+        return Err(range(&k.td("ball_count"), td.ball_count, "", "must be between 3 and 64"));
+    }
+    let clearance = non_negative(&k.td("ball_clearance_mm"), td.ball_clearance_mm, "mm")? * 1e-3;
+    let cage_phase = finite(&k.td("cage_phase_deg"), td.cage_phase_deg, "deg")?.to_radians();
+    let (r_in, r_out) = (dm / 2.0 - ball_d / 2.0, dm / 2.0 + ball_d / 2.0);
+    let reg_speed = positive(&k.td("drag_smoothing_rad_s"), td.drag_smoothing_rad_s, "rad/s")?;
+    let torque = non_negative(&k.td("drag_torque_n_m"), td.drag_torque_n_m, "N·m")?;
+    let f0 = non_negative(&k.td("palmgren_f0"), td.palmgren_f0, "")?;
+    let nu0_cst = positive(&k.td("palmgren_viscosity_cst"), td.palmgren_viscosity_cst, "cSt")?;
+    let f1 = non_negative(&k.td("palmgren_f1"), td.palmgren_f1, "")?;
+    let drag = match td.drag {
+        DragChoice::Constant => RaceDrag::Constant { torque, reg_speed },
+        DragChoice::Palmgren => RaceDrag::Palmgren { f0, nu0_cst, f1, pitch_diameter_mm: dm, reg_speed },
+    };
+
+    let damping_depth = positive(&k.ct("damping_depth_mm"), ct.damping_depth_mm, "mm")? * 1e-3;
+    let v_static = positive(&k.ct("stribeck_static_m_s"), ct.stribeck_static_m_s, "m/s")?;
+    let v_dynamic = positive(&k.ct("stribeck_dynamic_m_s"), ct.stribeck_dynamic_m_s, "m/s")?;
+    if v_dynamic < v_static {
+        return Err(range(
+            &k.ct("stribeck_dynamic_m_s"),
+            v_dynamic,
+            "m/s",
+            &format!("must be >= {}", k.ct("stribeck_static_m_s")),
+        ));
+    }
+    let friction = Friction {
+        mu_static: non_negative(&k.ct("friction_static"), ct.friction_static, "")?,
+        mu_dynamic: non_negative(&k.ct("friction_dynamic"), ct.friction_dynamic, "")?,
+        v_static,
+        v_dynamic,
+    };
+    let contact = RotorRace {
+        gap,
+        rotor_radius: share.radius,
+        bore_radius: share.radius + gap,
+        stiffness: positive(
+            &k.ct("rotor_race_stiffness_n_per_m10_9"),
+            ct.rotor_race_stiffness_n_per_m10_9,
+            "N/m^(10/9)",
+        )?,
+        damping_max: non_negative(&k.ct("rotor_race_damping_n_s_per_m"), ct.rotor_race_damping_n_s_per_m, "N·s/m")?,
+        damping_depth,
+        friction,
+    };
+    let balls = BallSet::new(
+        td.ball_count as usize,
+        clearance,
+        positive(&k.ct("ball_stiffness_n_per_m1_5"), ct.ball_stiffness_n_per_m1_5, "N/m^(3/2)")?,
+        non_negative(&k.ct("ball_damping_n_s_per_m"), ct.ball_damping_n_s_per_m, "N·s/m")?,
+        damping_depth,
+    );
+
+    let lumped_reference = positive(&k.td("lumped_reference_mm"), td.lumped_reference_mm, "mm")? * 1e-3;
+    let support = match td.support {
+        SupportChoice::Balls => Support::Balls,
+        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(&balls, lumped_reference)),
+    };
+    let release = match td.race_release {
+        ReleaseChoice::Equilibrium => Release::Equilibrium,
+        ReleaseChoice::Held => Release::Held,
+    };
+    let race_when_clear = match td.race_when_clear {
+        RaceWhenClearChoice::Free => RaceWhenClear::Free,
+        RaceWhenClearChoice::Parked => RaceWhenClear::Parked(release),
+    };
+    let ki = positive(&k.amb("ki_n_per_a"), amb.ki_n_per_a, "N/A")?;
+    let ks = non_negative(&k.amb("ks_n_per_m"), amb.ks_n_per_m, "N/m")?;
+    let s0 = positive(&k.amb("nominal_gap_mm"), amb.nominal_gap_mm, "mm")? * 1e-3;
+    let magnet_force_limit = positive(&k.amb("magnet_force_limit_n"), amb.magnet_force_limit_n, "N")?;
+    let amb_law = match amb.force_law {
+        ForceLaw::Linear => AmbLaw::Linear { ki, ks },
+        ForceLaw::Nonlinear => {
+            if ks == 0.0 {
+                return Err(range(
+                    &k.amb("ks_n_per_m"),
+                    ks,
+                    "N/m",
+                    "must be > 0 for the nonlinear law (it sets the bias current)",
+                ));
+            }
+            if s0 <= gap + clearance {
+                return Err(range(
+                    &k.amb("nominal_gap_mm"),
+                    amb.nominal_gap_mm,
+                    "mm",
+                    "must exceed the touchdown gap plus ball clearance",
+                ));
+            }
+            AmbLaw::nonlinear_matching(ki, ks, s0, magnet_force_limit)
+        }
+    };
+    let loop_constants = LoopConstants {
+        ki_n_per_a: ki,
+        ks_n_per_m: ks,
+        amp_gain_a_per_v: positive(&k.amb("amp_gain_a_per_v"), amb.amp_gain_a_per_v, "A/V")?,
+        sensor_gain_v_per_m: positive(&k.amb("sensor_gain_v_per_m"), amb.sensor_gain_v_per_m, "V/m")?,
+        rotor_mass_kg: share.mass,
+        gravity_m_s2: share.gravity,
+        air_gap_m: gap,
+    };
+    let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    Ok(Params {
+        gravity: share.gravity,
+        rotor_mass: share.mass,
+        eccentricity: share.eccentricity,
+        rotor_inertia: share.inertia,
+        speed: share.speed,
+        spin: share.spin,
+        race_mass,
+        race_inertia,
+        cage: td.cage,
+        cage_phase,
+        cage_ratio: r_in / (r_in + r_out),
+        contact,
+        balls,
+        support,
+        race_when_clear,
+        drag,
+        amb: amb_law,
+        loop_constants,
+        current_limit,
+    })
+}

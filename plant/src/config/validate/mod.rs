@@ -1,0 +1,323 @@
+//! Validation: a raw scene ([`crate::config::raw`]) into SI parameter types, each
+//! value checked with a message naming the full key, the value and its unit.
+//!
+//! # Bounds
+//!
+//! Every size that allocates or loops is bounded here, so a run stays finite
+//! and its allocations small (the key table of docs/guide/scenes.md lists them):
+//!
+//! | quantity | bound |
+//! |---|---|
+//! | `scene.duration_s` | ≤ [`MAX_DURATION_S`] |
+//! | `controller.rate_hz` | [`MIN_RATE_HZ`] to [`MAX_RATE_HZ`] |
+//! | controller ticks, `duration_s × rate_hz` | ≤ [`MAX_TICKS`] |
+//! | `output.rate_hz` | ≤ [`MAX_OUTPUT_RATE_HZ`] |
+//! | output rows, `duration_s × output.rate_hz` | ≤ [`MAX_OUTPUT_ROWS`] |
+//! | `[controller.params]` as TOML text | ≤ [`controller::PARAMS_LEN`] bytes |
+//! | `controller.stiffness_n_per_m` | ≤ [`MAX_STIFFNESS_N_PER_M`] |
+//!
+//! A run with fewer than [`FEW_TICKS`] controller ticks is allowed, with a warning.
+//!
+//! Every key is checked whatever the choices that read it: a NaN
+//! `amb.nominal_gap_mm` is refused with the linear bearing too, and a NaN
+//! `touchdown.palmgren_f0` with the constant drag.
+
+use super::raw::*;
+use super::{
+    ConfigError, ControllerSettings, CosimSettings, InitialSettings, IntegratorSettings, Rotor, Scene, Source,
+};
+use crate::force::lumped::LumpedSupport;
+use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
+use crate::integrate::Method;
+use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
+use controller::LoopConstants;
+use plant_physics::two_plane;
+use std::path::Path;
+
+mod bearing;
+mod checks;
+mod controller_keys;
+mod hardware_keys;
+mod two_plane_keys;
+
+use bearing::{bearing, Keys, Share};
+pub use checks::{finite, non_negative, positive, range};
+use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
+use hardware_keys::hardware;
+use two_plane_keys::{record_two_plane, refuse_two_plane_keys, two_plane_params};
+
+/// Longest simulated time (s): about 11.6 days.
+pub const MAX_DURATION_S: f64 = 1e6;
+/// Lowest controller rate (Hz): one tick per 1000 s.
+pub const MIN_RATE_HZ: f64 = 1e-3;
+/// Highest controller rate (Hz).
+pub const MAX_RATE_HZ: f64 = 1e7;
+/// Most controller ticks (macro steps) in a run: `scene.duration_s × controller.rate_hz`.
+pub const MAX_TICKS: f64 = 1e9;
+/// Highest trace rate (Hz).
+pub const MAX_OUTPUT_RATE_HZ: f64 = 1e7;
+/// Most trace rows in a run: `scene.duration_s × output.rate_hz` (1000 s at 10 kHz).
+pub const MAX_OUTPUT_ROWS: f64 = 1e7;
+/// Stiffest loop the controller may be designed for (N/m): a closed-loop natural frequency
+/// √(k_e / m_r) near 50 kHz for the study's rotor, six decades above the study's largest k_e.
+/// The integrators must resolve the loop, so their work grows as √k_e; far beyond this the
+/// current saturates within nanometres of the centre and the loop chatters: a 5 ms run at
+/// k_e = 1e300 took minutes of computing and a full-length one would not end.
+pub const MAX_STIFFNESS_N_PER_M: f64 = 1e12;
+/// Fewer controller ticks than this in a run gets a warning.
+pub const FEW_TICKS: f64 = 10.0;
+
+/// Validates a raw scene into SI parameter types. `base_dir` resolves relative file paths.
+///
+/// The deprecated `controller.relev_*` keys become `controller.params` keys
+/// (with law `relev`; ignored otherwise), each with a warning in
+/// [`Scene::warnings`]; the resolved scene ([`Scene::to_toml`]) holds the
+/// parameters only.
+///
+/// A realtime scene on `integrator.realtime = "fixed"` (the default) is then given the
+/// fixed-step setting ([`Scene::fixed_step_overrides`]), written into the resolved scene, with
+/// a warning when that changes its integrator.
+pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
+    let scene = validate_as_written(raw, base_dir)?;
+    if scene.controller.mode != ControlMode::Realtime || scene.integrator.realtime != RealtimeSetting::Fixed {
+        return Ok(scene);
+    }
+    let overrides = scene.fixed_step_overrides();
+    let mut table = scene.table()?;
+    for arg in &overrides {
+        super::apply_override(&mut table, arg)?;
+    }
+    let fixed = toml::Value::Table(table)
+        .try_into::<RawScene>()
+        .map_err(|e| ConfigError::Parse { path: "the realtime setting".into(), message: e.to_string() })?;
+    let mut fixed = validate_as_written(fixed, base_dir)?;
+    // The first pass's warnings (deprecated keys are moved by it and not seen again).
+    fixed.warnings = scene.warnings;
+    let (was, is) = (scene.source.raw.integrator_and_race(), fixed.source.raw.integrator_and_race());
+    if was != is {
+        fixed.warnings.push(format!(
+            "controller.mode = \"realtime\" runs the fixed-step setting (integrator.realtime = \"fixed\", a bounded \
+             cost per tick): {is} instead of the scene's {was}; integrator.realtime = \"scene\" keeps the scene's"
+        ));
+    }
+    Ok(fixed)
+}
+
+/// [`validate`] without the realtime setting: the scene as written.
+fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
+    let mut warnings = Vec::new();
+    migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
+    resolve_command(&mut raw.controller, base_dir)?;
+    let (r, td, ct, amb, ctl, int) =
+        (&raw.rotor, &raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &raw.integrator);
+    let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
+    let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;
+    if duration > MAX_DURATION_S {
+        return Err(range("scene.duration_s", duration, "s", &format!("must be <= {MAX_DURATION_S:e} s")));
+    }
+    positive("housing.mass_kg", raw.housing.mass_kg, "kg")?;
+    let unbalance_phase = finite("rotor.unbalance_phase_deg", r.unbalance_phase_deg, "deg")?.to_radians();
+    let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
+    let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
+    let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
+    let rotor_radius = positive("rotor.radius_mm", r.radius_mm, "mm")? * 1e-3;
+    let speed = non_negative("rotor.speed_hz", r.speed_hz, "Hz")? * std::f64::consts::TAU;
+    let drive_gain = non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?;
+    let torque_limit = non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?;
+    let spin = match r.spin {
+        SpinChoice::Held => Spin::Held,
+        SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
+    };
+    let whole =
+        Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
+    // The rotor model: how each is built from the scene (a new model is an arm here).
+    let rotor = match r.model {
+        RotorModel::Planar => {
+            refuse_two_plane_keys(&raw)?;
+            Rotor::Planar(bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?)
+        }
+        RotorModel::TwoPlane => Rotor::TwoPlane(two_plane_params(&raw, &whole)?),
+    };
+    // The sensor's and the controller's loop constants are the scene's (`[amb]`,
+    // `[controller]`), the same on every plane.
+    let loop_constants = rotor.plane(0).loop_constants;
+
+    let rate = positive("controller.rate_hz", ctl.rate_hz, "Hz")?;
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
+        return Err(range(
+            "controller.rate_hz",
+            rate,
+            "Hz",
+            &format!("must be between {MIN_RATE_HZ:e} and {MAX_RATE_HZ:e} Hz"),
+        ));
+    }
+    let ticks = (duration * rate).ceil();
+    if ticks > MAX_TICKS {
+        return Err(range(
+            "scene.duration_s",
+            duration,
+            "s",
+            &format!(
+                "with controller.rate_hz = {rate} Hz the run has {ticks:e} controller ticks: at most {MAX_TICKS:e} \
+                 (shorten the run or lower the rate)"
+            ),
+        ));
+    }
+    if ticks < FEW_TICKS {
+        warnings.push(format!(
+            "controller.rate_hz = {rate} Hz gives {ticks} controller tick(s) in scene.duration_s = {duration} s \
+             (fewer than {FEW_TICKS}): the controller acts once per tick"
+        ));
+    }
+    let params = controller::Params::new(ctl.params.clone());
+    if let Err(controller::ParamsError::TooLong { len }) = params.to_document() {
+        return Err(range(
+            "controller.params",
+            format!("{len} bytes of TOML text"),
+            "",
+            &format!("must be at most {} bytes (the handshake carries it)", controller::PARAMS_LEN),
+        ));
+    }
+    let controller = ControllerSettings {
+        mode: ctl.mode,
+        law: ctl.law.clone(),
+        rate_hz: rate,
+        period: 1.0 / rate,
+        stiffness: stiffness(ctl.stiffness_n_per_m)?,
+        damping_ratio: non_negative("controller.damping_ratio", ctl.damping_ratio, "")?,
+        delay_samples: ctl.delay_samples,
+        gravity_bias: ctl.gravity_bias,
+        params,
+        cosim: cosim_settings(ctl)?,
+        max_invalid_burst: ctl.max_invalid_burst,
+        max_invalid_fraction: match ctl.max_invalid_fraction {
+            f if f.is_finite() && (0.0..=1.0).contains(&f) => f,
+            f => return Err(range("controller.max_invalid_fraction", f, "", "must be between 0 and 1")),
+        },
+    };
+    if ctl.delay_samples > 1000 {
+        return Err(range("controller.delay_samples", ctl.delay_samples, "samples", "must be <= 1000"));
+    }
+    if ctl.mode == ControlMode::Realtime && ctl.delay_samples == 0 {
+        return Err(range(
+            "controller.delay_samples",
+            ctl.delay_samples,
+            "samples",
+            "must be >= 1 in realtime mode (the reply to sample k arrives during period k)",
+        ));
+    }
+
+    let rtol = positive("integrator.rtol", int.rtol, "")?;
+    let atol_all = positive("integrator.atol", int.atol, "")?;
+    let pick = |key: &str, v: Option<f64>, unit: &str| v.map_or(Ok(atol_all), |v| positive(key, v, unit));
+    let ap = pick("integrator.atol_position_m", int.atol_position_m, "m")?;
+    let av = pick("integrator.atol_velocity_m_s", int.atol_velocity_m_s, "m/s")?;
+    let aa = pick("integrator.atol_angle_rad", int.atol_angle_rad, "rad")?;
+    let aw = pick("integrator.atol_angular_speed_rad_s", int.atol_angular_speed_rad_s, "rad/s")?;
+    if !(1..=100_000).contains(&int.substeps) {
+        return Err(range("integrator.substeps", int.substeps, "", "must be between 1 and 100000"));
+    }
+    if int.contact_substeps > 100_000 {
+        return Err(range(
+            "integrator.contact_substeps",
+            int.contact_substeps,
+            "",
+            "must be between 0 (= substeps) and 100000",
+        ));
+    }
+    let integrator = IntegratorSettings {
+        method: int.method,
+        rtol,
+        atol_groups: [ap, av, aa, aw],
+        substeps: int.substeps,
+        contact_substeps: if int.contact_substeps == 0 { int.substeps } else { int.contact_substeps },
+        radius_guard: positive("integrator.radius_guard_mm", int.radius_guard_mm, "mm")? * 1e-3,
+        realtime: int.realtime,
+    };
+
+    let output_rate = positive("output.rate_hz", raw.output.rate_hz, "Hz")?;
+    if output_rate > MAX_OUTPUT_RATE_HZ {
+        return Err(range("output.rate_hz", output_rate, "Hz", &format!("must be <= {MAX_OUTPUT_RATE_HZ:e} Hz")));
+    }
+    let rows = (duration * output_rate).ceil();
+    if rows > MAX_OUTPUT_ROWS {
+        return Err(range(
+            "output.rate_hz",
+            output_rate,
+            "Hz",
+            &format!(
+                "with scene.duration_s = {duration} s the trace has {rows:e} rows: at most {MAX_OUTPUT_ROWS:e} \
+                 (lower the output rate or shorten the run)"
+            ),
+        ));
+    }
+    let initial = InitialSettings {
+        unbalance_orbit: raw.initial.unbalance_orbit,
+        unbalance_phase,
+        rotor_offset: [
+            finite("initial.rotor_x_um", raw.initial.rotor_x_um, "µm")? * 1e-6,
+            finite("initial.rotor_y_um", raw.initial.rotor_y_um, "µm")? * 1e-6,
+        ],
+        slope_offset: [
+            finite("initial.slope_x_urad", raw.initial.slope_x_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+            finite("initial.slope_y_urad", raw.initial.slope_y_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+        ],
+    };
+    if raw.sensor.adc_bits > 24 {
+        return Err(range("sensor.adc_bits", raw.sensor.adc_bits, "bits", "must be between 0 (ideal) and 24"));
+    }
+    let sensor = crate::sensor::SensorSettings {
+        gain: loop_constants.sensor_gain_v_per_m,
+        noise_v: non_negative("sensor.noise_v_rms", raw.sensor.noise_v_rms, "V")?,
+        seed: raw.sensor.noise_seed,
+        adc_bits: raw.sensor.adc_bits,
+        adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
+    };
+    let gaps: Vec<f64> = rotor.bearings().map(|p| p.contact.gap).collect();
+    let laws: Vec<AmbLaw> = rotor.bearings().map(|p| p.amb).collect();
+    let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
+    let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
+    // The resolved scene states the two-plane rotor's defaults.
+    if let Rotor::TwoPlane(_) = rotor {
+        record_two_plane(&mut raw);
+    }
+    let scene = Scene {
+        name: raw.scene.name.clone(),
+        description: raw.scene.description.clone(),
+        duration,
+        rotor,
+        base,
+        controller,
+        integrator,
+        initial,
+        sensor,
+        hardware,
+        output_interval: 1.0 / output_rate,
+        plots: raw.output.plots,
+        warnings,
+        source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
+    };
+    // The law validates its own parameters: a scene it refuses is bad input, before any run.
+    // A controller command serves laws of its own: it checks them, in the handshake.
+    if scene.controller.cosim.command.is_none() {
+        controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
+    }
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::range;
+
+    #[test]
+    fn huge_values_read_in_scientific_notation_and_others_as_written() {
+        assert_eq!(
+            range("scene.duration_s", 1e300, "s", "too long").to_string(),
+            "scene.duration_s = 1e300 s: too long"
+        );
+        assert_eq!(range("a.b", 2.5e-20, "m", "w").to_string(), "a.b = 2.5e-20 m: w");
+        assert_eq!(range("a.b", 0.5, "m", "w").to_string(), "a.b = 0.5 m: w");
+        assert_eq!(range("a.b", f64::NAN, "m", "w").to_string(), "a.b = NaN m: w");
+        assert_eq!(range("a.b", "\"long\"", "ms", "w").to_string(), "a.b = \"long\" ms: w");
+    }
+}
