@@ -24,7 +24,7 @@ if [[ -z "$python" ]]; then
     echo "fixture.sh: ROSS 3.1 needs Python >= 3.13; set PYTHON" >&2
     exit 2
 fi
-if [[ ! -x "$venv/bin/python" ]] || ! "$venv/bin/python" -c 'import ross' 2>/dev/null; then
+if [[ ! -x "$venv/bin/python" ]] || ! "$venv/bin/python" -c 'import ross' >/dev/null 2>&1; then
     rm -rf "$venv"
     "$python" -m venv "$venv"
     "$venv/bin/pip" install -q 'ross-rotordynamics==3.1.0' 'plotly<6'

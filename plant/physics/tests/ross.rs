@@ -69,8 +69,26 @@ fn compare_with_ross(name: &str) -> f64 {
             wd.iter().zip(&whirl).filter(|(_, w)| w.is_some()).map(|(f, w)| (*f, *w)).collect();
         let ours = at(speed);
         assert!(ours.len() >= lateral.len(), "{name} at {speed} rad/s");
-        for (mode, (f, w)) in ours.iter().zip(&lateral) {
+        let table = speed == 0.0 || entry == ross["modal"].as_array().unwrap().last().unwrap();
+        if table {
+            eprintln!(
+                "{name} at {:.0} Hz: | mode | ROSS (Hz) | ours (Hz) | difference | whirl (ROSS / ours) |",
+                speed / TAU
+            );
+        }
+        for (k, (mode, (f, w))) in ours.iter().zip(&lateral).enumerate() {
             let err = (mode.wd - f).abs() / f;
+            if table {
+                eprintln!(
+                    "| {} | {:.4} | {:.4} | {:.1e} % | {:?} / {:?} |",
+                    k + 1,
+                    f / TAU,
+                    mode.wd / TAU,
+                    100.0 * (mode.wd - f) / f,
+                    w.unwrap(),
+                    mode.whirl
+                );
+            }
             worst = worst.max(err);
             assert!(
                 err < 5e-3,
@@ -262,6 +280,7 @@ fn stiff_shaft_converges_to_the_rigid_two_plane_rotor() {
             el.material.shear_modulus = 81.2e9 * factor;
         }
         let body = rotor.rigid_body();
+        eprintln!("the AMB machine as a rigid body: {body:?}");
         let z = rotor.node_positions();
         let plane = |b: &LinearBearing| PlaneLoop {
             station: z[b.node] - body.centre,

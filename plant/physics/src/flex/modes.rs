@@ -484,3 +484,37 @@ fn null_vector(a: &DMatrix<C64>, lambda: C64) -> Option<DVector<C64>> {
     }
     Some(v)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::flex::shaft::{Material, ShaftElement};
+    use crate::flex::{Disk, Linear, LinearBearing, Rotor};
+
+    /// The Krylov iteration against the dense eigenvalues of the whole matrix, on a rotor with
+    /// anisotropic, damped bearings and a heavy disk, at rest and spinning.
+    #[test]
+    fn krylov_modes_match_the_dense_eigenvalues() {
+        let steel = Material { density: 7810.0, modulus: 211e9, shear_modulus: 81.2e9 };
+        let mut bearings = vec![LinearBearing::spring(0, 1e6), LinearBearing::spring(4, 1e6)];
+        bearings[1].stiffness[1][1] = 7e5;
+        bearings[0].damping = [[300.0, 0.0], [0.0, 200.0]];
+        let rotor = Rotor {
+            elements: (0..4).map(|_| ShaftElement::cylinder(0.15, 0.0, 0.03, steel)).collect(),
+            disks: vec![Disk { node: 3, mass: 8.0, diametral_inertia: 0.03, polar_inertia: 0.05 }],
+            bearings,
+            alpha: 0.0,
+            beta: 0.0,
+        };
+        let p = Linear::full(&rotor.matrices()).prepare().unwrap();
+        for speed in [0.0, 3000.0] {
+            let (fast, dense) = (p.modes(speed, 6).unwrap(), p.modes_dense(speed, 6).unwrap());
+            assert_eq!(fast.len(), 6);
+            for (a, b) in fast.iter().zip(&dense) {
+                assert!((a.eigenvalue - b.eigenvalue).norm() < 1e-8 * b.wn, "{speed}: {a:?} against {b:?}");
+                if speed > 0.0 {
+                    assert_eq!(a.whirl, b.whirl, "{speed}: {a:?} against {b:?}");
+                }
+            }
+        }
+    }
+}

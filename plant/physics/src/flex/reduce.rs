@@ -311,3 +311,76 @@ impl Reduced {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flex::shaft::{Material, ShaftElement};
+
+    /// A free steel shaft, 0.4 m in 8 elements, with a disk at node 3.
+    fn free_rotor() -> Rotor {
+        let steel = Material { density: 7810.0, modulus: 211e9, shear_modulus: 81.2e9 };
+        Rotor {
+            elements: (0..8).map(|_| ShaftElement::cylinder(0.05, 0.0, 0.04, steel)).collect(),
+            disks: vec![crate::flex::Disk { node: 3, mass: 3.0, diametral_inertia: 4e-3, polar_inertia: 7e-3 }],
+            bearings: vec![],
+            alpha: 0.0,
+            beta: 0.0,
+        }
+    }
+
+    fn spec(zeta: f64) -> Reduction {
+        Reduction {
+            cutoff_hz: 3000.0,
+            force_nodes: vec![1, 7],
+            static_correction: true,
+            gyroscopic_correction: true,
+            modal_damping: zeta,
+        }
+    }
+
+    /// A free rotor keeps its four rigid-body modes at 0 Hz; in a frame accelerating at g it
+    /// falls as a body, every node at −g; a force at a node accelerates the centre of mass by
+    /// F/M (the rigid-body modes span the rigid motion exactly).
+    #[test]
+    fn a_free_rotor_falls_and_is_pushed_as_a_body() {
+        let rotor = free_rotor();
+        let reduced = Reduced::new(&rotor, &spec(0.02)).unwrap();
+        assert_eq!(reduced.kinds.iter().filter(|k| **k == Kind::Rigid).count(), RIGID_MODES);
+        let r = reduced.size();
+        let mut d = vec![0.0; 2 * r];
+        reduced.derivative(&vec![0.0; 2 * r], 300.0, &[[0.0; 2], [0.0; 2]], [0.0, 9.81], &mut d);
+        let acc = &reduced.basis * DVector::from_column_slice(&d[r..]);
+        for node in 0..rotor.node_count() {
+            assert!((acc[4 * node + 1] + 9.81).abs() < 1e-9, "node {node}: {}", acc[4 * node + 1]);
+            assert!(acc[4 * node].abs() < 1e-9, "node {node}: {}", acc[4 * node]);
+        }
+        reduced.derivative(&vec![0.0; 2 * r], 300.0, &[[5.0, 0.0], [0.0, 0.0]], [0.0, 0.0], &mut d);
+        let acc = &reduced.basis * DVector::from_column_slice(&d[r..]);
+        let m = rotor.matrices().mass;
+        let rx = DVector::from_fn(rotor.dof(), |i, _| if i % 4 == 0 { 1.0 } else { 0.0 });
+        let centre = (rx.transpose() * &m * &acc)[0] / rotor.mass();
+        assert!((centre - 5.0 / rotor.mass()).abs() < 1e-9 * centre.abs(), "{centre}");
+    }
+
+    /// The modal damping ratio is each flexible mode's at rest; the accessors read the expanded
+    /// state at a node.
+    #[test]
+    fn modal_damping_is_the_modes_damping_ratio_and_accessors_read_the_nodes() {
+        let rotor = free_rotor();
+        let reduced = Reduced::new(&rotor, &spec(0.02)).unwrap();
+        let modes = reduced.linear().modes(0.0, 4).unwrap();
+        for m in &modes {
+            assert!((m.damping_ratio - 0.02).abs() < 1e-9, "{m:?}");
+        }
+        let r = reduced.size();
+        let state: Vec<f64> = (0..2 * r).map(|k| (k as f64 * 0.37).sin() * 1e-6).collect();
+        let q = reduced.expand(&state);
+        let v = &reduced.basis * DVector::from_column_slice(&state[r..]);
+        let [x, y] = reduced.displacement(&state, 5);
+        let [vx, vy] = reduced.velocity(&state, 5);
+        let [a, b] = reduced.rotation(&state, 5);
+        assert_eq!([x, y, a, b], [q[20], q[21], q[22], q[23]]);
+        assert_eq!([vx, vy], [v[20], v[21]]);
+    }
+}

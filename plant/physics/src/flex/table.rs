@@ -243,3 +243,72 @@ impl ShaftTable {
         Ok(rotor)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE: &str = r#"
+        [materials.steel]
+        density_kg_m3 = 7810.0
+        modulus_pa = 211e9
+        shear_modulus_pa = 81.2e9
+
+        [[element]]
+        length_mm = 100.0
+        outer_diameter_mm = 40.0
+        material = "steel"
+        split = 4
+
+        [[element]]
+        length_mm = 50.0
+        outer_diameter_mm = 40.0
+        outer_diameter_right_mm = 30.0
+        inner_diameter_mm = 10.0
+        material = "steel"
+
+        [[disk]]
+        node = 2
+        mass_kg = 2.0
+        diametral_inertia_kg_m2 = 1e-3
+        polar_inertia_kg_m2 = 2e-3
+    "#;
+
+    fn table() -> ShaftTable {
+        toml::from_str(TABLE).unwrap()
+    }
+
+    #[test]
+    fn a_table_builds_its_rotor() {
+        let rotor = table().rotor().unwrap();
+        assert_eq!(rotor.node_count(), 6);
+        let z = rotor.node_positions();
+        assert!((z[4] - 0.1).abs() < 1e-12 && (z[5] - 0.15).abs() < 1e-12, "{z:?}");
+        let shaft = 7810.0 * std::f64::consts::PI * 0.02f64.powi(2) * 0.1;
+        let cone = 7810.0 * std::f64::consts::PI * 0.05 / 12.0
+            * ((0.04f64.powi(2) + 0.04 * 0.03 + 0.03f64.powi(2)) - 3.0 * 0.01f64.powi(2));
+        assert!((rotor.mass() - (shaft + cone + 2.0)).abs() < 1e-9, "{}", rotor.mass());
+    }
+
+    #[test]
+    fn bad_tables_are_refused_naming_the_key_value_and_unit() {
+        let cases: Vec<(fn(&mut ShaftTable), &str)> = vec![
+            (|t| t.elements[1].length_mm = 0.0, "element[1]: length_mm = 0 mm must be positive"),
+            (|t| t.elements[0].outer_diameter_mm = -40.0, "element[0]: outer_diameter_mm = -40 mm must be positive"),
+            (|t| t.elements[1].inner_diameter_mm = 45.0, "element[1]: inner_diameter_mm = 0.045 m"),
+            (|t| t.materials.get_mut("steel").unwrap().density_kg_m3 = None, "materials.steel: material density_kg_m3"),
+            (|t| t.materials.get_mut("steel").unwrap().modulus_pa = None, "materials.steel: material modulus_pa"),
+            (|t| t.materials.get_mut("steel").unwrap().modulus_pa = Some(-1.0), "modulus_pa = -1 Pa must be positive"),
+            (|t| t.disks[0].node = 6, "disk[0].node: node 6 is out of range (the shaft has nodes 0 to 5)"),
+            (|t| t.elements[0].material = "brass".into(), "material = \"brass\" is not in [materials]"),
+        ];
+        for (spoil, expect) in cases {
+            let mut t = table();
+            spoil(&mut t);
+            let err = t.rotor().expect_err(expect).to_string();
+            assert!(err.contains(expect), "{err}\nshould contain: {expect}");
+        }
+        let unknown = TABLE.replace("split = 4", "split = 4\nlenght_mm = 3.0");
+        assert!(toml::from_str::<ShaftTable>(&unknown).unwrap_err().to_string().contains("lenght_mm"));
+    }
+}
