@@ -292,7 +292,8 @@ mod tests {
 
     #[test]
     fn bad_tables_are_refused_naming_the_key_value_and_unit() {
-        let cases: Vec<(fn(&mut ShaftTable), &str)> = vec![
+        type Spoil = fn(&mut ShaftTable);
+        let cases: Vec<(Spoil, &str)> = vec![
             (|t| t.elements[1].length_mm = 0.0, "element[1]: length_mm = 0 mm must be positive"),
             (|t| t.elements[0].outer_diameter_mm = -40.0, "element[0]: outer_diameter_mm = -40 mm must be positive"),
             (|t| t.elements[1].inner_diameter_mm = 45.0, "element[1]: inner_diameter_mm = 0.045 m"),
