@@ -52,9 +52,18 @@ fn build(design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawErr
             format!("must be below the Nyquist frequency of the law's rate, {nyquist} Hz"),
         ));
     }
+    let notch = Notch::new(&spec, design.period_s);
+    if !notch.is_finite() {
+        return Err(p.error(
+            "width_hz",
+            spec.width_hz,
+            "Hz",
+            format!("with frequency_hz = {} Hz gives a filter whose coefficients overflow", spec.frequency_hz),
+        ));
+    }
     p.finish()?;
     let gains = DelayPdGains::from_design(&design.pd(), &design.constants, design.period_s, design.delay_samples)?;
-    Ok(Box::new(PdNotch { notch: Notch::new(&spec, design.period_s), pd: DelayPd::new(gains, design.period_s) }))
+    Ok(Box::new(PdNotch { notch, pd: DelayPd::new(gains, design.period_s) }))
 }
 
 /// A notch's parameters.
@@ -101,6 +110,11 @@ impl Notch {
         };
         let (n, d) = (quadratic(zz), quadratic(zp));
         Notch { b: [n[0] / d[0], n[1] / d[0], n[2] / d[0]], a: [d[1] / d[0], d[2] / d[0]], state: [[0.0; 2]; 2] }
+    }
+
+    /// Every coefficient is finite (an extreme width against its centre overflows them).
+    pub fn is_finite(&self) -> bool {
+        self.b.iter().chain(&self.a).all(|v| v.is_finite())
     }
 
     /// Filters one sample of both axes.
@@ -230,5 +244,8 @@ mod tests {
         let p = Params::parse(&format!("frequency_hz = {}", 0.5 / design.period_s)).unwrap();
         let e = crate::registry::build_law("pd_notch", &design, &p).err().unwrap().to_string();
         assert!(e.contains("controller.params.frequency_hz") && e.contains("Nyquist"), "{e}");
+        let p = Params::parse("frequency_hz = 1e-300\nwidth_hz = 1e300").unwrap();
+        let e = crate::registry::build_law("pd_notch", &design, &p).err().unwrap().to_string();
+        assert!(e.contains("controller.params.width_hz") && e.contains("overflow"), "{e}");
     }
 }
