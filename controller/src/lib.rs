@@ -86,6 +86,7 @@ pub mod link;
 #[cfg(feature = "ipc")]
 pub mod lock;
 pub mod modal;
+pub mod notch;
 pub mod params;
 pub mod pd;
 pub mod pd_delay;

@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod amplifier;
+pub mod flex;
 pub mod force;
 pub mod initial;
 pub mod integrate;

@@ -1,0 +1,386 @@
+//! The rotor reduced to its modes below a cutoff frequency, with a static correction at the
+//! force nodes, and the pure derivative of the reduced state (MODEL.md §13.5).
+//!
+//! **Basis.** The undamped modes of the non-spinning rotor `K φ = ω² M φ` (with whatever linear
+//! bearings the [`Rotor`] has; none for a rotor on AMBs, whose forces come in at the force
+//! nodes), mass-normalised (`φᵀ M φ = 1`), those with `ω < 2π f_c`. With the static correction,
+//! the basis is augmented with the part of the static response to a unit force at each force
+//! node's `x` and `y` that the retained modes miss (the residual flexibility,
+//! `Ψ = (K + σM)⁻¹ F − Σ_r φ_r φ_rᵀ F / (ω_r² + σ)`, with `σ = 0` when the bearings hold the
+//! rotor and `σ = (2π f_c)²` when it is free and `K` singular), and the augmented basis is made
+//! M-orthonormal with `K` diagonal again (a Rayleigh–Ritz step: the retained modes stay as they
+//! are, the corrections become pseudo-modes above the cutoff). With it, the reduced model's
+//! static deflection under forces at the force nodes is the full model's exactly (for `σ = 0`).
+//! With the gyroscopic correction, the loads `G φ_k` of the retained modes are treated the same
+//! way: the spin couples each retained mode to the truncated ones through `Ω G φ_k`, and without
+//! these vectors a rotor with heavy disks at high speed loses accuracy in its retained
+//! frequencies (tests/ross.rs states by how much).
+//!
+//! **Equations.** With `q ≈ Φ η`, `Φᵀ M Φ = I`, `Φᵀ K Φ = Λ = diag(ω_k²)`:
+//!
+//! ```text
+//! η̈ = −Λ η − (D + Ω Gᵣ) η̇ + Σ_j Φ_jᵀ f_j − Φᵀ M (r_x a_x + r_y a_y)
+//! D = diag(2 ζ ω_k) + Φᵀ C Φ,   Gᵣ = Φᵀ G Φ
+//! ```
+//!
+//! `f_j = (f_x, f_y)` the force on the rotor at force node `j` (`Φ_j` the basis' rows of that
+//! node's `x`, `y`), `(a_x, a_y)` the acceleration of the housing frame plus gravity (`g ŷ + a_h`,
+//! as for the rigid rotors: every mass feels `−m (g ŷ + a_h)`), `r_x`, `r_y` the rigid
+//! translations, `ζ` the modal damping ratio (the rigid-body modes, `ω = 0`, get none).
+//! The state is `[η, η̇]`, positions then rates, as [`crate::integrate`] expects.
+
+use super::modes::Linear;
+use super::rotor::{Rotor, DOF_PER_NODE};
+use super::FlexError;
+use nalgebra::{DMatrix, DVector};
+
+/// How to reduce.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Reduction {
+    /// Keep the modes below this frequency (Hz).
+    pub cutoff_hz: f64,
+    /// Nodes where forces act (AMBs, touchdown bearings, disks with unbalance), in the order
+    /// the forces are given to [`Reduced::derivative`].
+    pub force_nodes: Vec<usize>,
+    /// Augment the modes with the residual flexibility at the force nodes.
+    pub static_correction: bool,
+    /// Augment the modes with the static response to each retained mode's gyroscopic force
+    /// `G φ_k` (what the spin couples the retained modes to among the truncated ones).
+    pub gyroscopic_correction: bool,
+    /// Modal damping ratio ζ of every basis vector with `ω > 0`.
+    pub modal_damping: f64,
+}
+
+/// What a basis vector is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// A rigid-body mode of a free rotor (ω = 0).
+    Rigid,
+    /// A mode of the full model below the cutoff.
+    Mode,
+    /// A static-correction pseudo-mode.
+    Correction,
+}
+
+/// The reduced rotor.
+#[derive(Clone, Debug)]
+pub struct Reduced {
+    /// The basis Φ (ndof × r), M-orthonormal.
+    pub basis: DMatrix<f64>,
+    /// `ω_k²` of each basis vector (rad²/s²).
+    pub omega_sq: DVector<f64>,
+    /// What each basis vector is.
+    pub kinds: Vec<Kind>,
+    /// `D = diag(2 ζ ω_k) + Φᵀ C Φ` (1/s).
+    pub damping: DMatrix<f64>,
+    /// `Gᵣ = Φᵀ G Φ`.
+    pub gyroscopic: DMatrix<f64>,
+    /// The force nodes.
+    pub force_nodes: Vec<usize>,
+    /// `Φᵀ M r_x` and `Φᵀ M r_y`.
+    frame: [DVector<f64>; 2],
+    /// The basis' rows of each force node's x and y: r × (2 × force nodes).
+    input: DMatrix<f64>,
+    /// The shaft's node count.
+    nodes: usize,
+}
+
+/// The lowest modes of `K φ = ω² M φ`: `(ω², Φ)` ascending, Φ mass-normalised.
+fn undamped_modes(mass: &DMatrix<f64>, stiffness: &DMatrix<f64>) -> Result<(DVector<f64>, DMatrix<f64>), FlexError> {
+    let chol = mass.clone().cholesky().ok_or(FlexError::MassNotPositive)?;
+    let l = chol.l();
+    let l_inv = l.clone().try_inverse().ok_or(FlexError::MassNotPositive)?;
+    let s = &l_inv * stiffness * l_inv.transpose();
+    let s = (&s + s.transpose()) * 0.5;
+    let eig = s.symmetric_eigen();
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+    let values = DVector::from_iterator(order.len(), order.iter().map(|&i| eig.eigenvalues[i]));
+    let u = DMatrix::from_columns(&order.iter().map(|&i| eig.eigenvectors.column(i).into_owned()).collect::<Vec<_>>());
+    Ok((values, l_inv.transpose() * u))
+}
+
+/// The modes of the full model's undamped, non-spinning rotor (Hz), ascending.
+pub fn undamped_frequencies_hz(rotor: &Rotor) -> Result<Vec<f64>, FlexError> {
+    let m = rotor.matrices();
+    let (w2, _) = undamped_modes(&m.mass, &m.stiffness)?;
+    Ok(w2.iter().map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU).collect())
+}
+
+/// Rigid-body modes of a rotor in the plane: two translations and two tilts.
+pub const RIGID_MODES: usize = 4;
+
+impl Reduced {
+    /// Reduces `rotor` as `spec` says.
+    pub fn new(rotor: &Rotor, spec: &Reduction) -> Result<Self, FlexError> {
+        rotor.validate()?;
+        let nodes = rotor.node_count();
+        for &n in &spec.force_nodes {
+            if n >= nodes {
+                return Err(FlexError::NodeOutOfRange { what: "force node".into(), node: n, nodes });
+            }
+        }
+        if !(spec.modal_damping.is_finite() && spec.modal_damping >= 0.0) {
+            return Err(FlexError::Value { key: "modal damping ratio", value: spec.modal_damping, unit: "" });
+        }
+        let m = rotor.matrices();
+        let (w2, phi) = undamped_modes(&m.mass, &m.stiffness)?;
+        let wc = std::f64::consts::TAU * spec.cutoff_hz;
+        // A free rotor's rigid-body modes: numerically zero against the cutoff.
+        let rigid_tol = 1e-8 * wc * wc;
+        let kept = w2.iter().take_while(|&&v| v < wc * wc).count();
+        if !(spec.cutoff_hz.is_finite() && spec.cutoff_hz > 0.0) || kept < RIGID_MODES {
+            let lowest: Vec<f64> =
+                w2.iter().take(RIGID_MODES).map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU).collect();
+            return Err(FlexError::CutoffBelowRigidModes { cutoff_hz: spec.cutoff_hz, rigid_hz: lowest });
+        }
+        let mut kinds: Vec<Kind> =
+            w2.iter().take(kept).map(|&v| if v.abs() <= rigid_tol { Kind::Rigid } else { Kind::Mode }).collect();
+        let mut omega_sq: Vec<f64> =
+            w2.iter().take(kept).map(|&v| if v.abs() <= rigid_tol { 0.0 } else { v }).collect();
+        let mut basis = phi.columns(0, kept).into_owned();
+
+        let n = rotor.dof();
+        let mut loads: Vec<DVector<f64>> = Vec::new();
+        if spec.static_correction {
+            for &node in &spec.force_nodes {
+                for axis in 0..2 {
+                    let mut e = DVector::zeros(n);
+                    e[DOF_PER_NODE * node + axis] = 1.0;
+                    loads.push(e);
+                }
+            }
+        }
+        if spec.gyroscopic_correction {
+            for k in 0..kept {
+                let g = &m.gyroscopic * phi.column(k);
+                if g.norm() > 0.0 {
+                    loads.push(g);
+                }
+            }
+        }
+        if !loads.is_empty() {
+            let f = DMatrix::from_columns(&loads);
+            let sigma = if kinds.contains(&Kind::Rigid) { wc * wc } else { 0.0 };
+            let shifted = &m.stiffness + &m.mass * sigma;
+            let mut psi = shifted.lu().solve(&f).ok_or(FlexError::SingularStiffness)?;
+            // Remove what the retained modes already carry.
+            for (k, w2k) in omega_sq.iter().enumerate().take(kept) {
+                let p = phi.column(k);
+                let coef = (p.transpose() * &f) / (w2k + sigma);
+                psi -= p * coef;
+            }
+            // M-orthonormalise the corrections among themselves (dropping dependent ones) and
+            // diagonalise K on them (Rayleigh–Ritz).
+            let gram = psi.transpose() * &m.mass * &psi;
+            let gram = (&gram + gram.transpose()) * 0.5;
+            let ge = gram.symmetric_eigen();
+            let top = ge.eigenvalues.iter().copied().fold(0.0, f64::max);
+            let cols: Vec<DVector<f64>> = (0..ge.eigenvalues.len())
+                .filter(|&i| ge.eigenvalues[i] > 1e-10 * top)
+                .map(|i| &psi * ge.eigenvectors.column(i) / ge.eigenvalues[i].sqrt())
+                .collect();
+            if !cols.is_empty() {
+                let q = DMatrix::from_columns(&cols);
+                let kq = q.transpose() * &m.stiffness * &q;
+                let kq = (&kq + kq.transpose()) * 0.5;
+                let ke = kq.symmetric_eigen();
+                let mut order: Vec<usize> = (0..ke.eigenvalues.len()).collect();
+                order.sort_by(|&a, &b| ke.eigenvalues[a].total_cmp(&ke.eigenvalues[b]));
+                let extra = q * DMatrix::from_columns(
+                    &order.iter().map(|&i| ke.eigenvectors.column(i).into_owned()).collect::<Vec<_>>(),
+                );
+                let mut all: Vec<DVector<f64>> = basis.column_iter().map(|c| c.into_owned()).collect();
+                all.extend(extra.column_iter().map(|c| c.into_owned()));
+                basis = DMatrix::from_columns(&all);
+                for &i in &order {
+                    omega_sq.push(ke.eigenvalues[i].max(0.0));
+                    kinds.push(Kind::Correction);
+                }
+            }
+        }
+        let r = basis.ncols();
+        let mut damping = basis.transpose() * &m.damping * &basis;
+        for k in 0..r {
+            damping[(k, k)] += 2.0 * spec.modal_damping * omega_sq[k].sqrt();
+        }
+        let gyroscopic = basis.transpose() * &m.gyroscopic * &basis;
+        let rigid =
+            |axis: usize| DVector::from_fn(rotor.dof(), |i, _| if i % DOF_PER_NODE == axis { 1.0 } else { 0.0 });
+        let frame = [basis.transpose() * (&m.mass * rigid(0)), basis.transpose() * (&m.mass * rigid(1))];
+        let mut input = DMatrix::zeros(r, 2 * spec.force_nodes.len());
+        for (j, &node) in spec.force_nodes.iter().enumerate() {
+            for axis in 0..2 {
+                input.column_mut(2 * j + axis).copy_from(&basis.row(DOF_PER_NODE * node + axis).transpose());
+            }
+        }
+        Ok(Reduced {
+            basis,
+            omega_sq: DVector::from_vec(omega_sq),
+            kinds,
+            damping,
+            gyroscopic,
+            force_nodes: spec.force_nodes.clone(),
+            frame,
+            input,
+            nodes,
+        })
+    }
+
+    /// Number of basis vectors r (the state has 2r entries).
+    pub fn size(&self) -> usize {
+        self.basis.ncols()
+    }
+
+    /// Frequencies `ω_k / 2π` of the basis vectors (Hz).
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.omega_sq.iter().map(|v| v.sqrt() / std::f64::consts::TAU).collect()
+    }
+
+    /// The derivative of the state `[η, η̇]` (length 2r) at spin speed `speed` (rad/s), under
+    /// the forces `forces[j] = (f_x, f_y)` (N) on the rotor at force node `j`, with the housing
+    /// frame accelerating at `frame_accel = g ŷ + a_h` (m/s²); written into `dstate`.
+    pub fn derivative(
+        &self,
+        state: &[f64],
+        speed: f64,
+        forces: &[[f64; 2]],
+        frame_accel: [f64; 2],
+        dstate: &mut [f64],
+    ) {
+        let r = self.size();
+        assert_eq!(forces.len(), self.force_nodes.len(), "one force per force node");
+        let (eta, rate) = state.split_at(r);
+        let (d_eta, d_rate) = dstate.split_at_mut(r);
+        d_eta.copy_from_slice(rate);
+        for k in 0..r {
+            let mut acc =
+                -self.omega_sq[k] * eta[k] - self.frame[0][k] * frame_accel[0] - self.frame[1][k] * frame_accel[1];
+            for (i, v) in rate.iter().enumerate() {
+                acc -= (self.damping[(k, i)] + speed * self.gyroscopic[(k, i)]) * v;
+            }
+            for (j, f) in forces.iter().enumerate() {
+                acc += self.input[(k, 2 * j)] * f[0] + self.input[(k, 2 * j + 1)] * f[1];
+            }
+            d_rate[k] = acc;
+        }
+    }
+
+    fn row_dot(&self, row: usize, v: &[f64]) -> f64 {
+        self.basis.row(row).iter().zip(v).map(|(a, b)| a * b).sum()
+    }
+
+    fn node_pair(&self, node: usize, v: &[f64], first: usize) -> [f64; 2] {
+        assert!(node < self.nodes, "node {node} of {}", self.nodes);
+        [self.row_dot(DOF_PER_NODE * node + first, v), self.row_dot(DOF_PER_NODE * node + first + 1, v)]
+    }
+
+    /// Displacement `(x, y)` (m) of node `node` in state `state`.
+    pub fn displacement(&self, state: &[f64], node: usize) -> [f64; 2] {
+        self.node_pair(node, &state[..self.size()], 0)
+    }
+
+    /// Velocity `(ẋ, ẏ)` (m/s) of node `node`.
+    pub fn velocity(&self, state: &[f64], node: usize) -> [f64; 2] {
+        self.node_pair(node, &state[self.size()..], 0)
+    }
+
+    /// Rotations `(α, β)` (rad) of node `node` (`β = dx/dz`, `α = −dy/dz`).
+    pub fn rotation(&self, state: &[f64], node: usize) -> [f64; 2] {
+        self.node_pair(node, &state[..self.size()], 2)
+    }
+
+    /// The full model's coordinates `q = Φ η` of a state.
+    pub fn expand(&self, state: &[f64]) -> DVector<f64> {
+        &self.basis * DVector::from_column_slice(&state[..self.size()])
+    }
+
+    /// The reduced model as a linear system (for its whirl modes and Campbell diagram).
+    pub fn linear(&self) -> Linear {
+        let r = self.size();
+        let node_xy = (0..self.nodes)
+            .map(|k| (self.basis.row(DOF_PER_NODE * k).transpose(), self.basis.row(DOF_PER_NODE * k + 1).transpose()))
+            .collect();
+        Linear {
+            mass: DMatrix::identity(r, r),
+            stiffness: DMatrix::from_diagonal(&self.omega_sq),
+            damping: self.damping.clone(),
+            gyroscopic: self.gyroscopic.clone(),
+            node_xy,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flex::shaft::{Material, ShaftElement};
+
+    /// A free steel shaft, 0.4 m in 8 elements, with a disk at node 3.
+    fn free_rotor() -> Rotor {
+        let steel = Material { density: 7810.0, modulus: 211e9, shear_modulus: 81.2e9 };
+        Rotor {
+            elements: (0..8).map(|_| ShaftElement::cylinder(0.05, 0.0, 0.04, steel)).collect(),
+            disks: vec![crate::flex::Disk { node: 3, mass: 3.0, diametral_inertia: 4e-3, polar_inertia: 7e-3 }],
+            bearings: vec![],
+            alpha: 0.0,
+            beta: 0.0,
+        }
+    }
+
+    fn spec(zeta: f64) -> Reduction {
+        Reduction {
+            cutoff_hz: 3000.0,
+            force_nodes: vec![1, 7],
+            static_correction: true,
+            gyroscopic_correction: true,
+            modal_damping: zeta,
+        }
+    }
+
+    /// A free rotor keeps its four rigid-body modes at 0 Hz; in a frame accelerating at g it
+    /// falls as a body, every node at −g; a force at a node accelerates the centre of mass by
+    /// F/M (the rigid-body modes span the rigid motion exactly).
+    #[test]
+    fn a_free_rotor_falls_and_is_pushed_as_a_body() {
+        let rotor = free_rotor();
+        let reduced = Reduced::new(&rotor, &spec(0.02)).unwrap();
+        assert_eq!(reduced.kinds.iter().filter(|k| **k == Kind::Rigid).count(), RIGID_MODES);
+        let r = reduced.size();
+        let mut d = vec![0.0; 2 * r];
+        reduced.derivative(&vec![0.0; 2 * r], 300.0, &[[0.0; 2], [0.0; 2]], [0.0, 9.81], &mut d);
+        let acc = &reduced.basis * DVector::from_column_slice(&d[r..]);
+        for node in 0..rotor.node_count() {
+            assert!((acc[4 * node + 1] + 9.81).abs() < 1e-9, "node {node}: {}", acc[4 * node + 1]);
+            assert!(acc[4 * node].abs() < 1e-9, "node {node}: {}", acc[4 * node]);
+        }
+        reduced.derivative(&vec![0.0; 2 * r], 300.0, &[[5.0, 0.0], [0.0, 0.0]], [0.0, 0.0], &mut d);
+        let acc = &reduced.basis * DVector::from_column_slice(&d[r..]);
+        let m = rotor.matrices().mass;
+        let rx = DVector::from_fn(rotor.dof(), |i, _| if i % 4 == 0 { 1.0 } else { 0.0 });
+        let centre = (rx.transpose() * &m * &acc)[0] / rotor.mass();
+        assert!((centre - 5.0 / rotor.mass()).abs() < 1e-9 * centre.abs(), "{centre}");
+    }
+
+    /// The modal damping ratio is each flexible mode's at rest; the accessors read the expanded
+    /// state at a node.
+    #[test]
+    fn modal_damping_is_the_modes_damping_ratio_and_accessors_read_the_nodes() {
+        let rotor = free_rotor();
+        let reduced = Reduced::new(&rotor, &spec(0.02)).unwrap();
+        let modes = reduced.linear().modes(0.0, 4).unwrap();
+        for m in &modes {
+            assert!((m.damping_ratio - 0.02).abs() < 1e-9, "{m:?}");
+        }
+        let r = reduced.size();
+        let state: Vec<f64> = (0..2 * r).map(|k| (k as f64 * 0.37).sin() * 1e-6).collect();
+        let q = reduced.expand(&state);
+        let v = &reduced.basis * DVector::from_column_slice(&state[r..]);
+        let [x, y] = reduced.displacement(&state, 5);
+        let [vx, vy] = reduced.velocity(&state, 5);
+        let [a, b] = reduced.rotation(&state, 5);
+        assert_eq!([x, y, a, b], [q[20], q[21], q[22], q[23]]);
+        assert_eq!([vx, vy], [v[20], v[21]]);
+    }
+}
