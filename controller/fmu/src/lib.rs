@@ -682,6 +682,8 @@ impl FmuLaw {
     }
 
     /// FMI 2.0 model exchange: the states from `t0` over one period, `substeps` fixed steps.
+    // Indexed loops: the Runge–Kutta stages read as the formulas.
+    #[allow(clippy::needless_range_loop)]
     fn integrate(&mut self, t0: f64) -> Result<(), String> {
         let Api::Two(f) = &self.fmu.api else { return Ok(()) };
         let comp = self.comp;
