@@ -326,6 +326,12 @@ impl Fmu {
         Ok(Arc::new(Self { spec: spec.clone(), description, interface, api, resources, _dir: dir }))
     }
 
+    /// The temporary folder the FMU is unpacked into (removed when the last user drops it; a
+    /// process that ends at once removes it first).
+    pub fn folder(&self) -> &Path {
+        &self._dir.0
+    }
+
     /// The model description.
     pub fn description(&self) -> &Description {
         &self.description
@@ -784,6 +790,7 @@ impl RotorLaw for FmuLaw {
                     eprintln!(
                         "controller-fmu: error: {message}; exiting (the plant's lost-controller handling takes over)"
                     );
+                    let _ = std::fs::remove_dir_all(self.fmu.folder());
                     std::process::exit(code);
                 }
                 OnFailure::Nan => {

@@ -74,7 +74,7 @@ fn on_crash() {
 }
 
 /// Ends the process when one tick's FMI calls take longer than `limit`.
-fn watchdog(limit: Duration) {
+fn watchdog(limit: Duration, folder: std::path::PathBuf) {
     std::thread::spawn(move || loop {
         std::thread::sleep(Duration::from_millis(10).min(limit / 4));
         if let Some((since, tick)) = controller_fmu::inside_since_ns() {
@@ -85,6 +85,7 @@ fn watchdog(limit: Duration) {
                      (controller.fmu.step_timeout_ms): it hangs; exiting (the plant's lost-controller handling takes over)",
                     limit.as_secs_f64() * 1e3
                 );
+                let _ = std::fs::remove_dir_all(&folder);
                 // SAFETY: ends the process at once (the FMU's thread is stuck inside it).
                 unsafe { libc::_exit(FMU_FAILED) };
             }
@@ -123,8 +124,12 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let folder = fmu.folder().to_path_buf();
     let _ = FMU.set(fmu);
     on_crash();
-    watchdog(Duration::from_secs_f64(spec.step_timeout_ms / 1e3));
-    controller::serve::serve_from(rest.into_iter().map(Into::into).collect(), &[LAW])
+    watchdog(Duration::from_secs_f64(spec.step_timeout_ms / 1e3), folder.clone());
+    let code = controller::serve::serve_from(rest.into_iter().map(Into::into).collect(), &[LAW]);
+    // The law (the instance) is gone; the unpacked FMU in the static is never dropped.
+    let _ = std::fs::remove_dir_all(&folder);
+    code
 }
