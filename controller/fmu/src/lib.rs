@@ -127,9 +127,10 @@ pub fn bind(md: &Description, spec: &Spec, axes: usize) -> Result<Binding, Strin
             ));
         }
         if v.ty != VarType::Float64 || v.array {
+            let label = v.ty.label(md.version);
             return Err(format!(
-                "{source}: the FMU's variable `{name}` is a {}{}, not a scalar {}",
-                v.ty.label(md.version),
+                "{source}: the FMU's variable `{name}` is {} {label}{}, not a scalar {}",
+                if label.starts_with(['A', 'E', 'I', 'O', 'U']) { "an" } else { "a" },
                 if v.array { " array" } else { "" },
                 VarType::Float64.label(md.version)
             ));
@@ -842,4 +843,53 @@ pub fn build(spec: &Spec, design: &RotorDesign, params: &Params) -> Result<Box<d
 /// The file name of `path` (for messages).
 pub fn file_name(path: &Path) -> String {
     path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn description() -> Description {
+        Description::parse(
+            r#"<fmiModelDescription fmiVersion="2.0" modelName="c" guid="g"><CoSimulation modelIdentifier="c"/>
+<ModelVariables>
+  <ScalarVariable name="sensor_x" valueReference="1" causality="input"><Real/></ScalarVariable>
+  <ScalarVariable name="y_in" valueReference="2" causality="input"><Real/></ScalarVariable>
+  <ScalarVariable name="angle" valueReference="3" causality="input"><Real/></ScalarVariable>
+  <ScalarVariable name="current_x" valueReference="4" causality="output"><Real/></ScalarVariable>
+  <ScalarVariable name="current_y" valueReference="5" causality="output"><Real/></ScalarVariable>
+  <ScalarVariable name="mode" valueReference="6" causality="input"><Integer/></ScalarVariable>
+</ModelVariables></fmiModelDescription>"#,
+        )
+        .unwrap()
+    }
+
+    /// The convention's names, the map's, the optional keyphasor and time; each refusal names
+    /// the signal, the variable and the FMU's variables of that causality.
+    #[test]
+    fn signals_bind_by_convention_or_map_and_refusals_name_what_is_missing() {
+        let md = description();
+        let mut spec = Spec::new("c.fmu");
+        let e = bind(&md, &spec, 2).unwrap_err();
+        assert!(e.contains("signal sensor_y (the naming convention"), "{e}");
+        assert!(e.contains("the FMU has no variable `sensor_y` (its inputs: sensor_x, y_in, angle, mode)"), "{e}");
+        spec.map.insert("sensor_y".into(), "y_in".into());
+        let b = bind(&md, &spec, 2).unwrap();
+        assert_eq!((b.sensors, b.currents), (vec![1, 2], vec![4, 5]));
+        assert_eq!((b.speed, b.angle, b.time), (None, Some(3), None));
+        spec.map.insert("speed".into(), "current_x".into());
+        let e = bind(&md, &spec, 2).unwrap_err();
+        assert!(
+            e.contains("controller.fmu.map.speed = \"current_x\": the FMU's variable `current_x` is not an input"),
+            "{e}"
+        );
+        spec.map.insert("speed".into(), "mode".into());
+        let e = bind(&md, &spec, 2).unwrap_err();
+        assert!(e.contains("the FMU's variable `mode` is an Integer, not a scalar Real"), "{e}");
+        spec.map.remove("speed");
+        spec.map.insert("current_x_b".into(), "current_x".into());
+        let e = bind(&md, &spec, 2).unwrap_err();
+        assert!(e.contains("controller.fmu.map.current_x_b: not a signal of this rotor (2 axes)"), "{e}");
+        assert_eq!(signal_names(4).1, ["current_x_a", "current_y_a", "current_x_b", "current_y_b"]);
+    }
 }

@@ -62,6 +62,14 @@ pub fn host_argv(spec: &Spec) -> Vec<String> {
     argv
 }
 
+/// The controller command of a resolved `controller.fmu` ([`host_argv`]), if the scene names one.
+pub fn command(ctl: &RawController) -> Result<Option<Vec<String>>, ConfigError> {
+    let Some(value) = &ctl.fmu else { return Ok(None) };
+    let spec = Spec::from_toml(value, Path::new("/"))
+        .map_err(|message| ConfigError::Parse { path: "scene".into(), message })?;
+    Ok(Some(host_argv(&spec)))
+}
+
 /// Checks the FMU for the scene's rotor without loading it ([`controller_fmu::inspect`]).
 pub fn check(spec: &Spec, axes: usize) -> Result<(), ConfigError> {
     let inspected = controller_fmu::inspect(spec, axes);

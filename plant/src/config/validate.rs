@@ -187,13 +187,8 @@ fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, ConfigError> {
         spin: ctl.spin_us * 1e-6,
         pin_cores,
         lockstep_timeout: ms("controller.lockstep_timeout_ms", ctl.lockstep_timeout_ms, false)?,
-        command: match &ctl.fmu {
-            Some(v) => Some(super::fmu::host_argv(
-                &controller_fmu::Spec::from_toml(v, Path::new("/"))
-                    .map_err(|message| ConfigError::Parse { path: "scene".into(), message })?,
-            )),
-            None => ctl.command.as_ref().map(command_argv).transpose()?,
-        },
+        command: super::fmu::command(ctl)?
+            .map_or_else(|| ctl.command.as_ref().map(command_argv).transpose(), |c| Ok(Some(c)))?,
         realtime_priority: ctl.realtime_priority,
         max_miss_fraction: ctl.max_miss_fraction,
         max_overrun_fraction: ctl.max_overrun_fraction,
