@@ -35,6 +35,7 @@ pub const PLANT_SIDE_KEYS: &[&str] = &[
     "spin_us",
     "pin_cores",
     "command",
+    "fmu",
     "lockstep_timeout_ms",
     "realtime_priority",
     "max_miss_fraction",

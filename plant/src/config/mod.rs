@@ -11,6 +11,7 @@
 //! (the resolved scene for `scene.toml`, a re-load with other overrides) is a
 //! method of [`Scene`].
 
+pub mod fmu;
 pub mod hardware;
 pub mod overrides;
 pub mod raw;

@@ -528,6 +528,11 @@ pub struct RawController {
     /// controller does, in the handshake. `None`: the built-in `controller`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub command: Option<toml::Value> = None,
+    /// A controller FMU as the controller (docs/guide/fmu-controller.md): its path (from the
+    /// scene file's folder) or a table `path`, `map`, `solver`, `substeps`, `step_timeout_ms`
+    /// ([`super::fmu`]). `None`: no FMU.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fmu: Option<toml::Value> = None,
     /// Co-simulation (lockstep, and realtime too): how long the plant waits for a reply from a
     /// controller that is alive (its node and process exist) before it treats it as lost (ms):
     /// a stopped (SIGSTOP), hung or confused controller (one answering another session).

@@ -262,9 +262,11 @@ pub fn run_into_from(
     let params = &scene.controller.params;
     let source = match scene.controller.mode {
         ControlMode::Continuous => Source::Continuous,
-        ControlMode::Sampled => {
-            Source::InProcess(build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?)
-        }
+        ControlMode::Sampled => Source::InProcess(match crate::config::fmu::spec_of(scene) {
+            // A controller FMU runs in the plant's process in sampled mode (docs/guide/fmu-controller.md).
+            Some(fmu) => controller_fmu::build(&fmu, &scene.rotor_design(), params)?,
+            None => build_rotor_law(&scene.controller.law, &scene.rotor_design(), params)?,
+        }),
         ControlMode::Lockstep | ControlMode::Realtime => {
             // A design the controller would refuse is bad input here, before any process starts
             // (a controller command checks the laws it serves itself, in the handshake).

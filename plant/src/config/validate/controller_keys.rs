@@ -91,7 +91,8 @@ pub(super) fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, Confi
         spin: ctl.spin_us * 1e-6,
         pin_cores,
         lockstep_timeout: ms("controller.lockstep_timeout_ms", ctl.lockstep_timeout_ms, false)?,
-        command: ctl.command.as_ref().map(command_argv).transpose()?,
+        command: crate::config::fmu::command(ctl)?
+            .map_or_else(|| ctl.command.as_ref().map(command_argv).transpose(), |c| Ok(Some(c)))?,
         realtime_priority: ctl.realtime_priority,
         max_miss_fraction: ctl.max_miss_fraction,
         max_overrun_fraction: ctl.max_overrun_fraction,

@@ -108,6 +108,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let mut warnings = Vec::new();
     migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
     resolve_command(&mut raw.controller, base_dir)?;
+    let fmu = super::fmu::resolve(&mut raw.controller, base_dir)?;
     let (r, td, ct, amb, ctl, int) =
         (&raw.rotor, &raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &raw.integrator);
     let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
@@ -299,7 +300,9 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     };
     // The law validates its own parameters: a scene it refuses is bad input, before any run.
     // A controller command serves laws of its own: it checks them, in the handshake.
-    if scene.controller.cosim.command.is_none() {
+    if let Some(spec) = &fmu {
+        super::fmu::check(spec, scene.rotor_design().axes() as usize)?;
+    } else if scene.controller.cosim.command.is_none() {
         controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
     }
     Ok(scene)
