@@ -11,7 +11,7 @@ currents, the inputs' start values, before the first answer) and sets them as th
 for the next step: what ``plant run`` does in ``controller.mode = "sampled"``.
 
 ``out.csv`` has one line per communication point: ``tick``, ``t_s``, the command applied
-over the step that starts there (``current_x_A``, ``current_y_A``; empty on the last line),
+over the step that starts there (``current_x_A``, ``current_y_A``; ``nan`` on the last line),
 and every output of the FMU, each number as Python's ``repr`` (the shortest text that reads
 back to the same double).
 
@@ -23,6 +23,7 @@ from tick K: another process continues the run where this one saved it.
 
 import argparse
 import json
+import math
 import sys
 import tomllib
 
@@ -111,7 +112,7 @@ def main() -> None:
                 f.write(blob)
         y = fmu.getReal(out_vrs)
         if k == ticks:
-            rows.append([k, k * period, None, None, *y])
+            rows.append([k, k * period, math.nan, math.nan, *y])
             break
         o = dict(zip(outputs, y))
         ix, iy = law.update(Sample(k, k * period, (o["sensor_x_A"], o["sensor_y_A"]), o["speed"], o["angle"]))
@@ -126,7 +127,7 @@ def main() -> None:
     with open(args.out, "w") as f:
         f.write(",".join(["tick", "t_s", "current_x_A", "current_y_A", *outputs]) + "\n")
         for r in rows:
-            f.write(",".join("" if x is None else repr(x) for x in r) + "\n")
+            f.write(",".join(repr(x) for x in r) + "\n")
 
 
 if __name__ == "__main__":

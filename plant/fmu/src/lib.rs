@@ -419,10 +419,13 @@ impl Instance {
         let sim = self.sim.as_mut().expect("a stepping instance has its plant");
         for _ in 0..ticks as u64 {
             if let Err(e) = sim.plant.step(&Command::Held(command), &mut row) {
-                let state = sim.plant.state().to_vec();
+                let what = e.to_string();
+                // The run's error names the state it failed in; if not, the plant's state.
+                let state =
+                    if what.contains("state") { String::new() } else { format!("; state = {:?}", sim.plant.state()) };
                 self.phase = Phase::Failed;
                 return self.error(&format!(
-                    "fmi2DoStep: the plant diverged at t = {} s: {e}; state = {state:?}; the inputs were {command:?} A",
+                    "fmi2DoStep: the plant diverged at t = {} s: {what}{state}; the inputs were {command:?} A",
                     self.start_time + e.time()
                 ));
             }
