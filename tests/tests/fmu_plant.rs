@@ -506,8 +506,8 @@ fn bad_calls_return_an_error_and_a_log_line_never_a_crash() {
     let s = a.deserialize(late.as_bytes()).expect("well-formed");
     assert_eq!(a.set_state(s), OK, "{:?}", a.log());
     a.free_state(s);
-    assert_eq!(a.step(2.9500000000030000, 5e-5), OK, "{:?}", a.log());
-    assert_eq!(a.step(2.9500000000030000 + 5e-5, 5e-5), OK, "{:?}", a.log());
+    assert_eq!(a.step(2.950_000_000_003, 5e-5), OK, "{:?}", a.log());
+    assert_eq!(a.step(2.950_000_000_003 + 5e-5, 5e-5), OK, "{:?}", a.log());
 
     // Divergence: the rotor, left to its bias currents, falls into its race; its radius passes
     // the guard (1 µm past the air gap and the ball clearance) within 60 ms.
