@@ -375,34 +375,7 @@ impl Model {
              providesDirectionalDerivative=\"false\"/>\n",
             self.identifier
         ));
-        let used: Vec<&str> =
-            UNITS.iter().map(|u| u.0).filter(|name| self.variables.iter().any(|v| v.unit == Some(name))).collect();
-        x.push_str("  <UnitDefinitions>\n");
-        for (name, [kg, m, s, a], factor) in UNITS.iter().filter(|u| used.contains(&u.0)) {
-            let mut base = String::new();
-            for (attr, e) in [("kg", kg), ("m", m), ("s", s), ("A", a)] {
-                if *e != 0 {
-                    base.push_str(&format!(" {attr}=\"{e}\""));
-                }
-            }
-            if *name == "rad" || *name == "rad/s" || *name == "urad" || *name == "deg" {
-                base.push_str(" rad=\"1\"");
-            }
-            if *factor != 1.0 {
-                base.push_str(&format!(" factor=\"{factor:?}\""));
-            }
-            x.push_str(&format!("    <Unit name=\"{}\"><BaseUnit{base}/></Unit>\n", esc(name)));
-        }
-        x.push_str("  </UnitDefinitions>\n");
-        x.push_str("  <LogCategories>\n");
-        for (name, what) in LOG_CATEGORIES {
-            x.push_str(&format!("    <Category name=\"{name}\" description=\"{}\"/>\n", esc(what)));
-        }
-        x.push_str("  </LogCategories>\n");
-        x.push_str(&format!(
-            "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{:?}\" stepSize=\"{:?}\"/>\n",
-            self.duration, self.period
-        ));
+        x.push_str(&self.units_and_categories());
         x.push_str("  <ModelVariables>\n");
         for (vr, v) in self.variables.iter().enumerate() {
             let (causality, variability, initial) = match v.role {
@@ -441,6 +414,135 @@ impl Model {
         }
         x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
         x
+    }
+}
+
+impl Model {
+    /// `modelDescription.xml` of the FMI 3.0 FMU: the same variables as `Float64`, the
+    /// independent variable `time` after them, `fixedInternalStepSize` the plant's tick.
+    pub fn xml3(&self) -> String {
+        let mut x = String::new();
+        x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        x.push_str(&format!(
+            "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{}\" instantiationToken=\"{}\" description=\"{}\" \
+             generationTool=\"plant {} (amb-touchdown-testbed)\" variableNamingConvention=\"flat\">\n",
+            esc(&self.name),
+            esc(&self.guid),
+            esc(&self.description),
+            env!("CARGO_PKG_VERSION")
+        ));
+        x.push_str(&format!(
+            "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
+             canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" \
+             canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" \
+             providesAdjointDerivatives=\"false\" canHandleVariableCommunicationStepSize=\"true\" \
+             fixedInternalStepSize=\"{:?}\" maxOutputDerivativeOrder=\"0\" providesIntermediateUpdate=\"false\" \
+             canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\"/>\n",
+            self.identifier, self.period
+        ));
+        x.push_str(&self.units_and_categories());
+        x.push_str("  <ModelVariables>\n");
+        for (vr, v) in self.variables.iter().enumerate() {
+            let (causality, variability, initial) = match v.role {
+                Role::Input(_) => ("input", "continuous", None),
+                Role::Output(_) => ("output", "continuous", Some("calculated")),
+                Role::Parameter(_) => ("parameter", "fixed", Some("exact")),
+            };
+            x.push_str(&format!(
+                "    <Float64 name=\"{}\" valueReference=\"{vr}\" description=\"{}\" causality=\"{causality}\" \
+                 variability=\"{variability}\"{}",
+                esc(&v.name),
+                esc(&v.description),
+                initial.map(|i| format!(" initial=\"{i}\"")).unwrap_or_default()
+            ));
+            if let Some(u) = v.unit {
+                x.push_str(&format!(" unit=\"{}\"", esc(u)));
+            }
+            for (attr, value) in [("start", v.start), ("min", v.min), ("max", v.max)] {
+                if let Some(value) = value {
+                    x.push_str(&format!(" {attr}=\"{value:?}\""));
+                }
+            }
+            x.push_str("/>\n");
+        }
+        x.push_str(&format!(
+            "    <Float64 name=\"time\" valueReference=\"{}\" description=\"simulated time\" \
+             causality=\"independent\" variability=\"continuous\" unit=\"s\"/>\n",
+            self.variables.len()
+        ));
+        x.push_str("  </ModelVariables>\n  <ModelStructure>\n");
+        let outputs: Vec<usize> =
+            (0..self.variables.len()).filter(|&i| matches!(self.variables[i].role, Role::Output(_))).collect();
+        for i in &outputs {
+            x.push_str(&format!("    <Output valueReference=\"{i}\" dependencies=\"\"/>\n"));
+        }
+        for i in &outputs {
+            x.push_str(&format!("    <InitialUnknown valueReference=\"{i}\"/>\n"));
+        }
+        x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
+        x
+    }
+
+    /// `<UnitDefinitions>`, `<LogCategories>` and `<DefaultExperiment>`, as both versions
+    /// write them.
+    fn units_and_categories(&self) -> String {
+        let mut x = String::new();
+        let mut units: Vec<&str> = self.variables.iter().filter_map(|v| v.unit).collect();
+        units.push("s");
+        x.push_str("  <UnitDefinitions>\n");
+        for (name, [kg, m, s, a], factor) in UNITS.iter().filter(|u| units.contains(&u.0)) {
+            let mut base = String::new();
+            for (attr, e) in [("kg", kg), ("m", m), ("s", s), ("A", a)] {
+                if *e != 0 {
+                    base.push_str(&format!(" {attr}=\"{e}\""));
+                }
+            }
+            if *name == "rad" || *name == "rad/s" || *name == "urad" || *name == "deg" {
+                base.push_str(" rad=\"1\"");
+            }
+            if *factor != 1.0 {
+                base.push_str(&format!(" factor=\"{factor:?}\""));
+            }
+            x.push_str(&format!("    <Unit name=\"{}\"><BaseUnit{base}/></Unit>\n", esc(name)));
+        }
+        x.push_str("  </UnitDefinitions>\n");
+        x.push_str("  <LogCategories>\n");
+        for (name, what) in LOG_CATEGORIES {
+            x.push_str(&format!("    <Category name=\"{name}\" description=\"{}\"/>\n", esc(what)));
+        }
+        x.push_str("  </LogCategories>\n");
+        x.push_str(&format!(
+            "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{:?}\" stepSize=\"{:?}\"/>\n",
+            self.duration, self.period
+        ));
+        x
+    }
+}
+
+/// Which FMI standard an FMU file follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fmi {
+    /// FMI 2.0 co-simulation (`binaries/linux64/`).
+    V2,
+    /// FMI 3.0 co-simulation (`binaries/x86_64-linux/`).
+    V3,
+}
+
+impl Fmi {
+    /// The version's number, as `fmiVersion` writes it.
+    pub fn version(self) -> &'static str {
+        match self {
+            Fmi::V2 => "2.0",
+            Fmi::V3 => "3.0",
+        }
+    }
+
+    /// The folder of the binary inside the FMU.
+    pub fn platform(self) -> &'static str {
+        match self {
+            Fmi::V2 => "linux64",
+            Fmi::V3 => "x86_64-linux",
+        }
     }
 }
 
@@ -503,10 +605,10 @@ pub fn find_library(library: Option<&Path>) -> Result<PathBuf, String> {
     }
 }
 
-/// Writes the FMU of `scene` to `out`: `modelDescription.xml`, `binaries/linux64/<id>.so`
+/// Writes the FMU of `scene` to `out` (FMI `fmi`): `modelDescription.xml`, `binaries/<platform>/<id>.so`
 /// (`library`), `resources/scene.toml` (the scene as resolved; a recorded shock's file beside
 /// it). Returns the model it describes.
-pub fn package(scene: &Scene, library: &Path, out: &Path) -> anyhow::Result<Model> {
+pub fn package(scene: &Scene, library: &Path, out: &Path, fmi: Fmi) -> anyhow::Result<Model> {
     use anyhow::Context;
     let mut raw: toml::Table = toml::from_str(&scene.to_toml()?).context("the resolved scene")?;
     // A recorded shock's file goes into resources/ and the scene names it there.
@@ -548,10 +650,14 @@ pub fn package(scene: &Scene, library: &Path, out: &Path) -> anyhow::Result<Mode
         zip.write_all(bytes)?;
         Ok(())
     };
-    add("modelDescription.xml", model.xml().as_bytes(), options)?;
+    let description = match fmi {
+        Fmi::V2 => model.xml(),
+        Fmi::V3 => model.xml3(),
+    };
+    add("modelDescription.xml", description.as_bytes(), options)?;
     // The binary is stored as it is: compressing a debug build's (over 100 MB) takes a minute.
     let stored = options.compression_method(zip::CompressionMethod::Stored).unix_permissions(0o755);
-    add(&format!("binaries/linux64/{}.so", model.identifier), &binary, stored)?;
+    add(&format!("binaries/{}/{}.so", fmi.platform(), model.identifier), &binary, stored)?;
     add("resources/scene.toml", text.as_bytes(), options)?;
     for (name, bytes) in &extra {
         add(&format!("resources/{name}"), bytes, options)?;

@@ -59,10 +59,15 @@ fn library() -> &'static Path {
 
 /// `plant fmu cosim-10g.toml --set SHORT… --out DIR/NAME`, the binary found next to `plant`.
 fn write_fmu(dir: &TempDir, name: &str, sets: &[&str]) -> PathBuf {
+    write_fmu_of(dir, name, sets, "2")
+}
+
+/// [`write_fmu`] of FMI version `fmi` (`--fmi`).
+fn write_fmu_of(dir: &TempDir, name: &str, sets: &[&str], fmi: &str) -> PathBuf {
     library();
     let out = dir.join(name);
     let mut cmd = Command::new(plant_bin());
-    cmd.arg("fmu").arg(scene("cosim-10g.toml")).arg("--out").arg(&out);
+    cmd.arg("fmu").arg(scene("cosim-10g.toml")).arg("--out").arg(&out).args(["--fmi", fmi]);
     for s in SHORT.iter().chain(sets) {
         cmd.args(["--set", s]);
     }
@@ -588,7 +593,8 @@ const SAME: &[(&str, &str)] = &[
 /// 30 ms are not a whole number of 50 µs ticks in binary, and `plant run` ends its last tick at
 /// 0.03 s, the FMU on the tick grid), and applies over each tick the command `plant run`
 /// applies. A state serialised at tick 300 by one Python process, loaded by another, goes on
-/// with the same rows. FMPy's validation finds no problem; `simulate_fmu` runs it.
+/// with the same rows. The FMI 3.0 FMU of the scene gives the same rows. FMPy's validation
+/// finds no problem in either; `simulate_fmu` runs both.
 #[test]
 fn fmpy_closes_the_loop_with_the_kits_pd_as_plant_run_does() {
     let dir = TempDir::new("fmu-fmpy");
@@ -640,22 +646,24 @@ fn fmpy_closes_the_loop_with_the_kits_pd_as_plant_run_does() {
         |rows: &[Vec<f64>]| rows.iter().map(|r| r.iter().map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<_>>();
     assert_eq!(bits(&rest.rows), bits(&fmu_rows.rows[300..]), "the run continued in another process");
 
-    // FMPy's own checks.
-    let check = output_within(
-        Command::new(fmpy_python())
-            .arg("-c")
-            .arg(
-                "import sys, fmpy\nfrom fmpy.validation import validate_fmu\nproblems = validate_fmu(sys.argv[1])\n\
-             print('problems:', problems)\nr = fmpy.simulate_fmu(sys.argv[1], stop_time=0.002)\n\
-             print('rows:', len(r), 'last t:', r['time'][-1], 'names:', ','.join(r.dtype.names))",
-            )
-            .arg(&fmu),
-        LIMIT,
-    );
-    assert_exit(&check, 0);
-    let said = String::from_utf8_lossy(&check.stdout);
-    assert!(said.contains("problems: []"), "{said}");
-    assert!(said.contains("rows: 41 last t: 0.002") && said.contains("sensor_y_A"), "{said}");
+    // The FMI 3.0 FMU of the same scene in the same loop: the same file, byte for byte.
+    let fmu3 = write_fmu_of(&dir, "plant3.fmu", &[], "3");
+    let looped3 = dir.join("loop3.csv");
+    assert_exit(&output_within(Command::new(fmpy_python()).arg(&script).arg(&fmu3).arg(&looped3), LIMIT), 0);
+    assert!(std::fs::read(&looped3).unwrap() == std::fs::read(&looped).unwrap(), "FMI 3.0 against FMI 2.0");
+
+    // FMPy's own checks, of both.
+    let check = "import sys, fmpy\nfrom fmpy.validation import validate_fmu\nproblems = validate_fmu(sys.argv[1])\n\
+                 print('version:', fmpy.read_model_description(sys.argv[1]).fmiVersion, 'problems:', problems)\n\
+                 r = fmpy.simulate_fmu(sys.argv[1], stop_time=0.002)\n\
+                 print('rows:', len(r), 'last t:', r['time'][-1], 'names:', ','.join(r.dtype.names))";
+    for (f, version) in [(&fmu, "2.0"), (&fmu3, "3.0")] {
+        let out = output_within(Command::new(fmpy_python()).arg("-c").arg(check).arg(f), LIMIT);
+        assert_exit(&out, 0);
+        let said = String::from_utf8_lossy(&out.stdout);
+        assert!(said.contains(&format!("version: {version} problems: []")), "{said}");
+        assert!(said.contains("rows: 41 last t: 0.002") && said.contains("sensor_y_A"), "{said}");
+    }
 }
 
 /// `plant fmu` checks the scene as `plant run` does, and names a missing binary with the cargo

@@ -1,4 +1,4 @@
-"""The plant FMU in a closed loop with the Python kit's ``pd``, tick by tick, under FMPy.
+"""The plant FMU (FMI 2.0 or 3.0) in a closed loop with the Python kit's ``pd``, tick by tick, under FMPy.
 
     python closed_loop.py plant.fmu out.csv [--ticks N] [--save-at K state.bin] [--from-state state.bin]
 
@@ -16,8 +16,8 @@ and every output of the FMU, each number as Python's ``repr`` (the shortest text
 back to the same double).
 
 ``--save-at K state.bin`` serialises the FMU's state at tick K (``fmi2SerializeFMUstate``,
-with the controller's own state beside it); ``--from-state state.bin`` starts a fresh
-instance from such a file (``fmi2DeSerializeFMUstate``, ``fmi2SetFMUstate``) and goes on
+``fmi3SerializeFMUState``), with the controller's own state beside it; ``--from-state
+state.bin`` starts a fresh instance from such a file (deserialised, set) and goes on
 from tick K: another process continues the run where this one saved it.
 """
 
@@ -29,6 +29,7 @@ import tomllib
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
 
 from amb_testbed_controller import PD, Design, LoopConstants, Params, Sample, saturate
 
@@ -80,23 +81,34 @@ def main() -> None:
     out_vrs = [vr[n] for n in outputs]
     inputs = [vr["current_x_A"], vr["current_y_A"]]
 
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName="plant")
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
+    identifier = md.coSimulation.modelIdentifier
+    if md.fmiVersion.startswith("3"):
+        fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=identifier, instanceName="plant")
+        fmu.instantiate()
+        fmu.enterInitializationMode(startTime=0.0)
+        get, put = fmu.getFloat64, fmu.setFloat64
+        get_state, set_state, free_state = fmu.getFMUState, fmu.setFMUState, fmu.freeFMUState
+        serialize, deserialize = fmu.serializeFMUState, fmu.deserializeFMUState
+    else:
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=identifier, instanceName="plant")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        get, put = fmu.getReal, fmu.setReal
+        get_state, set_state, free_state = fmu.getFMUstate, fmu.setFMUstate, fmu.freeFMUstate
+        serialize, deserialize = fmu.serializeFMUstate, fmu.deSerializeFMUstate
     fmu.exitInitializationMode()
     law = PD(design, Params.parse("pd", ""))
-    bias = tuple(fmu.getReal(inputs))
+    bias = tuple(get(inputs))
     line = [bias] * design.delay_samples
     first = 0
     if args.from_state:
         with open(args.from_state, "rb") as f:
             saved = json.loads(f.readline())
             blob = f.read()
-        state = fmu.deSerializeFMUstate(blob)
-        fmu.setFMUstate(state)
-        fmu.freeFMUstate(state)
+        state = deserialize(blob)
+        set_state(state)
+        free_state(state)
         first, line, law.prev = saved["tick"], [tuple(c) for c in saved["line"]], saved["prev"]
         law.prev = tuple(law.prev) if law.prev is not None else None
 
@@ -104,13 +116,13 @@ def main() -> None:
     limit = design.current_limit_a
     for k in range(first, ticks + 1):
         if args.save_at and k == int(args.save_at[0]):
-            state = fmu.getFMUstate()
-            blob = fmu.serializeFMUstate(state)
-            fmu.freeFMUstate(state)
+            state = get_state()
+            blob = serialize(state)
+            free_state(state)
             with open(args.save_at[1], "wb") as f:
                 f.write((json.dumps({"tick": k, "line": line, "prev": law.prev}) + "\n").encode())
                 f.write(blob)
-        y = fmu.getReal(out_vrs)
+        y = get(out_vrs)
         if k == ticks:
             rows.append([k, k * period, math.nan, math.nan, *y])
             break
@@ -119,7 +131,7 @@ def main() -> None:
         line.append((saturate(ix, limit), saturate(iy, limit)))
         applied = line.pop(0)
         rows.append([k, k * period, *applied, *y])
-        fmu.setReal(inputs, list(applied))
+        put(inputs, list(applied))
         fmu.doStep(currentCommunicationPoint=k * period, communicationStepSize=period)
     fmu.terminate()
     fmu.freeInstance()

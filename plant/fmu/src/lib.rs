@@ -26,6 +26,8 @@
 
 #![allow(non_snake_case, clippy::missing_safety_doc)]
 
+mod fmi3;
+
 use plant::fmu_export::{Model, Output, Role, Variable};
 use plant::run::Sink;
 use plant::snapshot::Snapshot;
@@ -103,7 +105,7 @@ struct Sim {
 /// One FMU instance.
 struct Instance {
     name: CString,
-    callbacks: CallbackFunctions,
+    callbacks: Callbacks,
     logging: bool,
     resources: PathBuf,
     model: Model,
@@ -128,18 +130,33 @@ const CAT_ERROR: &CStr = c"logStatusError";
 const CAT_WARNING: &CStr = c"logStatusWarning";
 const CAT_ALL: &CStr = c"logAll";
 
-fn log_with(callbacks: &CallbackFunctions, name: &CStr, status: Status, message: &str) {
-    let Some(logger) = callbacks.logger else { return };
+/// The importer's logger: FMI 2.0's callbacks or FMI 3.0's log message callback.
+#[derive(Clone, Copy)]
+enum Callbacks {
+    Fmi2(CallbackFunctions),
+    Fmi3 { environment: *mut c_void, log: Option<fmi3::LogMessage> },
+}
+
+fn log_with(callbacks: &Callbacks, name: &CStr, status: Status, message: &str) {
     let category = match status {
         OK => CAT_ALL,
         WARNING => CAT_WARNING,
         _ => CAT_ERROR,
     };
     let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
-    // The message goes as the argument of "%s": a '%' in it is not a format.
-    unsafe {
-        logger(callbacks.component_environment, name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), text.as_ptr())
-    };
+    match *callbacks {
+        Callbacks::Fmi2(c) => {
+            let Some(logger) = c.logger else { return };
+            // The message goes as the argument of "%s": a '%' in it is not a format.
+            unsafe {
+                logger(c.component_environment, name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), text.as_ptr())
+            };
+        }
+        Callbacks::Fmi3 { environment, log: Some(log) } => unsafe {
+            log(environment, status, category.as_ptr(), text.as_ptr())
+        },
+        Callbacks::Fmi3 { log: None, .. } => {}
+    }
 }
 
 impl Instance {
@@ -639,6 +656,57 @@ unsafe fn text(p: *const c_char) -> Option<String> {
     (!p.is_null()).then(|| CStr::from_ptr(p).to_string_lossy().into_owned())
 }
 
+/// A new instance of the FMU whose resources are at `location` (a `file:` URI or a path),
+/// checked against the importer's `token` (GUID, instantiation token); `None` after a log line.
+fn new_instance(
+    callbacks: Callbacks,
+    name: CString,
+    location: Option<String>,
+    token: Option<String>,
+    logging: bool,
+    call: &str,
+) -> Option<Box<Instance>> {
+    let fail = |message: String| {
+        log_with(&callbacks, &name, ERROR, &format!("{call}: {message}"));
+        None
+    };
+    let Some(location) = location else {
+        return fail("no resource location: the FMU's resources/ folder holds its scene".into());
+    };
+    let resources = resource_path(&location);
+    let scene = match plant::fmu_export::load_fmu_scene(&resources, &[]) {
+        Ok(s) => s,
+        Err(e) => return fail(format!("the FMU's scene ({}): {e}", resources.join("scene.toml").display())),
+    };
+    let model = match Model::of(&scene) {
+        Ok(m) => m,
+        Err(e) => return fail(format!("the FMU's scene: {e}")),
+    };
+    if let Some(g) = token {
+        if g != model.guid {
+            return fail(format!(
+                "fmuGUID = {g}, but this binary with resources/scene.toml makes {}: the binary, the scene and \
+                 modelDescription.xml are not of one FMU (rewrite it with `plant fmu`)",
+                model.guid
+            ));
+        }
+    }
+    let values = Instance::starts(&model);
+    let inst = Box::new(Instance {
+        name,
+        callbacks,
+        logging,
+        resources,
+        model,
+        phase: Phase::Instantiated,
+        values,
+        start_time: 0.0,
+        sim: None,
+    });
+    inst.info(&format!("instantiated from {}", inst.resources.display()));
+    Some(inst)
+}
+
 // ---------------------------------------------------------------------------------------------
 // The C API (fmi2Functions.h)
 
@@ -663,7 +731,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
     logging_on: c_int,
 ) -> *mut c_void {
     let made = catch_unwind(AssertUnwindSafe(|| {
-        let callbacks = if functions.is_null() {
+        let callbacks = Callbacks::Fmi2(if functions.is_null() {
             CallbackFunctions {
                 logger: None,
                 allocate_memory: None,
@@ -673,52 +741,24 @@ pub unsafe extern "C" fn fmi2Instantiate(
             }
         } else {
             *functions
-        };
-        let name = CString::new(text(instance_name).unwrap_or_default()).unwrap_or_default();
-        let fail = |message: String| {
-            log_with(&callbacks, &name, ERROR, &format!("fmi2Instantiate: {message}"));
-            std::ptr::null_mut()
-        };
-        if fmu_type != CO_SIMULATION {
-            return fail(format!(
-                "fmuType = {fmu_type}: this FMU is for co-simulation only (fmi2CoSimulation = 1), no model exchange"
-            ));
-        }
-        let Some(location) = text(resource_location) else {
-            return fail("no fmuResourceLocation: the FMU's resources/ folder holds its scene".into());
-        };
-        let resources = resource_path(&location);
-        let scene = match plant::fmu_export::load_fmu_scene(&resources, &[]) {
-            Ok(s) => s,
-            Err(e) => return fail(format!("the FMU's scene ({}): {e}", resources.join("scene.toml").display())),
-        };
-        let model = match Model::of(&scene) {
-            Ok(m) => m,
-            Err(e) => return fail(format!("the FMU's scene: {e}")),
-        };
-        if let Some(g) = text(guid) {
-            if g != model.guid {
-                return fail(format!(
-                    "fmuGUID = {g}, but this binary with resources/scene.toml makes {}: the binary, the scene and \
-                     modelDescription.xml are not of one FMU (rewrite it with `plant fmu`)",
-                    model.guid
-                ));
-            }
-        }
-        let values = Instance::starts(&model);
-        let inst = Box::new(Instance {
-            name,
-            callbacks,
-            logging: logging_on != 0,
-            resources,
-            model,
-            phase: Phase::Instantiated,
-            values,
-            start_time: 0.0,
-            sim: None,
         });
-        inst.info(&format!("instantiated from {}", inst.resources.display()));
-        Box::into_raw(inst) as *mut c_void
+        let name = CString::new(text(instance_name).unwrap_or_default()).unwrap_or_default();
+        if fmu_type != CO_SIMULATION {
+            log_with(
+                &callbacks,
+                &name,
+                ERROR,
+                &format!(
+                    "fmi2Instantiate: fmuType = {fmu_type}: this FMU is for co-simulation only (fmi2CoSimulation = 1), \
+                     no model exchange"
+                ),
+            );
+            return std::ptr::null_mut();
+        }
+        match new_instance(callbacks, name, text(resource_location), text(guid), logging_on != 0, "fmi2Instantiate") {
+            Some(inst) => Box::into_raw(inst) as *mut c_void,
+            None => std::ptr::null_mut(),
+        }
     }));
     made.unwrap_or(std::ptr::null_mut())
 }
