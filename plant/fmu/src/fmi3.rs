@@ -8,6 +8,33 @@ use super::*;
 /// `fmi3LogMessageCallback`.
 pub(crate) type LogMessage = unsafe extern "C" fn(*mut c_void, Status, *const c_char, *const c_char);
 
+/// A log line of the shared instance in FMI 3.0's names (the calls, the GUID).
+pub(crate) fn names(message: &str) -> String {
+    const NAMES: [(&str, &str); 16] = [
+        ("fmi2DoStep", "fmi3DoStep"),
+        ("fmi2SetReal", "fmi3SetFloat64"),
+        ("fmi2GetReal", "fmi3GetFloat64"),
+        ("fmi2Reset", "fmi3Reset"),
+        ("fmi2SetupExperiment", "fmi3EnterInitializationMode"),
+        ("fmi2EnterInitializationMode", "fmi3EnterInitializationMode"),
+        ("fmi2ExitInitializationMode", "fmi3ExitInitializationMode"),
+        ("fmi2Terminate", "fmi3Terminate"),
+        ("fmi2SetDebugLogging", "fmi3SetDebugLogging"),
+        ("fmi2GetFMUstate", "fmi3GetFMUState"),
+        ("fmi2SetFMUstate", "fmi3SetFMUState"),
+        ("fmi2FreeFMUstate", "fmi3FreeFMUState"),
+        ("fmi2SerializedFMUstateSize", "fmi3SerializedFMUStateSize"),
+        ("fmi2SerializeFMUstate", "fmi3SerializeFMUState"),
+        ("fmi2DeSerializeFMUstate", "fmi3DeserializeFMUState"),
+        ("fmuGUID", "instantiationToken"),
+    ];
+    let mut m = message.to_string();
+    for (two, three) in NAMES {
+        m = m.replace(two, three);
+    }
+    m
+}
+
 /// The value reference of `time`: after the model's variables.
 fn time_vr(inst: &Instance) -> u32 {
     inst.model.variables.len() as u32
@@ -353,4 +380,15 @@ pub unsafe extern "C" fn fmi3DoStep(
         }
         s
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn log_lines_name_the_fmi3_calls() {
+        assert_eq!(
+            super::names("fmi2DoStep: not allowed; fmi2Reset first; fmi2SerializedFMUstateSize"),
+            "fmi3DoStep: not allowed; fmi3Reset first; fmi3SerializedFMUStateSize"
+        );
+    }
 }

@@ -161,7 +161,9 @@ fn log_with(callbacks: &Callbacks, name: &CStr, status: Status, message: &str) {
 
 impl Instance {
     fn error(&self, message: &str) -> Status {
-        log_with(&self.callbacks, &self.name, ERROR, message);
+        let message =
+            if matches!(self.callbacks, Callbacks::Fmi3 { .. }) { fmi3::names(message) } else { message.into() };
+        log_with(&self.callbacks, &self.name, ERROR, &message);
         ERROR
     }
 
@@ -667,7 +669,9 @@ fn new_instance(
     call: &str,
 ) -> Option<Box<Instance>> {
     let fail = |message: String| {
-        log_with(&callbacks, &name, ERROR, &format!("{call}: {message}"));
+        let line = format!("{call}: {message}");
+        let line = if matches!(callbacks, Callbacks::Fmi3 { .. }) { fmi3::names(&line) } else { line };
+        log_with(&callbacks, &name, ERROR, &line);
         None
     };
     let Some(location) = location else {
