@@ -124,6 +124,27 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_value = "0,250,500")]
         decay_speeds_hz: Vec<f64>,
     },
+    /// Write the scene's plant as an FMI 2.0 (or 3.0) co-simulation FMU for Linux x86-64 (Simulink's FMU
+    /// block, OpenModelica/OMSimulator, FMPy): modelDescription.xml, the binary, the scene in
+    /// resources/ (docs/guide/fmu-plant.md).
+    Fmu {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// The FMU file to write (e.g. plant.fmu).
+        #[arg(long)]
+        out: PathBuf,
+        /// Override a scene key before it goes into the FMU (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// The FMI version: 2 (FMI 2.0 co-simulation) or 3 (FMI 3.0 co-simulation, with
+        /// fixedInternalStepSize the controller tick).
+        #[arg(long, default_value_t = 2, value_parser = clap::builder::RangedU64ValueParser::<u8>::new().range(2..=3))]
+        fmi: u8,
+        /// The FMU's binary (default: libplant_fmu.so next to this executable, which
+        /// `cargo build -p plant-fmu` puts there).
+        #[arg(long, value_name = "FILE")]
+        library: Option<PathBuf>,
+    },
     /// Analyse an existing run folder (trace.csv + scene.toml): spectra, spectrogram, Poincaré map,
     /// classification; updates summary.json and writes the analysis plots.
     Analyze {

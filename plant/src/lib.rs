@@ -31,6 +31,7 @@ pub mod cosim;
 pub mod ensemble;
 pub mod exit;
 pub mod figures;
+pub mod fmu_export;
 pub mod grid;
 pub mod hardware;
 pub mod hooks;

@@ -92,6 +92,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Analyze { dir } => analyze_cmd(&dir),
+        Command::Fmu { scene, out, set, fmi, library } => fmu_cmd(&scene, &out, &set, fmi, library.as_deref()),
         Command::Campbell { scene, out, set, max_speed_hz, points, decay_speeds_hz } => {
             let req = plant::campbell::Request {
                 scene: &scene,
@@ -461,6 +462,29 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
 }
 
 /// `plant analyze`.
+/// `plant fmu`: the scene checked as `plant run` checks it, then the FMU file.
+fn fmu_cmd(path: &Path, out: &Path, set: &[String], fmi: u8, library: Option<&Path>) -> anyhow::Result<()> {
+    let scene = load_scene(path, set)?;
+    load_checked(&scene)?;
+    let library = plant::fmu_export::find_library(library).map_err(Ending::BadArgument)?;
+    let fmi = if fmi == 3 { plant::fmu_export::Fmi::V3 } else { plant::fmu_export::Fmi::V2 };
+    let model = plant::fmu_export::package(&scene, &library, out, fmi)?;
+    let (inputs, outputs, parameters) = model.variables.iter().fold((0, 0, 0), |(i, o, p), v| match v.role {
+        plant::fmu_export::Role::Input(_) => (i + 1, o, p),
+        plant::fmu_export::Role::Output(_) => (i, o + 1, p),
+        plant::fmu_export::Role::Parameter(_) => (i, o, p + 1),
+    });
+    eprintln!(
+        "plant: wrote {} (FMI {} co-simulation, model {}, {inputs} inputs, {outputs} outputs, {parameters} parameters; \
+         communication step {} s or a whole multiple)",
+        out.display(),
+        fmi.version(),
+        model.identifier,
+        model.period
+    );
+    Ok(())
+}
+
 fn analyze_cmd(dir: &Path) -> anyhow::Result<()> {
     let _claim = plant::claim::claim(dir, false)?;
     let a = plant::output::analyze_dir(dir, &plant::interrupt::stop_flag())?;
