@@ -251,7 +251,7 @@ impl Decision {
     /// window) or `enabled` is false.
     pub fn new(scene: &Scene, enabled: bool) -> Option<Self> {
         let window = crate::figures::analysis_spec(scene).window_length();
-        if !enabled || !(window > 0.0) {
+        if !enabled || window.is_nan() || window <= 0.0 {
             return None;
         }
         let gaps = match &scene.two_plane {
@@ -473,6 +473,7 @@ pub fn ladder(
         let mut s = sets.to_vec();
         s.extend(rung_overrides(&base, *g)?);
         s.push("output.plots=false".into());
+        s.extend(super::cosim_overrides(&base));
         let scene = load_scene(path, &s)?;
         points.push(Point { path, sets: s, scene, index: i, values: vec![*g] });
     }
