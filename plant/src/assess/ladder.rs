@@ -473,7 +473,6 @@ pub fn ladder(
         let mut s = sets.to_vec();
         s.extend(rung_overrides(&base, *g)?);
         s.push("output.plots=false".into());
-        s.extend(super::cosim_overrides(&base));
         let scene = load_scene(path, &s)?;
         points.push(Point { path, sets: s, scene, index: i, values: vec![*g] });
     }

@@ -228,27 +228,10 @@ fn initial_offsets(scene: &Scene, axis: usize, offset_um: f64) -> Vec<String> {
     }
 }
 
-/// The overrides of every run of a lockstep controller in an assessment: no busy-polling
-/// (`controller.spin_us = 0`), plant and controller block until the other's frame. The runs go
-/// [`COSIM_JOBS`] at once, more processes than cores: a process that spins for its peer's
-/// frame holds a core the peer (or another run) needs. A lockstep run's trace does not depend
-/// on how either side waits (bit-identical), only its speed. Measured on the shared 2-core
-/// machine at a load average of 13 to 20, four lockstep runs of `pd_notch` at once (20 000
-/// ticks each, `plant run examples/rust-controller/pd-notch-10g.toml --set scene.duration_s=1.0
-/// --set controller.damping_ratio=0.1`, four started together): 5 000 to 5 400 ticks a second in
-/// all with the default `spin_us = 200`, 12 800 to 19 200 with 0.
-pub fn cosim_overrides(scene: &Scene) -> Vec<String> {
-    match scene.controller.mode {
-        ControlMode::Lockstep => vec!["controller.spin_us=0.0".into()],
-        _ => Vec::new(),
-    }
-}
-
 /// Overrides of a measurement run without shocks: the shocks moved past `duration`, the fast
 /// setting, the output at `output_hz`, no plots.
 fn quiet_run_overrides(scene: &Scene, duration: f64, output_hz: f64, substeps: u32) -> Vec<String> {
     let mut s: Vec<String> = setting_overrides(scene, MemberSetting::Fast);
-    s.extend(cosim_overrides(scene));
     s.retain(|o| !o.starts_with("integrator.substeps"));
     s.push(format!("integrator.substeps={substeps}"));
     s.extend((0..scene.shock_count()).map(|i| format!("shock[{i}].start_s={:?}", duration + 10.0)));
