@@ -169,8 +169,8 @@ impl ControlLaw for DelayPd {
         self.rate.reset();
     }
 
-    fn linear_pd(&self) -> Option<PdGains> {
-        Some(self.gains.pd)
+    fn linear_pd(&self) -> Option<crate::law::LinearPd> {
+        Some(crate::law::LinearPd { kp: self.gains.pd.kp, kd: self.gains.pd.kd })
     }
 }
 

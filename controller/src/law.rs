@@ -100,9 +100,19 @@ pub trait ControlLaw: Send {
     /// backward difference, as `pd` does): what `plant assess` takes the sampled loop's closed
     /// form of. `None` (the default) for a law that is no such PD; `plant assess` then grades
     /// the law by measurement alone.
-    fn linear_pd(&self) -> Option<crate::pd::PdGains> {
+    fn linear_pd(&self) -> Option<LinearPd> {
         None
     }
+}
+
+/// The gains of a PD around levitation ([`ControlLaw::linear_pd`]): `i = bias − A_a (k_p u + k_d u̇)`
+/// on the sensor voltage `u`, as `controller::PdGains` writes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearPd {
+    /// Proportional gain `k_p` (as `PdGains::kp`).
+    pub kp: f64,
+    /// Derivative gain `k_d` (s, as `PdGains::kd`).
+    pub kd: f64,
 }
 
 /// A sampled control law of the whole rotor: every axis in, every current out, one call per

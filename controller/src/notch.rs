@@ -231,8 +231,8 @@ mod tests {
     #[test]
     fn the_law_is_pd_delay_at_dc_and_refuses_a_centre_past_nyquist() {
         let design = crate::wire::Hello::example("run").design();
-        let mut notch = crate::registry::build_law("pd_notch", &design, &Params::default()).unwrap();
-        let mut plain = crate::registry::build_law("pd_delay", &design, &Params::default()).unwrap();
+        let mut notch = (LAW.build)(&design, &Params::default()).unwrap();
+        let mut plain = (crate::pd_delay::LAW.build)(&design, &Params::default()).unwrap();
         let s = Sample { seq: 0, t_s: 0.0, sensor_v: [0.2, -0.1], ..Default::default() };
         let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
         for k in 0..4000 {
@@ -242,10 +242,10 @@ mod tests {
         }
         assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9, "{a:?} against {b:?}");
         let p = Params::parse(&format!("frequency_hz = {}", 0.5 / design.period_s)).unwrap();
-        let e = crate::registry::build_law("pd_notch", &design, &p).err().unwrap().to_string();
+        let e = (LAW.build)(&design, &p).err().unwrap().to_string();
         assert!(e.contains("controller.params.frequency_hz") && e.contains("Nyquist"), "{e}");
         let p = Params::parse("frequency_hz = 1e-300\nwidth_hz = 1e300").unwrap();
-        let e = crate::registry::build_law("pd_notch", &design, &p).err().unwrap().to_string();
+        let e = (LAW.build)(&design, &p).err().unwrap().to_string();
         assert!(e.contains("controller.params.width_hz") && e.contains("overflow"), "{e}");
     }
 }

@@ -139,8 +139,8 @@ impl ControlLaw for SampledPd {
         self.rate.reset();
     }
 
-    fn linear_pd(&self) -> Option<PdGains> {
-        Some(self.gains)
+    fn linear_pd(&self) -> Option<crate::law::LinearPd> {
+        Some(crate::law::LinearPd { kp: self.gains.kp, kd: self.gains.kd })
     }
 }
 

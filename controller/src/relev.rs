@@ -245,8 +245,8 @@ impl ControlLaw for Relev {
     }
 
     /// The nominal loop (the recovery design acts only while the rotor touches).
-    fn linear_pd(&self) -> Option<crate::pd::PdGains> {
-        Some(self.nominal.pd)
+    fn linear_pd(&self) -> Option<crate::law::LinearPd> {
+        Some(crate::law::LinearPd { kp: self.nominal.pd.kp, kd: self.nominal.pd.kd })
     }
 }
 

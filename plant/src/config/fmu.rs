@@ -7,8 +7,8 @@
 //! it runs the FMU in its own process. The FMU is checked when the scene loads (a zip, FMI 2.0
 //! or 3.0, a Linux x86-64 binary, every signal's variable): bad input, exit 2.
 
+use super::range;
 use super::raw::RawController;
-use super::validate::range;
 use super::{ConfigError, Scene};
 use controller_fmu::Spec;
 use std::path::{Path, PathBuf};
