@@ -1,5 +1,5 @@
 //! The flexible rotor (a finite-element shaft reduced to its modes, two AMBs, two sensors and
-//! two touchdown bearings at its nodes, MODEL.md §13.7) behind [`Machine`].
+//! two touchdown bearings at its nodes, MODEL.md §13.6) behind [`Machine`].
 //!
 //! Its trace is the two-plane rotor's layout: plane A's and B's rows are taken at each plane's
 //! touchdown-bearing node (where its race and contact are), and the "slopes" are those of the

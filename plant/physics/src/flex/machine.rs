@@ -1,4 +1,4 @@
-//! The flexible rotor as a machine of the plant (MODEL.md §13.7): the reduced shaft
+//! The flexible rotor as a machine of the plant (MODEL.md §13.6): the reduced shaft
 //! ([`Reduced`]) with two AMBs, two displacement sensors and two touchdown bearings at nodes of
 //! the shaft, each touchdown bearing the planar race dynamics the rigid rotors call per plane
 //! ([`crate::model`]), the spin as for the rigid rotors.
