@@ -19,7 +19,7 @@ pub enum Rotor {
     /// The whole rigid rotor on two bearing planes, A and B (`rotor.model = "two_plane"`).
     TwoPlane(two_plane::Params),
     /// A flexible shaft on two bearing planes, A and B (`rotor.model = "flexible"`).
-    Flexible(Box<flexible::Params>),
+    Flexible(flexible::Params),
 }
 
 impl Rotor {

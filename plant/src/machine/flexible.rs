@@ -240,7 +240,7 @@ mod tests {
     fn model(scene: &crate::config::Scene) -> Model {
         let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
         Model {
-            params: (**params).clone(),
+            params: params.clone(),
             base: scene.base.clone(),
             control: [Control::Held([0.0; 2]); 2],
             race_parked: [false; 2],

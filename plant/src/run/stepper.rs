@@ -157,7 +157,7 @@ impl Plant {
                 let rigid = crate::initial::two_plane_initial_state(scene, &params.machine);
                 let y = flexible::Model::from_rigid(params, &rigid);
                 let model = flexible::Model {
-                    params: (**params).clone(),
+                    params: params.clone(),
                     base: scene.base.clone(),
                     control: controls,
                     race_parked: [false; 2],

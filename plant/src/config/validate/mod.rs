@@ -144,7 +144,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
             refuse_flexible_keys(&raw)?;
             Rotor::TwoPlane(two_plane_params(&raw, &whole)?)
         }
-        RotorModel::Flexible => Rotor::Flexible(Box::new(flexible_params(&raw, &whole, base_dir)?)),
+        RotorModel::Flexible => Rotor::Flexible(flexible_params(&raw, &whole, base_dir)?),
     };
     // The sensor's and the controller's loop constants are the scene's (`[amb]`,
     // `[controller]`), the same on every plane.
