@@ -83,7 +83,7 @@ pub struct Request<'a> {
 /// The linearised rotor of a two-plane scene with its continuous PD at each plane.
 pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
     let Rotor::TwoPlane(machine) = &scene.rotor else {
-        return Err(crate::bench::BadArgument(format!(
+        return Err(crate::exit::BadArgument(format!(
             "{}: plant campbell needs a two-plane scene (rotor.model = \"two_plane\"); this one is {}",
             scene.name,
             scene.rotor.model().name()
@@ -106,7 +106,7 @@ pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
         parts.push("sensor.runout");
     }
     if !parts.is_empty() {
-        return Err(crate::bench::BadArgument(format!(
+        return Err(crate::exit::BadArgument(format!(
             "{}: plant campbell linearises the rotor on the ideal loop, without the amplifier's and the \
              sensor's states, and its free decays carry no runout; this scene has {} on: switch it off \
              (--set amb.amplifier=false --set sensor.bandwidth_hz=0 --set 'sensor.runout=[]') for the \
@@ -273,21 +273,21 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
     let scene = load_scene(req.scene, req.set)?;
     let rotor = linear_rotor(&scene)?;
     if !(req.max_speed_hz.is_finite() && req.max_speed_hz >= 0.0 && req.max_speed_hz <= 1e5) {
-        return Err(crate::bench::BadArgument(format!(
+        return Err(crate::exit::BadArgument(format!(
             "--max-speed-hz {}: must be between 0 and 1e5 Hz",
             req.max_speed_hz
         ))
         .into());
     }
     if !(2..=10_000).contains(&req.points) {
-        return Err(crate::bench::BadArgument(format!("--points {}: must be between 2 and 10000", req.points)).into());
+        return Err(crate::exit::BadArgument(format!("--points {}: must be between 2 and 10000", req.points)).into());
     }
     if let Some(bad) = req.decay_speeds_hz.iter().find(|s| !(s.is_finite() && **s >= 0.0 && **s <= 1e5)) {
         return Err(
-            crate::bench::BadArgument(format!("--decay-speeds-hz {bad}: each must be between 0 and 1e5 Hz")).into()
+            crate::exit::BadArgument(format!("--decay-speeds-hz {bad}: each must be between 0 and 1e5 Hz")).into()
         );
     }
-    let out = crate::bench::out_dir(req.out, &format!("campbell-{}", scene.name));
+    let out = crate::output::out_dir(req.out, &format!("campbell-{}", scene.name));
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let speeds: Vec<f64> = (0..req.points).map(|i| req.max_speed_hz * i as f64 / (req.points - 1) as f64).collect();
     let rows = diagram(&rotor, &speeds)?;

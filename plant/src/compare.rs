@@ -85,12 +85,12 @@ fn deviation(r: &RunResult, reference: &RunResult, start: f64) -> (f64, f64) {
         return (f64::INFINITY, f64::INFINITY);
     }
     if r.trace.planes() == 1 {
-        return crate::bench::window_error(&r.trace, &reference.trace, start, start + WINDOW, 1.0);
+        return crate::trace::window_error(&r.trace, &reference.trace, start, start + WINDOW, 1.0);
     }
     // The worse of the two bearing planes.
     (0..r.trace.planes()).fold((0.0, 0.0), |(rms, max), i| {
         let (a, b) = (r.trace.plane(i), reference.trace.plane(i));
-        let (e_rms, e_max) = crate::bench::window_error(&a, &b, start, start + WINDOW, 1.0);
+        let (e_rms, e_max) = crate::trace::window_error(&a, &b, start, start + WINDOW, 1.0);
         (f64::max(rms, e_rms), f64::max(max, e_max))
     })
 }
@@ -733,7 +733,7 @@ pub fn compare_realtime(
     stop: &AtomicBool,
 ) -> anyhow::Result<Vec<RealtimeRow>> {
     if !(1..=1000).contains(&runs) {
-        return Err(crate::bench::BadArgument(format!("--runs {runs}: must be between 1 and 1000")).into());
+        return Err(crate::exit::BadArgument(format!("--runs {runs}: must be between 1 and 1000")).into());
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
@@ -747,7 +747,7 @@ pub fn compare_realtime(
         let c = s.cosim.clone();
         let tet = c.as_ref().and_then(|c| c.tet_us).unwrap_or_default();
         let (rms, max) = match r.run.outcome {
-            Outcome::Completed => crate::bench::window_error(&r.trace, &reference.trace, 0.0, scene.duration, 1.0),
+            Outcome::Completed => crate::trace::window_error(&r.trace, &reference.trace, 0.0, scene.duration, 1.0),
             _ => (f64::INFINITY, f64::INFINITY),
         };
         RealtimeRow {

@@ -113,8 +113,8 @@ fn code_of(cause: &(dyn std::error::Error + 'static)) -> Option<Code> {
         controller::LawError,
         controller::ParamsError,
         shock_table::ShockError,
-        crate::bench::BadArgument,
-        crate::bench::Interrupted,
+        BadArgument,
+        Interrupted,
         AnalyzeError,
         AssessError,
         crate::snapshot::SnapshotError,
@@ -266,19 +266,24 @@ macro_rules! bad_input {
         })*
     };
 }
-bad_input!(
-    ConfigError,
-    controller::LawError,
-    controller::ParamsError,
-    shock_table::ShockError,
-    crate::bench::BadArgument
-);
+bad_input!(ConfigError, controller::LawError, controller::ParamsError, shock_table::ShockError, BadArgument);
 
-impl HasExitCode for crate::bench::Interrupted {
+impl HasExitCode for Interrupted {
     fn exit_code(&self) -> Code {
         Code::Interrupted
     }
 }
+
+/// An argument of a command that cannot be used (bad input: exit 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadArgument(pub String);
+
+/// A command stopped by SIGINT/SIGTERM (exit 130): what it had finished was written, as the
+/// text says.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted: {0}")]
+pub struct Interrupted(pub String);
 
 #[cfg(test)]
 mod tests {
@@ -303,9 +308,9 @@ mod tests {
             (stopped(StopKind::Interrupted), 130),
             (Ending::CriteriaFailed(1).into(), 5),
             (Ending::Interrupted("2 of 5 runs written".into()).into(), 130),
-            (crate::bench::Interrupted("1 of 2 loops finished".into()).into(), 130),
+            (Interrupted("1 of 2 loops finished".into()).into(), 130),
             (Ending::BadArgument("diverged".into()).into(), 2),
-            (anyhow::Error::from(crate::bench::BadArgument("--peer-rows: x".into())).context("bench"), 2),
+            (anyhow::Error::from(BadArgument("--peer-rows: x".into())).context("bench"), 2),
             (anyhow::Error::from(ConfigError::Alias { old: "a".into(), new: "b".into() }).context("loading"), 2),
             (anyhow::Error::from(SetupError::Law(law)).context("the run"), 2),
             (SetupError::Cosim(CosimError::Refused { reason: "r", message: "m".into() }).into(), 2),

@@ -13,6 +13,12 @@ pub trait Hooks {
     fn cancelled(&self) -> bool {
         false
     }
+    /// Polled after each macro step, after [`Hooks::cancelled`]; `true` ends the run there as
+    /// completed: the caller has what it needs from it (an assessment's ladder member whose
+    /// outcome is decided before the scene's end: [`crate::assess::ladder`]). The default: never.
+    fn finished(&self) -> bool {
+        false
+    }
     /// A message for the user (co-simulation: waiting for a controller, a
     /// lost controller); the loop itself never prints.
     fn note(&mut self, _message: &str) {}

@@ -609,6 +609,11 @@ fn to_json<T: serde::Serialize>(v: &T) -> Result<serde_json::Value, AnalyzeError
     serde_json::to_value(v).map_err(|e| AnalyzeError::Output(anyhow::Error::new(e)))
 }
 
+/// The output folder of a command: `out`, or `runs/<default>`.
+pub fn out_dir(out: Option<&Path>, default: &str) -> std::path::PathBuf {
+    out.map_or_else(|| Path::new("runs").join(default), Path::to_path_buf)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

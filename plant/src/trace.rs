@@ -698,9 +698,66 @@ impl<R: std::io::Read> std::io::Read for LineBound<R> {
     }
 }
 
+/// Scaled error `|Δ − Δ_ref| / r_0` on the common samples of `[t0, t1]`: (RMS, max).
+/// A trace that stops early (diverged) counts as infinite error.
+pub fn window_error(trace: &Trace, reference: &Trace, t0: f64, t1: f64, gap: f64) -> (f64, f64) {
+    let (mut sum, mut max, mut n) = (0.0, 0.0_f64, 0usize);
+    for (i, &t) in reference.t_s.iter().enumerate() {
+        if t < t0 - 1e-12 || t > t1 + 1e-12 {
+            continue;
+        }
+        let Some(&tt) = trace.t_s.get(i) else { return (f64::INFINITY, f64::INFINITY) };
+        if (tt - t).abs() > 1e-9 {
+            return (f64::INFINITY, f64::INFINITY);
+        }
+        let e = (trace.dx_m[i] - reference.dx_m[i]).hypot(trace.dy_m[i] - reference.dy_m[i]) / gap;
+        if !e.is_finite() {
+            return (f64::INFINITY, f64::INFINITY);
+        }
+        sum += e * e;
+        max = max.max(e);
+        n += 1;
+    }
+    if n == 0 {
+        (f64::INFINITY, f64::INFINITY)
+    } else {
+        ((sum / n as f64).sqrt(), max)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn trace(t: &[f64], dx: &[f64], dy: &[f64]) -> Trace {
+        let mut tr = Trace::default();
+        for i in 0..t.len() {
+            let mut row = [0.0; crate::trace::WIDTH];
+            row[0] = t[i];
+            row[1] = dx[i];
+            row[2] = dy[i];
+            tr.push_row(&row);
+        }
+        tr
+    }
+
+    #[test]
+    fn window_error_is_the_rms_and_max_distance_over_the_window_scaled_by_the_gap() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        let reference = trace(&t, &[0.0; 4], &[0.0; 4]);
+        // Distances 5 (outside the window), 3, 4 (inside), 100 (outside); gap 2.
+        let run = trace(&t, &[3.0, 0.0, 4.0, 100.0], &[4.0, 3.0, 0.0, 0.0]);
+        let (rms, max) = window_error(&run, &reference, 1.0, 2.0, 2.0);
+        assert_eq!(max, 2.0);
+        assert!((rms - (12.5_f64 / 4.0).sqrt()).abs() < 1e-15, "{rms}");
+        // A run that stopped before the window's end, or off the reference's grid, is infinitely wrong.
+        let short = trace(&t[..2], &[0.0; 2], &[0.0; 2]);
+        assert_eq!(window_error(&short, &reference, 1.0, 2.0, 2.0), (f64::INFINITY, f64::INFINITY));
+        let shifted = trace(&[0.0, 1.5, 2.0, 3.0], &[0.0; 4], &[0.0; 4]);
+        assert_eq!(window_error(&shifted, &reference, 1.0, 2.0, 2.0), (f64::INFINITY, f64::INFINITY));
+        // An empty window too.
+        assert_eq!(window_error(&run, &reference, 5.0, 6.0, 2.0), (f64::INFINITY, f64::INFINITY));
+    }
 
     fn scratch(name: &str, text: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("plant-trace-{name}-{}", std::process::id()));

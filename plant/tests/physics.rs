@@ -415,7 +415,8 @@ fn rk4_blows_up_just_above_the_estimated_limit_on_the_balls_and_not_below() {
 /// released race on one step per tick it must still warn about contact.
 #[test]
 fn levitation_scene_setting_is_within_1e4_of_the_full_model_and_passes_the_stability_check() {
-    use plant::bench::{window_error, with_integrator, IntegratorSetting};
+    use plant::bench::{with_integrator, IntegratorSetting};
+    use plant::trace::window_error;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/levitation-1g.toml");
     let probe = plant::config::load_scene(&path, &[]).expect("scene loads");
     let start = probe.first_shock_start();

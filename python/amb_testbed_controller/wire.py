@@ -1,6 +1,6 @@
 """The wire protocol, version 4, as ctypes structures.
 
-The layouts and iceoryx2 type names are those of ``controller/src/wire.rs``
+The layouts and iceoryx2 type names are those of ``controller/src/wire/``
 (the source of truth) and ``docs/wire-protocol.md``: native endianness, no
 padding, ``f64`` = IEEE binary64, text UTF-8 padded with NUL bytes. Every
 size and offset is checked at import against the documented table

@@ -16,7 +16,10 @@
  * (0 none, 1 Discard, 2 Error, 3 Fatal from the step, 4 NaN currents, 5 SIGSEGV, 6 hang)
  * from step fault_tick on.
  *
- * The FMI types are written here from the standard (FMI 2.0.4, FMI 3.0): only what is used. */
+ * The FMI types: with -DFMI_HEADERS the headers FMPy ships (fmpy/c-code/fmi2Functions.h,
+ * fmi3Functions.h; the include path given with -I), so that the compiler checks every
+ * function here against the standard's declarations; without, the few declarations below,
+ * written from the standard (FMI 2.0.4, FMI 3.0) under the same names: only what is used. */
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -106,42 +109,56 @@ __attribute__((unused)) static int step(Pd *c, double h) {
 }
 
 #if FMI == 2
+#ifdef FMI_HEADERS
+#include "fmi2Functions.h"
+#else
 typedef void *fmi2Component;
-typedef void (*fmi2Logger)(void *, const char *, int, const char *, const char *, ...);
+typedef void *fmi2ComponentEnvironment;
+typedef const char *fmi2String;
+typedef double fmi2Real;
+typedef int fmi2Integer;
+typedef int fmi2Boolean;
+typedef unsigned int fmi2ValueReference;
+typedef int fmi2Status;
+typedef int fmi2Type;
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
 typedef struct {
-    fmi2Logger logger;
-    void *(*allocate)(size_t, size_t);
-    void (*release)(void *);
-    void *step_finished;
-    void *env;
+    fmi2CallbackLogger logger;
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void *stepFinished;
+    fmi2ComponentEnvironment componentEnvironment;
 } fmi2CallbackFunctions;
 typedef struct {
-    int newDiscreteStatesNeeded, terminateSimulation, nominalsChanged, valuesChanged, nextEventTimeDefined;
-    double nextEventTime;
+    fmi2Boolean newDiscreteStatesNeeded, terminateSimulation, nominalsOfContinuousStatesChanged,
+        valuesOfContinuousStatesChanged, nextEventTimeDefined;
+    fmi2Real nextEventTime;
 } fmi2EventInfo;
+#endif
 
-static fmi2Logger logger;
+static fmi2CallbackLogger logger;
 
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *resources,
-                                     const fmi2CallbackFunctions *f, int visible, int logging) {
+EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
+                                     const fmi2CallbackFunctions *f, fmi2Boolean visible, fmi2Boolean logging) {
     (void)type; (void)guid; (void)resources; (void)visible; (void)logging;
     logger = f->logger;
     Pd *c = create();
-    if (c && logger) logger(f->env, name, 0, "logAll", "pd: instantiated");
+    if (c && logger) logger(f->componentEnvironment, name, 0, "logAll", "pd: instantiated");
     return c;
 }
 EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT int fmi2SetupExperiment(fmi2Component c, int a, double b, double d, int e, double g) {
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean a, fmi2Real b, fmi2Real d, fmi2Boolean e,
+                                      fmi2Real g) {
     (void)c; (void)a; (void)b; (void)d; (void)e; (void)g; return 0; }
-EXPORT int fmi2EnterInitializationMode(fmi2Component c) { (void)c; return 0; }
-EXPORT int fmi2ExitInitializationMode(fmi2Component c) { (void)c; return 0; }
-EXPORT int fmi2Terminate(fmi2Component c) { (void)c; return 0; }
-EXPORT int fmi2Reset(fmi2Component c) { (void)c; return 0; }
-EXPORT int fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cats[]) {
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cats[]) {
     (void)c; (void)on; (void)n; (void)cats; return 0; }
-EXPORT int fmi2SetReal(fmi2Component c, const unsigned *vr, size_t n, const double *v) {
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]) {
     for (size_t i = 0; i < n; i++) { double *p = real_of(c, vr[i]); if (!p) return 3; *p = v[i]; }
     return 0;
 }
@@ -154,14 +171,14 @@ static void outputs(Pd *c) {
     law(c, u_dot);
 }
 #endif
-EXPORT int fmi2GetReal(fmi2Component c, const unsigned *vr, size_t n, double *v) {
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]) {
 #ifdef ME
     outputs(c);
 #endif
     for (size_t i = 0; i < n; i++) { double *p = real_of(c, vr[i]); if (!p) return 3; v[i] = *p; }
     return 0;
 }
-EXPORT int fmi2SetInteger(fmi2Component c, const unsigned *vr, size_t n, const int *v) {
+EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
     Pd *pd = c;
     for (size_t i = 0; i < n; i++) {
         if (vr[i] == VR_FAULT) pd->fault = v[i];
@@ -170,52 +187,68 @@ EXPORT int fmi2SetInteger(fmi2Component c, const unsigned *vr, size_t n, const i
     }
     return 0;
 }
-EXPORT int fmi2GetInteger(fmi2Component c, const unsigned *vr, size_t n, int *v) {
+EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
     (void)c; (void)vr; for (size_t i = 0; i < n; i++) v[i] = 0; return 0; }
-EXPORT int fmi2SetBoolean(fmi2Component c, const unsigned *vr, size_t n, const int *v) {
+EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]) {
     (void)c; (void)vr; (void)n; (void)v; return 3; }
-EXPORT int fmi2SetString(fmi2Component c, const unsigned *vr, size_t n, const char *const *v) {
+EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
     (void)c; (void)vr; (void)n; (void)v; return 3; }
 #ifndef ME
-EXPORT int fmi2DoStep(fmi2Component c, double t, double h, int no_prior) {
+EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean no_prior) {
     (void)t; (void)no_prior;
     return step(c, h);
 }
 #else
-EXPORT int fmi2SetTime(fmi2Component c, double t) { ((Pd *)c)->time = t; return 0; }
-EXPORT int fmi2SetContinuousStates(fmi2Component c, const double *x, size_t n) {
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, fmi2Real t) { ((Pd *)c)->time = t; return 0; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t n) {
     Pd *pd = c; if (n != AXES) return 3; memcpy(pd->x, x, sizeof pd->x); return 0; }
-EXPORT int fmi2GetContinuousStates(fmi2Component c, double *x, size_t n) {
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t n) {
     Pd *pd = c; if (n != AXES) return 3; memcpy(x, pd->x, sizeof pd->x); return 0; }
-EXPORT int fmi2GetDerivatives(fmi2Component c, double *dx, size_t n) {
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t n) {
     Pd *pd = c;
     if (n != AXES) return 3;
     for (int k = 0; k < AXES; k++) dx[k] = (pd->u[k] - pd->x[k]) / pd->tau;
     return 0;
 }
-EXPORT int fmi2GetEventIndicators(fmi2Component c, double *z, size_t n) { (void)c; (void)z; (void)n; return 0; }
-EXPORT int fmi2CompletedIntegratorStep(fmi2Component c, int no_prior, int *enter, int *terminate) {
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t n) { (void)c; (void)z; (void)n; return 0; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean no_prior, fmi2Boolean *enter,
+                                               fmi2Boolean *terminate) {
     Pd *pd = c; (void)no_prior;
     *enter = 0; *terminate = 0;
     int s = misbehave(pd);
     pd->ticks++;
     return s;
 }
-EXPORT int fmi2EnterEventMode(fmi2Component c) { (void)c; return 0; }
-EXPORT int fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     (void)c; memset(info, 0, sizeof *info); return 0; }
-EXPORT int fmi2EnterContinuousTimeMode(fmi2Component c) { (void)c; return 0; }
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { (void)c; return 0; }
 #endif
 #endif
 
 #if FMI == 3
+#ifdef FMI_HEADERS
+#include "fmi3Functions.h"
+#else
+#include <stdint.h>
 typedef void *fmi3Instance;
-typedef void (*fmi3Log)(void *, int, const char *, const char *);
+typedef void *fmi3InstanceEnvironment;
+typedef const char *fmi3String;
+typedef double fmi3Float64;
+typedef int32_t fmi3Int32;
+typedef bool fmi3Boolean;
+typedef uint32_t fmi3ValueReference;
+typedef int fmi3Status;
+typedef void (*fmi3LogMessageCallback)(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String);
+typedef void (*fmi3IntermediateUpdateCallback)(fmi3InstanceEnvironment, fmi3Float64, fmi3Boolean, fmi3Boolean,
+                                               fmi3Boolean, fmi3Boolean, fmi3Boolean *, fmi3Float64 *);
+#endif
 
 EXPORT const char *fmi3GetVersion(void) { return "3.0"; }
-EXPORT fmi3Instance fmi3InstantiateCoSimulation(const char *name, const char *token, const char *resources,
-        bool visible, bool logging, bool event_mode, bool early_return, const unsigned *required, size_t n_required,
-        void *env, fmi3Log log, void *intermediate) {
+EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
+        fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_return,
+        const fmi3ValueReference required[], size_t n_required, fmi3InstanceEnvironment env,
+        fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback intermediate) {
     (void)name; (void)token; (void)resources; (void)visible; (void)logging; (void)event_mode;
     (void)early_return; (void)required; (void)n_required; (void)intermediate;
     Pd *c = create();
@@ -223,21 +256,22 @@ EXPORT fmi3Instance fmi3InstantiateCoSimulation(const char *name, const char *to
     return c;
 }
 EXPORT void fmi3FreeInstance(fmi3Instance c) { free(c); }
-EXPORT int fmi3EnterInitializationMode(fmi3Instance c, bool a, double b, double d, bool e, double g) {
+EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean a, fmi3Float64 b, fmi3Float64 d, fmi3Boolean e,
+                                              fmi3Float64 g) {
     (void)c; (void)a; (void)b; (void)d; (void)e; (void)g; return 0; }
-EXPORT int fmi3ExitInitializationMode(fmi3Instance c) { (void)c; return 0; }
-EXPORT int fmi3Terminate(fmi3Instance c) { (void)c; return 0; }
-EXPORT int fmi3SetFloat64(fmi3Instance c, const unsigned *vr, size_t n, const double *v, size_t nv) {
+EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance c) { (void)c; return 0; }
+EXPORT fmi3Status fmi3Terminate(fmi3Instance c) { (void)c; return 0; }
+EXPORT fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[], size_t nv) {
     (void)nv;
     for (size_t i = 0; i < n; i++) { double *p = real_of(c, vr[i]); if (!p) return 3; *p = v[i]; }
     return 0;
 }
-EXPORT int fmi3GetFloat64(fmi3Instance c, const unsigned *vr, size_t n, double *v, size_t nv) {
+EXPORT fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[], size_t nv) {
     (void)nv;
     for (size_t i = 0; i < n; i++) { double *p = real_of(c, vr[i]); if (!p) return 3; v[i] = *p; }
     return 0;
 }
-EXPORT int fmi3SetInt32(fmi3Instance c, const unsigned *vr, size_t n, const int *v, size_t nv) {
+EXPORT fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3Int32 v[], size_t nv) {
     Pd *pd = c; (void)nv;
     for (size_t i = 0; i < n; i++) {
         if (vr[i] == VR_FAULT) pd->fault = v[i];
@@ -246,12 +280,12 @@ EXPORT int fmi3SetInt32(fmi3Instance c, const unsigned *vr, size_t n, const int 
     }
     return 0;
 }
-EXPORT int fmi3SetBoolean(fmi3Instance c, const unsigned *vr, size_t n, const bool *v, size_t nv) {
+EXPORT fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3Boolean v[], size_t nv) {
     (void)c; (void)vr; (void)n; (void)v; (void)nv; return 3; }
-EXPORT int fmi3SetString(fmi3Instance c, const unsigned *vr, size_t n, const char *const *v, size_t nv) {
+EXPORT fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3String v[], size_t nv) {
     (void)c; (void)vr; (void)n; (void)v; (void)nv; return 3; }
-EXPORT int fmi3DoStep(fmi3Instance c, double t, double h, bool no_prior, bool *event, bool *terminate,
-                      bool *early, double *last) {
+EXPORT fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3Boolean no_prior,
+                             fmi3Boolean *event, fmi3Boolean *terminate, fmi3Boolean *early, fmi3Float64 *last) {
     (void)no_prior;
     *event = false; *terminate = false; *early = false; *last = t + h;
     return step(c, h);

@@ -2,7 +2,7 @@
 //! a controller crate outside the workspace, built and run in lockstep; any
 //! executable as `controller.command`, with the contract it gets (argument,
 //! environment, paths, respawn) and the bad ones refused with a message, an
-//! exit code and `summary.json`; the C header checked against `wire.rs`.
+//! exit code and `summary.json`; the C header checked against `controller/src/wire/`.
 //! Every process is bounded in time.
 
 mod common;

@@ -6,10 +6,18 @@
 //! Rust `pd`'s. Then the bad input of the issue: not a zip, no binary for this platform, FMI
 //! 1.0, a missing variable, an unknown parameter, a step's Discard/Error/Fatal, NaN, a SIGSEGV
 //! and a hang inside the step, each with its message, exit code and what was written.
+//!
+//! Issue 29 item 3, against tools nobody here wrote: the same `pd.c` compiled against the FMI
+//! headers FMPy ships (`fmpy/c-code/`, from the FMPy of `target/fmpy-venv`, `common::fmpy_venv`)
+//! and a `pd` built with `pythonfmu` (PyPI) from `tests/fmu/pythonfmu_pd.py` write the Rust
+//! `pd`'s trace of `config/cosim-10g.toml` byte for byte; the four-axis FMU of the two-plane
+//! scene is compiled against FMPy's headers too.
 
 mod common;
 
-use common::{assert_exit, output_within, plant_bin, read_json, scene, stderr, workspace_root, TempDir, SHORT};
+use common::{
+    assert_exit, fmpy_venv, output_within, plant_bin, read_json, scene, stderr, workspace_root, TempDir, SHORT,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -47,13 +55,48 @@ enum Kind {
     Me2,
 }
 
+/// Which FMI declarations `pd.c` is compiled against.
+#[derive(Clone, Copy, PartialEq)]
+enum Headers {
+    /// Its own few declarations of the FMI types.
+    Own,
+    /// The headers FMPy ships (`fmpy/c-code/fmi2Functions.h`, `fmi3Functions.h`): the compiler
+    /// checks each function of `pd.c` against the standard's declaration.
+    Fmpy,
+}
+
+/// The folder of the FMI headers FMPy ships, in the FMPy of `target/fmpy-venv`.
+fn fmpy_headers() -> PathBuf {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let python = fmpy_venv().join("bin/python");
+        let code = "import os, fmpy; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))";
+        let out = output(Command::new(python).arg("-c").arg(code));
+        assert_exit(&out, 0);
+        let dir = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+        for h in ["fmi2Functions.h", "fmi3Functions.h"] {
+            assert!(dir.join(h).is_file(), "FMPy ships no {h} in {}", dir.display());
+        }
+        dir
+    })
+    .clone()
+}
+
 /// Compiles `tests/fmu/pd.c` as `kind` for `axes` axes into `dir/pd.so` (warnings are errors).
 fn compile(dir: &Path, kind: Kind, axes: usize) -> Vec<u8> {
-    let so = dir.join(format!("pd-{}-{axes}.so", kind as u8));
+    compile_with(dir, kind, axes, Headers::Own)
+}
+
+/// [`compile`] against `headers`.
+fn compile_with(dir: &Path, kind: Kind, axes: usize, headers: Headers) -> Vec<u8> {
+    let so = dir.join(format!("pd-{}-{axes}-{}.so", kind as u8, headers as u8));
     let mut cmd = Command::new("cc");
     cmd.args(["-std=c11", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC"])
         .arg(format!("-DAXES={axes}"))
         .arg(if kind == Kind::Cs3 { "-DFMI=3" } else { "-DFMI=2" });
+    if headers == Headers::Fmpy {
+        cmd.arg("-DFMI_HEADERS").arg(format!("-I{}", fmpy_headers().display()));
+    }
     if kind == Kind::Me2 {
         cmd.arg("-DME");
     }
@@ -143,11 +186,19 @@ fn zip(path: &Path, files: &[(&str, &[u8])]) -> PathBuf {
 
 /// The `.fmu` of `pd.c` built as `kind` for `axes` axes.
 fn pd_fmu(dir: &TempDir, kind: Kind, axes: usize) -> PathBuf {
-    let so = compile(&dir.join(""), kind, axes);
+    pd_fmu_with(dir, kind, axes, Headers::Own)
+}
+
+/// [`pd_fmu`] compiled against `headers`.
+fn pd_fmu_with(dir: &TempDir, kind: Kind, axes: usize, headers: Headers) -> PathBuf {
+    let so = compile_with(&dir.join(""), kind, axes, headers);
     let platform = if kind == Kind::Cs3 { "x86_64-linux" } else { "linux64" };
     let md = model_description(kind, axes, if kind == Kind::Cs3 { "3.0" } else { "2.0" }, "");
     let binary = format!("binaries/{platform}/pd.so");
-    zip(&dir.join(&format!("pd-{}-{axes}.fmu", kind as u8)), &[("modelDescription.xml", md.as_bytes()), (&binary, &so)])
+    zip(
+        &dir.join(&format!("pd-{}-{axes}-{}.fmu", kind as u8, headers as u8)),
+        &[("modelDescription.xml", md.as_bytes()), (&binary, &so)],
+    )
 }
 
 /// `[controller.params]` that make pd.c the Rust `pd` of `scene` with `sets`: each plane's
@@ -233,7 +284,94 @@ fn co_simulation_pd_fmus_write_the_rust_pds_trace_byte_for_byte() {
     assert!(trace(&out) != reference, "another k_p must change the trace");
 }
 
-/// A four-axis FMU (FMI 2.0 co-simulation) drives the two-plane rotor in lockstep: the Rust
+/// The `pd` of `tests/fmu/pythonfmu_pd.py` as an FMI 2.0 co-simulation FMU, built by
+/// `pythonfmu build` (PyPI) into `dir`.
+fn pythonfmu_pd(dir: &TempDir) -> PathBuf {
+    let script = workspace_root().join("tests/fmu/pythonfmu_pd.py");
+    let out = output(
+        Command::new(fmpy_venv().join("bin/pythonfmu")).arg("build").arg("-f").arg(&script).arg("-d").arg(dir.join("")),
+    );
+    assert_exit(&out, 0);
+    let fmu = dir.join("PythonPd.fmu");
+    assert!(fmu.is_file(), "pythonfmu build wrote no PythonPd.fmu: {}", stderr(&out));
+    fmu
+}
+
+/// The shared libpython of the venv's interpreter. pythonfmu's binary calls the Python C API
+/// but does not link libpython (it expects to be loaded by a Python process, as FMPy is):
+/// another host, here `controller-fmu`, must have it loaded (`LD_PRELOAD`).
+fn libpython() -> PathBuf {
+    let code =
+        "import os, sysconfig as s; print(os.path.join(s.get_config_var('LIBDIR'), s.get_config_var('INSTSONAME')))";
+    let out = output(Command::new(fmpy_venv().join("bin/python")).arg("-c").arg(code));
+    assert_exit(&out, 0);
+    let lib = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+    assert!(
+        lib.is_file(),
+        "the venv's Python has no shared libpython at {} (a pythonfmu FMU needs one)",
+        lib.display()
+    );
+    lib
+}
+
+/// Issue 29 item 3: a `pd` built with pythonfmu (PyPI) and `pd.c` compiled against the FMI
+/// headers FMPy ships (FMI 2.0 and 3.0 co-simulation), each doing the Rust `pd`'s arithmetic,
+/// write the Rust `pd`'s trace of `config/cosim-10g.toml` (50 ms, the shock from 10 ms: through
+/// the touchdown) byte for byte, in lockstep through `controller-fmu`; the pythonfmu FMU also
+/// in sampled mode (hosted in the plant's process).
+#[test]
+fn pythonfmu_and_fmpy_header_pds_write_the_rust_pds_cosim_trace_byte_for_byte() {
+    let dir = TempDir::new("fmu-outside-tools");
+    let cosim = scene("cosim-10g.toml");
+    let params = pd_params(&cosim, &short("sampled", &[]));
+    let rust = dir.join("rust");
+    assert_exit(&run(&cosim, &rust, &short("sampled", &["controller.law=\"pd\"".into()])), 0);
+    let reference = trace(&rust);
+    assert_eq!(reference.iter().filter(|b| **b == b'\n').count(), 1002, "a header and rows 0 to 1000");
+    let s = read_json(&rust.join("summary.json"));
+    assert!(s["max_contact_force_n"].as_f64().unwrap_or_default() > 0.0, "the window has the touchdown: {s:#}");
+    let c2 = pd_fmu_with(&dir, Kind::Cs2, 2, Headers::Fmpy);
+    let c3 = pd_fmu_with(&dir, Kind::Cs3, 2, Headers::Fmpy);
+    let py = pythonfmu_pd(&dir);
+    let preload = libpython();
+    for (name, fmu, mode) in [
+        ("c-fmi2-fmpy-headers", &c2, "lockstep"),
+        ("c-fmi3-fmpy-headers", &c3, "lockstep"),
+        ("pythonfmu", &py, "lockstep"),
+        ("pythonfmu-sampled", &py, "sampled"),
+    ] {
+        let out = dir.join(name);
+        host_built();
+        let mut cmd = Command::new(plant_bin());
+        cmd.arg("run").arg(&cosim).arg("--out").arg(&out);
+        for s in short(mode, &[fmu_set(fmu), params.clone()]) {
+            cmd.args(["--set", &s]);
+        }
+        if fmu == &py {
+            cmd.env("LD_PRELOAD", &preload);
+        }
+        let ran = output(&mut cmd);
+        assert_exit(&ran, 0);
+        let log = std::fs::read_to_string(out.join("controller.log")).unwrap_or_default();
+        assert!(trace(&out) == reference, "{name}: the trace differs from the Rust pd's\n{log}");
+        if mode == "lockstep" {
+            let s = read_json(&out.join("summary.json"));
+            assert!(s["cosim"]["controller"].as_str().unwrap_or_default().starts_with("fmu: k_e"), "{name}: {s:#}");
+        }
+    }
+    // The pythonfmu FMU computes: another gain, another trace.
+    let out = dir.join("pythonfmu-other-gain");
+    let kp = pd_params(&cosim, &short("sampled", &["controller.stiffness_n_per_m=1.1e6".into()]));
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("run").arg(&cosim).arg("--out").arg(&out).env("LD_PRELOAD", &preload);
+    for s in short("lockstep", &[fmu_set(&py), kp]) {
+        cmd.args(["--set", &s]);
+    }
+    assert_exit(&output(&mut cmd), 0);
+    assert!(trace(&out) != reference, "another k_p must change the pythonfmu FMU's trace");
+}
+
+/// A four-axis FMU (FMI 2.0 co-simulation, compiled against FMPy's headers) drives the two-plane rotor in lockstep: the Rust
 /// `pd`'s trace (one law per plane, each with its plane's design) byte for byte; and realtime
 /// runs it to the end.
 #[test]
@@ -248,7 +386,7 @@ fn a_four_axis_fmu_drives_the_two_plane_rotor() {
     let params = pd_params(&two_plane, &brief("sampled", &[]));
     let rust = dir.join("rust");
     assert_exit(&run(&two_plane, &rust, &brief("sampled", &[])), 0);
-    let fmu = pd_fmu(&dir, Kind::Cs2, 4);
+    let fmu = pd_fmu_with(&dir, Kind::Cs2, 4, Headers::Fmpy);
     let out = dir.join("fmu");
     assert_exit(&run(&two_plane, &out, &brief("lockstep", &[fmu_set(&fmu), params.clone()])), 0);
     assert!(trace(&out) == trace(&rust), "the four-axis FMU's trace differs from the Rust pd's");

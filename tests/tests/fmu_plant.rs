@@ -13,12 +13,12 @@
 //! state, a diverging plant) returns `fmi2Error` with a log line, never a crash.
 //!
 //! The FMPy test runs in its own virtual environment under the target folder
-//! (`target/fmpy-venv`: FMPy from PyPI and the Python kit, made once and reused while its
-//! stamp matches), as `tests/tests/python.rs` makes the kit's.
+//! (`target/fmpy-venv`: FMPy and pythonfmu from PyPI and the Python kit, made once and reused
+//! while its stamp matches, `common::fmpy_venv`), as `tests/tests/python.rs` makes the kit's.
 
 mod common;
 
-use common::{assert_exit, output_within, plant_bin, scene, stderr, workspace_root, Csv, TempDir};
+use common::{assert_exit, fmpy_venv, output_within, plant_bin, scene, stderr, workspace_root, Csv, TempDir};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -27,9 +27,6 @@ use std::time::Duration;
 
 /// The limit of one command.
 const LIMIT: Duration = Duration::from_secs(120);
-
-/// The FMPy release the test installs.
-const FMPY: &str = "0.3.32";
 
 /// The scene of these tests: the study's 10 G scene, 30 ms with the shock at 5 ms (the rotor
 /// touches its race from 7.5 ms on, tick 151).
@@ -538,38 +535,6 @@ fn bad_calls_return_an_error_and_a_log_line_never_a_crash() {
 }
 
 // ----- FMPy -----
-
-/// `target/fmpy-venv` with FMPy and the Python kit: made if absent or stale, under a file lock.
-fn fmpy_venv() -> &'static Path {
-    static VENV: OnceLock<PathBuf> = OnceLock::new();
-    VENV.get_or_init(|| {
-        let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().expect("CARGO_TARGET_TMPDIR is target/tmp");
-        let dir = target.join("fmpy-venv");
-        let kit = workspace_root().join("python");
-        let pyproject = std::fs::read_to_string(kit.join("pyproject.toml")).expect("python/pyproject.toml");
-        let stamp = format!("fmpy {FMPY}\nkit: {}\n{pyproject}", kit.display());
-        let lock = std::fs::File::create(target.join("fmpy-venv.lock")).expect("venv lock file");
-        lock.lock().expect("locking the venv");
-        let stamp_file = dir.join("amb-testbed.stamp");
-        if dir.join("bin/python").exists() && std::fs::read_to_string(&stamp_file).ok().as_deref() == Some(&stamp) {
-            return dir;
-        }
-        let _ = std::fs::remove_dir_all(&dir);
-        let venv = output_within(Command::new("python3").arg("-m").arg("venv").arg(&dir), Duration::from_secs(120));
-        assert_exit(&venv, 0);
-        let install = output_within(
-            Command::new(dir.join("bin/python"))
-                .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
-                .arg(format!("fmpy=={FMPY}"))
-                .arg("--editable")
-                .arg(&kit),
-            Duration::from_secs(600),
-        );
-        assert_exit(&install, 0);
-        std::fs::write(&stamp_file, stamp).expect("venv stamp");
-        dir
-    })
-}
 
 fn fmpy_python() -> PathBuf {
     fmpy_venv().join("bin/python")

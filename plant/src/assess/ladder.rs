@@ -9,6 +9,19 @@
 //! (0.9), or at `members`: the question each rung answers is whether recovery is at least
 //! 90 % likely there. The ladder's answer is the highest peak up to which every rung's lower
 //! bound is ≥ `min_p`.
+//!
+//! **A member ends once its outcome is decided** (`end_when_decided`, the default; [`Decision`]):
+//! when the loop's free decay was measured stable (the sensitivity part's probe at speed), the
+//! shock programme is over, the rotor has touched neither touchdown bearing for the steady
+//! window's length (the last 200 revolutions, over which a full run's mode is read), and the
+//! largest radius of its orbit has stopped growing (the last block of 50 revolutions no larger
+//! than the one before, or both within 5 % of the air gap). Such a member would be classified
+//! `recovered` with the same last contact at the scene's end: a stable loop whose rotor is clear
+//! and settling is not driven into the bearing again without a shock, and nothing of the duty
+//! accrues without contact. Its steady window is then taken as the full run's (its start
+//! `duration − 200 revolutions`), so that the verification of late recoveries decides as before.
+//! Every other member (still touching, rebounding, whirling, diverged, or an unstable or unprobed
+//! loop) runs to the scene's end.
 
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
@@ -18,11 +31,12 @@ use crate::ensemble::member::{
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
 use crate::grid::Point;
-use crate::hooks::Cancel;
-use crate::run::{run_into, Outcome, RunResult};
-use crate::trace::Trace;
+use crate::hooks::Hooks;
+use crate::run::{run_into, Outcome, RunResult, Sink};
+use crate::trace::{col, Record, Trace};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::cell::Cell;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -43,6 +57,9 @@ pub struct Settings {
     pub min_p: f64,
     /// The rung whose duty goes into the verdict (G).
     pub duty_g: f64,
+    /// End a member's run once its outcome is decided (module doc); `false`: every member runs
+    /// to the scene's end.
+    pub end_when_decided: bool,
 }
 
 impl Default for Settings {
@@ -55,6 +72,7 @@ impl Default for Settings {
             verify: true,
             min_p: 0.9,
             duty_g: 10.0,
+            end_when_decided: true,
         }
     }
 }
@@ -169,6 +187,11 @@ pub struct LadderResult {
     pub members_run: usize,
     /// Members re-run at the reference setting.
     pub verified: usize,
+    /// Members whose counted run ended once its outcome was decided (module doc).
+    pub ended_when_decided: usize,
+    /// Simulated time of all the members' runs, verification included (s): for co-simulation,
+    /// the round trips are this over the controller's period.
+    pub simulated_s: f64,
     /// True when interrupted before every rung was decided.
     pub interrupted: bool,
 }
@@ -189,6 +212,135 @@ pub struct NotControlling(pub String);
 struct Counted {
     result: MemberResult,
     duty: Duty,
+    /// The counted run ended once decided.
+    decided: bool,
+    /// Simulated time of the member's runs (s).
+    simulated_s: f64,
+}
+
+/// Revolutions per block of the orbit's envelope in [`Decision`].
+const BLOCK_REVOLUTIONS: f64 = 50.0;
+
+/// An orbit whose largest radius stays within this share of the air gap has settled (the
+/// unbalance orbit of the study's rotor is about 1.3 % of it).
+const SETTLED_RADIUS: f64 = 0.05;
+
+/// Whether a ladder member's outcome is decided before the scene's end (module doc): fed each
+/// output sample by [`Watch`], read after each tick by [`MemberHooks`].
+pub struct Decision {
+    /// When the shock programme is over (s).
+    shock_end: f64,
+    /// The steady window's length (s).
+    window: f64,
+    /// One block of the envelope (s).
+    block: f64,
+    /// Each bearing plane's air gap (m).
+    gaps: Vec<f64>,
+    /// Last sample with contact at either bearing (s).
+    last_contact: Cell<f64>,
+    /// The block being filled, and its largest radius (share of the gap).
+    current: Cell<(i64, f64)>,
+    /// The largest radius of the last two completed blocks, older first.
+    completed: Cell<[Option<f64>; 2]>,
+    /// Decided: the run may end.
+    decided: Cell<bool>,
+}
+
+impl Decision {
+    /// The decision for a member of `scene`; `None` when the rotor does not spin (no steady
+    /// window) or `enabled` is false.
+    pub fn new(scene: &Scene, enabled: bool) -> Option<Self> {
+        let window = crate::figures::analysis_spec(scene).window_length();
+        if !enabled || window.is_nan() || window <= 0.0 {
+            return None;
+        }
+        let gaps = scene.rotor.bearings().map(|p| p.contact.gap).collect();
+        Some(Self {
+            shock_end: scene.base.breakpoints().last().copied().unwrap_or(0.0),
+            window,
+            block: window * BLOCK_REVOLUTIONS / crate::analysis::STEADY_REVOLUTIONS,
+            gaps,
+            last_contact: Cell::new(f64::NEG_INFINITY),
+            current: Cell::new((i64::MIN, 0.0)),
+            completed: Cell::new([None, None]),
+            decided: Cell::new(false),
+        })
+    }
+
+    /// The start of the steady window of the scene's full run (s): what a decided member's
+    /// figures carry (the verification of late recoveries reads it).
+    pub fn full_window_start(&self, scene: &Scene) -> f64 {
+        (scene.duration - self.window).max(0.0)
+    }
+
+    /// One output sample.
+    fn sample(&self, record: &Record) {
+        let t = record.a[col::T_S];
+        let mut radius: f64 = 0.0;
+        for (i, gap) in self.gaps.iter().enumerate().take(record.planes()) {
+            let row = record.plane(i);
+            if row[col::CONTACT_FORCE_N] > 0.0 {
+                self.last_contact.set(t);
+            }
+            radius = radius.max(row[col::DX_M].hypot(row[col::DY_M]) / gap);
+        }
+        let k = (t / self.block).floor() as i64;
+        let (index, peak) = self.current.get();
+        if k == index {
+            self.current.set((index, peak.max(radius)));
+            return;
+        }
+        // A block is complete: its peak joins the last two, and the decision is taken here.
+        let mut completed = self.completed.get();
+        if index != i64::MIN {
+            completed = [completed[1], Some(peak)];
+            self.completed.set(completed);
+        }
+        self.current.set((k, radius));
+        let clear_since = self.last_contact.get().max(self.shock_end);
+        let settled = match completed {
+            [Some(before), Some(last)] => last <= before.max(SETTLED_RADIUS),
+            _ => false,
+        };
+        if t - clear_since >= self.window && settled {
+            self.decided.set(true);
+        }
+    }
+}
+
+/// The sink of a member's run: the samples go on to `inner`, and to the decision.
+struct Watch<'a> {
+    inner: &'a mut dyn Sink,
+    decision: Option<&'a Decision>,
+}
+
+impl Sink for Watch<'_> {
+    fn sample(&mut self, record: &Record) {
+        self.inner.sample(record);
+        if let Some(d) = self.decision {
+            d.sample(record);
+        }
+    }
+
+    fn planes(&mut self, planes: &dyn crate::run::PlaneStates) {
+        self.inner.planes(planes);
+    }
+}
+
+/// The hooks of a member's run: stopped by the flag (SIGINT/SIGTERM), ended once decided.
+struct MemberHooks<'a> {
+    stop: &'a AtomicBool,
+    decision: Option<&'a Decision>,
+}
+
+impl Hooks for MemberHooks<'_> {
+    fn cancelled(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    fn finished(&self) -> bool {
+        self.decision.is_some_and(|d| d.decided.get())
+    }
 }
 
 /// The overrides that give rung peak `g` (G) to the scene's programme.
@@ -213,15 +365,27 @@ fn run_counted(
     spec: &EnsembleSpec,
     j: usize,
     bearing: Bearing,
+    end_when_decided: bool,
     stop: &AtomicBool,
 ) -> anyhow::Result<Option<Counted>> {
-    let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty)>> {
+    // The figures of a run, a decided one's steady window taken as the full run's.
+    let figures_of = |scene: &Scene, result: &RunResult, decision: &Option<Decision>| {
+        let (mut f, _) = figures(scene, result);
+        if let Some(d) = decision.as_ref().filter(|d| d.decided.get()) {
+            f.steady_window_start_s = d.full_window_start(scene);
+        }
+        f
+    };
+    let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty, Option<Decision>)>> {
         let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
         // Every plane's touchdown bearing has the scene's ball set (`[touchdown]`).
         let balls = scene.plane(0).balls.count();
-        let mut sink = DutySink::new(&mut trace, bearing, balls);
-        let run = run_into(scene, &crate::cosim::Launch::default(), &mut Cancel(stop), &mut sink)?;
-        let duty = sink.finish();
+        let decision = Decision::new(scene, end_when_decided);
+        let mut hooks = MemberHooks { stop, decision: decision.as_ref() };
+        let mut duty_sink = DutySink::new(&mut trace, bearing, balls);
+        let mut sink = Watch { inner: &mut duty_sink, decision: decision.as_ref() };
+        let run = run_into(scene, &crate::cosim::Launch::default(), &mut hooks, &mut sink)?;
+        let duty = duty_sink.finish();
         match &run.outcome {
             Outcome::Interrupted => return Ok(None),
             // Ctrl-C in a terminal stops the controller process too: interrupted, not lost.
@@ -234,12 +398,14 @@ fn run_counted(
             Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),
             Outcome::Completed | Outcome::Diverged(_) => {}
         }
-        Ok(Some((RunResult { trace, run }, duty)))
+        Ok(Some((RunResult { trace, run }, duty, decision)))
     };
     let (sets, draw, drawn) = member_overrides(point, spec, j);
     let scene = load_scene(point.path, &sets)?;
-    let Some((result, mut duty)) = run(&scene)? else { return Ok(None) };
-    let (first, _) = figures(&scene, &result);
+    let Some((result, mut duty, decision)) = run(&scene)? else { return Ok(None) };
+    let first = figures_of(&scene, &result, &decision);
+    let mut simulated_s = result.run.simulated;
+    let mut decided = decision.is_some_and(|d| d.decided.get());
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
@@ -247,8 +413,10 @@ fn run_counted(
         sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
         sets.extend(drawn.iter().cloned());
         let reference = load_scene(point.path, &sets)?;
-        let Some((result, d)) = run(&reference)? else { return Ok(None) };
-        verified = Some(figures(&reference, &result).0);
+        let Some((result, d, decision)) = run(&reference)? else { return Ok(None) };
+        verified = Some(figures_of(&reference, &result, &decision));
+        simulated_s += result.run.simulated;
+        decided = decision.is_some_and(|d| d.decided.get());
         duty = d;
     }
     Ok(Some(Counted {
@@ -262,17 +430,22 @@ fn run_counted(
             poincare: Vec::new(),
         },
         duty,
+        decided,
+        simulated_s,
     }))
 }
 
 /// Runs the ladder for the controller whose scene is `path` with `sets`. A member that fails
 /// (its controller lost, a run that cannot start) stops the ladder after its round: the result
 /// then holds the rungs so far, the undecided ones marked incomplete, with the error beside it.
+/// `stable`: the loop's free decay at speed was measured stable (the members may then end once
+/// decided, with `settings.end_when_decided`; module doc).
 pub fn ladder(
     path: &Path,
     sets: &[String],
     settings: &Settings,
     bearing: Bearing,
+    stable: bool,
     stop: &AtomicBool,
     log: &(dyn Fn(&str) + Sync),
 ) -> anyhow::Result<(LadderResult, Option<anyhow::Error>)> {
@@ -292,7 +465,14 @@ pub fn ladder(
         let scene = load_scene(path, &s)?;
         points.push(Point { path, sets: s, scene, index: i, values: vec![*g] });
     }
-    let member_setting = crate::ensemble::member::setting_description(&base, &spec);
+    let end_early = settings.end_when_decided && stable;
+    let mut member_setting = crate::ensemble::member::setting_description(&base, &spec);
+    if end_early {
+        member_setting.push_str(
+            "; a member ends once its outcome is decided: the shock over, the rotor clear of the touchdown bearing \
+             for 200 revolutions and its orbit no longer growing (the loop measured stable)",
+        );
+    }
     let mut counted: Vec<Vec<Counted>> = points.iter().map(|_| Vec::new()).collect();
     let mut decided = vec![false; points.len()];
     let mut members_run = 0;
@@ -314,7 +494,7 @@ pub fn ladder(
         ));
         // A co-simulated controller's members: more at once than cores (super::COSIM_JOBS).
         let done: Vec<anyhow::Result<Option<Counted>>> = super::jobs_for(&base, || {
-            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, stop)).collect()
+            work.par_iter().map(|&(i, j)| run_counted(&points[i], &spec, j, bearing, end_early, stop)).collect()
         });
         for r in done {
             match r {
@@ -373,5 +553,69 @@ pub fn ladder(
     }
     let safe_up_to_g = rungs.iter().take_while(|r| r.complete && r.p_lo >= settings.min_p).last().map(|r| r.peak_g);
     let verified = rungs.iter().map(|r| r.verified).sum();
-    Ok((LadderResult { rungs, safe_up_to_g, member_setting, members_run, verified, interrupted }, failed))
+    let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();
+    let simulated_s = counted.iter().flatten().map(|m| m.simulated_s).sum();
+    let result = LadderResult {
+        rungs,
+        safe_up_to_g,
+        member_setting,
+        members_run,
+        verified,
+        ended_when_decided,
+        simulated_s,
+        interrupted,
+    };
+    Ok((result, failed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A member ended once decided is graded as its full run: on the 10 G scene with a
+    /// well-damped sampled PD (ξ = 0.1, stable), a rung without contact (1 G) and one every
+    /// member recovers from after touching (20 G), the rungs (modes, intervals, recovery times,
+    /// verifications, every duty figure) are those of the full runs, to the bit, and the
+    /// members simulate less.
+    #[test]
+    fn a_member_ended_once_decided_is_graded_as_its_full_run() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/paper-10g.toml");
+        let sets = ["controller.mode=\"sampled\"", "controller.law=\"pd_delay\"", "controller.damping_ratio=0.1"]
+            .map(String::from);
+        let scene = load_scene(&path, &sets).expect("scene");
+        let raw = scene.resolved().expect("resolved");
+        let t = &raw.touchdown;
+        let bearing = Bearing::new(
+            Default::default(),
+            t.ball_diameter_mm * 1e-3,
+            t.pitch_diameter_mm * 1e-3,
+            t.width_mm * 1e-3,
+            0.5,
+        );
+        let settings = |early| Settings {
+            peaks_g: vec![1.0, 20.0],
+            members: 3,
+            batch: 3,
+            end_when_decided: early,
+            ..Settings::default()
+        };
+        let stop = AtomicBool::new(false);
+        let run = |early| {
+            let (l, failed) = ladder(&path, &sets, &settings(early), bearing, true, &stop, &|_| {}).expect("ladder");
+            assert!(failed.is_none(), "{failed:?}");
+            l
+        };
+        let (early, full) = (run(true), run(false));
+        assert_eq!(early.rungs, full.rungs);
+        assert_eq!(early.safe_up_to_g, full.safe_up_to_g);
+        assert_eq!(full.ended_when_decided, 0);
+        assert_eq!(early.ended_when_decided, 6, "every member recovers: each ends once decided");
+        assert!(full.rungs[1].duty.contact_time_s.max.is_some_and(|c| c > 0.0), "20 G touches: {:?}", full.rungs[1]);
+        assert!(
+            early.simulated_s < 0.6 * full.simulated_s,
+            "{} s simulated against {} s",
+            early.simulated_s,
+            full.simulated_s
+        );
+    }
 }

@@ -618,6 +618,8 @@ fn assess_controller(
             log(&format!("{}: shock ladder", c.label));
             let t = Instant::now();
             let b = bearing(&scene, a)?;
+            // A member may end once decided only where the probe measured the loop stable.
+            let stable = decay_at_speed.is_some_and(|s| s > 0.0);
             let kind = |e: &anyhow::Error| {
                 if interrupted() {
                     Failure::Interrupted
@@ -629,7 +631,7 @@ fn assess_controller(
                     Failure::Other
                 }
             };
-            report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stop, log) {
+            report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
                 Ok((l, Some(e))) => {
                     let kind = kind(&e);
                     PartOutcome {

@@ -148,6 +148,7 @@ struct RawLadder {
     verify: Option<bool>,
     min_p: Option<f64>,
     duty_g: Option<f64>,
+    end_when_decided: Option<bool>,
 }
 
 #[derive(Deserialize, Default)]
@@ -352,6 +353,7 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         verify: l.verify.unwrap_or(dl.verify),
         min_p: number("ladder.min_p", l.min_p, dl.min_p, "", 0.0, 1.0)?,
         duty_g: number("ladder.duty_g", l.duty_g, default_duty.unwrap_or(dl.duty_g), "G", 0.0, 1e3)?,
+        end_when_decided: l.end_when_decided.unwrap_or(dl.end_when_decided),
     };
     // The verdict's duty is that of a rung: a `duty_g` on none would leave it out silently.
     if parts.contains(&Part::Ladder) && !ladder.peaks_g.iter().any(|g| (g - ladder.duty_g).abs() < 1e-9) {

@@ -19,11 +19,12 @@
 //! `failure_<scene>_<method>.png` (columns in [`super::rows`]).
 
 use super::rows::{self, AccuracyRow, AccuracyStatus, ReferenceRow, StabilityRow};
-use super::{atol_scale, measure, method_name, window_error, with_integrator, BenchScene, IntegratorSetting, WINDOW};
+use super::{atol_scale, measure, method_name, with_integrator, BenchScene, IntegratorSetting, WINDOW};
 use crate::config::Scene;
 use crate::integrate::Method;
 use crate::plot::{self, PointGroup, Scale, Series};
 use crate::run::{run, Outcome, Quiet};
+use crate::trace::window_error;
 use crate::trace::Trace;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -376,7 +377,7 @@ pub struct Request<'a> {
 /// `plant bench accuracy`: runs the bench, joins any earlier peer rows, draws the charts;
 /// returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {
-    let dir = super::out_dir(req.out, "bench-accuracy");
+    let dir = crate::output::out_dir(req.out, "bench-accuracy");
     let peer = req.peer_python.map(|python| Peer {
         script: req.config.join("..").join("bench").join("peer").join("run_peer.py"),
         python: python.to_path_buf(),
@@ -384,7 +385,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
     // Read the earlier rows first: they may live in the output folder.
     let earlier = req
         .peer_rows
-        .map(|p| rows::read_accuracy(p).map_err(|e| super::BadArgument(format!("--peer-rows: {e:#}"))))
+        .map(|p| rows::read_accuracy(p).map_err(|e| crate::exit::BadArgument(format!("--peer-rows: {e:#}"))))
         .transpose()?
         .unwrap_or_default();
     let mut report = accuracy(req.config, &dir, req.quick, req.repeats, peer.as_ref(), log)?;

@@ -196,7 +196,7 @@ pub fn command(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
-    let dir = super::out_dir(out, "bench-engineering");
+    let dir = crate::output::out_dir(out, "bench-engineering");
     engineering(config, &dir, repeats, log)?;
     Ok(dir.join("engineering.csv"))
 }

@@ -133,7 +133,7 @@ fn tally(
 
 /// Runs the bench and writes `host.csv`; returns its path.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathBuf> {
-    let bad = |why: String| -> anyhow::Error { super::BadArgument(why).into() };
+    let bad = |why: String| -> anyhow::Error { crate::exit::BadArgument(why).into() };
     if !(req.rate_hz.is_finite() && (1.0..=1e6).contains(&req.rate_hz)) {
         return Err(bad(format!("--rate-hz {}: must be from 1 to 1e6 Hz", req.rate_hz)));
     }
@@ -145,7 +145,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     }
     let period_ns = (1e9 / req.rate_hz).round() as u64;
     let ticks = ((req.seconds * req.rate_hz).round() as u64).max(1);
-    let dir = super::out_dir(req.out, "bench-host");
+    let dir = crate::output::out_dir(req.out, "bench-host");
     let _claim = crate::claim::claim(&dir, true)?;
     let scheduling = super::tick::schedule(req.pin_core, req.realtime_priority, log)?;
     let runtime = controller::link::rt_runtime_us().filter(|_| scheduling.starts_with("fifo"));
@@ -203,7 +203,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     crate::table::write_with_header(&path, HOST_HEADER, &rows)?;
     if stop.load(Ordering::Relaxed) {
         let why = format!("{} of 2 loops finished, written to {}", rows.len(), path.display());
-        return Err(super::Interrupted(why).into());
+        return Err(crate::exit::Interrupted(why).into());
     }
     Ok(path)
 }

@@ -46,7 +46,6 @@ use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::model::N;
 use crate::run::{run, Outcome, Quiet, RunResult};
-use crate::trace::Trace;
 use anyhow::Context;
 use std::path::Path;
 
@@ -109,17 +108,10 @@ impl std::fmt::Display for IntegratorSetting {
     }
 }
 
-/// Scale of the absolute tolerances of positions, velocities, angles and angular speeds (see
-/// the module doc): plane A's gap, the gap times the spin speed, a turn, the spin speed.
-pub fn atol_scale_groups(scene: &Scene) -> [f64; 4] {
-    let (r0, w) = (scene.plane(0).contact.gap, scene.rotor.speed().max(1.0));
-    [r0, r0 * w, std::f64::consts::TAU, w]
-}
-
 /// Per-component scale of the planar model's absolute tolerances ([`atol_scale_groups`] laid
 /// out as [`crate::model::ix`]).
 pub fn atol_scale(scene: &Scene) -> [f64; N] {
-    <crate::model::Model as crate::machine::Machine<N>>::atol(atol_scale_groups(scene))
+    <crate::model::Model as crate::machine::Machine<N>>::atol(scene.atol_scale_groups())
 }
 
 /// The scene with another integrator.
@@ -129,7 +121,7 @@ pub fn with_integrator(scene: &Scene, method: Method, setting: IntegratorSetting
     match setting {
         IntegratorSetting::Rtol(rtol) => {
             s.integrator.rtol = rtol;
-            s.integrator.atol_groups = atol_scale_groups(scene).map(|g| rtol * g);
+            s.integrator.atol_groups = scene.atol_scale_groups().map(|g| rtol * g);
         }
         IntegratorSetting::Substeps(n) => s.integrator.substeps = n,
     }
@@ -156,87 +148,14 @@ pub fn measure(scene: &Scene, repeats: usize) -> anyhow::Result<Measured> {
     Ok(Measured { result, best_wall })
 }
 
-/// Scaled error `|Δ − Δ_ref| / r_0` on the common samples of `[t0, t1]`: (RMS, max).
-/// A trace that stops early (diverged) counts as infinite error.
-pub fn window_error(trace: &Trace, reference: &Trace, t0: f64, t1: f64, gap: f64) -> (f64, f64) {
-    let (mut sum, mut max, mut n) = (0.0, 0.0_f64, 0usize);
-    for (i, &t) in reference.t_s.iter().enumerate() {
-        if t < t0 - 1e-12 || t > t1 + 1e-12 {
-            continue;
-        }
-        let Some(&tt) = trace.t_s.get(i) else { return (f64::INFINITY, f64::INFINITY) };
-        if (tt - t).abs() > 1e-9 {
-            return (f64::INFINITY, f64::INFINITY);
-        }
-        let e = (trace.dx_m[i] - reference.dx_m[i]).hypot(trace.dy_m[i] - reference.dy_m[i]) / gap;
-        if !e.is_finite() {
-            return (f64::INFINITY, f64::INFINITY);
-        }
-        sum += e * e;
-        max = max.max(e);
-        n += 1;
-    }
-    if n == 0 {
-        (f64::INFINITY, f64::INFINITY)
-    } else {
-        ((sum / n as f64).sqrt(), max)
-    }
-}
-
 /// A method's name as the scene file writes it (`dp5`, `symplectic_euler`).
 pub fn method_name(m: Method) -> String {
     crate::summary::snake_name(&m)
 }
 
-/// An argument of a bench command that cannot be used (bad input: exit 2).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct BadArgument(pub String);
-
-/// A bench stopped by SIGINT/SIGTERM (exit 130): what it had finished was written, as the
-/// text says.
-#[derive(Debug, thiserror::Error)]
-#[error("interrupted: {0}")]
-pub struct Interrupted(pub String);
-
-/// The output folder of a bench: `out`, or `runs/<default>`.
-pub fn out_dir(out: Option<&Path>, default: &str) -> std::path::PathBuf {
-    out.map_or_else(|| Path::new("runs").join(default), Path::to_path_buf)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn trace(t: &[f64], dx: &[f64], dy: &[f64]) -> Trace {
-        let mut tr = Trace::default();
-        for i in 0..t.len() {
-            let mut row = [0.0; crate::trace::WIDTH];
-            row[0] = t[i];
-            row[1] = dx[i];
-            row[2] = dy[i];
-            tr.push_row(&row);
-        }
-        tr
-    }
-
-    #[test]
-    fn window_error_is_the_rms_and_max_distance_over_the_window_scaled_by_the_gap() {
-        let t = [0.0, 1.0, 2.0, 3.0];
-        let reference = trace(&t, &[0.0; 4], &[0.0; 4]);
-        // Distances 5 (outside the window), 3, 4 (inside), 100 (outside); gap 2.
-        let run = trace(&t, &[3.0, 0.0, 4.0, 100.0], &[4.0, 3.0, 0.0, 0.0]);
-        let (rms, max) = window_error(&run, &reference, 1.0, 2.0, 2.0);
-        assert_eq!(max, 2.0);
-        assert!((rms - (12.5_f64 / 4.0).sqrt()).abs() < 1e-15, "{rms}");
-        // A run that stopped before the window's end, or off the reference's grid, is infinitely wrong.
-        let short = trace(&t[..2], &[0.0; 2], &[0.0; 2]);
-        assert_eq!(window_error(&short, &reference, 1.0, 2.0, 2.0), (f64::INFINITY, f64::INFINITY));
-        let shifted = trace(&[0.0, 1.5, 2.0, 3.0], &[0.0; 4], &[0.0; 4]);
-        assert_eq!(window_error(&shifted, &reference, 1.0, 2.0, 2.0), (f64::INFINITY, f64::INFINITY));
-        // An empty window too.
-        assert_eq!(window_error(&run, &reference, 5.0, 6.0, 2.0), (f64::INFINITY, f64::INFINITY));
-    }
 
     #[test]
     fn tolerances_scale_per_component_and_settings_reach_the_integrator() {

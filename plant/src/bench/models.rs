@@ -11,11 +11,12 @@
 //! of the two planes' against the planar trace, the cost against the planar model's.
 
 use super::rows::{self, ModelRow};
-use super::{measure, window_error, with_integrator, BenchScene, IntegratorSetting, WINDOW};
+use super::{measure, with_integrator, BenchScene, IntegratorSetting, WINDOW};
 use crate::config::Scene;
 use crate::integrate::Method;
 use crate::plot::{self, PointGroup};
 use crate::run::{run, Quiet};
+use crate::trace::window_error;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
@@ -215,7 +216,7 @@ pub fn command(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
-    let dir = super::out_dir(out, "bench-models");
+    let dir = crate::output::out_dir(out, "bench-models");
     models(config, &dir, repeats, log)?;
     Ok(dir.join("models.csv"))
 }

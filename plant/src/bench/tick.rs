@@ -257,7 +257,7 @@ pub fn load_average() -> f64 {
 pub fn schedule(pin_core: Option<usize>, priority: u32, log: &mut dyn FnMut(&str)) -> anyhow::Result<String> {
     let mut scheduling = String::from("other");
     if let Some(core) = pin_core {
-        controller::link::pin_to_core(core).map_err(|e| super::BadArgument(format!("--pin-core: {e}")))?;
+        controller::link::pin_to_core(core).map_err(|e| crate::exit::BadArgument(format!("--pin-core: {e}")))?;
     }
     if priority > 0 {
         let refused = controller::link::realtime(priority as i32);
@@ -318,14 +318,14 @@ fn settings(req: &Request) -> anyhow::Result<Vec<(String, Scene)>> {
 /// Runs the bench and writes `tick.csv`; returns its path.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathBuf> {
     if !(1..=1000).contains(&req.repeats) {
-        return Err(super::BadArgument(format!("--repeats {}: must be between 1 and 1000", req.repeats)).into());
+        return Err(crate::exit::BadArgument(format!("--repeats {}: must be between 1 and 1000", req.repeats)).into());
     }
     if req.realtime_priority > 99 {
         let why = format!("--realtime-priority {}: must be 0 (off) to 99", req.realtime_priority);
-        return Err(super::BadArgument(why).into());
+        return Err(crate::exit::BadArgument(why).into());
     }
     let settings = settings(req)?;
-    let dir = super::out_dir(req.out, "bench-tick");
+    let dir = crate::output::out_dir(req.out, "bench-tick");
     let _claim = crate::claim::claim(&dir, true)?;
     let scheduling = schedule(req.pin_core, req.realtime_priority, log)?;
     let stop = crate::interrupt::stop_flag();
@@ -388,7 +388,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     if stopped() {
         let planned = settings.len() * req.repeats;
         let why = format!("{} of {planned} runs finished, written to {}", rows.len(), path.display());
-        return Err(super::Interrupted(why).into());
+        return Err(crate::exit::Interrupted(why).into());
     }
 
     let (label, fixed) = &settings[0];

@@ -268,6 +268,14 @@ impl Scene {
         }
     }
 
+    /// Scale of the absolute tolerances of positions, velocities, angles and angular speeds
+    /// (`atol = rtol × scale`, the benches' and the ensembles' reference setting): plane A's
+    /// gap, the gap times the spin speed, a turn, the spin speed.
+    pub fn atol_scale_groups(&self) -> [f64; 4] {
+        let (r0, w) = (self.plane(0).contact.gap, self.rotor.speed().max(1.0));
+        [r0, r0 * w, std::f64::consts::TAU, w]
+    }
+
     /// Bearing planes: 1 (planar) or 2.
     pub fn planes(&self) -> usize {
         self.rotor.planes()

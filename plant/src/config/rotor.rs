@@ -13,6 +13,8 @@ use plant_physics::two_plane;
 
 /// The rotor of a scene, validated (SI).
 #[derive(Clone, Debug)]
+// One value per scene, built once and read by reference: its size does not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum Rotor {
     /// One bearing plane (the study's model, `rotor.model = "planar"`): its parameters.
     Planar(Params),

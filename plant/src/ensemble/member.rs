@@ -153,7 +153,7 @@ pub fn setting_description(scene: &Scene, spec: &EnsembleSpec) -> String {
 
 /// `--set` overrides of the reference setting that verifies a member.
 pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
-    let [p, v, a, w] = crate::bench::atol_scale_groups(scene);
+    let [p, v, a, w] = scene.atol_scale_groups();
     vec![
         "integrator.method=\"dop853\"".into(),
         format!("integrator.rtol={rtol:?}"),

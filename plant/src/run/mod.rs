@@ -400,6 +400,9 @@ fn drive(
             outcome = Outcome::Interrupted;
             break;
         }
+        if hooks.finished() {
+            break;
+        }
     }
     let wall_time = start.elapsed().as_secs_f64();
     let t = plant.time();

@@ -470,3 +470,43 @@ impl Png {
 
 /// The first series colour of the charts (matplotlib's tab10 blue).
 pub const SERIES_BLUE: [u8; 3] = [0x1f, 0x77, 0xb4];
+
+/// The FMPy release the FMU tests install.
+pub const FMPY: &str = "0.3.32";
+/// The pythonfmu release the FMU tests install (builds a Python controller FMU).
+pub const PYTHONFMU: &str = "0.7.0";
+
+/// `target/fmpy-venv` with FMPy, pythonfmu and the Python kit (tests/tests/fmu_plant.rs,
+/// fmu_controller.rs): made if absent or stale, under a file lock.
+pub fn fmpy_venv() -> &'static Path {
+    static VENV: OnceLock<PathBuf> = OnceLock::new();
+    VENV.get_or_init(|| {
+        let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().expect("CARGO_TARGET_TMPDIR is target/tmp");
+        let dir = target.join("fmpy-venv");
+        let kit = workspace_root().join("python");
+        let pyproject = std::fs::read_to_string(kit.join("pyproject.toml")).expect("python/pyproject.toml");
+        let stamp = format!("fmpy {FMPY}\npythonfmu {PYTHONFMU}\nkit: {}\n{pyproject}", kit.display());
+        let lock = std::fs::File::create(target.join("fmpy-venv.lock")).expect("venv lock file");
+        lock.lock().expect("locking the venv");
+        let stamp_file = dir.join("amb-testbed.stamp");
+        if dir.join("bin/python").exists() && std::fs::read_to_string(&stamp_file).ok().as_deref() == Some(&stamp) {
+            return dir;
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+        let venv =
+            output_within(Command::new("python3").arg("-m").arg("venv").arg(&dir), std::time::Duration::from_secs(120));
+        assert_exit(&venv, 0);
+        let install = output_within(
+            Command::new(dir.join("bin/python"))
+                .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+                .arg(format!("fmpy=={FMPY}"))
+                .arg(format!("pythonfmu=={PYTHONFMU}"))
+                .arg("--editable")
+                .arg(&kit),
+            std::time::Duration::from_secs(600),
+        );
+        assert_exit(&install, 0);
+        std::fs::write(&stamp_file, stamp).expect("venv stamp");
+        dir
+    })
+}
