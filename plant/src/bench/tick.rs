@@ -129,6 +129,29 @@ fn repeat_two_plane_contact_tick(
     time_repeated_tick(scene, &model, settings, y0, repeats)
 }
 
+/// [`repeat_two_plane_contact_tick`] for the flexible rotor: the two-plane contact state (its
+/// AMB nodes 2 µm into the races) as a rigid motion of the shaft, so where the touchdown nodes
+/// are the AMB nodes, both press into their races.
+fn repeat_flexible_contact_tick(
+    scene: &Scene,
+    params: &plant_physics::flex::machine::Params,
+    repeats: u64,
+) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+    use crate::model::Control;
+    use plant_physics::flex::machine::Model;
+    let gains = crate::run::plane_gains(scene)?;
+    let bias = crate::run::bias_of(scene, &gains);
+    let model = Model {
+        params: params.clone(),
+        base: scene.base.clone(),
+        control: [Control::Held([bias[0], bias[1]]), Control::Held([bias[2], bias[3]])],
+        race_parked: [false; 2],
+    };
+    let y0 = Model::from_rigid(params, &two_plane_contact_state(scene, &params.machine));
+    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
+    time_repeated_tick(scene, &model, settings, y0, repeats)
+}
+
 /// The two-plane rotor's initial state with both bearing planes 2 µm into their races,
 /// straight down, and centred on them in x. Plane i's rotor position is `X + z_i a`,
 /// `Y + z_i b`: two planes, two unknowns per axis.
@@ -373,6 +396,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
     let (p, rhs_evals) = match &fixed.rotor {
         Rotor::Planar(params) => repeat_contact_tick(fixed, params, repeats)?,
         Rotor::TwoPlane(params) => repeat_two_plane_contact_tick(fixed, params, repeats)?,
+        Rotor::Flexible(params) => repeat_flexible_contact_tick(fixed, params, repeats)?,
     };
     let repeat = RepeatRow {
         setting: format!("one contact tick repeated, {label}"),

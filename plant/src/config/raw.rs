@@ -74,7 +74,7 @@ scene_table! {
 /// machine has 23 kg and 11.62e-3 kg·m², docs/MODEL.md §10.1). The keys after `drive_*` are the
 /// two-plane rotor's, `None` unless given, and refused in a planar scene.
 pub struct RawRotor {
-    /// `planar` or `two_plane`.
+    /// `planar`, `two_plane` or `flexible`.
     pub model: RotorModel = RotorModel::Planar,
     /// m_r (kg); two-plane: the whole rotor's mass M.
     pub mass_kg: f64 = 11.5,
@@ -125,6 +125,38 @@ pub struct RawRotor {
     /// Two-plane: axial position of the rotor's end on plane B's side (mm); none: 230.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_b_mm: Option<f64> = None,
+    /// Flexible: the shaft as a table of elements, materials and disks (`[rotor.shaft]`,
+    /// `plant_physics::flex::table`); this or `ross_file`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shaft: Option<plant_physics::flex::table::ShaftTable> = None,
+    /// Flexible: a rotor saved by ROSS's `Rotor.save()` (path from the scene's folder); this or
+    /// `shaft`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ross_file: Option<String> = None,
+    /// Flexible: the node of AMB A (on the −z side of the centre of mass).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amb_a_node: Option<usize> = None,
+    /// Flexible: the node of AMB B (on the +z side of the centre of mass).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amb_b_node: Option<usize> = None,
+    /// Flexible: the node of plane A's displacement sensor; none: `amb_a_node` (collocated).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_a_node: Option<usize> = None,
+    /// Flexible: the node of plane B's displacement sensor; none: `amb_b_node`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_b_node: Option<usize> = None,
+    /// Flexible: the node of touchdown bearing A; none: `amb_a_node`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub touchdown_a_node: Option<usize> = None,
+    /// Flexible: the node of touchdown bearing B; none: `amb_b_node`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub touchdown_b_node: Option<usize> = None,
+    /// Flexible: keep the shaft's modes below this frequency (Hz); none: 2000.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64> = None,
+    /// Flexible: modal damping ratio ζ of every bending mode; none: 0.005.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modal_damping: Option<f64> = None,
 }
 }
 
@@ -137,6 +169,8 @@ pub enum RotorModel {
     Planar,
     /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
     TwoPlane,
+    /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
+    Flexible,
 }
 
 scene_table! {

@@ -8,6 +8,7 @@
 
 use super::RotorModel;
 use crate::model::Params;
+use plant_physics::flex::machine as flexible;
 use plant_physics::two_plane;
 
 /// The rotor of a scene, validated (SI).
@@ -19,6 +20,8 @@ pub enum Rotor {
     Planar(Params),
     /// The whole rigid rotor on two bearing planes, A and B (`rotor.model = "two_plane"`).
     TwoPlane(two_plane::Params),
+    /// A flexible shaft on two bearing planes, A and B (`rotor.model = "flexible"`).
+    Flexible(flexible::Params),
 }
 
 impl Rotor {
@@ -27,6 +30,7 @@ impl Rotor {
         match self {
             Rotor::Planar(_) => RotorModel::Planar,
             Rotor::TwoPlane(_) => RotorModel::TwoPlane,
+            Rotor::Flexible(_) => RotorModel::Flexible,
         }
     }
 
@@ -35,6 +39,7 @@ impl Rotor {
         match self {
             Rotor::Planar(_) => 1,
             Rotor::TwoPlane(m) => m.planes.len(),
+            Rotor::Flexible(f) => f.machine.planes.len(),
         }
     }
 
@@ -47,6 +52,7 @@ impl Rotor {
                 p
             }
             Rotor::TwoPlane(m) => &m.planes[i].params,
+            Rotor::Flexible(f) => &f.machine.planes[i].params,
         }
     }
 
@@ -58,6 +64,7 @@ impl Rotor {
                 p
             }
             Rotor::TwoPlane(m) => &mut m.planes[i].params,
+            Rotor::Flexible(f) => &mut f.machine.planes[i].params,
         }
     }
 
@@ -77,6 +84,7 @@ impl Rotor {
         match self {
             Rotor::Planar(_) => None,
             Rotor::TwoPlane(m) => m.planes.iter().position(|p| p.sensor != p.station),
+            Rotor::Flexible(f) => f.nodes.iter().position(|n| n.sensor != n.amb),
         }
     }
 
@@ -86,45 +94,44 @@ impl Rotor {
     /// the other plane's sensor where it was (both modes, translation and tilt, start to move).
     pub fn sensor_offset(&self, axis: usize, offset_um: f64) -> Vec<String> {
         let xy = ["x", "y"][axis % 2];
-        match self {
-            Rotor::Planar(_) => vec![format!("initial.rotor_{xy}_um={offset_um:?}")],
-            Rotor::TwoPlane(m) => {
-                let (own, other) = (m.planes[axis / 2].sensor, m.planes[1 - axis / 2].sensor);
-                // x(z) = x₀ + a z: offset_um at z = own, 0 at z = other (µm, µrad for z in m).
-                let slope = offset_um / (own - other);
-                vec![
-                    format!("initial.rotor_{xy}_um={:?}", -slope * other),
-                    format!("initial.slope_{xy}_urad={slope:?}"),
-                ]
-            }
-        }
+        let machine = match self {
+            Rotor::Planar(_) => return vec![format!("initial.rotor_{xy}_um={offset_um:?}")],
+            Rotor::TwoPlane(m) => m,
+            // The rigid motion that moves the sensor node: the flexible rotor starts rigid.
+            Rotor::Flexible(f) => &f.machine,
+        };
+        let (own, other) = (machine.planes[axis / 2].sensor, machine.planes[1 - axis / 2].sensor);
+        // x(z) = x₀ + a z: offset_um at z = own, 0 at z = other (µm, µrad for z in m).
+        let slope = offset_um / (own - other);
+        vec![format!("initial.rotor_{xy}_um={:?}", -slope * other), format!("initial.slope_{xy}_urad={slope:?}")]
     }
 
     /// Whether the rotor tilts (its trace and analysis have the tilt's columns and figures).
     pub fn tilts(&self) -> bool {
         match self {
             Rotor::Planar(_) => false,
-            Rotor::TwoPlane(_) => true,
+            Rotor::TwoPlane(_) | Rotor::Flexible(_) => true,
         }
     }
 
     /// The whole rotor's geometry as a law sees it (`None` for the planar model, which has
     /// one plane and no tilt).
     pub fn geometry(&self) -> Option<controller::Geometry> {
-        match self {
-            Rotor::Planar(_) => None,
-            Rotor::TwoPlane(m) => {
-                let [a, b] = &m.planes;
-                Some(controller::Geometry {
-                    mass_kg: m.rotor.mass,
-                    transverse_inertia_kg_m2: m.rotor.transverse_inertia,
-                    polar_inertia_kg_m2: m.rotor.polar_inertia,
-                    rated_speed_rad_s: m.rotor.speed,
-                    bearing_z_m: [a.station, b.station],
-                    sensor_z_m: [a.sensor, b.sensor],
-                })
-            }
-        }
+        let m = match self {
+            Rotor::Planar(_) => return None,
+            Rotor::TwoPlane(m) => m,
+            // The rigid body of the shaft, its AMBs and sensors at their nodes.
+            Rotor::Flexible(f) => &f.machine,
+        };
+        let [a, b] = &m.planes;
+        Some(controller::Geometry {
+            mass_kg: m.rotor.mass,
+            transverse_inertia_kg_m2: m.rotor.transverse_inertia,
+            polar_inertia_kg_m2: m.rotor.polar_inertia,
+            rated_speed_rad_s: m.rotor.speed,
+            bearing_z_m: [a.station, b.station],
+            sensor_z_m: [a.sensor, b.sensor],
+        })
     }
 
     /// Absolute tolerances per state component of the model, laid out from those of
@@ -135,6 +142,7 @@ impl Rotor {
         match self {
             Rotor::Planar(_) => crate::model::Model::atol(groups).to_vec(),
             Rotor::TwoPlane(_) => two_plane::Model::atol(groups).to_vec(),
+            Rotor::Flexible(_) => flexible::Model::atol(groups).to_vec(),
         }
     }
 
@@ -146,6 +154,7 @@ impl Rotor {
         match self {
             Rotor::Planar(_) => crate::model::Model::failure(t, y.get(..crate::model::N)?.try_into().ok()?),
             Rotor::TwoPlane(_) => two_plane::Model::failure(t, y.get(..two_plane::N)?.try_into().ok()?),
+            Rotor::Flexible(_) => flexible::Model::failure(t, y.get(..flexible::N)?.try_into().ok()?),
         }
         .into()
     }
@@ -157,6 +166,7 @@ impl RotorModel {
         match self {
             RotorModel::Planar => "planar",
             RotorModel::TwoPlane => "two_plane",
+            RotorModel::Flexible => "flexible",
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The rotor models the run loop steps, behind one trait: the planar model (one bearing plane,
-//! the study's, [`planar`]) and the two-plane rotor (two bearing planes, tilt, [`two_plane`]).
+//! the study's, [`planar`]), the two-plane rotor (two bearing planes, tilt, [`two_plane`]) and
+//! the flexible rotor (a reduced finite-element shaft on two bearing planes, [`flexible`]).
 //! The loop ([`crate::run`]) is generic over it, so that the planar model runs the very code it
 //! ran before the second plane existed: its `trace.csv` is unchanged byte for byte.
 //!
@@ -8,9 +9,11 @@
 //! plane's state for the touchdown bearing's duty, its failing state) is answered here, one
 //! file per model.
 
+mod flexible;
 mod planar;
 mod two_plane;
 
+pub use flexible::FlexibleFailure;
 pub use planar::PlanarFailure;
 pub use two_plane::{RaceFailure, TwoPlaneFailure};
 
@@ -54,6 +57,8 @@ pub enum FailureState {
     Planar(PlanarFailure),
     /// The two-plane rotor's.
     TwoPlane(TwoPlaneFailure),
+    /// The flexible rotor's.
+    Flexible(FlexibleFailure),
 }
 
 /// A rotor model on a state of `N` numbers with one or two bearing planes, each with its AMB,

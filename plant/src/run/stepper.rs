@@ -150,6 +150,20 @@ impl Plant {
                 let y = crate::initial::two_plane_initial_state(scene, params);
                 stepper_of!(scene, model, y, two_plane::N, controls, gains, timed)
             }
+            Rotor::Flexible(params) => {
+                use plant_physics::flex::machine as flexible;
+                // The rigid two-plane rotor's initial state (levitated on the unbalance orbit),
+                // projected on the shaft's basis.
+                let rigid = crate::initial::two_plane_initial_state(scene, &params.machine);
+                let y = flexible::Model::from_rigid(params, &rigid);
+                let model = flexible::Model {
+                    params: params.clone(),
+                    base: scene.base.clone(),
+                    control: controls,
+                    race_parked: [false; 2],
+                };
+                stepper_of!(scene, model, y, flexible::N, controls, gains, timed)
+            }
         };
         let fingerprint = Fingerprint::of(scene, core.state().len());
         let mut plant = Self { core, sample: RotorSample::default(), fingerprint };

@@ -5,9 +5,10 @@
 //! described: a file saved by ROSS's `Rotor.save()` ([`ross`]) or a table of elements that a
 //! scene embeds ([`table`]).
 //!
-//! Not yet wired into the plant's scenes: [`reduce::Reduced::derivative`] is the kernel the
-//! rotor seam calls, given the reduced state, the spin speed and the forces at the force nodes.
+//! [`machine`] is the rotor the plant steps (`rotor.model = "flexible"`): the reduced shaft
+//! with two AMBs, two sensors and two touchdown bearings at its nodes.
 
+pub mod machine;
 pub mod modes;
 pub mod reduce;
 pub mod ross;

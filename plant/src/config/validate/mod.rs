@@ -37,12 +37,14 @@ use std::path::Path;
 mod bearing;
 mod checks;
 mod controller_keys;
+mod flexible_keys;
 mod hardware_keys;
 mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
 pub use checks::{finite, non_negative, positive, range};
 use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
+use flexible_keys::{flexible_params, record_flexible, refuse_flexible_keys};
 use hardware_keys::hardware;
 use two_plane_keys::{record_two_plane, refuse_two_plane_keys, two_plane_params};
 
@@ -135,9 +137,14 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let rotor = match r.model {
         RotorModel::Planar => {
             refuse_two_plane_keys(&raw)?;
+            refuse_flexible_keys(&raw)?;
             Rotor::Planar(bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?)
         }
-        RotorModel::TwoPlane => Rotor::TwoPlane(two_plane_params(&raw, &whole)?),
+        RotorModel::TwoPlane => {
+            refuse_flexible_keys(&raw)?;
+            Rotor::TwoPlane(two_plane_params(&raw, &whole)?)
+        }
+        RotorModel::Flexible => Rotor::Flexible(flexible_params(&raw, &whole, base_dir)?),
     };
     // The sensor's and the controller's loop constants are the scene's (`[amb]`,
     // `[controller]`), the same on every plane.
@@ -281,6 +288,9 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // The resolved scene states the two-plane rotor's defaults.
     if let Rotor::TwoPlane(_) = rotor {
         record_two_plane(&mut raw);
+    }
+    if let Rotor::Flexible(m) = &rotor {
+        record_flexible(&mut raw, m);
     }
     let scene = Scene {
         name: raw.scene.name.clone(),

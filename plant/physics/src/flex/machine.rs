@@ -1,0 +1,255 @@
+//! The flexible rotor as a machine of the plant (MODEL.md §13.6): the reduced shaft
+//! ([`Reduced`]) with two AMBs, two displacement sensors and two touchdown bearings at nodes of
+//! the shaft, each touchdown bearing the planar race dynamics the rigid rotors call per plane
+//! ([`crate::model`]), the spin as for the rigid rotors.
+//!
+//! **State.** The plant steps fixed-size states, so the reduced coordinates sit in
+//! [`MAX_MODES`] slots (a scene whose basis is larger is refused when it loads); the slots past
+//! the basis' size stay zero:
+//!
+//! ```text
+//! y = [η_0 … η_{R−1}, θ,  x_A, y_A, θ_A,  x_B, y_B, θ_B,   (their rates)]   R = MAX_MODES
+//! ```
+//!
+//! **Forces** at the force nodes `[AMB A, AMB B, touchdown A, touchdown B]`: each AMB's force
+//! at its node's displacement with its plane's current (the continuous PD reads the plane's
+//! sensor node), each touchdown bearing's contact force at its node. **Unbalance**: the
+//! rotor's eccentricity `e` is every mass's (the rigid rotors' static unbalance: the centre of
+//! every section `e` off the axis, in phase), so it enters as the frame's acceleration:
+//! `a_f = g ŷ + a_h − e ω² u − e θ̈ J u`, which the rigid-body modes carry exactly. **Spin**:
+//! held, or `I_p θ̈ = T_drive + Σ T_i` (free; the eccentricity's coupling to the spin, second
+//! order in `e`, is left out).
+
+use super::reduce::Reduced;
+use super::rotor::DOF_PER_NODE;
+use crate::integrate::System;
+use crate::model::{parked_race_spin_accel, race_dynamics, Control, RaceInput, Spin};
+use crate::two_plane;
+use controller::saturate;
+use nalgebra::{DMatrix, DVector, Vector2};
+use shock_table::Programme;
+use std::sync::Arc;
+
+/// Reduced coordinates the state has room for.
+pub const MAX_MODES: usize = 40;
+/// State dimension.
+pub const N: usize = 2 * (MAX_MODES + 7);
+/// The state vector.
+pub type State = [f64; N];
+
+/// Indices into [`State`].
+pub mod ix {
+    use super::MAX_MODES;
+    /// Rotor spin angle (rad).
+    pub const TR: usize = MAX_MODES;
+    /// Race of plane A: x, then y and angle.
+    pub const RACE_A: usize = MAX_MODES + 1;
+    /// Race of plane B.
+    pub const RACE_B: usize = MAX_MODES + 4;
+    /// The races' position pairs, plane A then B.
+    pub const RACE: [usize; 2] = [RACE_A, RACE_B];
+    /// Offset from a position to its rate.
+    pub const V: usize = super::N / 2;
+    /// Rotor spin speed (rad/s).
+    pub const WR: usize = TR + V;
+}
+
+/// The nodes of one bearing plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct PlaneNodes {
+    /// The AMB's node.
+    pub amb: usize,
+    /// The displacement sensor's node.
+    pub sensor: usize,
+    /// The touchdown bearing's node.
+    pub touchdown: usize,
+}
+
+/// The flexible machine, validated.
+#[derive(Clone, Debug)]
+pub struct Params {
+    /// The machine as the two-plane rotor sees it: gravity, the rigid body (mass, inertias,
+    /// eccentricity, speed, spin), each plane's bearing parameters (touchdown bearing, AMB, loop
+    /// constants, load share) with the AMB node's station and the sensor node's, from the
+    /// centre of mass (m).
+    pub machine: two_plane::Params,
+    /// Each plane's nodes.
+    pub nodes: [PlaneNodes; 2],
+    /// The reduced shaft (force nodes AMB A, AMB B, touchdown A, touchdown B).
+    pub reduced: Arc<Reduced>,
+    /// The finite-element rotor it was reduced from (for its Campbell diagram).
+    pub shaft: Arc<super::Rotor>,
+    /// Each node's axial position from the centre of mass (m).
+    pub z: Vec<f64>,
+}
+
+/// What one plane does during an evaluation.
+pub type PlaneEvaluation = two_plane::PlaneEvaluation;
+
+/// Everything one evaluation computes.
+#[derive(Clone, Copy, Debug)]
+pub struct Evaluation {
+    /// Time derivative of the state.
+    pub dy: State,
+    /// Planes A and B.
+    pub planes: [PlaneEvaluation; 2],
+}
+
+/// The model: parameters, base motion, and the control in force at each plane.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Physical parameters.
+    pub params: Params,
+    /// Housing motion.
+    pub base: Programme,
+    /// Control during the current macro step, plane A then B.
+    pub control: [Control; 2],
+    /// Each race is parked during the current macro step.
+    pub race_parked: [bool; 2],
+}
+
+/// The reduced state `[η, η̇]` (2r) of `y`, copied into `buf`.
+#[inline]
+fn reduced_state<'b>(y: &State, r: usize, buf: &'b mut [f64; 2 * MAX_MODES]) -> &'b [f64] {
+    buf[..r].copy_from_slice(&y[..r]);
+    buf[r..2 * r].copy_from_slice(&y[ix::V..ix::V + r]);
+    &buf[..2 * r]
+}
+
+impl Model {
+    /// Node `node`'s displacement and velocity relative to the housing (m, m/s).
+    pub fn node(&self, y: &State, node: usize) -> (Vector2<f64>, Vector2<f64>) {
+        let red = &self.params.reduced;
+        let r = red.size();
+        let mut buf = [0.0; 2 * MAX_MODES];
+        let s = reduced_state(y, r, &mut buf);
+        (Vector2::from(red.displacement(s, node)), Vector2::from(red.velocity(s, node)))
+    }
+
+    /// Evaluates all forces and the state derivative at time `t`.
+    pub fn evaluate(&self, t: f64, y: &State) -> Evaluation {
+        use ix::*;
+        let p = &self.params;
+        let red = &*p.reduced;
+        let r = red.size();
+        let mut buf = [0.0; 2 * MAX_MODES];
+        let s = reduced_state(y, r, &mut buf);
+        let at = |node: usize| (Vector2::from(red.displacement(s, node)), Vector2::from(red.velocity(s, node)));
+        let a_h = Vector2::from(self.base.accel(t));
+        let w = y[WR];
+        let mut dy = [0.0; N];
+        dy[r..V].copy_from_slice(&y[V + r..]);
+        dy[..r].copy_from_slice(&y[V..V + r]);
+        let mut planes = [PlaneEvaluation::default(); 2];
+        for (i, (plane, out)) in p.machine.planes.iter().zip(&mut planes).enumerate() {
+            let bearing = &plane.params;
+            let nodes = p.nodes[i];
+            let (delta, _) = at(nodes.amb);
+            out.current = match self.control[i] {
+                Control::Continuous(gains) => {
+                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
+                    let (x, v) = at(nodes.sensor);
+                    saturate(gains.current((x * a_s).into(), (v * a_s).into()), bearing.current_limit)
+                }
+                Control::ContinuousExcited(gains, sine) => {
+                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
+                    let (x, v) = at(nodes.sensor);
+                    let (e, e_dot) = sine.at(t);
+                    let u = x * a_s + Vector2::from(e);
+                    let u_dot = v * a_s + Vector2::from(e_dot);
+                    saturate(gains.current(u.into(), u_dot.into()), bearing.current_limit)
+                }
+                Control::Held(c) => c,
+                Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
+            };
+            out.amb_force = match self.control[i] {
+                Control::Magnets { plus, minus } => bearing.amb.magnet_force(delta, plus.into(), minus.into()),
+                _ => bearing.amb.force(delta, out.current.into()),
+            };
+            let race = RaceInput::of(y, RACE[i]);
+            let (x, v) = (RACE[i], RACE[i] + V);
+            if self.race_parked[i] {
+                dy[x] = 0.0;
+                dy[x + 1] = 0.0;
+                dy[v + 2] = parked_race_spin_accel(bearing, race.speed, a_h);
+            } else {
+                let (pos, vel) = at(nodes.touchdown);
+                let rd = race_dynamics(bearing, race, pos, vel, w, a_h);
+                out.contact = rd.contact;
+                out.balls = rd.balls;
+                dy[v] = rd.accel.x;
+                dy[v + 1] = rd.accel.y;
+                dy[v + 2] = rd.spin_accel;
+            }
+        }
+        let rotor = &p.machine.rotor;
+        let spin_accel = match rotor.spin {
+            Spin::Held => 0.0,
+            Spin::Free { drive_gain, torque_limit } => {
+                let drive = (drive_gain * (rotor.speed - w)).clamp(-torque_limit, torque_limit);
+                (drive + planes[0].contact.torque_rotor + planes[1].contact.torque_rotor) / rotor.polar_inertia
+            }
+        };
+        let (sn, cs) = y[TR].sin_cos();
+        let e = rotor.eccentricity;
+        let frame = [
+            a_h.x - e * w * w * cs + e * spin_accel * sn,
+            a_h.y + p.machine.gravity - e * w * w * sn - e * spin_accel * cs,
+        ];
+        let forces = [
+            planes[0].amb_force.into(),
+            planes[1].amb_force.into(),
+            planes[0].contact.on_rotor.into(),
+            planes[1].contact.on_rotor.into(),
+        ];
+        let mut ds = [0.0; 2 * MAX_MODES];
+        red.derivative(s, w, &forces, frame, &mut ds[..2 * r]);
+        dy[V..V + r].copy_from_slice(&ds[r..2 * r]);
+        dy[WR] = spin_accel;
+        Evaluation { dy, planes }
+    }
+
+    /// The rotor's displacement field as the rigid two-plane rotor's state `rigid` puts it
+    /// (translation `x, y` at the centre of mass and slopes `a, b`), projected on the basis:
+    /// the flexible state that starts where the rigid rotor starts, its races as `rigid`'s.
+    pub fn from_rigid(params: &Params, rigid: &two_plane::State) -> State {
+        use two_plane::ix as rix;
+        let red = &*params.reduced;
+        let shaft = &*params.shaft;
+        let mass = shaft.matrices().mass;
+        let n = shaft.dof();
+        let field = |x: f64, y: f64, a: f64, b: f64| {
+            let mut q = DVector::zeros(n);
+            for (k, &z) in params.z.iter().enumerate() {
+                q[DOF_PER_NODE * k] = x + a * z;
+                q[DOF_PER_NODE * k + 1] = y + b * z;
+                q[DOF_PER_NODE * k + 2] = -b;
+                q[DOF_PER_NODE * k + 3] = a;
+            }
+            q
+        };
+        let project: DMatrix<f64> = red.basis.transpose() * &mass;
+        let eta = &project * field(rigid[rix::X], rigid[rix::Y], rigid[rix::SX], rigid[rix::SY]);
+        let rate = &project * field(rigid[rix::VX], rigid[rix::VY], rigid[rix::VSX], rigid[rix::VSY]);
+        let mut y = [0.0; N];
+        let r = red.size();
+        y[..r].copy_from_slice(eta.as_slice());
+        y[ix::V..ix::V + r].copy_from_slice(rate.as_slice());
+        y[ix::TR] = rigid[rix::TR];
+        y[ix::WR] = rigid[rix::WR];
+        for (fx, rx) in ix::RACE.iter().zip(rix::RACE) {
+            for k in 0..3 {
+                y[fx + k] = rigid[rx + k];
+                y[fx + k + ix::V] = rigid[rx + k + rix::V];
+            }
+        }
+        y
+    }
+}
+
+impl System<N> for Model {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State, dy: &mut State) {
+        *dy = self.evaluate(t, y).dy;
+    }
+}

@@ -1,0 +1,188 @@
+//! `rotor.model = "flexible"`: the shaft (a table in the scene or a ROSS file), its nodes for the
+//! AMBs, sensors and touchdown bearings, the reduction; the flexible keys refused in a rigid
+//! scene and the rigid rotor's geometry keys refused in a flexible one.
+
+use super::*;
+use plant_physics::flex::{self, machine, Reduction};
+use std::sync::Arc;
+
+/// Reduced coordinates the flexible state has room for.
+const MAX_BASIS: usize = machine::MAX_MODES;
+/// Cutoff when none is given (Hz).
+pub(super) const CUTOFF_HZ: f64 = 2000.0;
+/// Modal damping ratio when none is given.
+pub(super) const MODAL_DAMPING: f64 = 0.005;
+
+/// The flexible rotor's keys given in a rigid scene, refused by name.
+pub(super) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
+    let r = &raw.rotor;
+    const WHY: &str = "is a key of the flexible rotor and this scene's rotor is rigid: set rotor.model = \
+                       \"flexible\" or remove the key";
+    if r.shaft.is_some() {
+        return Err(range("rotor.shaft", "a table", "", WHY));
+    }
+    if let Some(f) = &r.ross_file {
+        return Err(range("rotor.ross_file", f, "", WHY));
+    }
+    let nodes = [
+        ("rotor.amb_a_node", r.amb_a_node),
+        ("rotor.amb_b_node", r.amb_b_node),
+        ("rotor.sensor_a_node", r.sensor_a_node),
+        ("rotor.sensor_b_node", r.sensor_b_node),
+        ("rotor.touchdown_a_node", r.touchdown_a_node),
+        ("rotor.touchdown_b_node", r.touchdown_b_node),
+    ];
+    if let Some((key, n)) = nodes.iter().find_map(|(k, v)| v.map(|v| (*k, v))) {
+        return Err(range(key, n, "", WHY));
+    }
+    for (key, value, unit) in [("rotor.cutoff_hz", r.cutoff_hz, "Hz"), ("rotor.modal_damping", r.modal_damping, "")] {
+        if let Some(v) = value {
+            return Err(range(key, v, unit, WHY));
+        }
+    }
+    Ok(())
+}
+
+fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
+    ConfigError::Range { key: key.to_string(), value: value.to_string(), unit: String::new(), why: e.to_string() }
+}
+
+/// The flexible machine of a scene, validated.
+pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) -> Result<machine::Params, ConfigError> {
+    let r = &raw.rotor;
+    const RIGID: &str = "is a key of the rigid two-plane rotor: a flexible rotor's geometry and inertia come from \
+                         its shaft (rotor.shaft or rotor.ross_file) and its nodes (rotor.amb_a_node, …)";
+    let rigid_keys = [
+        ("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2, "kg·m²"),
+        ("rotor.couple_unbalance_urad", r.couple_unbalance_urad, "µrad"),
+        ("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg, "deg"),
+        ("rotor.bearing_a_mm", r.bearing_a_mm, "mm"),
+        ("rotor.bearing_b_mm", r.bearing_b_mm, "mm"),
+        ("rotor.sensor_a_mm", r.sensor_a_mm, "mm"),
+        ("rotor.sensor_b_mm", r.sensor_b_mm, "mm"),
+        ("rotor.end_a_mm", r.end_a_mm, "mm"),
+        ("rotor.end_b_mm", r.end_b_mm, "mm"),
+    ];
+    if let Some((key, value, unit)) = rigid_keys.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
+        return Err(range(key, value, unit, RIGID));
+    }
+    let shaft = match (&r.shaft, &r.ross_file) {
+        (Some(_), Some(f)) => {
+            return Err(range("rotor.ross_file", f, "", "a flexible rotor has either rotor.shaft or rotor.ross_file"))
+        }
+        (None, None) => {
+            return Err(range(
+                "rotor.shaft",
+                "none",
+                "",
+                "a flexible rotor needs its shaft: a [rotor.shaft] table or rotor.ross_file",
+            ))
+        }
+        (Some(table), None) => table.rotor().map_err(|e| flex_error("rotor.shaft", "the table", e))?,
+        (None, Some(file)) => {
+            let path = base_dir.join(file);
+            let text = shock_table::input::read_text(&path, shock_table::input::MAX_TOML_BYTES)
+                .map_err(|e| range("rotor.ross_file", file, "", &format!("cannot read {}: {e}", path.display())))?;
+            flex::ross::parse(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?
+        }
+    };
+    shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
+    let nodes = shaft.node_count();
+    let node = |key: &str, value: Option<usize>, default: Option<usize>| -> Result<usize, ConfigError> {
+        let Some(n) = value.or(default) else {
+            return Err(range(key, "none", "", "a flexible rotor needs the node of each AMB"));
+        };
+        if n >= nodes {
+            return Err(range(key, n, "", &format!("is out of range: the shaft has nodes 0 to {}", nodes - 1)));
+        }
+        Ok(n)
+    };
+    let amb = [node("rotor.amb_a_node", r.amb_a_node, None)?, node("rotor.amb_b_node", r.amb_b_node, None)?];
+    let sensor = [
+        node("rotor.sensor_a_node", r.sensor_a_node, Some(amb[0]))?,
+        node("rotor.sensor_b_node", r.sensor_b_node, Some(amb[1]))?,
+    ];
+    let touchdown = [
+        node("rotor.touchdown_a_node", r.touchdown_a_node, Some(amb[0]))?,
+        node("rotor.touchdown_b_node", r.touchdown_b_node, Some(amb[1]))?,
+    ];
+    let body = shaft.rigid_body();
+    let z: Vec<f64> = shaft.node_positions().iter().map(|p| p - body.centre).collect();
+    const SIDES: &str = "AMB A lies on the −z side of the rotor's centre of mass and AMB B on the +z side: the \
+                         centre of mass is between the AMBs";
+    if z[amb[0]] >= 0.0 {
+        return Err(range(
+            "rotor.amb_a_node",
+            amb[0],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[0]] * 1e3),
+        ));
+    }
+    if z[amb[1]] <= 0.0 {
+        return Err(range(
+            "rotor.amb_b_node",
+            amb[1],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
+        ));
+    }
+    let cutoff = positive("rotor.cutoff_hz", r.cutoff_hz.unwrap_or(CUTOFF_HZ), "Hz")?;
+    let zeta = non_negative("rotor.modal_damping", r.modal_damping.unwrap_or(MODAL_DAMPING), "")?;
+    if zeta >= 1.0 {
+        return Err(range("rotor.modal_damping", zeta, "", "must be below 1 (a damping ratio)"));
+    }
+    let spec = Reduction {
+        cutoff_hz: cutoff,
+        force_nodes: vec![amb[0], amb[1], touchdown[0], touchdown[1]],
+        static_correction: true,
+        gyroscopic_correction: false,
+        modal_damping: zeta,
+    };
+    let reduced = flex::Reduced::new(&shaft, &spec).map_err(|e| match e {
+        flex::FlexError::CutoffBelowRigidModes { .. } => flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e),
+        e => flex_error("rotor.shaft", "the shaft", e),
+    })?;
+    if reduced.size() > MAX_BASIS {
+        return Err(range(
+            "rotor.cutoff_hz",
+            cutoff,
+            "Hz",
+            &format!(
+                "keeps {} modes and static corrections, more than the {MAX_BASIS} the flexible state has room for: \
+                 lower the cutoff",
+                reduced.size()
+            ),
+        ));
+    }
+    // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
+    // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
+    let mm = |n: usize| Some(z[n] * 1e3);
+    let mut as_rigid = raw.clone();
+    let rr = &mut as_rigid.rotor;
+    rr.transverse_inertia_kg_m2 = Some(body.transverse_inertia);
+    rr.bearing_a_mm = mm(amb[0]);
+    rr.bearing_b_mm = mm(amb[1]);
+    rr.sensor_a_mm = mm(sensor[0]);
+    rr.sensor_b_mm = mm(sensor[1]);
+    rr.end_a_mm = Some(z[0] * 1e3);
+    rr.end_b_mm = Some(z[nodes - 1] * 1e3);
+    let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
+    let machine = two_plane_params(&as_rigid, &share)?;
+    let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
+    Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z })
+}
+
+/// Writes the flexible rotor's defaults into the raw scene, and the mass and polar inertia its
+/// shaft has (what the scene's `mass_kg` and `polar_inertia_kg_m2` are replaced by), so that the
+/// resolved `scene.toml` states them.
+pub(super) fn record_flexible(raw: &mut RawScene, params: &machine::Params) {
+    let r = &mut raw.rotor;
+    r.mass_kg = params.machine.rotor.mass;
+    r.polar_inertia_kg_m2 = params.machine.rotor.polar_inertia;
+    r.sensor_a_node.get_or_insert(params.nodes[0].sensor);
+    r.sensor_b_node.get_or_insert(params.nodes[1].sensor);
+    r.touchdown_a_node.get_or_insert(params.nodes[0].touchdown);
+    r.touchdown_b_node.get_or_insert(params.nodes[1].touchdown);
+    r.cutoff_hz.get_or_insert(CUTOFF_HZ);
+    r.modal_damping.get_or_insert(MODAL_DAMPING);
+}

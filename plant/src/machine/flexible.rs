@@ -1,0 +1,375 @@
+//! The flexible rotor (a finite-element shaft reduced to its modes, two AMBs, two sensors and
+//! two touchdown bearings at its nodes, MODEL.md §13.6) behind [`Machine`].
+//!
+//! Its trace is the two-plane rotor's layout: plane A's and B's rows are taken at each plane's
+//! touchdown-bearing node (where its race and contact are), and the "slopes" are those of the
+//! line through the two touchdown nodes (the rigid part of the motion there).
+
+use super::two_plane::RaceFailure;
+use super::{FailureState, Machine, PlaneState};
+use crate::model::{Control, Params, Release};
+use crate::park::{self, GapMotion};
+use crate::trace::{colb, Record, WIDTH_B};
+use nalgebra::Vector2;
+use plant_physics::flex::machine::{ix, Model, State, N};
+use serde::Serialize;
+
+/// The flexible rotor's failing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FlexibleFailure {
+    /// Time of the failure (s).
+    pub t_s: f64,
+    /// The rotor at touchdown node A and B, x, y relative to the housing (m).
+    pub rotor_at_touchdown_m: [[f64; 2]; 2],
+    /// Their velocities (m/s).
+    pub rotor_velocity_at_touchdown_m_s: [[f64; 2]; 2],
+    /// Rotor spin angle (rad) and speed (rad/s).
+    pub rotor_spin: [f64; 2],
+    /// Race A.
+    pub race_a: RaceFailure,
+    /// Race B.
+    pub race_b: RaceFailure,
+}
+
+/// The rotor at plane `i`'s touchdown node: displacement and velocity relative to the housing.
+fn touchdown(m: &Model, y: &State, i: usize) -> (Vector2<f64>, Vector2<f64>) {
+    m.node(y, m.params.nodes[i].touchdown)
+}
+
+/// The line through the two touchdown nodes: its slopes a = dx/dz, b = dy/dz and their rates.
+fn slopes(m: &Model, y: &State) -> [f64; 4] {
+    let [za, zb] = [0, 1].map(|i| m.params.z[m.params.nodes[i].touchdown]);
+    let ((pa, va), (pb, vb)) = (touchdown(m, y, 0), touchdown(m, y, 1));
+    let l = zb - za;
+    [(pb.x - pa.x) / l, (pb.y - pa.y) / l, (vb.x - va.x) / l, (vb.y - va.y) / l]
+}
+
+/// The race of plane `i` in `y`: position and velocity relative to the housing.
+fn race(y: &State, i: usize) -> (Vector2<f64>, Vector2<f64>) {
+    let x = ix::RACE[i];
+    (Vector2::new(y[x], y[x + 1]), Vector2::new(y[x + ix::V], y[x + 1 + ix::V]))
+}
+
+impl Machine<N> for Model {
+    const PLANES: usize = 2;
+
+    fn bearing(&self, i: usize) -> &Params {
+        &self.params.machine.planes[i].params
+    }
+
+    fn set_control(&mut self, i: usize, control: Control) {
+        self.control[i] = control;
+    }
+
+    fn sensed(&self, y: &State, i: usize) -> [f64; 2] {
+        self.node(y, self.params.nodes[i].sensor).0.into()
+    }
+
+    fn parked(&self, i: usize) -> bool {
+        self.race_parked[i]
+    }
+
+    fn set_parked(&mut self, i: usize, parked: bool) {
+        self.race_parked[i] = parked;
+    }
+
+    fn race_clear(&self, t0: f64, h: f64, y: &State, i: usize) -> bool {
+        let (pos, vel) = touchdown(self, y, i);
+        let (rp, rv) = race(y, i);
+        // The node's acceleration: the derivative's rates through the basis.
+        let dy = self.evaluate(t0, y).dy;
+        let mut shifted = [0.0; N];
+        shifted[..ix::V].copy_from_slice(&dy[ix::V..]);
+        let (acc, _) = self.node(&shifted, self.params.nodes[i].touchdown);
+        let motion = GapMotion { distance: (pos - rp).norm(), speed: (vel - rv).norm(), accel: acc.norm() };
+        park::stays_open(self.bearing(i), &self.base, t0, h, motion)
+    }
+
+    fn park_race(&self, y: &mut State, i: usize) {
+        park::park_race(y, ix::RACE[i]);
+    }
+
+    fn release_race(&self, t: f64, y: &mut State, i: usize, release: Release) {
+        park::release_race(self.bearing(i), &self.base, t, y, ix::RACE[i], release);
+    }
+
+    fn radii(&self, y: &State, i: usize) -> (f64, f64) {
+        let (pos, _) = touchdown(self, y, i);
+        let (rp, _) = race(y, i);
+        (pos.norm(), rp.norm())
+    }
+
+    fn spin(&self, y: &State) -> (f64, f64) {
+        (y[ix::TR], y[ix::WR])
+    }
+
+    fn touching(&self, y: &State, i: usize) -> bool {
+        let (pos, _) = touchdown(self, y, i);
+        let (rp, _) = race(y, i);
+        (pos - rp).norm() > self.bearing(i).contact.gap
+    }
+
+    fn record(&self, t: f64, y: &State) -> Record {
+        let ev = self.evaluate(t, y);
+        let housing = self.base.eval(t);
+        let plane = |i: usize| {
+            let (pos, vel) = touchdown(self, y, i);
+            let race = ix::RACE[i];
+            let p = &ev.planes[i];
+            [
+                pos.x,
+                pos.y,
+                vel.x,
+                vel.y,
+                y[race],
+                y[race + 1],
+                y[race + ix::V],
+                y[race + 1 + ix::V],
+                y[race + 2 + ix::V],
+                p.contact.normal,
+                p.contact.tangential,
+                p.balls.on_race[0].hypot(p.balls.on_race[1]),
+                p.current[0],
+                p.current[1],
+            ]
+        };
+        let [dx, dy, vx, vy, xb, yb, vxb, vyb, race_speed, normal, tangential, balls, ix_a, iy_a] = plane(0);
+        let a = [
+            t,
+            dx,
+            dy,
+            vx,
+            vy,
+            xb,
+            yb,
+            vxb,
+            vyb,
+            y[ix::TR],
+            y[ix::WR],
+            race_speed,
+            normal,
+            tangential,
+            balls,
+            ix_a,
+            iy_a,
+            housing.disp[0],
+            housing.disp[1],
+        ];
+        let mut b = [0.0; WIDTH_B];
+        b[..14].copy_from_slice(&plane(1));
+        b[colb::SLOPE..].copy_from_slice(&slopes(self, y));
+        Record { a, b: Some(b), hw: None, magnets: None }
+    }
+
+    fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {
+        self.node(y, self.params.nodes[i].sensor).1.into()
+    }
+
+    fn bearing_velocity(&self, y: &State, i: usize) -> [f64; 2] {
+        self.node(y, self.params.nodes[i].amb).1.into()
+    }
+
+    fn plane_states(&self, t: f64, y: &State, visit: &mut dyn FnMut(usize, &PlaneState<'_>)) {
+        let ev = self.evaluate(t, y);
+        for i in 0..2 {
+            let x = ix::RACE[i];
+            visit(
+                i,
+                &PlaneState {
+                    params: self.bearing(i),
+                    normal: ev.planes[i].contact.normal,
+                    tangential: ev.planes[i].contact.tangential,
+                    rotor: touchdown(self, y, i),
+                    race: race(y, i),
+                    rotor_speed: y[ix::WR],
+                    race_angle: y[x + 2],
+                    race_speed: y[x + 2 + ix::V],
+                    race_accel: ev.dy[x + 2 + ix::V],
+                },
+            );
+        }
+    }
+
+    /// The modal coordinates count as positions and their rates as velocities (the basis is
+    /// mass-normalised, so a coordinate's error moves a node by about that error / √M: for a
+    /// rotor heavier than 1 kg the tolerance at the nodes is tighter than the groups say).
+    fn atol(groups: [f64; 4]) -> [f64; N] {
+        let [p, v, a, w] = groups;
+        let mut t = [p; N];
+        t[ix::V..].fill(v);
+        t[ix::TR] = a;
+        t[ix::WR] = w;
+        for x in ix::RACE {
+            t[x + 2] = a;
+            t[x + 2 + ix::V] = w;
+        }
+        t
+    }
+
+    fn failure(t: f64, y: &State) -> FailureState {
+        let race = |x: usize| RaceFailure {
+            race_radius_m: y[x].hypot(y[x + 1]),
+            race_m: [y[x], y[x + 1]],
+            race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
+            race_spin: [y[x + 2], y[x + 2 + ix::V]],
+        };
+        // The node displacements need the model's basis, which `failure` does not have: the
+        // races and the spin are what the state alone says.
+        FailureState::Flexible(FlexibleFailure {
+            t_s: t,
+            rotor_at_touchdown_m: [[f64::NAN; 2]; 2],
+            rotor_velocity_at_touchdown_m_s: [[f64::NAN; 2]; 2],
+            rotor_spin: [y[ix::TR], y[ix::WR]],
+            race_a: race(ix::RACE_A),
+            race_b: race(ix::RACE_B),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{load_scene, Rotor};
+    use std::path::Path;
+
+    fn scene() -> crate::config::Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+        load_scene(&path, &[]).expect("the shipped flexible scene loads")
+    }
+
+    fn model(scene: &crate::config::Scene) -> Model {
+        let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
+        Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [Control::Held([0.0; 2]); 2],
+            race_parked: [false; 2],
+        }
+    }
+
+    /// A rigid translation and tilt put into the flexible state reads back at every node as
+    /// the rigid rotor's axis there: at the sensors, at the touchdown nodes, and in the slopes.
+    #[test]
+    fn a_rigid_motion_reads_back_at_its_nodes() {
+        let scene = scene();
+        let m = model(&scene);
+        let mut rigid = [0.0; plant_physics::two_plane::N];
+        use plant_physics::two_plane::ix as r;
+        rigid[r::X] = 3e-6;
+        rigid[r::Y] = -2e-6;
+        rigid[r::SX] = 1e-5;
+        rigid[r::SY] = -4e-5;
+        rigid[r::VX] = 1e-3;
+        rigid[r::WR] = 100.0;
+        let y = Model::from_rigid(&m.params, &rigid);
+        for i in 0..2 {
+            let z = m.params.z[m.params.nodes[i].sensor];
+            let [x, yy] = m.sensed(&y, i);
+            assert!((x - (3e-6 + 1e-5 * z)).abs() < 1e-12, "plane {i}: x {x}");
+            assert!((yy - (-2e-6 - 4e-5 * z)).abs() < 1e-12, "plane {i}: y {yy}");
+            let [vx, _] = m.sensed_rate(&y, i);
+            assert!((vx - 1e-3).abs() < 1e-12, "plane {i}: vx {vx}");
+        }
+        let s = slopes(&m, &y);
+        assert!((s[0] - 1e-5).abs() < 1e-12 && (s[1] + 4e-5).abs() < 1e-12, "{s:?}");
+        assert_eq!(m.spin(&y), (0.0, 100.0));
+    }
+
+    /// Plane i's touchdown bearing is where the model says: the rotor pushed against race A's
+    /// side at its touchdown node touches race A and not race B.
+    #[test]
+    fn touching_is_at_the_touchdown_node() {
+        let scene = scene();
+        let m = model(&scene);
+        let gap = m.bearing(0).contact.gap;
+        let mut rigid = [0.0; plant_physics::two_plane::N];
+        use plant_physics::two_plane::ix as r;
+        // A tilt about touchdown node B: node B stays, node A moves by 1.5 gaps.
+        let [za, zb] = [0, 1].map(|i| m.params.z[m.params.nodes[i].touchdown]);
+        let slope = 1.5 * gap / (za - zb);
+        rigid[r::SX] = slope;
+        rigid[r::X] = -slope * zb;
+        let y = Model::from_rigid(&m.params, &rigid);
+        assert!(m.touching(&y, 0));
+        assert!(!m.touching(&y, 1));
+        let (ra, _) = m.radii(&y, 0);
+        assert!((ra - 1.5 * gap).abs() < 1e-9 * gap, "{ra}");
+        let rec = m.record(0.0, &y);
+        assert!(rec.a[12] > 0.0, "contact force at A: {}", rec.a[12]);
+        assert_eq!(rec.b.unwrap()[9], 0.0, "no contact at B");
+    }
+
+    /// Every slot past the basis' size stays zero under the derivative.
+    #[test]
+    fn the_unused_slots_stay_at_rest() {
+        let scene = scene();
+        let m = model(&scene);
+        let r = m.params.reduced.size();
+        let y = Model::from_rigid(&m.params, &crate::initial::two_plane_initial_state(&scene, &m.params.machine));
+        let dy = m.evaluate(0.0, &y).dy;
+        assert!(dy[r..ix::TR].iter().chain(&dy[ix::V + r..ix::WR]).all(|v| *v == 0.0));
+    }
+}
+
+#[cfg(test)]
+mod convergence {
+    use crate::config::{load_scene, Rotor, Scene};
+    use std::path::Path;
+
+    /// The flexible scene, shortened, with its shaft's moduli scaled by `stiffer` and the shock
+    /// at `peak_g`; and the same machine as the rigid two-plane rotor (its rigid body, the same
+    /// bearings, stations and sensors).
+    pub(super) fn pair(stiffer: f64, peak_g: f64, duration: f64) -> (Scene, Scene) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+        let sets = [
+            format!("rotor.shaft.materials.steel.modulus_pa={:e}", 211e9 * stiffer),
+            format!("rotor.shaft.materials.steel.shear_modulus_pa={:e}", 81.2e9 * stiffer),
+            format!("scene.duration_s={duration}"),
+            format!("shock[0].peak_g={peak_g:?}"),
+            "output.plots=false".to_string(),
+        ];
+        let flexible = load_scene(&path, &sets).expect("the flexible scene loads");
+        let Rotor::Flexible(f) = &flexible.rotor else { panic!("a flexible scene") };
+        let mut rigid = flexible.clone();
+        rigid.rotor = Rotor::TwoPlane(f.machine.clone());
+        (flexible, rigid)
+    }
+
+    /// The largest difference between two runs' rotor positions at both bearing planes, over
+    /// the largest of the rigid run's (relative).
+    pub(super) fn difference(a: &Scene, b: &Scene) -> f64 {
+        let quiet = &mut crate::hooks::Quiet;
+        let ta = crate::run::run(a, quiet).expect("runs").trace;
+        let tb = crate::run::run(b, quiet).expect("runs").trace;
+        assert_eq!(ta.len(), tb.len());
+        let (ba, bb) = (ta.b.as_ref().unwrap(), tb.b.as_ref().unwrap());
+        let cols = |t: &crate::trace::Trace, b: &crate::trace::TraceB, i: usize| {
+            [t.dx_m[i], t.dy_m[i], b.b_dx_m[i], b.b_dy_m[i]]
+        };
+        let (mut diff, mut size) = (0.0f64, 0.0f64);
+        for i in 0..ta.len() {
+            let (x, y) = (cols(&ta, ba, i), cols(&tb, bb, i));
+            for k in 0..4 {
+                diff = diff.max((x[k] - y[k]).abs());
+                size = size.max(y[k].abs());
+            }
+        }
+        diff / size
+    }
+
+    /// A stiff shaft converges to the rigid two-plane rotor: under a 1 G shock (no contact),
+    /// the rotor's positions at both bearings differ by less than 1 % of their largest with the
+    /// shaft 1000 times stiffer than steel, and the difference falls as the shaft stiffens.
+    #[test]
+    fn a_stiff_shaft_converges_to_the_two_plane_rotor() {
+        let mut last = f64::INFINITY;
+        for stiffer in [1.0, 1e3] {
+            let (f, r) = pair(stiffer, 1.0, 0.08);
+            let d = difference(&f, &r);
+            eprintln!("shaft {stiffer:e} x steel: relative difference {d:.3e}");
+            assert!(d < last, "{d} after {last}");
+            last = d;
+        }
+        assert!(last < 1e-2, "{last}");
+    }
+}
