@@ -72,10 +72,10 @@ pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) ->
         }
         (None, None) => {
             return Err(range(
-                "rotor.shaft",
-                "none",
+                "rotor.model",
+                "\"flexible\"",
                 "",
-                "a flexible rotor needs its shaft: a [rotor.shaft] table or rotor.ross_file",
+                "a flexible rotor needs its shaft: a [rotor.shaft] table or rotor.ross_file (neither is given)",
             ))
         }
         (Some(table), None) => table.rotor().map_err(|e| flex_error("rotor.shaft", "the table", e))?,
