@@ -331,32 +331,33 @@ pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) 
             p.current[1],
         ]
     };
-    let [dx, dy, vx, vy, xb, yb, vxb, vyb, race_speed, normal, tangential, balls, ix_a, iy_a] = plane(0);
+    let slopes = [y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]];
+    two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes)
+}
+
+/// One bearing plane's values in a two-bearing record, in the order of plane B's columns: the
+/// rotor at the plane (x, y, their rates), the race (x, y, their rates, its spin speed), the
+/// contact's normal and tangential force, the balls' force on the race, the currents x, y.
+pub type PlaneValues = [f64; 14];
+
+/// The record of a rotor on two bearing planes (the two-plane rotor, the flexible rotor):
+/// plane A in the planar columns, plane B and the slopes `[a, b, ȧ, ḃ]` of the line through the
+/// planes in the others; `spin` is the rotor's angle and speed, `housing` its displacement.
+pub fn two_bearing_record(
+    t: f64,
+    spin: [f64; 2],
+    housing: [f64; 2],
+    planes: [PlaneValues; 2],
+    slopes: [f64; 4],
+) -> Record {
+    let [dx, dy, vx, vy, xb, yb, vxb, vyb, race_speed, normal, tangential, balls, ix_a, iy_a] = planes[0];
     let a = [
-        t,
-        dx,
-        dy,
-        vx,
-        vy,
-        xb,
-        yb,
-        vxb,
-        vyb,
-        y[ix::TR],
-        y[ix::WR],
-        race_speed,
-        normal,
-        tangential,
-        balls,
-        ix_a,
-        iy_a,
-        housing.disp[0],
-        housing.disp[1],
+        t, dx, dy, vx, vy, xb, yb, vxb, vyb, spin[0], spin[1], race_speed, normal, tangential, balls, ix_a, iy_a,
+        housing[0], housing[1],
     ];
-    let pb = plane(1);
     let mut b = [0.0; WIDTH_B];
-    b[..14].copy_from_slice(&pb);
-    b[colb::SLOPE..].copy_from_slice(&[y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]]);
+    b[..14].copy_from_slice(&planes[1]);
+    b[colb::SLOPE..].copy_from_slice(&slopes);
     Record { a, b: Some(b), hw: None, magnets: None }
 }
 

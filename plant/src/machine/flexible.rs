@@ -9,7 +9,7 @@ use super::two_plane::RaceFailure;
 use super::{FailureState, Machine, PlaneState};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
-use crate::trace::{colb, Record, WIDTH_B};
+use crate::trace::{self, Record};
 use nalgebra::Vector2;
 use plant_physics::flex::machine::{ix, Model, State, N};
 use serde::Serialize;
@@ -133,32 +133,7 @@ impl Machine<N> for Model {
                 p.current[1],
             ]
         };
-        let [dx, dy, vx, vy, xb, yb, vxb, vyb, race_speed, normal, tangential, balls, ix_a, iy_a] = plane(0);
-        let a = [
-            t,
-            dx,
-            dy,
-            vx,
-            vy,
-            xb,
-            yb,
-            vxb,
-            vyb,
-            y[ix::TR],
-            y[ix::WR],
-            race_speed,
-            normal,
-            tangential,
-            balls,
-            ix_a,
-            iy_a,
-            housing.disp[0],
-            housing.disp[1],
-        ];
-        let mut b = [0.0; WIDTH_B];
-        b[..14].copy_from_slice(&plane(1));
-        b[colb::SLOPE..].copy_from_slice(&slopes(self, y));
-        Record { a, b: Some(b), hw: None, magnets: None }
+        trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y))
     }
 
     fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {
