@@ -52,17 +52,7 @@ pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) ->
     let r = &raw.rotor;
     const RIGID: &str = "is a key of the rigid two-plane rotor: a flexible rotor's geometry and inertia come from \
                          its shaft (rotor.shaft or rotor.ross_file) and its nodes (rotor.amb_a_node, …)";
-    let rigid_keys = [
-        ("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2, "kg·m²"),
-        ("rotor.couple_unbalance_urad", r.couple_unbalance_urad, "µrad"),
-        ("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg, "deg"),
-        ("rotor.bearing_a_mm", r.bearing_a_mm, "mm"),
-        ("rotor.bearing_b_mm", r.bearing_b_mm, "mm"),
-        ("rotor.sensor_a_mm", r.sensor_a_mm, "mm"),
-        ("rotor.sensor_b_mm", r.sensor_b_mm, "mm"),
-        ("rotor.end_a_mm", r.end_a_mm, "mm"),
-        ("rotor.end_b_mm", r.end_b_mm, "mm"),
-    ];
+    let rigid_keys = super::two_plane_keys::rigid_geometry_keys(raw);
     if let Some((key, value, unit)) = rigid_keys.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
         return Err(range(key, value, unit, RIGID));
     }

@@ -3,11 +3,11 @@
 
 use super::*;
 
-/// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
-/// silently ignored otherwise.
-pub(super) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
+/// The `[rotor]` keys of the rigid two-plane rotor's geometry and inertia, as given: key, value,
+/// unit.
+pub(super) fn rigid_geometry_keys(raw: &RawScene) -> [(&'static str, Option<f64>, &'static str); 9] {
     let r = &raw.rotor;
-    let given = [
+    [
         ("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2, "kg·m²"),
         ("rotor.couple_unbalance_urad", r.couple_unbalance_urad, "µrad"),
         ("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg, "deg"),
@@ -17,9 +17,17 @@ pub(super) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
         ("rotor.sensor_b_mm", r.sensor_b_mm, "mm"),
         ("rotor.end_a_mm", r.end_a_mm, "mm"),
         ("rotor.end_b_mm", r.end_b_mm, "mm"),
+    ]
+}
+
+/// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
+/// silently ignored otherwise.
+pub(super) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
+    let mut given = rigid_geometry_keys(raw).to_vec();
+    given.extend([
         ("initial.slope_x_urad", raw.initial.slope_x_urad, "µrad"),
         ("initial.slope_y_urad", raw.initial.slope_y_urad, "µrad"),
-    ];
+    ]);
     const WHY: &str = "is a key of the two-plane rotor and this scene is planar (rotor.model = \"planar\"): set \
                        rotor.model = \"two_plane\" or remove the key";
     if let Some((key, value, unit)) = given.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
