@@ -64,6 +64,11 @@ pub enum Command {
         /// No progress display.
         #[arg(long)]
         quiet: bool,
+        /// Continue the soak in the output folder from its last checkpoint (taken at each
+        /// shock's start), under the same programme and `--set`s: the soak's files come out as
+        /// the uninterrupted soak's.
+        #[arg(long)]
+        resume: bool,
     },
     /// Measurements of the testbed itself.
     Bench {

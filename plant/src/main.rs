@@ -75,7 +75,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let states = States { save_at: save_state_at, from: from_state };
             run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
         }
-        Command::Soak { programme, out, set, quiet } => soak_cmd(&programme, out, &set, quiet),
+        Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
             let req = plant::compare::Request {
                 scene: &scene,
@@ -423,7 +423,7 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
 }
 
 /// `plant soak`.
-fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> anyhow::Result<()> {
+fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resume: bool) -> anyhow::Result<()> {
     let prog = plant::soak::programme::load(path, set)?;
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
@@ -435,17 +435,19 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> a
         (false, false) => plant::soak::Progress::Lines,
     };
     eprintln!(
-        "plant soak: {} shocks over {} s simulated ({}), results in {}",
+        "plant soak: {} shocks over {} s simulated ({}), results in {}{}",
         prog.shocks.len(),
         prog.scene.duration,
         plant::summary::snake_name(&prog.scene.controller.mode),
-        dir.display()
+        dir.display(),
+        if resume { ", resumed from its checkpoint" } else { "" }
     );
-    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress };
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress, resume };
     let done = match plant::soak::run(&prog, path, opts) {
         Ok(d) => d,
         Err(plant::soak::SoakError::Setup(e)) => return Err(e.into()),
         Err(plant::soak::SoakError::Io(e)) => return Err(e),
+        Err(plant::soak::SoakError::Resume(e)) => return Err(Ending::BadArgument(e.to_string()).into()),
     };
     let r = &done.report;
     eprintln!("plant soak: {}", r.headline());

@@ -61,6 +61,47 @@ pub fn create(path: &Path) -> std::io::Result<File> {
     Err(Error::new(ErrorKind::AlreadyExists, format!("{}: another process keeps creating it", path.display())))
 }
 
+/// Opens `path` again to go on writing it: a file streamed as it was made by an earlier,
+/// interrupted run of the same command (a soak continued, `plant soak --resume`), cut to its
+/// first `len` bytes (what that run's checkpoint had seen written) and positioned at its end.
+/// A link at the name (symbolic or hard) is refused, never followed, as is anything but a
+/// regular file and a file shorter than `len`.
+pub fn reopen_at(path: &Path, len: u64) -> std::io::Result<File> {
+    use std::io::{Seek, SeekFrom};
+    use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+    let mut file = OpenOptions::new().read(true).write(true).custom_flags(libc::O_NOFOLLOW).open(path)?;
+    let m = file.metadata()?;
+    let refuse = |why: String| Err(Error::new(ErrorKind::InvalidData, format!("{}: {why}", path.display())));
+    if !m.is_file() || m.nlink() > 1 {
+        return refuse("not a regular file of its own (a link, a device or a folder)".into());
+    }
+    if m.len() < len {
+        return refuse(format!("{} bytes, fewer than the {len} written when the checkpoint was taken", m.len()));
+    }
+    file.set_len(len)?;
+    file.seek(SeekFrom::End(0))?;
+    Ok(file)
+}
+
+/// Moves the entry at `path` (`controller.log`) aside to the first free `controller.N.log`
+/// (`N` from 1), so that a file about to be created anew at `path` keeps the earlier one; the
+/// entry itself is renamed (a link stays a link, never followed). Nothing at `path`: `None`.
+pub fn keep_aside(path: &Path) -> anyhow::Result<Option<std::path::PathBuf>> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(None);
+    }
+    let (stem, ext) = match (path.file_stem(), path.extension()) {
+        (Some(s), Some(e)) => (s.to_string_lossy(), format!(".{}", e.to_string_lossy())),
+        _ => (path.file_name().unwrap_or_default().to_string_lossy(), String::new()),
+    };
+    let free = (1..10_000)
+        .map(|n| path.with_file_name(format!("{stem}.{n}{ext}")))
+        .find(|p| std::fs::symlink_metadata(p).is_err())
+        .with_context(|| format!("{}: the names to keep it under (.1 to .9999) are all taken", path.display()))?;
+    std::fs::rename(path, &free).with_context(|| format!("keeping {} as {}", path.display(), free.display()))?;
+    Ok(Some(free))
+}
+
 /// Creates the folder `path` (and its parents) if missing; a symbolic link at `path` is
 /// refused, so that the files written into it stay inside the output folder.
 pub fn folder(path: &Path) -> anyhow::Result<()> {

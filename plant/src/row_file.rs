@@ -61,6 +61,31 @@ impl RowFile {
         Ok(f)
     }
 
+    /// Opens `path` again to append to it ([`crate::outfile::reopen_at`]): its first `len`
+    /// bytes, which must begin with `header`, are kept; what came after them is cut.
+    pub fn reopen(path: &Path, header: &[&str], len: u64) -> std::io::Result<Self> {
+        use std::io::{Read, Seek, SeekFrom};
+        let mut file = crate::outfile::reopen_at(path, len)?;
+        let expected = format!("{}\n", header.join(","));
+        let mut found = vec![0; expected.len().min(len as usize)];
+        file.seek(SeekFrom::Start(0))?;
+        file.read_exact(&mut found)?;
+        if found != expected.as_bytes() {
+            let message = format!("{}: its header is not `{}`", path.display(), header.join(","));
+            return Err(std::io::Error::new(std::io::ErrorKind::InvalidData, message));
+        }
+        file.seek(SeekFrom::End(0))?;
+        let pending = Pending::default();
+        let csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(pending.clone());
+        Ok(Self { file, csv, pending })
+    }
+
+    /// The bytes in the file once the pending rows are written out.
+    pub fn written(&mut self) -> std::io::Result<u64> {
+        self.flush()?;
+        Ok(self.file.metadata()?.len())
+    }
+
     /// Appends a row (fields already formatted); written out past 64 KiB pending.
     pub fn row<I, T>(&mut self, fields: I) -> std::io::Result<()>
     where

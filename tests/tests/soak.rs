@@ -9,7 +9,8 @@
 //! 2 G shock of `soak-short` recovers and the 10 G one leaves the rotor
 //! rubbing (cosim-10g with the naive PD); a criterion that cannot be met
 //! exits 5 naming it with its measured value; a malformed programme exits 2
-//! naming the key.
+//! naming the key; a soak killed with SIGKILL leaves whole rows and
+//! `--resume` continues it to the uninterrupted soak's files.
 
 mod common;
 
@@ -202,68 +203,83 @@ fn a_soak_whose_controller_never_starts_leaves_soak_json() {
     assert!(out.join("scene.toml").is_file());
 }
 
-/// Issue 11 item 8: a soak killed with SIGKILL leaves every file it writes as it goes with
-/// its header and whole rows only (no torn last row, no missing header).
+/// Issue 11 item 8: a soak killed with SIGKILL leaves every file it writes as it goes with its
+/// header and whole rows only (no torn last row, no missing header). Issue 28 item 5: it
+/// continues from its last checkpoint (`plant soak --resume`), and its `soak.csv` and
+/// `envelope.csv` are then byte for byte those of the soak that never stopped; a resume under
+/// another programme, or on a folder without a checkpoint, is refused with exit 2 and touches
+/// nothing.
 #[cfg(target_os = "linux")]
 #[test]
-fn a_soak_killed_with_sigkill_leaves_headers_and_whole_rows() {
+fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted_files() {
     use std::time::{Duration, Instant};
     controller_bin();
-    let dir = TempDir::new("soak-sigkill");
-    // Ten shocks over about 6 s simulated at 5 kHz: far longer than the test lets it run.
+    let dir = TempDir::new("soak-resume");
     let scene = workspace_root().join("config").join("cosim-10g.toml");
-    let programme = dir.join("long.toml");
-    let shocks: String = (0..10)
-        .map(|i| {
-            format!(
-                "[[shock]]\nkind = \"double_half_sine\"\npeak_g = 2.0\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = {}\n",
-                0.02 + 0.55 * f64::from(i)
-            )
-        })
-        .collect();
-    std::fs::write(
-        &programme,
+    let programme = |peak: f64| {
+        let shocks: String = [2.0, peak, 6.0]
+            .iter()
+            .enumerate()
+            .map(|(i, g)| {
+                format!(
+                    "[[shock]]\nkind = \"double_half_sine\"\npeak_g = {g}\nf1_hz = 10.0\nf2_hz = 80.0\nstart_s = {}\n",
+                    0.02 + 0.12 * i as f64
+                )
+            })
+            .collect();
         format!(
             "scene = {scene:?}\nset = [\"output.plots=false\", \"controller.rate_hz=5000\", \"output.rate_hz=5000\"]\n\
-             settle_s = 0.2\nrss_every_s = 0.02\n[recovery]\nhold_s = 0.05\n{shocks}"
-        ),
-    )
-    .unwrap();
-    let out = dir.join("out");
-    let mut child = soak(&programme, &out, &[]).spawn().expect("start plant soak");
-    let pid = child.id();
+             settle_s = 0.1\nrss_every_s = 0.02\n[recovery]\nhold_s = 0.05\n{shocks}"
+        )
+    };
+    let file = dir.join("three.toml");
+    std::fs::write(&file, programme(10.0)).unwrap();
 
-    // Wait for the soak to be under way (RSS rows written), then a random but seeded moment.
-    let deadline = Instant::now() + Duration::from_secs(240);
-    let rows = |name: &str| std::fs::read_to_string(out.join(name)).map_or(0, |t| t.lines().count());
-    while rows("rss.csv") < 3 {
+    // The soak that never stops.
+    let whole = dir.join("whole");
+    let out = output_within(&mut soak(&file, &whole, &[]), LIMIT);
+    assert_exit(&out, 0);
+    assert!(!whole.join("soak-state.json").exists(), "a completed soak keeps no checkpoint");
+
+    // The same soak, killed once its checkpoint at the second shock is written.
+    let cut = dir.join("cut");
+    let mut child = soak(&file, &cut, &[]).spawn().expect("start plant soak");
+    let pid = child.id();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let checkpoint_t = || -> f64 {
+        std::fs::read_to_string(cut.join("soak-state.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .and_then(|v| v["plant"]["t_s"].as_f64())
+            .unwrap_or(0.0)
+    };
+    while checkpoint_t() < 0.14 {
         assert!(child.try_wait().expect("poll").is_none(), "the soak ended before it was killed");
-        assert!(Instant::now() < deadline, "the soak did not start within 240 s");
-        std::thread::sleep(Duration::from_millis(20));
+        assert!(Instant::now() < deadline, "no checkpoint at the second shock within 300 s");
+        std::thread::sleep(Duration::from_millis(10));
     }
-    let seed = 20_261_122;
-    let delay = plant::rng::SplitMix64::new(seed).uniform([0.0, 1.5]);
-    std::thread::sleep(Duration::from_secs_f64(delay));
     let controller: Vec<u32> = std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children"))
         .unwrap_or_default()
         .split_whitespace()
         .filter_map(|p| p.parse().ok())
         .collect();
-    assert!(child.try_wait().expect("poll").is_none(), "the soak ended before it was killed (seed {seed})");
+    assert!(child.try_wait().expect("poll").is_none(), "the soak ended before it was killed");
     unsafe { libc::kill(pid as libc::pid_t, libc::SIGKILL) };
-    let status = child.wait().expect("reap plant");
-    assert_eq!(std::os::unix::process::ExitStatusExt::signal(&status), Some(libc::SIGKILL));
-
+    child.wait().expect("reap plant");
+    for cpid in controller {
+        unsafe { libc::kill(cpid as libc::pid_t, libc::SIGKILL) };
+    }
+    let t = checkpoint_t();
     let headers = [
         ("soak.csv", plant::soak::SOAK_CSV_HEADER),
         ("envelope.csv", plant::soak::ENVELOPE_CSV_HEADER),
         ("rss.csv", plant::soak::RSS_CSV_HEADER),
     ];
     for (name, header) in headers {
-        let text = std::fs::read_to_string(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let text = std::fs::read_to_string(cut.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut lines = text.lines();
-        assert_eq!(lines.next(), Some(header), "{name}: no header (killed {delay:.3} s in, seed {seed})");
-        assert!(text.ends_with('\n'), "{name}: a torn last row (killed {delay:.3} s in, seed {seed}):\n{text}");
+        assert_eq!(lines.next(), Some(header), "{name}: no header (killed after t = {t} s)");
+        assert!(text.ends_with('\n'), "{name}: a torn last row (killed after t = {t} s):\n{text}");
         let width = header.split(',').count();
         for (n, line) in lines.enumerate() {
             let fields: Vec<&str> = line.split(',').collect();
@@ -274,16 +290,43 @@ fn a_soak_killed_with_sigkill_leaves_headers_and_whole_rows() {
             }
         }
     }
-    assert!(rows("rss.csv") >= 3);
 
-    // The orphaned controller notices the plant is gone and exits; do not leave it behind.
-    for cpid in controller {
-        let gone = Instant::now() + Duration::from_secs(30);
-        while std::path::Path::new(&format!("/proc/{cpid}")).exists() && Instant::now() < gone {
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        if std::path::Path::new(&format!("/proc/{cpid}")).exists() {
-            unsafe { libc::kill(cpid as libc::pid_t, libc::SIGKILL) };
-        }
+    // Another programme (the second shock's peak) is refused, naming it, and nothing is touched.
+    let before: Vec<(String, Vec<u8>)> = ["soak.csv", "envelope.csv", "rss.csv", "soak-state.json"]
+        .iter()
+        .map(|n| (n.to_string(), std::fs::read(cut.join(n)).unwrap()))
+        .collect();
+    // (The same file name: the scene's name is the programme file's.)
+    std::fs::create_dir_all(dir.join("other")).unwrap();
+    let other = dir.join("other").join("three.toml");
+    std::fs::write(&other, programme(12.0)).unwrap();
+    let out = output_within(soak(&other, &cut, &[]).arg("--resume"), LIMIT);
+    assert_exit(&out, 2);
+    assert!(stderr(&out).contains("scene.shock[1].peak_g is 10"), "{}", stderr(&out));
+    let out = output_within(soak(&file, &cut, &["controller.damping_ratio=0.03"]).arg("--resume"), LIMIT);
+    assert_exit(&out, 2);
+    assert!(stderr(&out).contains("damping_ratio"), "{}", stderr(&out));
+    for (name, bytes) in &before {
+        assert_eq!(&std::fs::read(cut.join(name)).unwrap(), bytes, "{name} was touched by a refused resume");
     }
+    let out = output_within(soak(&file, &dir.join("nothing"), &[]).arg("--resume"), LIMIT);
+    assert_exit(&out, 2);
+    assert!(stderr(&out).contains("no checkpoint"), "{}", stderr(&out));
+
+    // The resume goes on from the checkpoint to the uninterrupted soak's files.
+    let out = output_within(soak(&file, &cut, &[]).arg("--resume"), LIMIT);
+    assert_exit(&out, 0);
+    for name in ["soak.csv", "envelope.csv"] {
+        let (a, b) = (std::fs::read(whole.join(name)).unwrap(), std::fs::read(cut.join(name)).unwrap());
+        assert!(a == b, "{name} resumed from t = {t} s differs from the uninterrupted soak's");
+    }
+    let (a, b) = (read_json(&whole.join("soak.json")), read_json(&cut.join("soak.json")));
+    assert_eq!(b["resumed_from_s"].as_f64(), Some(t), "{b:#}");
+    for key in
+        ["status", "shocks", "shocks_completed", "recovered", "recovery_s", "max_contact_force_n", "contact_time_s"]
+    {
+        assert_eq!(a[key], b[key], "soak.json {key}");
+    }
+    assert!(!cut.join("soak-state.json").exists(), "a completed soak keeps no checkpoint");
+    assert!(cut.join("controller.1.log").is_file(), "the killed soak's controller.log is kept");
 }

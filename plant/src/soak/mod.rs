@@ -17,9 +17,11 @@
 //! shock's end (and each RSS sample) and whenever 64 KiB are pending.
 //!
 //! Rooms: [`run`] (the loop's hooks and the whole soak), [`sink`] (the
-//! per-sample figures and the files written as it goes), [`report`]
+//! per-sample figures and the files written as it goes), [`checkpoint`]
+//! (the state `plant soak --resume` continues from), [`report`]
 //! (`soak.json` and the criteria), [`plots`].
 
+pub mod checkpoint;
 pub mod monitor;
 pub mod plots;
 pub mod programme;

@@ -17,10 +17,26 @@
 //! Samples are taken at the output rate, so contacts shorter than one sample
 //! interval can be missed and times are resolved to one interval.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+/// A NaN written as JSON `null` (as `serde_json` writes one) and read back as NaN: the
+/// `recovery_s` of a shock not recovered, in `soak.json` and in a soak's checkpoint.
+mod nan_as_null {
+    pub fn serialize<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_nan() {
+            s.serialize_none()
+        } else {
+            s.serialize_f64(*v)
+        }
+    }
+
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
+}
 
 /// The figures of one shock's window.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ShockFigures {
     /// Shock index (0-based).
     pub index: usize,
@@ -31,6 +47,7 @@ pub struct ShockFigures {
     /// Recovered before the window's end (see the module docs).
     pub recovered: bool,
     /// Shock start to the start of the final clear stretch (s); NaN if not recovered.
+    #[serde(with = "nan_as_null")]
     pub recovery_s: f64,
     /// Largest rotor–race normal force in the window (N).
     pub max_contact_force_n: f64,
@@ -45,7 +62,7 @@ pub struct ShockFigures {
 }
 
 /// Accumulates [`ShockFigures`] window by window.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ShockTracker {
     starts: Vec<f64>,
     end: f64,
@@ -61,7 +78,7 @@ pub struct ShockTracker {
     last_t: f64,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 struct Acc {
     max_force: f64,
     contact_samples: u64,
@@ -155,7 +172,7 @@ impl ShockTracker {
 }
 
 /// Per-bin maxima of the radius and the contact force: the coarse trace of a soak.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Envelope {
     bin: f64,
     index: u64,

@@ -88,6 +88,11 @@ pub struct Report {
     pub simulated_s: f64,
     /// Simulated time planned (s).
     pub planned_s: f64,
+    /// A soak continued from its checkpoint (`plant soak --resume`): the simulated time it
+    /// continued from (s). Its figures per shock cover the whole soak; `sequence_gaps`,
+    /// `deadline_misses`, `realtime_factor` and `cosim` cover the part after this time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resumed_from_s: Option<f64>,
     /// Wall time of the whole soak, start-up and outputs included (s).
     pub wall_time_s: f64,
     /// Simulated over loop wall time.
@@ -227,8 +232,9 @@ pub(crate) fn report(
         error,
         simulated_s: result.simulated,
         planned_s: prog.scene.duration,
+        resumed_from_s: (result.started > 0.0).then_some(result.started),
         wall_time_s: started.elapsed().as_secs_f64(),
-        realtime_factor: result.simulated / result.wall_time.max(1e-12),
+        realtime_factor: (result.simulated - result.started) / result.wall_time.max(1e-12),
         shocks,
         shocks_completed: figures.iter().filter(|f| f.complete).count(),
         recovered,

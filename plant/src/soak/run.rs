@@ -1,18 +1,22 @@
 //! Running a soak: the loop's hooks (progress, Ctrl-C, RSS samples) and the
 //! whole soak from `scene.toml` to `soak.json` and the charts.
 
+use super::checkpoint::{self, Checkpoint, ResumeError};
 use super::programme::Programme;
 use super::report::{report, Finished};
-use super::sink::{RssSample, SoakSink};
+use super::sink::{Checkpoints, RssSample, SoakSink};
 use super::{monitor, rss, ENVELOPE_BIN_S, ENVELOPE_CSV_HEADER, RSS_CSV_HEADER, SOAK_CSV_HEADER};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
 use crate::offload::run_into_offloaded;
 use crate::row_file::RowFile;
 use crate::run::SetupError;
+use crate::snapshot::Snapshot;
 use anyhow::Context;
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// How progress is shown.
@@ -36,6 +40,8 @@ pub struct Options<'a> {
     pub stop: &'a AtomicBool,
     /// Progress display.
     pub progress: Progress,
+    /// Continue the soak in `dir` from its checkpoint (`plant soak --resume`).
+    pub resume: bool,
 }
 
 /// Why a soak could not run or write its results.
@@ -47,6 +53,10 @@ pub enum SoakError {
     /// A file could not be written.
     #[error("{0:#}")]
     Io(anyhow::Error),
+    /// `--resume`: the folder holds no checkpoint of this programme, or its files do not
+    /// match it.
+    #[error(transparent)]
+    Resume(#[from] super::checkpoint::ResumeError),
 }
 
 /// Progress, Ctrl-C, notes, and the RSS samples.
@@ -66,6 +76,8 @@ struct SoakHooks<'a> {
     rss: Vec<RssSample>,
     rss_csv: RowFile,
     error: Option<std::io::Error>,
+    /// The plant's snapshots at the shocks' starts, for the sink's checkpoints.
+    snapshots: Arc<Mutex<VecDeque<Snapshot>>>,
 }
 
 impl SoakHooks<'_> {
@@ -136,6 +148,14 @@ impl Hooks for SoakHooks<'_> {
     fn controller_connected(&mut self, pid: u32) {
         self.controller_pid = Some(pid);
     }
+
+    fn save_state_at(&self) -> &[f64] {
+        &self.starts
+    }
+
+    fn state_saved(&mut self, _at: f64, snapshot: Snapshot) {
+        self.snapshots.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push_back(snapshot);
+    }
 }
 
 /// Runs a programme: writes `scene.toml` first, `soak.csv`, `rss.csv` and
@@ -146,19 +166,56 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     let io = SoakError::Io;
     std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display())).map_err(io)?;
     let scene = &prog.scene;
-    let resolved = scene.to_toml().context("serialising the resolved scene").map_err(io)?;
-    crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
-
-    let create = |name: &str, header: &[&str]| {
-        let path = dir.join(name);
-        RowFile::create(&path, header).with_context(|| format!("creating {}", path.display())).map_err(io)
-    };
+    let programme = checkpoint::fingerprint(prog).context("the programme as a value").map_err(io)?;
     let soak_header: Vec<&str> = SOAK_CSV_HEADER.split(',').collect();
-    let soak_csv = create("soak.csv", &soak_header)?;
-    let envelope_csv = create("envelope.csv", &ENVELOPE_CSV_HEADER.split(',').collect::<Vec<_>>())?;
-    let rss_csv = create("rss.csv", &RSS_CSV_HEADER.split(',').collect::<Vec<_>>())?;
-
+    let envelope_header: Vec<&str> = ENVELOPE_CSV_HEADER.split(',').collect();
+    let rss_header: Vec<&str> = RSS_CSV_HEADER.split(',').collect();
     let starts: Vec<f64> = prog.shocks.iter().map(|s| s.start_s).collect();
+
+    // A resumed soak: everything checked before a file is touched.
+    let saved = if opts.resume { Some(resumable(dir, prog)?) } else { None };
+    let (soak_csv, envelope_csv, rss_csv, rss) = match &saved {
+        None => {
+            // A checkpoint of an earlier soak in this folder would not describe this one's files.
+            match std::fs::remove_file(checkpoint::path(dir)) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(io(anyhow::Error::new(e).context("removing the earlier soak's checkpoint")))
+                }
+                _ => {}
+            }
+            let resolved = scene.to_toml().context("serialising the resolved scene").map_err(io)?;
+            crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
+            let create = |name: &str, header: &[&str]| {
+                let path = dir.join(name);
+                RowFile::create(&path, header).with_context(|| format!("creating {}", path.display())).map_err(io)
+            };
+            (
+                create("soak.csv", &soak_header)?,
+                create("envelope.csv", &envelope_header)?,
+                create("rss.csv", &rss_header)?,
+                Vec::new(),
+            )
+        }
+        Some(c) => {
+            let reopen = |name: &str, header: &[&str], len: u64| {
+                let path = dir.join(name);
+                RowFile::reopen(&path, header, len).with_context(|| format!("reopening {}", path.display())).map_err(io)
+            };
+            let (rss_csv, rss) = rss_until(dir, &rss_header, c.plant.t_s).map_err(io)?;
+            // The killed soak's controller log, kept before the resumed one writes its own.
+            crate::outfile::keep_aside(&dir.join("controller.log")).map_err(io)?;
+            (
+                reopen("soak.csv", &soak_header, c.soak_csv_bytes)?,
+                reopen("envelope.csv", &envelope_header, c.envelope_csv_bytes)?,
+                rss_csv,
+                rss,
+            )
+        }
+    };
+
+    let checkpoints =
+        Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
+    let snapshots = checkpoints.queue.clone();
     let mut sink = SoakSink {
         tracker: monitor::ShockTracker::new(
             starts.clone(),
@@ -174,7 +231,20 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         soak_csv,
         envelope_csv,
         error: None,
+        rows: 0,
+        checkpoints,
     };
+    // The wall clock goes on from the last RSS sample's of the soak resumed.
+    let wall_before = Duration::from_secs_f64(rss.last().map_or(0.0, |s| s.wall_s));
+    let started = started.checked_sub(wall_before).unwrap_or(started);
+    let half = 0.5 * scene.controller.period;
+    let next_rss = rss.last().map_or(0, |s| ((s.t_s + half) / prog.rss_every).floor() as u64 + 1);
+    if let Some(c) = &saved {
+        sink.tracker = c.tracker.clone();
+        sink.envelope = c.envelope.clone();
+        sink.figures = c.figures.clone();
+        sink.rows = c.rows;
+    }
     let bar = (opts.progress == Progress::Bar).then(|| {
         let bar = indicatif::ProgressBar::new((scene.duration * 1e3) as u64);
         bar.set_style(
@@ -187,20 +257,25 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         stop: opts.stop,
         progress: opts.progress,
         bar,
-        started: Instant::now(),
+        started,
         last_line: Instant::now(),
         duration: scene.duration,
         period: scene.controller.period,
         starts,
         rss_every: prog.rss_every,
-        next_rss: 0,
+        next_rss,
         controller_pid: None,
-        rss: Vec::with_capacity((scene.duration / prog.rss_every).ceil() as usize + 4),
+        rss: {
+            let mut all = Vec::with_capacity((scene.duration / prog.rss_every).ceil() as usize + 4);
+            all.extend(rss);
+            all
+        },
         rss_csv,
         error: None,
+        snapshots,
     };
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
-    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink, None) {
+    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink, saved.as_ref().map(|c| &c.plant)) {
         Ok(r) => r,
         Err(e) => {
             // The programme loaded: the folder records why the soak did not start.
@@ -222,6 +297,11 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         bar.finish_and_clear();
     }
     sink.finish();
+    if let Some(e) = sink.checkpoints.error.take() {
+        hooks.note(&format!(
+            "warning: a checkpoint could not be written ({e:#}): --resume continues from the last one written"
+        ));
+    }
     if let Some(e) = sink.error.take().or(hooks.error.take()) {
         return Err(io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
     }
@@ -255,6 +335,15 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         report = super::report::report(prog, programme_file, &result, &sink.figures, &hooks.rss, started);
         write(&report)?;
     }
+    if result.outcome == crate::run::Outcome::Completed {
+        // A completed soak has nothing to resume.
+        match std::fs::remove_file(checkpoint::path(dir)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                hooks.note(&format!("warning: {}: {e}", checkpoint::path(dir).display()));
+            }
+            _ => {}
+        }
+    }
     Ok(Finished { outcome: result.outcome, report })
 }
 
@@ -262,4 +351,57 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
 pub fn default_dir(programme_file: &Path) -> PathBuf {
     let stem = programme_file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     PathBuf::from("runs").join(format!("soak-{stem}"))
+}
+
+/// The checkpoint of the soak in `dir` and the check that it can go on under `prog`: the same
+/// programme, a plant that takes its state, and its files at least as long as when the
+/// checkpoint was taken. Nothing is written.
+fn resumable(dir: &Path, prog: &Programme) -> Result<Checkpoint, SoakError> {
+    let c = Checkpoint::read(dir, prog)?;
+    crate::run::check_start(&prog.scene, &c.plant)?;
+    for (name, len) in [("soak.csv", c.soak_csv_bytes), ("envelope.csv", c.envelope_csv_bytes), ("rss.csv", 0)] {
+        let path = dir.join(name);
+        let fail = |message: String| ResumeError::File { path: path.display().to_string(), message };
+        match std::fs::symlink_metadata(&path) {
+            Err(e) => return Err(fail(format!("{e}: the soak's files are not all here")).into()),
+            Ok(m) if !m.is_file() => return Err(fail("not a regular file".into()).into()),
+            Ok(m) if m.len() < len => {
+                return Err(fail(format!(
+                    "{} bytes, fewer than the {len} written when the checkpoint was taken: cut short or replaced",
+                    m.len()
+                ))
+                .into())
+            }
+            Ok(_) => {}
+        }
+    }
+    Ok(c)
+}
+
+/// `rss.csv` of a soak resumed from `t_s`: its rows up to that time kept (written anew, whole),
+/// and reopened to go on.
+fn rss_until(dir: &Path, header: &[&str], t_s: f64) -> anyhow::Result<(RowFile, Vec<RssSample>)> {
+    let path = dir.join("rss.csv");
+    let text = crate::input::read_text(&path, 1 << 30)?;
+    let mut kept = format!("{}\n", header.join(","));
+    let mut samples = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (Some(t), Some(wall)) =
+            (f.first().and_then(|v| v.parse::<f64>().ok()), f.get(1).and_then(|v| v.parse().ok()))
+        else {
+            continue;
+        };
+        if f.len() != header.len() || t > t_s {
+            continue;
+        }
+        let kib = |i: usize| f.get(i).and_then(|v| v.parse::<u64>().ok());
+        samples.push(RssSample { t_s: t, wall_s: wall, plant_kib: kib(2), controller_kib: kib(3) });
+        kept.push_str(line);
+        kept.push('\n');
+    }
+    crate::outfile::write(&path, kept.as_bytes())?;
+    let file =
+        RowFile::reopen(&path, header, kept.len() as u64).with_context(|| format!("reopening {}", path.display()))?;
+    Ok((file, samples))
 }

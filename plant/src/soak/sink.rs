@@ -6,7 +6,11 @@ use super::monitor::{Envelope, EnvelopeRow, ShockFigures, ShockTracker};
 use super::programme::PlannedShock;
 use crate::row_file::RowFile;
 use crate::run::Sink;
+use crate::snapshot::Snapshot;
 use crate::trace::{col, Record};
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 
 /// The sink: per-shock figures and the envelope, each written as it closes;
 /// both files are written out at each shock's end.
@@ -20,6 +24,38 @@ pub struct SoakSink<'a> {
     pub(crate) soak_csv: RowFile,
     pub(crate) envelope_csv: RowFile,
     pub(crate) error: Option<std::io::Error>,
+    /// Output rows taken so far (counted from the run's first: a resumed soak starts at its
+    /// checkpoint's).
+    pub(crate) rows: u64,
+    /// Where the checkpoints go.
+    pub(crate) checkpoints: Checkpoints,
+}
+
+/// The plant's snapshots at the shocks' starts, handed over by the loop's hooks, and the
+/// checkpoints the sink writes from them ([`super::checkpoint`]).
+pub(crate) struct Checkpoints {
+    /// The soak's folder.
+    pub(crate) dir: PathBuf,
+    /// The resolved programme ([`super::checkpoint::fingerprint`]).
+    pub(crate) programme: serde_json::Value,
+    /// Snapshots taken by the loop, not yet written (the loop's hooks push them; the sink,
+    /// on the loop's thread or on the row thread of a realtime soak, takes each once it has
+    /// every row up to the snapshot's time).
+    pub(crate) queue: Arc<Mutex<VecDeque<Snapshot>>>,
+    /// The first checkpoint that could not be written.
+    pub(crate) error: Option<anyhow::Error>,
+}
+
+impl Checkpoints {
+    /// The snapshot whose rows the sink has all taken, `rows` of them, if one is queued.
+    fn due(&self, rows: u64) -> Option<Snapshot> {
+        let mut queue = self.queue.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut due = None;
+        while queue.front().is_some_and(|s| s.next_output <= rows) {
+            due = queue.pop_front().filter(|s| s.next_output == rows);
+        }
+        due
+    }
 }
 
 impl SoakSink<'_> {
@@ -57,8 +93,38 @@ impl SoakSink<'_> {
         }
     }
 
+    /// Writes the checkpoint of `plant`, the sink's state now.
+    fn checkpoint(&mut self, plant: Snapshot) {
+        let written = (|| -> anyhow::Result<()> {
+            let checkpoint = super::checkpoint::Checkpoint {
+                format: super::checkpoint::FORMAT,
+                programme: self.checkpoints.programme.clone(),
+                plant,
+                rows: self.rows,
+                tracker: self.tracker.clone(),
+                envelope: self.envelope.clone(),
+                figures: self.figures.clone(),
+                soak_csv_bytes: self.soak_csv.written()?,
+                envelope_csv_bytes: self.envelope_csv.written()?,
+            };
+            checkpoint.write(&self.checkpoints.dir)
+        })();
+        if let Err(e) = written {
+            self.checkpoints.error.get_or_insert(e);
+        }
+    }
+
+    /// The checkpoint of the snapshot queued for the rows taken so far, if any.
+    fn take_checkpoint(&mut self) {
+        if let Some(plant) = self.checkpoints.due(self.rows) {
+            self.checkpoint(plant);
+        }
+    }
+
     /// Closes the window and the bin in progress, and writes everything out.
     pub fn finish(&mut self) {
+        // A soak stopped right after a snapshot: its checkpoint, before the windows close.
+        self.take_checkpoint();
         if let Some(r) = self.envelope.finish() {
             self.write_bin(r);
         }
@@ -72,6 +138,8 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn sample(&mut self, record: &Record) {
+        self.take_checkpoint();
+        self.rows += 1;
         // Of a two-plane rotor: the larger radius and contact force of the planes, and clear
         // while each plane is inside its own clear radius.
         let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
