@@ -663,7 +663,7 @@ pub fn package(scene: &Scene, library: &Path, out: &Path, fmi: Fmi) -> anyhow::R
         add(&format!("resources/{name}"), bytes, options)?;
     }
     let bytes = zip.finish()?.into_inner();
-    crate::outfile::write(out, &bytes).with_context(|| format!("writing {}", out.display()))?;
+    crate::outfile::write(out, &bytes)?;
     Ok(model)
 }
 
