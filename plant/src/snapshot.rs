@@ -36,8 +36,12 @@ pub struct Fingerprint(pub Vec<(String, String)>);
 impl Fingerprint {
     /// The fingerprint of `scene` for a plant of `state_len` state numbers.
     pub fn of(scene: &Scene, state_len: usize) -> Self {
-        let mut entries = vec![("state.length".to_owned(), state_len.to_string())];
-        entries.extend(scene.state_fingerprint());
+        // The rotor model first, so that a snapshot of another model is named as such.
+        let mut entries = vec![
+            ("rotor.model".to_owned(), scene.rotor.model().name().to_owned()),
+            ("state.length".to_owned(), state_len.to_string()),
+        ];
+        entries.extend(scene.state_fingerprint().into_iter().filter(|(k, _)| k != "rotor.model"));
         Self(entries)
     }
 

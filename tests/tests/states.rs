@@ -134,7 +134,7 @@ fn bad_states_and_times_are_refused_before_anything_is_written() {
     cmd.arg("--from-state").arg(&state);
     let out = output(&mut cmd);
     assert_exit(&out, 2);
-    assert!(stderr(&out).contains("state.length is 12 in the snapshot, 22 in the scene"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("rotor.model is planar in the snapshot, two_plane in the scene"), "{}", stderr(&out));
     assert!(!out_dir.exists());
     // Times outside the run, or not ascending.
     for (times, needle) in

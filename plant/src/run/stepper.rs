@@ -843,7 +843,7 @@ mod tests {
             e
         };
         let e = refused(&scene("two-plane-asymmetric-10g.toml", &[]));
-        assert!(e.contains("state.length is 12 in the snapshot, 22 in the scene"), "{e}");
+        assert!(e.contains("rotor.model is planar in the snapshot, two_plane in the scene"), "{e}");
         let e = refused(&scene("cosim-10g.toml", &["rotor.mass_kg=3.0"]));
         assert!(e.contains("rotor.mass_kg"), "{e}");
         let e = refused(&scene("cosim-10g.toml", &["amb.amplifier=true"]));
