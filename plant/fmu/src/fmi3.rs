@@ -82,7 +82,23 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     made.unwrap_or(std::ptr::null_mut())
 }
 
-/// Model exchange and scheduled execution: refused with a log line.
+/// Model exchange and scheduled execution: refused with a log line naming the call.
+unsafe fn refuse_instantiation(
+    call: &str,
+    instance_name: *const c_char,
+    environment: *mut c_void,
+    log: Option<LogMessage>,
+) -> *mut c_void {
+    let name = CString::new(text(instance_name).unwrap_or_default()).unwrap_or_default();
+    log_with(
+        &Callbacks::Fmi3 { environment, log },
+        &name,
+        ERROR,
+        &format!("{call}: this FMU is for co-simulation only"),
+    );
+    std::ptr::null_mut()
+}
+
 #[no_mangle]
 pub unsafe extern "C" fn fmi3InstantiateModelExchange(
     instance_name: *const c_char,
@@ -93,14 +109,7 @@ pub unsafe extern "C" fn fmi3InstantiateModelExchange(
     environment: *mut c_void,
     log: Option<LogMessage>,
 ) -> *mut c_void {
-    let name = CString::new(text(instance_name).unwrap_or_default()).unwrap_or_default();
-    log_with(
-        &Callbacks::Fmi3 { environment, log },
-        &name,
-        ERROR,
-        "fmi3InstantiateModelExchange: this FMU is for co-simulation only",
-    );
-    std::ptr::null_mut()
+    refuse_instantiation("fmi3InstantiateModelExchange", instance_name, environment, log)
 }
 
 #[no_mangle]
@@ -113,14 +122,7 @@ pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     environment: *mut c_void,
     log: Option<LogMessage>,
 ) -> *mut c_void {
-    let name = CString::new(text(instance_name).unwrap_or_default()).unwrap_or_default();
-    log_with(
-        &Callbacks::Fmi3 { environment, log },
-        &name,
-        ERROR,
-        "fmi3InstantiateScheduledExecution: this FMU is for co-simulation only",
-    );
-    std::ptr::null_mut()
+    refuse_instantiation("fmi3InstantiateScheduledExecution", instance_name, environment, log)
 }
 
 #[no_mangle]
