@@ -270,8 +270,9 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             out
         }
     };
-    // Plane A's gap (the excitation's default amplitude).
-    let gap = probe.plane(0).contact.gap;
+    // The smallest bearing plane's gap: the excitation's default amplitude and the bound of
+    // what is injected, so that it stays inside every plane's clearance.
+    let gap = (0..probe.planes()).map(|i| probe.plane(i).contact.gap).fold(f64::INFINITY, f64::min);
     let d = sensitivity::Settings::for_gap(gap);
     let s = &raw.sensitivity;
     let k = |name: &str| format!("sensitivity.{name}");
@@ -393,4 +394,30 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         materials,
         capacity_fraction,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    /// The excitation is bounded by the smallest bearing plane's gap, not plane A's: on the
+    /// two-plane machine with plane B's gap cut to 50 µm, 80 µm is refused (plane A's is 150).
+    #[test]
+    fn the_excitation_is_bounded_by_the_smallest_gap() {
+        let dir = std::env::temp_dir().join(format!("plant-assess-spec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
+        let file = dir.join("a.toml");
+        let write = |gap_b: f64| {
+            let text = format!(
+                "scene = {:?}\nset = [\"touchdown.b.air_gap_mm={gap_b}\"]\n[sensitivity]\nexcitation_um = 80.0\n",
+                scene.display().to_string()
+            );
+            std::fs::write(&file, text).unwrap();
+        };
+        write(0.25);
+        assert!(super::load(&file, &[], &[]).is_ok());
+        write(0.05);
+        let e = super::load(&file, &[], &[]).err().expect("refused").to_string();
+        assert!(e.contains("sensitivity.excitation_um"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
