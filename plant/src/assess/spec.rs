@@ -416,7 +416,8 @@ mod tests {
         write(0.25);
         assert!(super::load(&file, &[], &[]).is_ok());
         write(0.05);
-        let e = super::load(&file, &[], &[]).err().expect("refused").to_string();
+        let Err(e) = super::load(&file, &[], &[]) else { panic!("80 µm past plane B's 50 µm gap was taken") };
+        let e = e.to_string();
         assert!(e.contains("sensitivity.excitation_um"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
