@@ -378,7 +378,7 @@ fn run_counted(
     };
     let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty, Option<Decision>)>> {
         let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
-        // Every plane's touchdown bearing has the scene's ball set (`[touchdown]`).
+        // A start: each plane's duty takes its own bearing's ball count at its first sample.
         let balls = scene.plane(0).balls.count();
         let decision = Decision::new(scene, end_when_decided);
         let mut hooks = MemberHooks { stop, decision: decision.as_ref() };
