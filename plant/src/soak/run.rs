@@ -78,6 +78,9 @@ struct SoakHooks<'a> {
     error: Option<std::io::Error>,
     /// The plant's snapshots at the shocks' starts, for the sink's checkpoints.
     snapshots: Arc<Mutex<VecDeque<Snapshot>>>,
+    /// When to take them: the shocks' starts in lockstep; none in realtime, where a snapshot
+    /// (it allocates) would fall inside a tick's deadline.
+    checkpoint_at: Vec<f64>,
 }
 
 impl SoakHooks<'_> {
@@ -150,7 +153,7 @@ impl Hooks for SoakHooks<'_> {
     }
 
     fn save_state_at(&self) -> &[f64] {
-        &self.starts
+        &self.checkpoint_at
     }
 
     fn state_saved(&mut self, _at: f64, snapshot: Snapshot) {
@@ -261,6 +264,11 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         last_line: Instant::now(),
         duration: scene.duration,
         period: scene.controller.period,
+        checkpoint_at: if scene.controller.mode == crate::config::ControlMode::Realtime {
+            Vec::new()
+        } else {
+            starts.clone()
+        },
         starts,
         rss_every: prog.rss_every,
         next_rss,
