@@ -103,6 +103,23 @@ pub trait ControlLaw: Send {
     fn linear_pd(&self) -> Option<LinearPd> {
         None
     }
+    /// The law around levitation as a linear filter of each axis: its PD ([`LinearPd`], read at
+    /// each sample, the rate as the backward difference) behind an optional second-order filter
+    /// of the sensor voltage (a notch). What `plant assess` takes a flexible rotor's closed form
+    /// of. The default: [`ControlLaw::linear_pd`] with no filter.
+    fn linear(&self) -> Option<LinearLaw> {
+        self.linear_pd().map(|pd| LinearLaw { pd, filter: None })
+    }
+}
+
+/// A law around levitation as a linear filter ([`ControlLaw::linear`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearLaw {
+    /// The PD on the filtered voltage.
+    pub pd: LinearPd,
+    /// The filter ahead of it, `y_k = b₀ u_k + b₁ u_{k−1} + b₂ u_{k−2} − a₁ y_{k−1} − a₂ y_{k−2}`:
+    /// `([b₀, b₁, b₂], [a₁, a₂])`.
+    pub filter: Option<([f64; 3], [f64; 2])>,
 }
 
 /// The gains of a PD around levitation ([`ControlLaw::linear_pd`]): `i = bias − A_a (k_p u + k_d u̇)`

@@ -103,8 +103,8 @@ pub mod wire;
 pub use discrete_pd::{DelayPd, DelayPdGains};
 pub use law::{
     build_among, saturate, saturate_axes, wrap_angle, AnyLaw, BuildLaw, BuildRotorLaw, ControlLaw, Decentralised,
-    Design, Geometry, LawEntry, LawError, LinearPd, LoopConstants, PdDesign, RotorDesign, RotorLaw, RotorLawEntry,
-    RotorSample, Sample, ROTOR_AXES,
+    Design, Geometry, LawEntry, LawError, LinearLaw, LinearPd, LoopConstants, PdDesign, RotorDesign, RotorLaw,
+    RotorLawEntry, RotorSample, Sample, ROTOR_AXES,
 };
 pub use modal::{Modal, ModalGains, ModalSpec};
 pub use params::{Check, ParamReader, Params, ParamsError, PARAMS_LEN};

@@ -156,6 +156,11 @@ impl ControlLaw for PdNotch {
         self.notch.reset();
         self.pd.reset();
     }
+
+    fn linear(&self) -> Option<crate::law::LinearLaw> {
+        let pd = self.pd.linear_pd()?;
+        Some(crate::law::LinearLaw { pd, filter: Some((self.notch.b, self.notch.a)) })
+    }
 }
 
 #[cfg(test)]
@@ -224,6 +229,43 @@ mod tests {
         assert!(((hi - lo) / TAU - spec.width_hz).abs() < 1e-9);
         let shallow = NotchSpec { depth_db: 20.0, ..spec };
         assert!((shallow.response(wn).norm() - 0.1).abs() < 1e-12);
+    }
+
+    /// What the law says it is around levitation ([`ControlLaw::linear`], the closed form
+    /// `plant assess` takes of a flexible rotor's loop): the filter's difference equation, then
+    /// the PD on the filtered voltage with the rate as the backward difference, answers as the
+    /// law does, sample by sample (the bias is the design's, read from a zero input).
+    #[test]
+    fn the_law_is_the_linear_filter_it_says() {
+        let design = crate::wire::Hello::example("run").design();
+        let p = Params::parse("frequency_hz = 480.0\nwidth_hz = 120.0\ndepth_db = 25.0").unwrap();
+        let mut law = (LAW.build)(&design, &p).unwrap();
+        let linear = law.linear().expect("a linear law");
+        let (b, a) = linear.filter.expect("a filter");
+        let bias = {
+            let mut zero = (LAW.build)(&design, &p).unwrap();
+            zero.update(&Sample { seq: 0, t_s: 0.0, sensor_v: [0.0; 2], ..Default::default() })
+        };
+        let amp = design.constants.amp_gain_a_per_v;
+        let (mut u1, mut u2, mut y1, mut y2, mut prev) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for k in 0..400u64 {
+            // From rest (the backward difference reads zero at the first sample).
+            let u = 1e-3 * ((k as f64) * 0.37).sin() + 4e-4 * ((k as f64) * 1.9).sin();
+            let y = b[0] * u + b[1] * u1 + b[2] * u2 - a[0] * y1 - a[1] * y2;
+            let rate = (y - prev) / design.period_s;
+            let expected = bias[0] - amp * (linear.pd.kp * y + linear.pd.kd * rate);
+            let got = law.update(&Sample {
+                seq: k,
+                t_s: k as f64 * design.period_s,
+                sensor_v: [u, 0.0],
+                ..Default::default()
+            });
+            assert!(
+                (got[0] - expected).abs() < 1e-9 * expected.abs().max(1e-3),
+                "sample {k}: {got:?} against {expected}"
+            );
+            (u2, u1, y2, y1, prev) = (u1, u, y1, y, y);
+        }
     }
 
     /// Below the notch the law is `pd_delay` (the filter is transparent at DC); a centre at or

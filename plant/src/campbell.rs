@@ -1,7 +1,10 @@
-//! `plant campbell`: the whirl modes of a two-plane scene's rotor on its continuous PD against
-//! spin speed, the Campbell diagram (the linearisation of docs/MODEL.md §10.4,
-//! [`plant_physics::two_plane::linear`]), and the same frequencies recovered from simulated free
-//! decays of the full model at a few speeds.
+//! `plant campbell`: the whirl modes of a scene's rotor on its continuous PD against spin
+//! speed, the Campbell diagram, through the rotor seam ([`Rotor::linearised`]): the two-plane
+//! rotor's four (the linearisation of docs/MODEL.md §10.4, [`plant_physics::two_plane::linear`])
+//! or a flexible rotor's rigid-body and bending modes (§13.7, [`plant_physics::flex::linear`]);
+//! and, for the two-plane rotor, the same frequencies recovered from simulated free decays of
+//! the full model at a few speeds (a flexible rotor's bending modes lie far above what the
+//! decays sample: its diagram is the linearisation alone, and the log says so).
 //!
 //! **Free decay.** The scene at the speed asked for, without unbalance or shock, the PD inside
 //! the derivative, the races parked (no contact happens), started 10 µm off centre and tilted
@@ -16,27 +19,51 @@
 //! `decay.csv` (each decay mode against the linear one).
 
 use crate::config::{load_scene, Rotor, Scene};
+use crate::machine::Linearised;
 use crate::plot::{self, Scale, Series};
 use crate::run::{plane_gains, run, Outcome, Quiet};
 use crate::trace::{col, colb};
 use anyhow::Context;
 use nalgebra::{Complex, DMatrix};
+use plant_physics::flex::linear::ModeKind;
 use plant_physics::two_plane::linear::{LinearRotor, Mode, Shape, Whirl};
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 
 type C64 = Complex<f64>;
+
+/// What a mode is, as `campbell.csv` writes it: `cylindrical`, `conical` (the rigid-body
+/// modes), `bending_1`, `bending_2`, … (a flexible rotor's bending modes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ModeName(pub ModeKind);
+
+impl ModeName {
+    /// The name written.
+    pub fn name(&self) -> String {
+        match self.0 {
+            ModeKind::Cylindrical => "cylindrical".into(),
+            ModeKind::Conical => "conical".into(),
+            ModeKind::Bending(n) => format!("bending_{n}"),
+        }
+    }
+}
+
+impl Serialize for ModeName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.name())
+    }
+}
 
 /// One mode at one speed: a row of `campbell.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModeRow {
     /// Spin speed (Hz).
     pub speed_hz: f64,
-    /// `cylindrical` or `conical`.
-    pub mode: Shape,
-    /// `forward` or `backward`.
-    pub whirl: Whirl,
+    /// `cylindrical`, `conical`, or `bending_<n>`.
+    pub mode: ModeName,
+    /// `forward` or `backward` (`mixed` for a mode whose nodes whirl each way).
+    pub whirl: plant_physics::flex::Whirl,
     /// Damped natural frequency (Hz).
     pub frequency_hz: f64,
     /// Damping ratio.
@@ -90,6 +117,30 @@ pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
         ))
         .into());
     };
+    ideal_loop(scene)?;
+    let gains = plane_gains(scene)?;
+    Ok(LinearRotor::from_gains(machine, &[gains[0], gains[1]]))
+}
+
+/// The scene's rotor linearised on its continuous PD at each plane, through the rotor seam
+/// ([`Rotor::linearised`]): the two-plane rotor's four whirl modes, or a flexible rotor's with
+/// its bending modes.
+pub fn linearised(scene: &Scene) -> anyhow::Result<Box<dyn Linearised>> {
+    ideal_loop(scene)?;
+    let gains = plane_gains(scene)?;
+    scene.rotor.linearised(&gains).ok_or_else(|| {
+        crate::exit::BadArgument(format!(
+            "{}: plant campbell needs a two-plane scene (rotor.model = \"two_plane\") or a flexible one \
+             (\"flexible\"); this one is {}",
+            scene.name,
+            scene.rotor.model().name()
+        ))
+        .into()
+    })
+}
+
+/// Refuses a scene whose loop is not the ideal one the linearisation is.
+fn ideal_loop(scene: &Scene) -> anyhow::Result<()> {
     // The linearisation is the rotor on the ideal loop: an amplifier's coil and current loop
     // and a sensor's filter would add states it does not have, and runout forces the free
     // decays at 1× and 2× the spin. Refused rather than drawn wrong; the range does not act
@@ -116,18 +167,18 @@ pub fn linear_rotor(scene: &Scene) -> anyhow::Result<LinearRotor> {
         ))
         .into());
     }
-    let gains = plane_gains(scene)?;
-    Ok(LinearRotor::from_gains(machine, &[gains[0], gains[1]]))
+    Ok(())
 }
 
-/// The diagram's rows: the four modes at each speed.
-pub fn diagram(rotor: &LinearRotor, speeds_hz: &[f64]) -> anyhow::Result<Vec<ModeRow>> {
+/// The diagram's rows: the modes at each speed (the two-plane rotor's four; a flexible rotor's
+/// rigid-body and bending modes, ascending).
+pub fn diagram(rotor: &dyn Linearised, speeds_hz: &[f64]) -> anyhow::Result<Vec<ModeRow>> {
     let mut rows = Vec::with_capacity(4 * speeds_hz.len());
     for &hz in speeds_hz {
-        for m in rotor.modes(hz * TAU)? {
+        for m in rotor.whirl_modes(hz * TAU)? {
             rows.push(ModeRow {
                 speed_hz: hz,
-                mode: m.shape,
+                mode: ModeName(m.kind),
                 whirl: m.whirl,
                 frequency_hz: m.frequency_hz,
                 damping_ratio: m.damping_ratio,
@@ -271,7 +322,7 @@ pub const DECAY_HEADER: &str =
 /// `plant campbell` (module doc); returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {
     let scene = load_scene(req.scene, req.set)?;
-    let rotor = linear_rotor(&scene)?;
+    let rotor = linearised(&scene)?;
     if !(req.max_speed_hz.is_finite() && req.max_speed_hz >= 0.0 && req.max_speed_hz <= 1e5) {
         return Err(crate::exit::BadArgument(format!(
             "--max-speed-hz {}: must be between 0 and 1e5 Hz",
@@ -290,17 +341,27 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
     let out = crate::output::out_dir(req.out, &format!("campbell-{}", scene.name));
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let speeds: Vec<f64> = (0..req.points).map(|i| req.max_speed_hz * i as f64 / (req.points - 1) as f64).collect();
-    let rows = diagram(&rotor, &speeds)?;
+    let rows = diagram(rotor.as_ref(), &speeds)?;
     let csv = out.join("campbell.csv");
     crate::table::write_with_header(&csv, CAMPBELL_HEADER, &rows)?;
     let png = out.join("campbell.png");
     chart(&png, &scene.name, &rows)?;
     let mut written = vec![csv, png];
-    if !req.decay_speeds_hz.is_empty() {
+    // The free decays check the rigid rotor's four modes (a flexible rotor's bending modes lie
+    // far above what the decays sample).
+    let rigid = linear_rotor(&scene).ok();
+    if !req.decay_speeds_hz.is_empty() && rigid.is_none() {
+        log(&format!(
+            "{}: no free decays: they check the two-plane rotor's linearisation; this rotor is {}",
+            scene.name,
+            scene.rotor.model().name()
+        ));
+    }
+    if let (false, Some(rigid)) = (req.decay_speeds_hz.is_empty(), rigid) {
         let mut decay_rows = Vec::new();
         for &hz in req.decay_speeds_hz {
             let fitted = free_decay(&scene, hz)?;
-            let linear = rotor.modes(hz * TAU)?;
+            let linear = rigid.modes(hz * TAU)?;
             for row in match_modes(hz, &linear, &fitted) {
                 log(&format!(
                     "{hz:>6} Hz {:<8} {:<11} linear {:>8.3} Hz (ξ {:.4})  free decay {:>8.3} Hz (ξ {:.4})  {:+.2e}",
@@ -325,25 +386,43 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
 /// `campbell.png`: each mode's frequency against the spin speed, and the synchronous line
 /// `f = speed` where the unbalance excites a mode (up to 1.5 times the highest mode).
 fn chart(path: &Path, name: &str, rows: &[ModeRow]) -> Result<(), plot::PlotError> {
-    let modes = [
-        (Whirl::Forward, Shape::Cylindrical, "forward cylindrical"),
-        (Whirl::Backward, Shape::Cylindrical, "backward cylindrical"),
-        (Whirl::Forward, Shape::Conical, "forward conical"),
-        (Whirl::Backward, Shape::Conical, "backward conical"),
-    ];
-    let lines: Vec<(&str, Vec<f64>, Vec<f64>)> = modes
+    use plant_physics::flex::Whirl as W;
+    // One line per (whirl, mode), in the order the rows first name them; the rigid rotor's four
+    // as before (forward and backward cylindrical, then conical).
+    let mut modes: Vec<(W, ModeName)> = Vec::new();
+    for r in rows {
+        if !modes.contains(&(r.whirl, r.mode)) {
+            modes.push((r.whirl, r.mode));
+        }
+    }
+    let order = |m: &(W, ModeName)| {
+        let kind = match m.1 .0 {
+            ModeKind::Cylindrical => 0,
+            ModeKind::Conical => 1,
+            ModeKind::Bending(n) => 1 + n,
+        };
+        let whirl = match m.0 {
+            W::Forward => 0,
+            W::Backward => 1,
+            W::Mixed => 2,
+        };
+        (kind, whirl)
+    };
+    modes.sort_by_key(order);
+    let lines: Vec<(String, Vec<f64>, Vec<f64>)> = modes
         .iter()
-        .map(|(w, s, label)| {
+        .map(|(w, s)| {
             let (x, y): (Vec<f64>, Vec<f64>) =
                 rows.iter().filter(|r| r.whirl == *w && r.mode == *s).map(|r| (r.speed_hz, r.frequency_hz)).unzip();
-            (*label, x, y)
+            let whirl = crate::summary::snake_name(w);
+            (format!("{whirl} {}", s.name().replace('_', " ")), x, y)
         })
         .collect();
     let top = rows.iter().map(|r| r.frequency_hz).fold(0.0, f64::max) * 1.5;
     let max_speed = rows.iter().map(|r| r.speed_hz).fold(0.0, f64::max);
     let end = top.min(max_speed);
     let sync = (vec![0.0, end], vec![0.0, end]);
-    let mut series: Vec<Series> = lines.iter().map(|(l, x, y)| Series { label: l, x, y }).collect();
+    let mut series: Vec<Series> = lines.iter().map(|(l, x, y)| Series { label: l.as_str(), x, y }).collect();
     series.push(Series { label: "1× spin (unbalance)", x: &sync.0, y: &sync.1 });
     plot::lines(
         path,

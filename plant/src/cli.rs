@@ -107,11 +107,12 @@ pub enum Command {
         #[arg(long, default_value_t = 1, requires = "realtime")]
         runs: usize,
     },
-    /// The whirl modes of a two-plane scene's rotor on its continuous PD against spin speed
-    /// (Campbell diagram, linearised) and the same frequencies from simulated free decays;
-    /// writes campbell.csv, campbell.png and decay.csv.
+    /// The whirl modes of a two-plane or flexible scene's rotor on its continuous PD against spin
+    /// speed (Campbell diagram, linearised; a flexible rotor's bending modes beside its
+    /// rigid-body modes) and, for the two-plane rotor, the same frequencies from simulated free
+    /// decays; writes campbell.csv, campbell.png and decay.csv.
     Campbell {
-        /// A two-plane scene file (TOML, `rotor.model = "two_plane"`).
+        /// A two-plane or flexible scene file (TOML, `rotor.model = "two_plane"` or `"flexible"`).
         scene: PathBuf,
         /// Output folder (default: runs/campbell-<scene name>).
         #[arg(long)]

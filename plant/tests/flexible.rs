@@ -154,3 +154,135 @@ mod convergence {
         assert!(last < 1e-2, "{last}");
     }
 }
+
+/// The bending mode in the loop (issue 30 item 3): the linearised flexible rotor's whirl modes
+/// (`plant campbell`) and the closed form of its loop (`plant assess`) against the rigid rotor
+/// and against the simulated loop.
+mod in_the_loop {
+    use plant::assess::{coupled, measure_axis, sensitivity};
+    use plant::config::{load_scene, Rotor, Scene};
+    use plant_physics::flex::linear::ModeKind;
+    use plant_physics::flex::Whirl;
+    use std::path::Path;
+
+    fn shipped(name: &str, sets: &[&str]) -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config").join(name);
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load_scene(&path, &sets).expect("a shipped scene")
+    }
+
+    const STIFF: [&str; 2] =
+        ["rotor.shaft.materials.steel.modulus_pa=211e12", "rotor.shaft.materials.steel.shear_modulus_pa=81.2e12"];
+    const NOTCH: [&str; 2] =
+        ["controller.law=\"pd_notch\"", "controller.params={frequency_hz=495.0, width_hz=150.0, depth_db=30.0}"];
+
+    /// `plant campbell`'s modes of the flexible scene: the four rigid-body modes (cylindrical and
+    /// conical, forward and backward) and the first bending mode's pair beside them, near the
+    /// free shaft's 498 Hz, forward above backward at speed. With a shaft 1000 times stiffer the
+    /// rigid-body modes are the rigid two-plane rotor's of the same rigid body (its
+    /// linearisation, `two_plane::linear`), within 0.1 %, with the same names and whirls.
+    #[test]
+    fn campbell_shows_the_bending_modes_beside_the_rigid_body_modes() {
+        let scene = shipped("flexible-10g.toml", &[]);
+        let lin = plant::campbell::linearised(&scene).expect("linearised");
+        let speed = 300.0 * std::f64::consts::TAU;
+        let modes = lin.whirl_modes(speed).expect("modes");
+        let count = |k: ModeKind| modes.iter().filter(|m| m.kind == k).count();
+        assert_eq!((count(ModeKind::Cylindrical), count(ModeKind::Conical)), (2, 2), "{modes:?}");
+        let bending: Vec<_> = modes.iter().filter(|m| m.kind == ModeKind::Bending(1)).collect();
+        assert_eq!(bending.len(), 2, "{modes:?}");
+        let hz = |w: Whirl| bending.iter().find(|m| m.whirl == w).map(|m| m.frequency_hz).expect("a whirl");
+        assert!(hz(Whirl::Forward) > hz(Whirl::Backward) + 10.0, "{bending:?}");
+        assert!(bending.iter().all(|m| (440.0..560.0).contains(&m.frequency_hz)), "{bending:?}");
+        let rigid_top = modes.iter().filter(|m| !matches!(m.kind, ModeKind::Bending(_))).map(|m| m.frequency_hz);
+        assert!(rigid_top.fold(0.0, f64::max) < 100.0, "{modes:?}");
+
+        let stiff = shipped("flexible-10g.toml", &STIFF);
+        let Rotor::Flexible(f) = &stiff.rotor else { panic!("flexible") };
+        let gains = plant::run::plane_gains(&stiff).expect("gains");
+        let rigid = plant_physics::two_plane::linear::LinearRotor::from_gains(&f.machine, &[gains[0], gains[1]]);
+        let flexible = plant::campbell::linearised(&stiff).expect("linearised").whirl_modes(speed).expect("modes");
+        for m in rigid.modes(speed).expect("rigid modes") {
+            let kind = match m.shape {
+                plant_physics::two_plane::linear::Shape::Cylindrical => ModeKind::Cylindrical,
+                plant_physics::two_plane::linear::Shape::Conical => ModeKind::Conical,
+            };
+            let whirl = match m.whirl {
+                plant_physics::two_plane::linear::Whirl::Forward => Whirl::Forward,
+                plant_physics::two_plane::linear::Whirl::Backward => Whirl::Backward,
+            };
+            let twin = flexible.iter().find(|x| x.kind == kind && x.whirl == whirl).expect("the same mode");
+            let d = twin.frequency_hz / m.frequency_hz - 1.0;
+            assert!(d.abs() < 1e-3, "{m:?} against {twin:?}: {d:e}");
+        }
+    }
+
+    /// The sensor across the bending mode's nodes: the sampled PD that is stable on the rigid
+    /// rotor (a stiff shaft) is unstable on the flexible one, at the first bending mode; the
+    /// notch at that mode restores stability: the closed loop's poles (plant, notch, PD, delay
+    /// line). `plant assess`'s measurement says the same (tests/tests/flexible.rs).
+    #[test]
+    fn a_non_collocated_pd_is_unstable_at_the_bending_mode_and_the_notch_restores_it() {
+        let pole = |scene: &Scene| {
+            let open = scene.rotor.open_loop().expect("a flexible rotor");
+            let c = &scene.controller;
+            let laws: Vec<_> = scene
+                .plane_designs()
+                .iter()
+                .map(|d| {
+                    let l = controller::build_law(&c.law, d, &c.params).expect("law").linear().expect("linear");
+                    let pd = plant_physics::flex::linear::PlanePd {
+                        kp: l.pd.kp,
+                        kd: l.pd.kd,
+                        amp_gain: d.constants.amp_gain_a_per_v,
+                        sensor_gain: d.constants.sensor_gain_v_per_m,
+                    };
+                    plant_physics::flex::linear::AxisLaw::pd(&pd, c.period, l.filter)
+                })
+                .collect();
+            let lp = plant_physics::flex::linear::SampledLoop {
+                laws: [laws[0].clone(), laws[0].clone(), laws[1].clone(), laws[1].clone()],
+                period: c.period,
+                delay: c.delay_samples,
+            };
+            open.discretise(0.0, c.period).least_stable(&lp)
+        };
+        let rigid = shipped("flexible-noncollocated.toml", &STIFF);
+        let flexible = shipped("flexible-noncollocated.toml", &[]);
+        let notched = shipped("flexible-noncollocated.toml", &NOTCH);
+        let (r, _) = pole(&rigid);
+        let (f, f_hz) = pole(&flexible);
+        let (n, _) = pole(&notched);
+        eprintln!("largest |z|: rigid {r}, flexible {f} at {f_hz} Hz, notched {n}");
+        assert!(r < 1.0 && n < 1.0 && f > 1.0, "rigid {r}, flexible {f}, notched {n}");
+        assert!((440.0..560.0).contains(&f_hz), "the unstable pole at {f_hz} Hz");
+    }
+
+    /// The measured sensitivity of the notched loop (sampled, in the plant) is the closed form of
+    /// the linear loop (all four axes closed on the reduced shaft, the law's notch and PD, the
+    /// delay and the hold) within 0.5 dB at every measured frequency, around the bending mode.
+    #[test]
+    fn the_measured_sensitivity_is_the_closed_form_of_the_linear_loop() {
+        let scene = shipped("flexible-noncollocated.toml", &NOTCH);
+        let mut settings = sensitivity::Settings::for_gap(scene.plane(0).contact.gap);
+        settings.probe_s = 0.1;
+        settings.settle = 0.1;
+        settings.min_cycles = 30.0;
+        settings.f_min_hz = 470.0;
+        settings.f_max_hz = 530.0;
+        settings.points = 3;
+        settings.resolution = 1.0;
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let axis = measure_axis(&scene, 0, 0.0, &settings, &stop).expect("measured");
+        assert!(axis.stable, "{axis:?}");
+        let mut forms = coupled::closed_form_axes(&scene, &settings, &[0.0]).expect("a closed form");
+        assert!(forms.iter().all(|f| f.stable), "{forms:?}");
+        coupled::compare(&mut forms, std::slice::from_ref(&axis), &scene);
+        let x_a = forms.iter().find(|f| f.axis == "x_A").expect("x_A");
+        let d = x_a.measured_difference_db.expect("compared");
+        eprintln!("x_A: {} points, largest difference {d:.3e} dB: {:?}", axis.points.len(), axis.points);
+        assert!(axis.points.len() >= 2 && d < 0.5, "{d} dB over {:?}", axis.points);
+        // The bending mode's peak is one of the closed form's.
+        assert!(x_a.peaks.iter().any(|(f, _)| (470.0..530.0).contains(f)), "{:?}", x_a.peaks);
+    }
+}

@@ -106,3 +106,40 @@ fn flexible_scene_runs_in_every_mode_and_analyze_reads_it_back() {
     }
     assert_eq!(traces[0].rows, traces[1].rows, "lockstep differs from sampled");
 }
+
+/// `plant campbell` of the flexible scene (issue 30 item 3): campbell.csv has the rigid rotor's
+/// four modes and the first bending mode's pair beside them at every speed (forward above
+/// backward once spinning), campbell.png is drawn, and the log says that no free decays were
+/// run (they check the two-plane rotor's linearisation).
+#[test]
+fn campbell_of_a_flexible_scene_shows_its_bending_modes() {
+    let dir = TempDir::new("flexible-campbell");
+    let out = dir.join("c");
+    let run = output_within(
+        Command::new(plant_bin())
+            .arg("campbell")
+            .arg(scene("flexible-10g.toml"))
+            .args(["--points", "3", "--max-speed-hz", "300", "--out"])
+            .arg(&out),
+        RUN,
+    );
+    assert_exit(&run, 0);
+    assert!(stderr(&run).contains("no free decays"), "{}", stderr(&run));
+    assert!(out.join("campbell.png").is_file());
+    let text = std::fs::read_to_string(out.join("campbell.csv")).expect("campbell.csv");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("speed_hz,mode,whirl,frequency_hz,damping_ratio"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    for speed in ["0.0", "150.0", "300.0"] {
+        let at: Vec<&Vec<&str>> = rows.iter().filter(|r| r[0] == speed).collect();
+        let of = |mode: &str| at.iter().filter(|r| r[1] == mode).count();
+        assert_eq!((of("cylindrical"), of("conical"), of("bending_1")), (2, 2, 2), "{speed} Hz: {at:?}");
+        let bending: Vec<(&str, f64)> =
+            at.iter().filter(|r| r[1] == "bending_1").map(|r| (r[2], r[3].parse().expect("Hz"))).collect();
+        assert!(bending.iter().all(|(_, f)| (440.0..560.0).contains(f)), "{bending:?}");
+        if speed == "300.0" {
+            let hz = |w: &str| bending.iter().find(|b| b.0 == w).map(|b| b.1).expect("whirl");
+            assert!(hz("forward") > hz("backward") + 10.0, "{bending:?}");
+        }
+    }
+}

@@ -11,6 +11,7 @@
 //! as a black box through the same run loop every other command uses.
 
 pub mod closed_form;
+pub mod coupled;
 pub mod duty;
 pub mod hertz;
 pub mod ladder;
@@ -138,6 +139,10 @@ pub struct SensitivityPart {
     /// The two-plane rotor: each plane's closed form (its load share as a planar rotor with the
     /// plane's design, [`closed_form_of_plane`]), planes A then B; empty for the planar model.
     pub closed_form_planes: Vec<ClosedFormPeak>,
+    /// A rotor whose axes couple through it (the flexible rotor): each axis' closed form at each
+    /// speed, the loops of all axes closed ([`coupled`]), with its difference from the
+    /// measurement; empty for the rigid rotors.
+    pub closed_form_axes: Vec<coupled::AxisClosedForm>,
     /// Simulated time of all the measurement's runs (s).
     pub simulated_s: f64,
     /// The settings.
@@ -461,7 +466,21 @@ fn sensitivity_part(
         .collect();
     let closed_form = closed.first().cloned().flatten();
     let closed_form_planes = if scene.planes() > 1 { closed.into_iter().flatten().collect() } else { Vec::new() };
-    let part = SensitivityPart { axes, closed_form, closed_form_planes, simulated_s, settings: a.sensitivity.clone() };
+    let mut closed_form_axes = coupled::closed_form_axes(scene, &a.sensitivity, &speeds).unwrap_or_default();
+    coupled::compare(&mut closed_form_axes, &axes, scene);
+    for f in &closed_form_axes {
+        let peak = f.s_db.map_or(String::new(), |d| format!(", {d:.2} dB at {:.2} Hz", f.f_hz.unwrap_or(f64::NAN)));
+        let diff = f.measured_difference_db.map_or(String::new(), |d| format!("; measured within {d:.2} dB"));
+        log(&format!("  closed form {} at {:.0} Hz: zone {}{peak}{diff}", f.axis, f.speed_hz, f.zone));
+    }
+    let part = SensitivityPart {
+        axes,
+        closed_form,
+        closed_form_planes,
+        closed_form_axes,
+        simulated_s,
+        settings: a.sensitivity.clone(),
+    };
     if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
         // The axes often fail alike (one controller command, one interruption): each reason once.
         let mut reasons: Vec<&str> = Vec::new();

@@ -301,6 +301,17 @@ fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line
         let label = if s.closed_form_planes.is_empty() { "|S| closed form" } else { "|S| closed form, plane A alone" };
         lines.push(Line { label: label.into(), points: cf.curve.clone(), colour: BLACK, dashed: true, width: 2 });
     }
+    // The coupled loop's closed form of each axis (the flexible rotor).
+    for (i, f) in s.closed_form_axes.iter().filter(|f| speed.is_none_or(|sp| f.speed_hz == sp) && f.stable).enumerate()
+    {
+        lines.push(Line {
+            label: format!("|S| closed form {} at {:.0} Hz, all axes' loops", f.axis, f.speed_hz),
+            points: f.curve.clone(),
+            colour: colour(i),
+            dashed: true,
+            width: 1,
+        });
+    }
     lines
 }
 
@@ -601,6 +612,28 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
         }
         Some(_) => "unstable".into(),
         None => "–".into(),
+    });
+    row(&mut h, "closed form of the coupled loop (flexible rotor), per axis", &|c| {
+        let forms = c.sensitivity.result.as_ref().map(|s| s.closed_form_axes.as_slice()).unwrap_or_default();
+        if forms.is_empty() {
+            return "–".into();
+        }
+        forms
+            .iter()
+            .map(|f| match (f.stable, f.s_db) {
+                (true, Some(d)) => format!(
+                    "{} at {:.0} Hz: zone {}, {:.2} dB at {} Hz{}",
+                    f.axis,
+                    f.speed_hz,
+                    f.zone,
+                    d,
+                    num(f.f_hz, 2),
+                    f.measured_difference_db.map_or(String::new(), |m| format!(" (measured within {m:.2} dB)"))
+                ),
+                _ => format!("{} at {:.0} Hz: unstable", f.axis, f.speed_hz),
+            })
+            .collect::<Vec<_>>()
+            .join("<br>")
     });
     row(&mut h, "vibration (ISO 14839-2)", &|c| {
         match &c.vibration.result {

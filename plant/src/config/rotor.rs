@@ -160,6 +160,30 @@ impl Rotor {
     }
 }
 
+impl Rotor {
+    /// The rotor linearised about the centre on the continuous PD `gains` of each plane, for its
+    /// whirl modes (`plant campbell`): the two-plane rotor's four, the flexible rotor's with its
+    /// bending modes; `None` for the planar model (one plane: no whirl modes to tell apart).
+    pub fn linearised(&self, gains: &[controller::PdGains]) -> Option<Box<dyn crate::machine::Linearised>> {
+        match self {
+            Rotor::Planar(_) => None,
+            Rotor::TwoPlane(m) => Some(Box::new(two_plane::linear::LinearRotor::from_gains(m, &[gains[0], gains[1]]))),
+            Rotor::Flexible(f) => Some(Box::new(crate::machine::FlexibleLinear::new(f, gains))),
+        }
+    }
+
+    /// The open loop from the AMB currents to the sensor displacements of all axes, where the
+    /// closed form of `plant assess` needs it whole (`plant_physics::flex::linear`): the flexible
+    /// rotor's. The planar model's axis and the two-plane rotor's planes have their closed forms
+    /// in `assess::closed_form`.
+    pub fn open_loop(&self) -> Option<plant_physics::flex::linear::OpenLoop> {
+        match self {
+            Rotor::Planar(_) | Rotor::TwoPlane(_) => None,
+            Rotor::Flexible(f) => Some(plant_physics::flex::linear::OpenLoop::of(f)),
+        }
+    }
+}
+
 impl RotorModel {
     /// The name `rotor.model` gives it.
     pub fn name(self) -> &'static str {

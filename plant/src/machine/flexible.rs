@@ -6,12 +6,14 @@
 //! line through the two touchdown nodes (the rigid part of the motion there).
 
 use super::two_plane::RaceFailure;
-use super::{FailureState, Machine, PlaneState};
+use super::{FailureState, Linearised, Machine, PlaneState, WhirlMode};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
 use crate::trace::{self, Record};
 use nalgebra::Vector2;
-use plant_physics::flex::machine::{ix, Model, State, N};
+use plant_physics::flex::linear::{OpenLoop, PlanePd};
+use plant_physics::flex::machine::{ix, Model, Params as FlexParams, State, N};
+use plant_physics::flex::reduce::Kind;
 use serde::Serialize;
 
 /// The flexible rotor's failing state.
@@ -198,5 +200,53 @@ impl Machine<N> for Model {
             race_a: race(ix::RACE_A),
             race_b: race(ix::RACE_B),
         })
+    }
+}
+
+/// The flexible rotor linearised on the continuous PD of each plane ([`Linearised`]): the
+/// closed loop of [`OpenLoop`], its whirl modes below 0.9 times its lowest static-correction
+/// pseudo-mode (those above stand for the modes the reduction left out).
+pub struct FlexibleLinear {
+    open: OpenLoop,
+    pd: [PlanePd; 2],
+    f_max_hz: f64,
+}
+
+impl FlexibleLinear {
+    /// `p` on the continuous PD `gains` of each plane.
+    pub fn new(p: &FlexParams, gains: &[controller::PdGains]) -> Self {
+        let pd = [0, 1].map(|i| PlanePd {
+            kp: gains[i].kp,
+            kd: gains[i].kd,
+            amp_gain: gains[i].amp_gain_a_per_v,
+            sensor_gain: p.machine.planes[i].params.loop_constants.sensor_gain_v_per_m,
+        });
+        // The modes below the lowest static-correction pseudo-mode (which lies above the
+        // cutoff): the retained modes' range.
+        let red = &p.reduced;
+        let lowest_correction = red
+            .frequencies_hz()
+            .iter()
+            .zip(&red.kinds)
+            .filter(|(_, k)| **k == Kind::Correction)
+            .map(|(f, _)| *f)
+            .fold(f64::INFINITY, f64::min);
+        FlexibleLinear { open: OpenLoop::of(p), pd, f_max_hz: 0.9 * lowest_correction }
+    }
+}
+
+impl Linearised for FlexibleLinear {
+    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<WhirlMode>> {
+        Ok(self
+            .open
+            .whirl_modes(&self.pd, speed, self.f_max_hz)?
+            .into_iter()
+            .map(|m| WhirlMode {
+                kind: m.kind,
+                whirl: m.whirl,
+                frequency_hz: m.frequency_hz,
+                damping_ratio: m.damping_ratio,
+            })
+            .collect())
     }
 }

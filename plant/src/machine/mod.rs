@@ -13,7 +13,7 @@ mod flexible;
 mod planar;
 mod two_plane;
 
-pub use flexible::FlexibleFailure;
+pub use flexible::{FlexibleFailure, FlexibleLinear};
 pub use planar::PlanarFailure;
 pub use two_plane::{RaceFailure, TwoPlaneFailure};
 
@@ -23,6 +23,27 @@ use controller::{saturate, PdGains};
 use nalgebra::Vector2;
 use plant_physics::integrate::System;
 use serde::Serialize;
+
+/// A whirl mode of a rotor linearised on its continuous PD ([`Linearised`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhirlMode {
+    /// Cylindrical, conical, or the n-th bending mode.
+    pub kind: plant_physics::flex::linear::ModeKind,
+    /// Forward, backward (or mixed: nodes whirling each way).
+    pub whirl: plant_physics::flex::Whirl,
+    /// Damped natural frequency (Hz).
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+/// A rotor linearised about the centred, levitated rotor on the continuous PD of each plane:
+/// what `plant campbell` draws (the model's side of [`crate::config::Rotor::linearised`]).
+pub trait Linearised {
+    /// The whirl modes at spin speed `speed` (rad/s), ascending in frequency: the rigid rotor's
+    /// four, and a flexible rotor's bending modes below its cutoff beside them.
+    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<WhirlMode>>;
+}
 
 /// One bearing plane's state at an output time, for a sink that needs what a row does not hold
 /// (the race's angle and acceleration, each ball's load: the touchdown bearing's duty).

@@ -164,3 +164,27 @@ impl Machine<N> for Model {
         })
     }
 }
+
+impl super::Linearised for plant_physics::two_plane::linear::LinearRotor {
+    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<super::WhirlMode>> {
+        use plant_physics::flex::{linear::ModeKind, Whirl};
+        use plant_physics::two_plane::linear::{Shape, Whirl as RigidWhirl};
+        // In the order `LinearRotor::modes` gives (campbell.csv's rows as before).
+        Ok(self
+            .modes(speed)?
+            .iter()
+            .map(|m| super::WhirlMode {
+                kind: match m.shape {
+                    Shape::Cylindrical => ModeKind::Cylindrical,
+                    Shape::Conical => ModeKind::Conical,
+                },
+                whirl: match m.whirl {
+                    RigidWhirl::Forward => Whirl::Forward,
+                    RigidWhirl::Backward => Whirl::Backward,
+                },
+                frequency_hz: m.frequency_hz,
+                damping_ratio: m.damping_ratio,
+            })
+            .collect())
+    }
+}

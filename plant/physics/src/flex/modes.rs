@@ -174,24 +174,45 @@ impl Prepared {
     /// about 1 rad/s (as ROSS's ARPACK call), every one checked by its residual; the dense
     /// eigenvalues of the whole matrix when the iteration does not converge.
     pub fn modes(&self, speed: f64, count: usize) -> Result<Vec<Mode>, ModesError> {
+        Ok(self.finish(self.pairs(speed, count)?, count))
+    }
+
+    /// [`Prepared::modes`] with each mode's node orbits: the complex amplitudes `(X, Y)` of
+    /// each node's `x`, `y` (`Re((X, Y) e^{jωt})`), in the order of the system's `node_xy`
+    /// (empty when the mode's vector is not known).
+    pub fn modes_with_orbits(&self, speed: f64, count: usize) -> Result<Vec<(Mode, Vec<(C64, C64)>)>, ModesError> {
+        let mut pairs = self.pairs(speed, count)?;
+        pairs.sort_by(|x, y| x.0.im.total_cmp(&y.0.im).then(x.0.norm().total_cmp(&y.0.norm())));
+        pairs.truncate(count);
+        let orbits: Vec<Vec<(C64, C64)>> =
+            pairs.iter().map(|(_, v)| v.as_ref().map_or_else(Vec::new, |v| self.orbits(v))).collect();
+        Ok(self.finish(pairs, count).into_iter().zip(orbits).collect())
+    }
+
+    /// The eigenpairs at `speed`: by the Krylov iteration, or the dense eigenvalues.
+    fn pairs(&self, speed: f64, count: usize) -> Result<Vec<(C64, Option<DVector<C64>>)>, ModesError> {
         let a = self.state_matrix(speed);
         let size = a.nrows();
         let mut dim = (3 * count + 30).min(size);
         loop {
             if let Some(pairs) = self.arnoldi(&a, dim, count) {
-                return Ok(self.finish(pairs, count));
+                return Ok(pairs);
             }
             if dim == size {
                 break;
             }
             dim = (2 * dim).min(size);
         }
-        self.modes_dense(speed, count)
+        self.dense_pairs(speed)
     }
 
     /// The same from the dense eigenvalues of the whole first-order matrix (slower; the
     /// reference the Arnoldi iteration is tested against).
     pub fn modes_dense(&self, speed: f64, count: usize) -> Result<Vec<Mode>, ModesError> {
+        Ok(self.finish(self.dense_pairs(speed)?, count))
+    }
+
+    fn dense_pairs(&self, speed: f64) -> Result<Vec<(C64, Option<DVector<C64>>)>, ModesError> {
         let a = self.state_matrix(speed);
         let values = a.clone().complex_eigenvalues();
         if values.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
@@ -203,7 +224,7 @@ impl Prepared {
             .filter(|v| v.norm() > 0.1 && v.im > 0.0)
             .map(|&lambda| (lambda, null_vector(&ac, lambda)))
             .collect();
-        Ok(self.finish(pairs, count))
+        Ok(pairs)
     }
 
     fn finish(&self, mut pairs: Vec<(C64, Option<DVector<C64>>)>, count: usize) -> Vec<Mode> {
@@ -308,16 +329,7 @@ impl Prepared {
     /// when `Im(X̄ Y) < 0` (its orbit `Re((X, Y) e^{jωt})` turns from +x towards +y, the spin's
     /// sense). Nodes with less than 1 % of the largest amplitude do not vote.
     fn whirl(&self, z: &DVector<C64>) -> Whirl {
-        let n = self.scale.len();
-        let top = z.rows(0, n);
-        let orbits: Vec<(C64, C64)> = self
-            .node_xy
-            .iter()
-            .map(|(rx, ry)| {
-                let dot = |r: &DVector<f64>| r.iter().zip(top.iter()).map(|(a, b)| *b * *a).sum::<C64>();
-                (dot(rx), dot(ry))
-            })
-            .collect();
+        let orbits = self.orbits(z);
         let largest = orbits.iter().map(|(x, y)| x.norm_sqr() + y.norm_sqr()).fold(0.0, f64::max);
         let (mut fw, mut bw) = (0, 0);
         for (x, y) in &orbits {
@@ -335,6 +347,19 @@ impl Prepared {
             (0, _) => Whirl::Backward,
             _ => Whirl::Mixed,
         }
+    }
+
+    /// Each node's `(X, Y)` in the mode of first-order eigenvector `z = (W η, η̇)`.
+    fn orbits(&self, z: &DVector<C64>) -> Vec<(C64, C64)> {
+        let n = self.scale.len();
+        let top = z.rows(0, n);
+        self.node_xy
+            .iter()
+            .map(|(rx, ry)| {
+                let dot = |r: &DVector<f64>| r.iter().zip(top.iter()).map(|(a, b)| *b * *a).sum::<C64>();
+                (dot(rx), dot(ry))
+            })
+            .collect()
     }
 
     /// The modal matrix Φ the prepared coordinates are built on.
