@@ -159,6 +159,84 @@ pub fn peer(run_id: &str, role: &str) -> Peer {
     }
 }
 
+/// A node lookup ([`peer`]) may take this many times its own duration of the wall time at
+/// most: after a lookup that took `d`, the next one comes no sooner than `LOOKUP_SHARE × d`
+/// later (its cost then stays under 1/20 of the time a peer is waited for).
+///
+/// A lookup lists every iceoryx2 node of the machine (a directory and a file or two per
+/// node), so its cost grows with the runs of everyone on the machine and with their load.
+/// Measured on the shared 2-core machine: 1.4 ms (p50) in a debug build with a handful of
+/// nodes (`timed_wait`), but 200 to 340 ms each in a debug build at a load average of 23 with
+/// 48 nodes, where unpaced lookups took 79 % of a lockstep run's wall time (292 of 370 s for
+/// 2 000 ticks: docs/wire-protocol.md, "Liveness and deadlines").
+pub const LOOKUP_SHARE: u32 = 20;
+
+/// Watches a silent peer by its node, pacing the lookups so that their cost stays a bounded
+/// share of the wait ([`LOOKUP_SHARE`]), and counts them.
+#[derive(Debug)]
+pub struct PeerWatch {
+    run_id: String,
+    role: &'static str,
+    /// No lookup before this instant (the pacing), `None` before the first.
+    not_before: Option<Instant>,
+    /// The last lookup's duration.
+    last: Duration,
+    lookups: u64,
+    spent: Duration,
+}
+
+impl PeerWatch {
+    /// Watches the node `amb-testbed/<run_id>/<role>`.
+    pub fn new(run_id: &str, role: &'static str) -> Self {
+        Self {
+            run_id: run_id.to_string(),
+            role,
+            not_before: None,
+            last: Duration::ZERO,
+            lookups: 0,
+            spent: Duration::ZERO,
+        }
+    }
+
+    /// Looks the peer up, unless the last lookup was less than `every`, or less than
+    /// [`LOOKUP_SHARE`] times its own duration, ago: `None` then (not looked up).
+    pub fn paced(&mut self, every: Duration) -> Option<Peer> {
+        let now = Instant::now();
+        if self.not_before.is_some_and(|t| now < t) {
+            return None;
+        }
+        let peer = self.lookup();
+        self.not_before = Some(now + pacing(every, self.last));
+        Some(peer)
+    }
+
+    /// Looks the peer up now, whatever the pacing (a decision that needs the answer).
+    pub fn lookup(&mut self) -> Peer {
+        let start = Instant::now();
+        let state = peer(&self.run_id, self.role);
+        self.last = start.elapsed();
+        self.spent += self.last;
+        self.lookups += 1;
+        state
+    }
+
+    /// Lookups made.
+    pub fn lookups(&self) -> u64 {
+        self.lookups
+    }
+
+    /// Wall time spent in lookups.
+    pub fn spent(&self) -> Duration {
+        self.spent
+    }
+}
+
+/// The least time from the start of one paced lookup to the next: `every`, or [`LOOKUP_SHARE`]
+/// times the lookup's duration `took` if that is longer.
+pub fn pacing(every: Duration, took: Duration) -> Duration {
+    every.max(took * LOOKUP_SHARE)
+}
+
 fn service_name(run_id: &str, what: &str) -> Result<ServiceName, LinkError> {
     let full = wire::name(run_id, what);
     ServiceName::new(&full).map_err(|e| ipc_err(format!("service name {full}"))(&e))
@@ -269,6 +347,9 @@ pub struct Endpoint<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy 
     /// Blocking waits that found a frame after a slice ran out without a notification: the
     /// frame had been published, but the peer did not wake this side although it asked.
     unwoken: u64,
+    /// Slices of blocked waits that ran out without a notification (whether or not a frame
+    /// was then found): the waits that made progress by a timeout, not by the peer.
+    timeouts: u64,
 }
 
 impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend + 'static> Endpoint<Tx, Rx> {
@@ -293,7 +374,19 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
             .subscriber_builder()
             .create()
             .map_err(|e| ipc_err(format!("subscriber on {}", wire::name(run_id, &wake_tx)))(&e))?;
-        Ok(Self { mail, notifier, listener, wake_out, wake_in, spin_max: spin, spin, blocks: 0, woken: 0, unwoken: 0 })
+        Ok(Self {
+            mail,
+            notifier,
+            listener,
+            wake_out,
+            wake_in,
+            spin_max: spin,
+            spin,
+            blocks: 0,
+            woken: 0,
+            unwoken: 0,
+            timeouts: 0,
+        })
     }
 
     /// Sets the busy-poll budget before blocking.
@@ -317,6 +410,12 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
     /// costs a whole timed slice, which iceoryx2 may stretch well past the one asked for).
     pub fn unwoken(&self) -> u64 {
         self.unwoken
+    }
+
+    /// How many slices of blocked waits ran out without a notification (each costs a whole
+    /// timed slice; a peer that is merely slow shows here too, a lost wake-up always does).
+    pub fn timeouts(&self) -> u64 {
+        self.timeouts
     }
 
     /// Publishes a frame, then notifies the peer if it asked to be woken.
@@ -406,6 +505,8 @@ impl<Tx: Debug + Copy + ZeroCopySend + 'static, Rx: Debug + Copy + ZeroCopySend 
             }
             if notified {
                 self.woken += 1;
+            } else {
+                self.timeouts += 1;
             }
             if let Some(frame) = self.try_receive()? {
                 if !notified {
@@ -593,6 +694,28 @@ mod tests {
             assert_eq!(libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set), 0);
             (0..libc::CPU_SETSIZE as usize).filter(|c| libc::CPU_ISSET(*c, &set)).collect()
         }
+    }
+
+    /// A peer's node is looked up at most once per pacing interval: `every`, or 20 times the
+    /// lookup's own duration when that is longer (a slow listing, on a loaded machine with
+    /// many nodes, is made rarer, not at every slice of a wait); a decision that needs the
+    /// answer ([`PeerWatch::lookup`]) looks it up whatever the pacing.
+    #[test]
+    fn a_silent_peer_is_looked_up_at_the_paced_rate() {
+        assert_eq!(pacing(Duration::from_millis(1), Duration::from_micros(20)), Duration::from_millis(1));
+        assert_eq!(pacing(Duration::from_millis(1), Duration::from_millis(300)), Duration::from_secs(6));
+        let run_id = format!("pacing-{}", std::process::id());
+        let _watcher = node(&run_id, "controller").expect("node"); // iceoryx2's node folder exists
+        let mut w = PeerWatch::new(&run_id, "plant");
+        assert_eq!(w.paced(Duration::from_secs(600)), Some(Peer::Absent));
+        assert_eq!(w.paced(Duration::from_secs(600)), None, "within the interval");
+        assert_eq!(w.lookups(), 1);
+        assert_eq!(w.lookup(), Peer::Absent);
+        assert_eq!(w.lookups(), 2);
+        let mut w = PeerWatch::new(&run_id, "plant");
+        assert!(w.paced(Duration::ZERO).is_some());
+        std::thread::sleep(w.spent() * (LOOKUP_SHARE + 1));
+        assert!(w.paced(Duration::ZERO).is_some(), "due again after 20 times its duration");
     }
 
     /// A helper thread started by a pinned loop leaves the loop's core and runs under

@@ -72,7 +72,9 @@ pub const CRASH_AT_SEQ_ENV: &str = "AMB_CONTROLLER_CRASH_AT_SEQ";
 /// The default wait for the hello (s).
 pub const DEFAULT_CONNECT_TIMEOUT_S: f64 = 30.0;
 
-/// How often a silent plant is looked up by its node (a directory listing).
+/// How often at most a silent plant that is not this process's parent is looked up by its
+/// node (a listing of the machine's iceoryx2 nodes; slower ones are paced further by their
+/// cost, [`link::PeerWatch`]).
 const LIVENESS_EVERY: Duration = Duration::from_millis(20);
 
 /// Slice of a blocking wait: the longest a signal goes unnoticed while blocked.
@@ -405,7 +407,11 @@ pub fn run<L: Copy + Into<AnyLaw>>(
 
     let (session, token, axes) = (hello.session, hello.token, hello.axes);
     let mut last_heard = Instant::now();
-    let mut last_check = Instant::now();
+    // The plant that started this process is its parent: its death shows in `getppid` (the
+    // process is handed to another parent), a system call, where a node lookup lists every
+    // iceoryx2 node of the machine (paced for a plant that is not the parent: link::PeerWatch).
+    let parent = (hello.plant_pid != 0 && parent_pid() == hello.plant_pid).then_some(hello.plant_pid);
+    let mut watch = link::PeerWatch::new(run_id, "plant");
     let mut lost: Option<String> = None;
     let mut answered: u64 = 0;
     loop {
@@ -425,15 +431,19 @@ pub fn run<L: Copy + Into<AnyLaw>>(
             if stop.load(Ordering::Relaxed) {
                 return false;
             }
-            if last_check.elapsed() >= LIVENESS_EVERY && last_heard.elapsed() >= LIVENESS_EVERY {
-                last_check = Instant::now();
-                match link::peer(run_id, "plant") {
-                    Peer::Alive => {}
-                    Peer::Dead => {
+            if parent.is_some_and(|p| p != parent_pid()) {
+                lost =
+                    Some(format!("the plant of run {run_id} died (this process, its child, has another parent now)"));
+                return false;
+            }
+            if parent.is_none() && last_heard.elapsed() >= LIVENESS_EVERY {
+                match watch.paced(LIVENESS_EVERY) {
+                    None | Some(Peer::Alive) => {}
+                    Some(Peer::Dead) => {
                         lost = Some(format!("the plant of run {run_id} died (its node is dead)"));
                         return false;
                     }
-                    Peer::Absent => {
+                    Some(Peer::Absent) => {
                         lost = Some(format!("the plant of run {run_id} is gone (its node no longer exists)"));
                         return false;
                     }
@@ -648,4 +658,10 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         assert_eq!(e.to_string(), "--law relev: this controller serves pd");
     }
+}
+
+/// The parent process's id (`getppid`).
+fn parent_pid() -> u32 {
+    // SAFETY: getppid has no preconditions and cannot fail.
+    unsafe { libc::getppid() as u32 }
 }

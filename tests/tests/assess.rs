@@ -410,6 +410,36 @@ fn a_report_card_over_the_wire_is_made_within_a_bound() {
 /// The bound of [`a_report_card_over_the_wire_is_made_within_a_bound`]: its card takes seconds.
 const WIRE_LIMIT: std::time::Duration = std::time::Duration::from_secs(120);
 
+/// Issue 31, item 2: an assessment's lockstep runs block for each other's frame
+/// (`controller.spin_us = 0`, [`plant::assess::LOCKSTEP_WAIT`]). Blocking waits had made a
+/// loaded debug build ten times slower: not by a lost wake-up, but because the plant, at every
+/// 1 ms slice of a reply later than `controller.reply_timeout_ms`, listed every iceoryx2 node
+/// of the machine to see whether its controller still lived. A controller answering each frame
+/// 2 ms late (every wait of the plant blocks past that timeout, whatever the machine), with
+/// no spin: every blocked wait is ended by the controller's wake-up, not by a timed slice (a
+/// lost wake-up would leave every one of them `unwoken`), and the plant looks up no node of a
+/// controller it started that still runs (it did at each slice, 200 times here at least).
+#[test]
+fn a_blocked_lockstep_wait_is_ended_by_the_peer_and_lists_no_node() {
+    let dir = TempDir::new("assess-blocking-wait");
+    let out = dir.join("run");
+    let late = format!(
+        "controller.command=[{:?}, \"--mode\", \"late\", \"--late-us\", \"2000\"]",
+        rogue_bin().display().to_string()
+    );
+    let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.spin_us=0", late.as_str()];
+    let o = output_within(&mut plant_run(&scene("cosim-10g.toml"), &out, &sets), LIMIT);
+    assert_exit(&o, 0);
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["status"], "completed", "{s:#}");
+    let c = &s["cosim"];
+    let ticks = num(c, "messages_sent");
+    assert_eq!(ticks, 200.0, "{c:#}");
+    assert_eq!(num(c, "blocking_waits"), ticks, "every wait blocks for a reply 2 ms late: {c:#}");
+    assert!(num(c, "unwoken_waits") <= 0.05 * ticks, "waits that progressed only by a timed slice: {c:#}");
+    assert_eq!(num(c, "node_lookups"), 0.0, "{c:#}");
+}
+
 /// Issue 31, item 3: the report reads without the guide and names no folder of the machine.
 /// Run from a folder of its own, on an assessment file and an output folder given by absolute
 /// paths: neither that folder's nor the repository's absolute path, nor any other absolute

@@ -218,6 +218,17 @@ fn initial_offsets(scene: &Scene, axis: usize, offset_um: f64) -> Vec<String> {
     scene.rotor.sensor_offset(axis, offset_um)
 }
 
+/// The override put before a lockstep controller's own (so that its `set` still decides):
+/// plant and controller block for each other's frame instead of busy-polling first. An
+/// assessment runs [`COSIM_JOBS`] lockstep runs at once, more processes than cores, where a
+/// process spinning for its peer's frame holds a core the peer (or another run) needs; a
+/// lockstep trace does not depend on how either side waits. Measured on the shared 2-core
+/// machine: the report card of `config/assess/external-notch.toml` in 26.7 s instead of 207 s
+/// (docs/results/assessment.md). It became the default once the plant stopped listing every
+/// iceoryx2 node of the machine at each slice of a reply that was merely late (the reason
+/// blocking waits had been slower in a loaded debug build: `cosim::session::check_silence`).
+pub const LOCKSTEP_WAIT: &str = "controller.spin_us=0.0";
+
 /// Overrides of a measurement run without shocks: the shocks moved past `duration`, the fast
 /// setting, the output at `output_hz`, no plots.
 fn quiet_run_overrides(scene: &Scene, duration: f64, output_hz: f64, substeps: u32) -> Vec<String> {
@@ -730,7 +741,12 @@ pub struct Report {
 /// each controller, writes the report (also when a part failed or the run was interrupted).
 pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> {
     let started = Instant::now();
-    let a = spec::load(&args.file, &args.set, &args.laws)?;
+    let mut a = spec::load(&args.file, &args.set, &args.laws)?;
+    for c in a.controllers.iter_mut() {
+        if load_scene(&a.scene, &c.sets)?.controller.mode == ControlMode::Lockstep {
+            c.sets.insert(0, LOCKSTEP_WAIT.into());
+        }
+    }
     // Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2).
     let mut first = None;
     for c in &a.controllers {

@@ -147,6 +147,8 @@ pub struct Session {
     figures: Figures,
     scheduling: Scheduling,
     wake_warned: bool,
+    /// The controller's node, looked up while it is silent (paced: [`link::PeerWatch`]).
+    watch: link::PeerWatch,
     /// Plant and controller on one core under `SCHED_FIFO`: demotes a controller that holds
     /// the core ([`super::watchdog`]).
     watchdog: Option<super::watchdog::Watchdog>,
@@ -299,12 +301,12 @@ impl Session {
         let mut verdict = Verdict::Wait;
         let mut seen = Seen::default();
         loop {
-            let (run_id, child, log) = (&self.run_id, &mut self.child, &mut self.log);
+            let (child, log, watch) = (&mut self.child, &mut self.log, &mut self.watch);
             let waited = self.frames.wait(SLICE, || {
                 if hooks.cancelled() {
                     return false;
                 }
-                verdict = check_silence(t0, &mut next_check, timeout, deadline, run_id, child, log);
+                verdict = check_silence(t0, &mut next_check, timeout, deadline, child, log, watch);
                 matches!(verdict, Verdict::Wait)
             });
             let reply = match waited {
@@ -344,7 +346,7 @@ impl Session {
                 if t0.elapsed() < deadline {
                     continue;
                 }
-                return match controller_gone(&self.run_id, &mut self.child, &mut self.log) {
+                return match controller_gone(&mut self.child, &mut self.log, &mut self.watch, None) {
                     Some(why) => self.on_lost(sample, why, hooks),
                     None => self.on_silent(sample, &seen, hooks),
                 };
@@ -558,7 +560,8 @@ impl Session {
                         // other sign of life.
                         let running = self.child.as_mut().is_some_and(|c| c.exited().is_none());
                         if !running {
-                            if let Some(why) = controller_gone(&self.run_id, &mut self.child, &mut self.log) {
+                            let every = Some(Duration::from_secs_f64(self.settings.reply_timeout));
+                            if let Some(why) = controller_gone(&mut self.child, &mut self.log, &mut self.watch, every) {
                                 return self.on_lost(sample, why, hooks);
                             }
                         }
@@ -630,6 +633,9 @@ impl Session {
             fallback_ticks: f.fallback_ticks,
             blocking_waits: self.frames.blocks(),
             woken_waits: self.frames.woken(),
+            timed_out_waits: self.frames.timeouts(),
+            unwoken_waits: self.frames.unwoken(),
+            node_lookups: self.watch.lookups(),
             scheduling: self.scheduling.clone(),
             latency_us: f.latency.percentiles(),
             round_trip_us: (self.mode == ControlMode::Lockstep).then(|| f.round_trip.percentiles()),
@@ -643,42 +649,66 @@ impl Session {
 /// Why a loss was declared when the controller said it was stopped (SIGINT/SIGTERM to it).
 const STOPPED_BY_SIGNAL: &str = "the controller was stopped by a signal (it sent STOPPING)";
 
-/// A lockstep reply is missing since `t0`: every `timeout` the controller's process and
-/// node are looked up (gone: a lost peer); past `deadline` a live one is silent.
+/// A lockstep reply is missing since `t0`: every `timeout` the controller is checked (gone: a
+/// lost peer); past `deadline` a live one is silent.
+///
+/// A child of ours that is still running is alive: its exit is all there is to watch, and a
+/// `waitpid` tells it. Only an external controller (or a child that exited) is looked up by
+/// its node, paced ([`link::PeerWatch`]): a lookup lists every iceoryx2 node of the machine,
+/// and unpaced, one at every slice of every wait that outlasted `timeout` (1 ms by default),
+/// the lookups took most of a loaded machine's time (292 s of a 370 s debug run of 2 000
+/// ticks at a load of 23), which made the replies later still. At the deadline the node is
+/// looked up whatever the pacing, to say which it is.
 fn check_silence(
     t0: Instant,
     next_check: &mut Duration,
     timeout: Duration,
     deadline: Duration,
-    run_id: &str,
     child: &mut Option<Child>,
     log: &mut OutputLog,
+    watch: &mut link::PeerWatch,
 ) -> Verdict {
     let waited = t0.elapsed();
     if waited < *next_check {
         return Verdict::Wait;
     }
     *next_check = waited + timeout;
-    if let Some(why) = controller_gone(run_id, child, log) {
-        return Verdict::Gone(why);
-    }
     if waited >= deadline {
-        Verdict::Silent
-    } else {
-        Verdict::Wait
+        return match controller_gone(child, log, watch, None) {
+            Some(why) => Verdict::Gone(why),
+            None => Verdict::Silent,
+        };
+    }
+    if child.as_mut().is_some_and(|c| c.exited().is_none()) {
+        return Verdict::Wait;
+    }
+    match controller_gone(child, log, watch, Some(timeout)) {
+        Some(why) => Verdict::Gone(why),
+        None => Verdict::Wait,
     }
 }
 
 /// `Some(why)` if the controller's process is gone: our child exited (with its last output),
-/// or its node is dead or absent.
-fn controller_gone(run_id: &str, child: &mut Option<Child>, log: &mut OutputLog) -> Option<String> {
+/// or its node is dead or absent. `paced`: the node is looked up only if the pacing allows
+/// ([`link::PeerWatch::paced`] with this interval; not looked up: presumed alive); `None`:
+/// looked up now.
+fn controller_gone(
+    child: &mut Option<Child>,
+    log: &mut OutputLog,
+    watch: &mut link::PeerWatch,
+    paced: Option<Duration>,
+) -> Option<String> {
     if let Some(c) = child.as_mut() {
         if let Some(status) = c.exited() {
             log.settle();
             return Some(format!("the controller process exited ({status}){}", log.quote(3)));
         }
     }
-    let why = match link::peer(run_id, "controller") {
+    let peer = match paced {
+        Some(every) => watch.paced(every)?,
+        None => watch.lookup(),
+    };
+    let why = match peer {
         Peer::Alive => return None,
         Peer::Dead => "the controller's node is dead (its process died)",
         Peer::Absent => "the controller's node is gone",

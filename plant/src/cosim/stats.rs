@@ -386,6 +386,17 @@ pub struct CosimReport {
     /// Blocked waits of the plant that the controller ended by a notification (it served the
     /// plant's wake request).
     pub woken_waits: u64,
+    /// Slices of the plant's blocked waits (1 ms asked, longer in fact) that ran out without a
+    /// notification: a controller slower than a slice, or one that does not wake the plant.
+    pub timed_out_waits: u64,
+    /// Blocked waits of the plant whose reply was found only after a slice had run out
+    /// without a notification: those that progressed by a timeout, not by the controller's
+    /// wake-up (every blocked wait of a controller that does not serve wake requests).
+    pub unwoken_waits: u64,
+    /// Lookups of the controller's node (a listing of the machine's iceoryx2 nodes) while it
+    /// was silent: an external controller's sign of life, paced so that they take at most a
+    /// twentieth of the wait; none for a controller the plant started and that still runs.
+    pub node_lookups: u64,
     /// Scheduling of the plant's loop thread and of the controller (`fifo` with
     /// `controller.realtime_priority`, else `other`).
     pub scheduling: Scheduling,

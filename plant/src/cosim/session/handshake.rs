@@ -190,6 +190,7 @@ impl Session {
         let node = link::node(&run_id, "plant")?;
         let handshake = Mailbox::open(&node, &run_id, "hello", "ack")?;
         let frames = Endpoint::open(&node, &run_id, "sensor", "command", Duration::from_secs_f64(settings.spin))?;
+        let watch = link::PeerWatch::new(&run_id, "controller");
         let mut s = Session {
             mode,
             run_id,
@@ -224,6 +225,7 @@ impl Session {
             figures: Figures::default(),
             scheduling,
             wake_warned: false,
+            watch,
             watchdog: None,
             settings,
         };
