@@ -25,11 +25,8 @@ impl Sink for Nothing {
 }
 
 /// The scenes benched: file, label.
-const SCENES: [(&str, &str); 3] = [
-    ("cosim-10g.toml", "planar"),
-    ("two-plane-asymmetric-10g.toml", "two_plane"),
-    ("flexible-10g.toml", "flexible"),
-];
+const SCENES: [(&str, &str); 3] =
+    [("cosim-10g.toml", "planar"), ("two-plane-asymmetric-10g.toml", "two_plane"), ("flexible-10g.toml", "flexible")];
 
 /// The plant of `file` in sampled mode, 60 ms with the shock at 5 ms, and its bias currents.
 fn plant_of(file: &str) -> (Plant, [f64; controller::ROTOR_AXES]) {

@@ -17,12 +17,12 @@
 #   cargo build --release --locked -p plant --bench stepper        # for 2.'s Rust side
 #   scripts/bench/fmu.sh runs/bench-fmu [ROUNDS]
 #
-# BIN (default target/release) holds the binaries; VENV (default target/fmpy-venv, which the
+# SAMPLES (default 20000) round trips per `plant bench ipc`. BIN (default target/release) holds the binaries; VENV (default target/fmpy-venv, which the
 # FMU tests make) a Python with FMPy 0.3.32 and the kit: made here if it lacks them.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=$(realpath -m "${1:-runs/bench-fmu}"); ROUNDS=${2:-3}
-BIN=$(realpath "${BIN:-target/release}"); VENV=${VENV:-target/fmpy-venv}
+BIN=$(realpath "${BIN:-target/release}"); VENV=${VENV:-target/fmpy-venv}; SAMPLES=${SAMPLES:-20000}
 P=$BIN/plant
 mkdir -p "$OUT"
 if ! "$VENV/bin/python" -c "import fmpy, amb_testbed_controller" 2> /dev/null; then
@@ -83,14 +83,14 @@ EOF
   for who in pd_spawned pd_external fmu_external; do
     l=$(load); id=bench-$$-$r-$who
     case $who in
-      pd_spawned) "$P" bench ipc --samples 100000 --warmup 10000 > "$OUT/ipc-$who-$r.log" 2>&1 ;;
+      pd_spawned) "$P" bench ipc --samples "$SAMPLES" --warmup "$((SAMPLES / 10))" > "$OUT/ipc-$who-$r.log" 2>&1 ;;
       pd_external)
         "$BIN/controller" --run-id "$id" --law pd --quiet > "$OUT/ipc-$who-$r.ctl.log" 2>&1 &
-        "$P" bench ipc --samples 100000 --warmup 10000 --controller external --run-id "$id" > "$OUT/ipc-$who-$r.log" 2>&1
+        "$P" bench ipc --samples "$SAMPLES" --warmup "$((SAMPLES / 10))" --controller external --run-id "$id" > "$OUT/ipc-$who-$r.log" 2>&1
         wait ;;
       fmu_external)
         "$BIN/controller-fmu" --fmu "$OUT/pd.fmu" --run-id "$id" --law fmu --quiet > "$OUT/ipc-$who-$r.ctl.log" 2>&1 &
-        "$P" bench ipc --samples 100000 --warmup 10000 --controller external --run-id "$id" > "$OUT/ipc-$who-$r.log" 2>&1
+        "$P" bench ipc --samples "$SAMPLES" --warmup "$((SAMPLES / 10))" --controller external --run-id "$id" > "$OUT/ipc-$who-$r.log" 2>&1
         wait ;;
     esac
     python3 - "$OUT/ipc-$who-$r.log" "$r" "$l" "$who" >> "$RESULTS" <<'EOF'
