@@ -1,7 +1,9 @@
 //! A `Plant` step from a driver outside the CLI allocates nothing: the state, the integrator's
 //! stages, the output times and the rows are all made before the first tick. Counted with a
 //! global allocator that counts, over many ticks in and out of contact, on the planar model,
-//! the two-plane rotor and a scene with amplifiers and a sensor front end.
+//! the two-plane rotor, the flexible rotor and a scene with amplifiers and a sensor front end,
+//! and with every tick's execution time measured (`Plant::time_ticks`: a realtime driver's
+//! histograms, recorded in place).
 
 use plant::run::Sink;
 use plant::stepper::{Command, Plant};
@@ -43,12 +45,15 @@ impl Sink for Largest {
 #[test]
 fn a_plant_step_allocates_nothing() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config");
-    for (file, sets) in [
-        ("paper-10g.toml", vec!["controller.mode=\"sampled\""]),
-        ("two-plane-asymmetric-10g.toml", vec!["controller.mode=\"sampled\""]),
-        ("realistic-10g.toml", vec![]),
+    for (file, timed, sets) in [
+        ("paper-10g.toml", false, vec!["controller.mode=\"sampled\""]),
+        ("paper-10g.toml", true, vec!["controller.mode=\"sampled\""]),
+        ("two-plane-asymmetric-10g.toml", false, vec!["controller.mode=\"sampled\""]),
+        ("flexible-10g.toml", false, vec!["controller.mode=\"sampled\""]),
+        ("realistic-10g.toml", false, vec![]),
         (
             "paper-10g.toml",
+            false,
             vec![
                 "controller.mode=\"sampled\"",
                 "integrator.method=\"rk4\"",
@@ -64,6 +69,9 @@ fn a_plant_step_allocates_nothing() {
         let scene = plant::config::load_scene(&root.join(file), &sets).unwrap();
         let bias = plant::run::bias_of(&scene, &plant::run::plane_gains(&scene).unwrap());
         let mut plant = Plant::new(&scene, &Command::Held(bias)).unwrap();
+        if timed {
+            plant.time_ticks();
+        }
         let mut sink = Largest(0.0);
         // A proportional law of the test's own: no allocation of its own.
         let step = |plant: &mut Plant, sink: &mut Largest| {
@@ -82,6 +90,11 @@ fn a_plant_step_allocates_nothing() {
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
         assert!(before > 0, "the counter counts (building the plant allocates)");
         assert!(sink.0 > scene.plane(0).contact.gap, "{file}: the shock brought the rotor into contact");
-        assert_eq!(during, 0, "{file} {sets:?}: {during} allocations in {} ticks", plant.tick() - 1);
+        assert_eq!(
+            during,
+            0,
+            "{file} {sets:?} (ticks timed: {timed}): {during} allocations in {} ticks",
+            plant.tick() - 1
+        );
     }
 }
