@@ -152,6 +152,12 @@ impl Linear {
     }
 }
 
+/// An eigenvalue with its first-order eigenvector, where known.
+type Pair = (C64, Option<DVector<C64>>);
+
+/// A mode with each node's orbit `(X, Y)`.
+pub type ModeOrbits = (Mode, Vec<(C64, C64)>);
+
 /// The shift of the shift-and-invert iteration (rad/s), as ROSS's (`sigma = 1`).
 const SHIFT: f64 = 1.0;
 
@@ -180,7 +186,7 @@ impl Prepared {
     /// [`Prepared::modes`] with each mode's node orbits: the complex amplitudes `(X, Y)` of
     /// each node's `x`, `y` (`Re((X, Y) e^{jωt})`), in the order of the system's `node_xy`
     /// (empty when the mode's vector is not known).
-    pub fn modes_with_orbits(&self, speed: f64, count: usize) -> Result<Vec<(Mode, Vec<(C64, C64)>)>, ModesError> {
+    pub fn modes_with_orbits(&self, speed: f64, count: usize) -> Result<Vec<ModeOrbits>, ModesError> {
         let mut pairs = self.pairs(speed, count)?;
         pairs.sort_by(|x, y| x.0.im.total_cmp(&y.0.im).then(x.0.norm().total_cmp(&y.0.norm())));
         pairs.truncate(count);
@@ -190,7 +196,7 @@ impl Prepared {
     }
 
     /// The eigenpairs at `speed`: by the Krylov iteration, or the dense eigenvalues.
-    fn pairs(&self, speed: f64, count: usize) -> Result<Vec<(C64, Option<DVector<C64>>)>, ModesError> {
+    fn pairs(&self, speed: f64, count: usize) -> Result<Vec<Pair>, ModesError> {
         let a = self.state_matrix(speed);
         let size = a.nrows();
         let mut dim = (3 * count + 30).min(size);
@@ -212,7 +218,7 @@ impl Prepared {
         Ok(self.finish(self.dense_pairs(speed)?, count))
     }
 
-    fn dense_pairs(&self, speed: f64) -> Result<Vec<(C64, Option<DVector<C64>>)>, ModesError> {
+    fn dense_pairs(&self, speed: f64) -> Result<Vec<Pair>, ModesError> {
         let a = self.state_matrix(speed);
         let values = a.clone().complex_eigenvalues();
         if values.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
