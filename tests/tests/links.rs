@@ -145,7 +145,16 @@ fn run_and_analyze_write_through_no_link() {
 fn soak_writes_through_no_link() {
     controller_bin();
     let dir = TempDir::new("links-soak");
-    let programme = workspace_root().join("config").join("soak").join("soak-short.toml");
+    // One short 2 G pulse and a short settle, through one lockstep co-simulation: every file a
+    // soak writes (the shipped soak-short.toml simulates 0.65 s, twice here, for the same names).
+    let programme = dir.join("soak.toml");
+    let text = format!(
+        "name = \"links\"\nscene = {:?}\nset = [\"controller.law=\\\"pd\\\"\"]\nmode = \"lockstep\"\nsettle_s = 0.03\nrss_every_s = 0.01\n\
+         [recovery]\nhold_s = 0.01\nradius_fraction = 0.6\n\
+         [[shock]]\nkind = \"half_sine\"\npeak_g = 2.0\nduration_s = 0.005\nstart_s = 0.01\n",
+        scene("cosim-10g.toml").display().to_string()
+    );
+    std::fs::write(&programme, text).unwrap();
     let args = os(&["soak", programme.to_str().unwrap(), "--out", "{out}", "--quiet"]);
     let written = holds(&dir, "soak", &args, &[], &nothing);
     for f in ["soak.csv", "envelope.csv", "rss.csv", "controller.log"] {

@@ -49,39 +49,58 @@ pub fn small_ensemble_sweep(dir: &TempDir) -> PathBuf {
     path
 }
 
-/// Builds `bin` of `package` in the profile these tests were built in and
-/// returns the executable's path.
+/// The workspace's binaries the tests start, all built by one `cargo build` per test binary
+/// (in the profile these tests were built in); maps a binary's name to its executable.
 ///
-/// The path is taken from Cargo's own `compiler-artifact` message rather
-/// than guessed from the target folder, so `CARGO_TARGET_DIR`,
-/// `build.target-dir` in a Cargo config, and `--release` are all honoured
-/// without special cases.
-fn build_bin(package: &str, bin: &str) -> PathBuf {
-    let mut cmd = Command::new(env!("CARGO"));
-    cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "-p", package, "--bin", bin]);
-    if !cfg!(debug_assertions) {
-        cmd.arg("--release");
-    }
-    let out = cmd.output().unwrap_or_else(|e| panic!("cannot start cargo to build {bin}: {e}"));
-    assert!(
-        out.status.success(),
-        "cargo build -p {package} --bin {bin} failed ({}):\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    stdout
-        .lines()
-        .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
-        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == bin)
-        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-        .unwrap_or_else(|| panic!("cargo built no executable named {bin}"))
+/// The paths are taken from Cargo's own `compiler-artifact` messages rather than guessed from
+/// the target folder, so `CARGO_TARGET_DIR`, `build.target-dir` in a Cargo config, and
+/// `--release` are all honoured without special cases.
+///
+/// The build selects the whole workspace and names a test target too (`--test docs`, any
+/// would do: one fixed, so that a test binary does not compile itself a second time): that
+/// resolves the dependencies' features as `cargo test --workspace` (CI's command) did,
+/// dev-dependencies included, so after it every binary is already fresh. A narrower
+/// selection (`-p plant --bin plant`) resolves other features (criterion's, proptest's,
+/// png's are left out) and compiled the plant, nalgebra and iceoryx2 again, once per
+/// selection: minutes of a CI run on two cores.
+fn workspace_bins() -> &'static std::collections::HashMap<String, PathBuf> {
+    static BINS: OnceLock<std::collections::HashMap<String, PathBuf>> = OnceLock::new();
+    BINS.get_or_init(|| {
+        const BINS: [&str; 5] = ["plant", "controller", "rogue-controller", "peak-rss", "shock-table"];
+        let mut cmd = Command::new(env!("CARGO"));
+        cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "--workspace"]);
+        for bin in BINS {
+            cmd.args(["--bin", bin]);
+        }
+        cmd.args(["--test", "docs"]);
+        if !cfg!(debug_assertions) {
+            cmd.arg("--release");
+        }
+        let out = cmd.output().unwrap_or_else(|e| panic!("cannot start cargo to build {BINS:?}: {e}"));
+        assert!(out.status.success(), "{cmd:?} failed ({}):\n{}", out.status, String::from_utf8_lossy(&out.stderr));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let found: std::collections::HashMap<String, PathBuf> = stdout
+            .lines()
+            .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
+            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["kind"][0] == "bin")
+            .filter_map(|m| Some((m["target"]["name"].as_str()?.to_string(), PathBuf::from(m["executable"].as_str()?))))
+            .collect();
+        for bin in BINS {
+            assert!(found.contains_key(bin), "cargo built no executable named {bin}");
+        }
+        found
+    })
+}
+
+/// Builds `bin` (a binary of the workspace) and returns the executable's path.
+fn build_bin(bin: &str) -> PathBuf {
+    workspace_bins().get(bin).cloned().unwrap_or_else(|| panic!("cargo built no executable named {bin}"))
 }
 
 /// The `plant` binary, built once per test binary.
 pub fn plant_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| build_bin("plant", "plant"))
+    BIN.get_or_init(|| build_bin("plant"))
 }
 
 /// The `controller` binary (the co-simulation's controller process), built
@@ -89,20 +108,20 @@ pub fn plant_bin() -> &'static Path {
 #[allow(dead_code)] // used by cosim.rs only
 pub fn controller_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| build_bin("controller", "controller"))
+    BIN.get_or_init(|| build_bin("controller"))
 }
 
 /// The `rogue-controller` test binary (a controller that misbehaves on purpose, see
 /// `tests/bin/rogue_controller.rs`), built once per test binary.
 pub fn rogue_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| build_bin("testbed-tests", "rogue-controller"))
+    BIN.get_or_init(|| build_bin("rogue-controller"))
 }
 
 /// The `shock-table` binary, built once per test binary.
 pub fn shock_table_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| build_bin("shock-table", "shock-table"))
+    BIN.get_or_init(|| build_bin("shock-table"))
 }
 
 /// Overrides that keep a paper scene short: 50 ms with the shock from 10 ms,
@@ -401,7 +420,7 @@ pub fn num(v: &serde_json::Value, key: &str) -> f64 {
 /// The `peak-rss` helper (`tests/bin/peak_rss.rs`), built once per test binary.
 pub fn peak_rss_bin() -> &'static Path {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| build_bin("testbed-tests", "peak-rss"))
+    BIN.get_or_init(|| build_bin("peak-rss"))
 }
 
 /// Runs a command to completion within `limit` (killed past it, failing the test) and
