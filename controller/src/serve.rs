@@ -555,6 +555,12 @@ fn refuse(handshake: &Mailbox<Ack, Hello>, hello: &Hello, why: Refusal, message:
     }
 }
 
+/// The parent process's id (`getppid`).
+fn parent_pid() -> u32 {
+    // SAFETY: getppid has no preconditions and cannot fail.
+    unsafe { libc::getppid() as u32 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -658,10 +664,4 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         assert_eq!(e.to_string(), "--law relev: this controller serves pd");
     }
-}
-
-/// The parent process's id (`getppid`).
-fn parent_pid() -> u32 {
-    // SAFETY: getppid has no preconditions and cannot fail.
-    unsafe { libc::getppid() as u32 }
 }
