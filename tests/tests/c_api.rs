@@ -31,28 +31,7 @@ const NATIVE_LIBS: &[&str] = &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", 
 fn libraries() -> &'static (PathBuf, PathBuf) {
     static LIBS: OnceLock<(PathBuf, PathBuf)> = OnceLock::new();
     LIBS.get_or_init(|| {
-        let mut cmd = Command::new(env!("CARGO"));
-        cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "-p", "controller-c", "--lib"]);
-        if !cfg!(debug_assertions) {
-            cmd.arg("--release");
-        }
-        let out = output(&mut cmd);
-        assert!(out.status.success(), "building controller-c: {}", stderr(&out));
-        let files: Vec<PathBuf> = String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "amb_testbed_controller")
-            .flat_map(|m| m["filenames"].as_array().cloned().unwrap_or_default())
-            .filter_map(|f| f.as_str().map(PathBuf::from))
-            .collect();
-        let find = |ext: &str| {
-            files
-                .iter()
-                .find(|f| f.extension().is_some_and(|e| e == ext))
-                .cloned()
-                .unwrap_or_else(|| panic!("no .{ext} in {files:?}"))
-        };
-        (find("a"), find("so"))
+        (common::workspace_lib("amb_testbed_controller", "a"), common::workspace_lib("amb_testbed_controller", "so"))
     })
 }
 

@@ -36,13 +36,7 @@ fn host_built() {
     static BUILT: OnceLock<()> = OnceLock::new();
     BUILT.get_or_init(|| {
         plant_bin();
-        let mut cmd = Command::new(env!("CARGO"));
-        cmd.current_dir(workspace_root()).args(["build", "-q", "-p", "controller-fmu", "--bin", "controller-fmu"]);
-        if !cfg!(debug_assertions) {
-            cmd.arg("--release");
-        }
-        let out = output(&mut cmd);
-        assert!(out.status.success(), "building controller-fmu: {}", stderr(&out));
+        common::workspace_bin("controller-fmu");
         assert!(plant_bin().with_file_name("controller-fmu").is_file(), "controller-fmu is not next to plant");
     });
 }

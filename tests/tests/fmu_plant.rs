@@ -35,23 +35,7 @@ const SHORT: &[&str] = &["scene.duration_s=0.03", "shock[0].start_s=0.005"];
 /// `libplant_fmu.so`, built once per test binary in this profile, next to `plant`.
 fn library() -> &'static Path {
     static LIB: OnceLock<PathBuf> = OnceLock::new();
-    LIB.get_or_init(|| {
-        let mut cmd = Command::new(env!("CARGO"));
-        cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "-p", "plant-fmu", "--lib"]);
-        if !cfg!(debug_assertions) {
-            cmd.arg("--release");
-        }
-        let out = output_within(&mut cmd, Duration::from_secs(900));
-        assert!(out.status.success(), "building plant-fmu: {}", stderr(&out));
-        String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "plant_fmu")
-            .flat_map(|m| m["filenames"].as_array().cloned().unwrap_or_default())
-            .filter_map(|f| f.as_str().map(PathBuf::from))
-            .find(|f| f.extension().is_some_and(|e| e == "so"))
-            .expect("cargo built no libplant_fmu.so")
-    })
+    LIB.get_or_init(|| common::workspace_lib("plant_fmu", "so"))
 }
 
 /// `plant fmu cosim-10g.toml --set SHORT… --out DIR/NAME`, the binary found next to `plant`.

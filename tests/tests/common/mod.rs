@@ -64,11 +64,24 @@ pub fn small_ensemble_sweep(dir: &TempDir) -> PathBuf {
 /// png's are left out) and compiled the plant, nalgebra and iceoryx2 again, once per
 /// selection: minutes of a CI run on two cores.
 fn workspace_bins() -> &'static std::collections::HashMap<String, PathBuf> {
-    static BINS: OnceLock<std::collections::HashMap<String, PathBuf>> = OnceLock::new();
-    BINS.get_or_init(|| {
-        const BINS: [&str; 5] = ["plant", "controller", "rogue-controller", "peak-rss", "shock-table"];
+    &workspace_build().0
+}
+
+/// The artifacts of the one `cargo build` ([`workspace_bins`]): the binaries by name, and the
+/// libraries' files (`libplant_fmu.so`, `libamb_testbed_controller.a` and `.so`: `--lib` builds
+/// the workspace's C and FMI libraries in the same resolution of features) by target name.
+#[allow(clippy::type_complexity)]
+fn workspace_build(
+) -> &'static (std::collections::HashMap<String, PathBuf>, std::collections::HashMap<String, Vec<PathBuf>>) {
+    static BUILT: OnceLock<(
+        std::collections::HashMap<String, PathBuf>,
+        std::collections::HashMap<String, Vec<PathBuf>>,
+    )> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        const BINS: [&str; 6] =
+            ["plant", "controller", "rogue-controller", "peak-rss", "shock-table", "controller-fmu"];
         let mut cmd = Command::new(env!("CARGO"));
-        cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "--workspace"]);
+        cmd.current_dir(workspace_root()).args(["build", "-q", "--message-format=json", "--workspace", "--lib"]);
         for bin in BINS {
             cmd.args(["--bin", bin]);
         }
@@ -79,17 +92,47 @@ fn workspace_bins() -> &'static std::collections::HashMap<String, PathBuf> {
         let out = cmd.output().unwrap_or_else(|e| panic!("cannot start cargo to build {BINS:?}: {e}"));
         assert!(out.status.success(), "{cmd:?} failed ({}):\n{}", out.status, String::from_utf8_lossy(&out.stderr));
         let stdout = String::from_utf8_lossy(&out.stdout);
-        let found: std::collections::HashMap<String, PathBuf> = stdout
+        let artifacts: Vec<serde_json::Value> = stdout
             .lines()
             .filter_map(|line| serde_json::from_str::<serde_json::Value>(line).ok())
-            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["kind"][0] == "bin")
+            .filter(|m| m["reason"] == "compiler-artifact")
+            .collect();
+        let bins: std::collections::HashMap<String, PathBuf> = artifacts
+            .iter()
+            .filter(|m| m["target"]["kind"][0] == "bin")
             .filter_map(|m| Some((m["target"]["name"].as_str()?.to_string(), PathBuf::from(m["executable"].as_str()?))))
             .collect();
         for bin in BINS {
-            assert!(found.contains_key(bin), "cargo built no executable named {bin}");
+            assert!(bins.contains_key(bin), "cargo built no executable named {bin}");
         }
-        found
+        let libs = artifacts
+            .iter()
+            .filter(|m| m["target"]["kind"].as_array().is_some_and(|k| k.iter().any(|k| k != "bin" && k != "test")))
+            .filter_map(|m| {
+                let files = m["filenames"].as_array()?.iter().filter_map(|f| f.as_str().map(PathBuf::from)).collect();
+                Some((m["target"]["name"].as_str()?.to_string(), files))
+            })
+            .collect();
+        (bins, libs)
     })
+}
+
+/// A file of the workspace library `target` (its target name, `plant_fmu`) with extension
+/// `ext` (`so`, `a`), built by the one `cargo build` ([`workspace_bins`]).
+#[allow(dead_code)] // used by c_api.rs and fmu_plant.rs only
+pub fn workspace_lib(target: &str, ext: &str) -> PathBuf {
+    let files = workspace_build().1.get(target).unwrap_or_else(|| panic!("cargo built no library {target}"));
+    files
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == ext))
+        .cloned()
+        .unwrap_or_else(|| panic!("no .{ext} of {target} in {files:?}"))
+}
+
+/// A binary of the workspace (`controller-fmu`), built by the one `cargo build`.
+#[allow(dead_code)] // used by fmu_controller.rs only
+pub fn workspace_bin(bin: &str) -> PathBuf {
+    build_bin(bin)
 }
 
 /// Builds `bin` (a binary of the workspace) and returns the executable's path.
