@@ -119,7 +119,7 @@ fn acquire_in(dir: &std::path::Path, run_id: &str, role: &str) -> Result<RunLock
         }
     }
     remove_stale(dir, &path);
-    for _ in 0..RETRIES {
+    for attempt in 0..RETRIES {
         let mut file =
             OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).map_err(io)?;
         match file.try_lock() {
@@ -128,6 +128,15 @@ fn acquire_in(dir: &std::path::Path, run_id: &str, role: &str) -> Result<RunLock
                 let mut holder = String::new();
                 let _ = file.read_to_string(&mut holder);
                 let holder = holder.trim();
+                // No name yet: the holder may be another process's `remove_stale`, which locks
+                // every lock file it finds for a moment to see whether it is stale (and a file
+                // just created, not yet locked by its owner, looks so): a controller started
+                // beside others (a ladder's members) was refused its own fresh run id. A real
+                // holder writes its name at once; wait for it a little.
+                if holder.is_empty() && attempt + 1 < RETRIES {
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                    continue;
+                }
                 return Err(LockError::InUse {
                     run_id: run_id.to_string(),
                     role: role.to_string(),
@@ -217,6 +226,27 @@ mod tests {
             drop((plant, controller));
         }
         assert!(files(&dir).is_empty(), "{:?}", files(&dir));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A controller started beside others was refused its own fresh run id: another process's
+    /// `remove_stale` held the new file's lock for a moment (it locks every lock file to see
+    /// whether it is stale), and the owner took that for a live holder. A lock held for a
+    /// moment by a process that writes no name is now waited for.
+    #[test]
+    fn a_lock_held_for_a_moment_by_a_stale_scan_is_waited_for() {
+        let dir = scratch("scan");
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("fresh.controller.lock");
+        let scanner = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).unwrap();
+        scanner.try_lock().unwrap();
+        let released = std::thread::spawn(move || {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            drop(scanner);
+        });
+        let lock = acquire_in(&dir, "fresh", "controller");
+        released.join().unwrap();
+        assert!(lock.is_ok(), "{:?}", lock.err().map(|e| e.to_string()));
         let _ = std::fs::remove_dir_all(&dir);
     }
 
