@@ -313,23 +313,8 @@ pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) 
     let plane = |i: usize| {
         let (pos, vel) = two_plane::at_station(y, model.params.planes[i].station);
         let race = ix::RACE[i];
-        let p = &ev.planes[i];
-        [
-            pos.x,
-            pos.y,
-            vel.x,
-            vel.y,
-            y[race],
-            y[race + 1],
-            y[race + ix::V],
-            y[race + 1 + ix::V],
-            y[race + 2 + ix::V],
-            p.contact.normal,
-            p.contact.tangential,
-            p.balls.on_race[0].hypot(p.balls.on_race[1]),
-            p.current[0],
-            p.current[1],
-        ]
+        let race = [y[race], y[race + 1], y[race + ix::V], y[race + 1 + ix::V], y[race + 2 + ix::V]];
+        plane_values([pos.x, pos.y], [vel.x, vel.y], race, &ev.planes[i])
     };
     let slopes = [y[ix::SX], y[ix::SY], y[ix::VSX], y[ix::VSY]];
     two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes)
@@ -339,6 +324,27 @@ pub fn two_plane_record(model: &two_plane::Model, t: f64, y: &two_plane::State) 
 /// rotor at the plane (x, y, their rates), the race (x, y, their rates, its spin speed), the
 /// contact's normal and tangential force, the balls' force on the race, the currents x, y.
 pub type PlaneValues = [f64; 14];
+
+/// One bearing plane's [`PlaneValues`]: the rotor's position and velocity at the plane, the
+/// race's state `[x, y, ẋ, ẏ, ω]`, and what the model evaluated there.
+pub fn plane_values(pos: [f64; 2], vel: [f64; 2], race: [f64; 5], p: &two_plane::PlaneEvaluation) -> PlaneValues {
+    [
+        pos[0],
+        pos[1],
+        vel[0],
+        vel[1],
+        race[0],
+        race[1],
+        race[2],
+        race[3],
+        race[4],
+        p.contact.normal,
+        p.contact.tangential,
+        p.balls.on_race[0].hypot(p.balls.on_race[1]),
+        p.current[0],
+        p.current[1],
+    ]
+}
 
 /// The record of a rotor on two bearing planes (the two-plane rotor, the flexible rotor):
 /// plane A in the planar columns, plane B and the slopes `[a, b, ȧ, ḃ]` of the line through the

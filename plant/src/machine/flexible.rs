@@ -117,23 +117,8 @@ impl Machine<N> for Model {
         let plane = |i: usize| {
             let (pos, vel) = touchdown(self, y, i);
             let race = ix::RACE[i];
-            let p = &ev.planes[i];
-            [
-                pos.x,
-                pos.y,
-                vel.x,
-                vel.y,
-                y[race],
-                y[race + 1],
-                y[race + ix::V],
-                y[race + 1 + ix::V],
-                y[race + 2 + ix::V],
-                p.contact.normal,
-                p.contact.tangential,
-                p.balls.on_race[0].hypot(p.balls.on_race[1]),
-                p.current[0],
-                p.current[1],
-            ]
+            let race = [y[race], y[race + 1], y[race + ix::V], y[race + 1 + ix::V], y[race + 2 + ix::V]];
+            trace::plane_values([pos.x, pos.y], [vel.x, vel.y], race, &ev.planes[i])
         };
         trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y))
     }
