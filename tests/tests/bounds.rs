@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{assert_exit, output_within, plant_bin, plant_run, read_json, scene, stderr, TempDir, SHORT};
+use common::{assert_exit, output_within, plant_bin, plant_run, read_json, refused, scene, stderr, TempDir, SHORT};
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -20,20 +20,6 @@ const RUN: Duration = Duration::from_secs(120);
 
 fn sets<'a>(extra: &[&'a str]) -> Vec<&'a str> {
     SHORT.iter().copied().chain(extra.iter().copied()).collect()
-}
-
-/// `plant run` with `set` exits 2 quickly, names every needle, writes nothing, never panics.
-fn refused(name: &str, scene_file: &Path, set: &[&str], needles: &[&str]) {
-    let dir = TempDir::new(name);
-    let out = dir.join("run");
-    let run = output_within(&mut plant_run(scene_file, &out, set), QUICK);
-    let err = stderr(&run);
-    assert_exit(&run, 2);
-    assert!(!err.contains("panicked"), "{set:?}:\n{err}");
-    for n in needles {
-        assert!(err.contains(n), "{set:?}: no {n:?} in:\n{err}");
-    }
-    assert!(!out.exists(), "{set:?}: bad input created {}", out.display());
 }
 
 #[test]

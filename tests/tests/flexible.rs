@@ -7,32 +7,15 @@
 
 mod common;
 
-use common::{assert_exit, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv, TempDir};
-use std::path::Path;
+use common::{assert_exit, output_within, plant_bin, plant_run, read_json, refused, scene, stderr, Csv, TempDir};
 use std::process::Command;
 use std::time::Duration;
 
-/// Refusals happen while the scene loads.
-const QUICK: Duration = Duration::from_secs(30);
 /// A short run in a debug build on a loaded machine.
 const RUN: Duration = Duration::from_secs(180);
 
 /// The shipped scene cut to 25 ms (the shock at 7 ms: both planes touch).
 const SHORT: &[&str] = &["scene.duration_s=0.025", "shock[0].start_s=0.007", "output.plots=false"];
-
-/// `plant run` with `set` exits 2 quickly, names every needle, writes nothing.
-fn refused(name: &str, scene_file: &Path, set: &[&str], needles: &[&str]) {
-    let dir = TempDir::new(name);
-    let out = dir.join("run");
-    let run = output_within(&mut plant_run(scene_file, &out, set), QUICK);
-    let err = stderr(&run);
-    assert_exit(&run, 2);
-    assert!(!err.contains("panicked"), "{set:?}:\n{err}");
-    for n in needles {
-        assert!(err.contains(n), "{set:?}: no {n:?} in:\n{err}");
-    }
-    assert!(!out.exists(), "{set:?}: bad input created {}", out.display());
-}
 
 #[test]
 fn bad_flexible_input_is_refused_at_load_naming_the_key() {

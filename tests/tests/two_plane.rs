@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{assert_exit, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv, TempDir};
+use common::{assert_exit, output_within, plant_bin, plant_run, read_json, refused, scene, stderr, Csv, TempDir};
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -19,20 +19,6 @@ const RUN: Duration = Duration::from_secs(180);
 
 /// The asymmetric scene cut to 40 ms (the shock at 10 ms: both planes touch).
 const SHORT: &[&str] = &["scene.duration_s=0.04", "shock[0].start_s=0.01"];
-
-/// `plant run` with `set` exits 2 quickly, names every needle, writes nothing.
-fn refused(name: &str, scene_file: &Path, set: &[&str], needles: &[&str]) {
-    let dir = TempDir::new(name);
-    let out = dir.join("run");
-    let run = output_within(&mut plant_run(scene_file, &out, set), QUICK);
-    let err = stderr(&run);
-    assert_exit(&run, 2);
-    assert!(!err.contains("panicked"), "{set:?}:\n{err}");
-    for n in needles {
-        assert!(err.contains(n), "{set:?}: no {n:?} in:\n{err}");
-    }
-    assert!(!out.exists(), "{set:?}: bad input created {}", out.display());
-}
 
 #[test]
 fn bad_two_plane_input_is_refused_at_load_naming_the_key() {

@@ -572,3 +572,19 @@ pub fn fmpy_venv() -> &'static Path {
         dir
     })
 }
+
+/// `plant run SCENE` with `set` exits 2 within 30 s (the refusal comes while the scene loads),
+/// names every needle, writes nothing, never panics.
+#[allow(dead_code)] // used by bounds.rs, two_plane.rs and flexible.rs only
+pub fn refused(name: &str, scene_file: &Path, set: &[&str], needles: &[&str]) {
+    let dir = TempDir::new(name);
+    let out = dir.join("run");
+    let run = output_within(&mut plant_run(scene_file, &out, set), std::time::Duration::from_secs(30));
+    let err = stderr(&run);
+    assert_exit(&run, 2);
+    assert!(!err.contains("panicked"), "{set:?}:\n{err}");
+    for n in needles {
+        assert!(err.contains(n), "{set:?}: no {n:?} in:\n{err}");
+    }
+    assert!(!out.exists(), "{set:?}: bad input created {}", out.display());
+}
