@@ -106,6 +106,12 @@ pub struct TickRow {
     pub load_1min: f64,
 }
 
+/// Both bearing planes' controls for a contact tick: each plane's bias current, held.
+fn held_bias(scene: &Scene) -> anyhow::Result<[crate::model::Control; 2]> {
+    let bias = crate::run::bias_of(scene, &crate::run::plane_gains(scene)?);
+    Ok([crate::model::Control::Held([bias[0], bias[1]]), crate::model::Control::Held([bias[2], bias[3]])])
+}
+
 /// [`repeat_contact_tick`] for the two-plane rotor: both bearing planes 2 µm into their races
 /// (straight down, the rotor level where the gaps are equal, tilted where they differ), the
 /// races free.
@@ -114,16 +120,9 @@ fn repeat_two_plane_contact_tick(
     params: &plant_physics::two_plane::Params,
     repeats: u64,
 ) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
-    use crate::model::Control;
     use plant_physics::two_plane::Model;
-    let gains = crate::run::plane_gains(scene)?;
-    let bias = crate::run::bias_of(scene, &gains);
-    let model = Model {
-        params: params.clone(),
-        base: scene.base.clone(),
-        control: [Control::Held([bias[0], bias[1]]), Control::Held([bias[2], bias[3]])],
-        race_parked: [false; 2],
-    };
+    let model =
+        Model { params: params.clone(), base: scene.base.clone(), control: held_bias(scene)?, race_parked: [false; 2] };
     let y0 = two_plane_contact_state(scene, params);
     let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
     time_repeated_tick(scene, &model, settings, y0, repeats)
@@ -137,16 +136,9 @@ fn repeat_flexible_contact_tick(
     params: &plant_physics::flex::machine::Params,
     repeats: u64,
 ) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
-    use crate::model::Control;
     use plant_physics::flex::machine::Model;
-    let gains = crate::run::plane_gains(scene)?;
-    let bias = crate::run::bias_of(scene, &gains);
-    let model = Model {
-        params: params.clone(),
-        base: scene.base.clone(),
-        control: [Control::Held([bias[0], bias[1]]), Control::Held([bias[2], bias[3]])],
-        race_parked: [false; 2],
-    };
+    let model =
+        Model { params: params.clone(), base: scene.base.clone(), control: held_bias(scene)?, race_parked: [false; 2] };
     let y0 = Model::from_rigid(params, &two_plane_contact_state(scene, &params.machine));
     let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
     time_repeated_tick(scene, &model, settings, y0, repeats)
