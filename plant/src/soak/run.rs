@@ -219,22 +219,32 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     let checkpoints =
         Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
     let snapshots = checkpoints.queue.clone();
-    let mut sink = SoakSink {
-        tracker: monitor::ShockTracker::new(
-            starts.clone(),
-            scene.duration,
-            scene.output_interval,
-            prog.clear_radius[0],
-            prog.hold,
+    // The monitor from its checkpoint, or new.
+    let (tracker, envelope, figures, rows) = match &saved {
+        Some(c) => (c.tracker.clone(), c.envelope.clone(), c.figures.clone(), c.rows),
+        None => (
+            monitor::ShockTracker::new(
+                starts.clone(),
+                scene.duration,
+                scene.output_interval,
+                prog.clear_radius[0],
+                prog.hold,
+            ),
+            monitor::Envelope::new(ENVELOPE_BIN_S),
+            Vec::with_capacity(prog.shocks.len()),
+            0,
         ),
-        envelope: monitor::Envelope::new(ENVELOPE_BIN_S),
+    };
+    let mut sink = SoakSink {
+        tracker,
+        envelope,
         planned: &prog.shocks,
         clear_radius: prog.clear_radius.clone(),
-        figures: Vec::with_capacity(prog.shocks.len()),
+        figures,
         soak_csv,
         envelope_csv,
         error: None,
-        rows: 0,
+        rows,
         checkpoints,
     };
     // The wall clock goes on from the last RSS sample's of the soak resumed.
@@ -242,12 +252,6 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     let started = started.checked_sub(wall_before).unwrap_or(started);
     let half = 0.5 * scene.controller.period;
     let next_rss = rss.last().map_or(0, |s| ((s.t_s + half) / prog.rss_every).floor() as u64 + 1);
-    if let Some(c) = &saved {
-        sink.tracker = c.tracker.clone();
-        sink.envelope = c.envelope.clone();
-        sink.figures = c.figures.clone();
-        sink.rows = c.rows;
-    }
     let bar = (opts.progress == Progress::Bar).then(|| {
         let bar = indicatif::ProgressBar::new((scene.duration * 1e3) as u64);
         bar.set_style(
