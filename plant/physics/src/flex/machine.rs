@@ -108,52 +108,55 @@ pub struct Model {
     pub race_parked: [bool; 2],
 }
 
-/// The reduced state `[η, η̇]` (2r) of `y`, copied into `buf`.
-#[inline]
-fn reduced_state<'b>(y: &State, r: usize, buf: &'b mut [f64; 2 * MAX_MODES]) -> &'b [f64] {
-    buf[..r].copy_from_slice(&y[..r]);
-    buf[r..2 * r].copy_from_slice(&y[ix::V..ix::V + r]);
-    &buf[..2 * r]
-}
-
 impl Model {
     /// Node `node`'s displacement and velocity relative to the housing (m, m/s).
     pub fn node(&self, y: &State, node: usize) -> (Vector2<f64>, Vector2<f64>) {
-        let red = &self.params.reduced;
-        let r = red.size();
-        let mut buf = [0.0; 2 * MAX_MODES];
-        let s = reduced_state(y, r, &mut buf);
-        (Vector2::from(red.displacement(s, node)), Vector2::from(red.velocity(s, node)))
+        let [x, v] = self.params.reduced.motion_of(&y[..MAX_MODES], &y[ix::V..ix::V + MAX_MODES], node);
+        (Vector2::from(x), Vector2::from(v))
     }
 
     /// Evaluates all forces and the state derivative at time `t`.
     pub fn evaluate(&self, t: f64, y: &State) -> Evaluation {
+        let mut dy = [0.0; N];
+        let planes = self.evaluate_into(t, y, &mut dy);
+        Evaluation { dy, planes }
+    }
+
+    /// [`Model::evaluate`] with the derivative written into `dy` (every entry), the planes
+    /// returned: the integrator's form, which spares the hot loop a copy of the state.
+    pub fn evaluate_into(&self, t: f64, y: &State, dy: &mut State) -> [PlaneEvaluation; 2] {
         use ix::*;
         let p = &self.params;
         let red = &*p.reduced;
         let r = red.size();
-        let mut buf = [0.0; 2 * MAX_MODES];
-        let s = reduced_state(y, r, &mut buf);
-        let at = |node: usize| (Vector2::from(red.displacement(s, node)), Vector2::from(red.velocity(s, node)));
+        let (eta, rate) = (&y[..MAX_MODES], &y[V..V + MAX_MODES]);
+        let at = |node: usize| {
+            let [x, v] = red.motion_of(eta, rate, node);
+            (Vector2::from(x), Vector2::from(v))
+        };
         let a_h = Vector2::from(self.base.accel(t));
         let w = y[WR];
-        let mut dy = [0.0; N];
+        dy[V..].fill(0.0);
         dy[r..V].copy_from_slice(&y[V + r..]);
         dy[..r].copy_from_slice(&y[V..V + r]);
         let mut planes = [PlaneEvaluation::default(); 2];
         for (i, (plane, out)) in p.machine.planes.iter().zip(&mut planes).enumerate() {
             let bearing = &plane.params;
             let nodes = p.nodes[i];
-            let (delta, _) = at(nodes.amb);
+            // Each node is read once: the AMB's, and the sensor's and the touchdown bearing's
+            // where they are not at the AMB (a collocated plane reads one node, not three).
+            let amb = at(nodes.amb);
+            let delta = amb.0;
+            let sensor = || if nodes.sensor == nodes.amb { amb } else { at(nodes.sensor) };
             out.current = match self.control[i] {
                 Control::Continuous(gains) => {
                     let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (x, v) = at(nodes.sensor);
+                    let (x, v) = sensor();
                     saturate(gains.current((x * a_s).into(), (v * a_s).into()), bearing.current_limit)
                 }
                 Control::ContinuousExcited(gains, sine) => {
                     let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (x, v) = at(nodes.sensor);
+                    let (x, v) = sensor();
                     let (e, e_dot) = sine.at(t);
                     let u = x * a_s + Vector2::from(e);
                     let u_dot = v * a_s + Vector2::from(e_dot);
@@ -173,7 +176,7 @@ impl Model {
                 dy[x + 1] = 0.0;
                 dy[v + 2] = parked_race_spin_accel(bearing, race.speed, a_h);
             } else {
-                let (pos, vel) = at(nodes.touchdown);
+                let (pos, vel) = if nodes.touchdown == nodes.amb { amb } else { at(nodes.touchdown) };
                 let rd = race_dynamics(bearing, race, pos, vel, w, a_h);
                 out.contact = rd.contact;
                 out.balls = rd.balls;
@@ -202,11 +205,9 @@ impl Model {
             planes[0].contact.on_rotor.into(),
             planes[1].contact.on_rotor.into(),
         ];
-        let mut ds = [0.0; 2 * MAX_MODES];
-        red.derivative(s, w, &forces, frame, &mut ds[..2 * r]);
-        dy[V..V + r].copy_from_slice(&ds[r..2 * r]);
+        red.accelerations(eta, rate, w, &forces, frame, &mut dy[V..V + r]);
         dy[WR] = spin_accel;
-        Evaluation { dy, planes }
+        planes
     }
 
     /// The rotor's displacement field as the rigid two-plane rotor's state `rigid` puts it
@@ -250,6 +251,6 @@ impl Model {
 impl System<N> for Model {
     #[inline]
     fn rhs(&self, t: f64, y: &State, dy: &mut State) {
-        *dy = self.evaluate(t, y).dy;
+        self.evaluate_into(t, y, dy);
     }
 }

@@ -84,6 +84,13 @@ pub struct Reduced {
     input: DMatrix<f64>,
     /// The shaft's node count.
     nodes: usize,
+    /// The basis laid out row by row, a copy of `basis` for the node readers.
+    ///
+    /// Written by hand, not a nalgebra view, because of the hot loop: `DMatrix` is
+    /// column-major, so a node's row of it is strided (one cache line per element at 16 nodes ×
+    /// 4 DOF) and bounds-checked element by element; the node readers walk such rows several
+    /// times per evaluation, up to 271 evaluations per controller tick in contact.
+    basis_rows: Vec<f64>,
 }
 
 /// The lowest modes of `K φ = ω² M φ`: `(ω², Φ)` ascending, Φ mass-normalised.
@@ -107,6 +114,14 @@ pub fn undamped_frequencies_hz(rotor: &Rotor) -> Result<Vec<f64>, FlexError> {
     let (w2, _) = undamped_modes(&m.mass, &m.stiffness)?;
     Ok(w2.iter().map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU).collect())
 }
+
+/// Rows `k .. k + L` of each column of `m` (column-major, `r` rows), as arrays.
+fn columns<const L: usize>(m: &DMatrix<f64>, r: usize, k: usize) -> impl Iterator<Item = &[f64; L]> {
+    m.as_slice().chunks_exact(r).map(move |c| <&[f64; L]>::try_from(&c[k..k + L]).expect("k + L <= r"))
+}
+
+/// Rows of the derivative computed side by side ([`Reduced::rate_rows`]).
+const ROWS: usize = 4;
 
 /// Rigid-body modes of a rotor in the plane: two translations and two tilts.
 pub const RIGID_MODES: usize = 4;
@@ -216,6 +231,7 @@ impl Reduced {
             }
         }
         Ok(Reduced {
+            basis_rows: basis.transpose().as_slice().to_vec(),
             basis,
             omega_sq: DVector::from_vec(omega_sq),
             kinds,
@@ -250,45 +266,141 @@ impl Reduced {
         dstate: &mut [f64],
     ) {
         let r = self.size();
-        assert_eq!(forces.len(), self.force_nodes.len(), "one force per force node");
         let (eta, rate) = state.split_at(r);
         let (d_eta, d_rate) = dstate.split_at_mut(r);
         d_eta.copy_from_slice(rate);
-        for k in 0..r {
-            let mut acc =
-                -self.omega_sq[k] * eta[k] - self.frame[0][k] * frame_accel[0] - self.frame[1][k] * frame_accel[1];
-            for (i, v) in rate.iter().enumerate() {
-                acc -= (self.damping[(k, i)] + speed * self.gyroscopic[(k, i)]) * v;
-            }
-            for (j, f) in forces.iter().enumerate() {
-                acc += self.input[(k, 2 * j)] * f[0] + self.input[(k, 2 * j + 1)] * f[1];
-            }
-            d_rate[k] = acc;
+        self.accelerations(eta, rate, speed, forces, frame_accel, d_rate);
+    }
+
+    /// The rate part of [`Reduced::derivative`], `η̈` (length r) into `out`, from the
+    /// coordinates `eta` and their rates `rate` given apart (the plant's state keeps them in
+    /// two halves).
+    pub fn accelerations(
+        &self,
+        eta: &[f64],
+        rate: &[f64],
+        speed: f64,
+        forces: &[[f64; 2]],
+        frame_accel: [f64; 2],
+        out: &mut [f64],
+    ) {
+        let r = self.size();
+        assert_eq!(forces.len(), self.force_nodes.len(), "one force per force node");
+        let (eta, rate, out) = (&eta[..r], &rate[..r], &mut out[..r]);
+        let mut k = 0;
+        while k + ROWS <= r {
+            self.rate_rows::<ROWS>(k, eta, rate, speed, forces, frame_accel, out);
+            k += ROWS;
+        }
+        for k in k..r {
+            self.rate_rows::<1>(k, eta, rate, speed, forces, frame_accel, out);
         }
     }
 
-    fn row_dot(&self, row: usize, v: &[f64]) -> f64 {
-        self.basis.row(row).iter().zip(v).map(|(a, b)| a * b).sum()
+    /// Rows `k .. k + L` of the derivative's rate part, `η̈_k`, computed side by side.
+    ///
+    /// Written by hand for the hot loop: each row is a chain of `r + 2 × force nodes` dependent
+    /// additions, so one row at a time waits on the adder's latency; `L` rows at once keep `L`
+    /// chains in flight, read the column-major matrices along their columns, and let the
+    /// compiler pair the lanes. Each row's terms are added in the same order as a row-by-row
+    /// sum (`−ω²η − frame`, then the rates in order, then the forces in order), so the result
+    /// is the same to the bit; only the rows are interleaved.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn rate_rows<const L: usize>(
+        &self,
+        k: usize,
+        eta: &[f64],
+        rate: &[f64],
+        speed: f64,
+        forces: &[[f64; 2]],
+        frame_accel: [f64; 2],
+        d_rate: &mut [f64],
+    ) {
+        let r = self.size();
+        let (w2, fx, fy) = (
+            &self.omega_sq.as_slice()[k..][..L],
+            &self.frame[0].as_slice()[k..][..L],
+            &self.frame[1].as_slice()[k..][..L],
+        );
+        let eta = &eta[k..][..L];
+        let mut acc = [0.0; L];
+        for j in 0..L {
+            acc[j] = -w2[j] * eta[j] - fx[j] * frame_accel[0] - fy[j] * frame_accel[1];
+        }
+        assert!(k + L <= r, "rows {k}..{} of {r}", k + L);
+        let columns = |m| columns::<L>(m, r, k);
+        for ((d, g), v) in columns(&self.damping).zip(columns(&self.gyroscopic)).zip(rate) {
+            for j in 0..L {
+                acc[j] -= (d[j] + speed * g[j]) * v;
+            }
+        }
+        let mut input = columns(&self.input);
+        for f in forces {
+            let (Some(bx), Some(by)) = (input.next(), input.next()) else {
+                unreachable!("two input columns per force node")
+            };
+            for j in 0..L {
+                acc[j] += bx[j] * f[0] + by[j] * f[1];
+            }
+        }
+        d_rate[k..k + L].copy_from_slice(&acc);
     }
 
-    fn node_pair(&self, node: usize, v: &[f64], first: usize) -> [f64; 2] {
+    /// Node `node`'s rows `first`, `first + 1` (x and y, or the two rotations) dotted with the
+    /// positions `q` and, if given, the rates `v`: `([x, y], [ẋ, ẏ])`.
+    ///
+    /// The four sums run side by side (see [`Reduced::rate_rows`] for why), each over the
+    /// basis row in order from −0.0, as `Iterator::sum` adds, so the result is the same to the
+    /// bit as four separate sums.
+    #[inline]
+    fn node_rows(&self, node: usize, first: usize, q: &[f64], v: &[f64]) -> [[f64; 2]; 2] {
         assert!(node < self.nodes, "node {node} of {}", self.nodes);
-        [self.row_dot(DOF_PER_NODE * node + first, v), self.row_dot(DOF_PER_NODE * node + first + 1, v)]
+        let r = self.size();
+        let row = DOF_PER_NODE * node + first;
+        let bx = &self.basis_rows[row * r..][..r];
+        let by = &self.basis_rows[(row + 1) * r..][..r];
+        let (q, v) = (&q[..r], &v[..r.min(v.len())]);
+        let mut acc = [[-0.0; 2]; 2];
+        for i in 0..r {
+            acc[0][0] += bx[i] * q[i];
+            acc[0][1] += by[i] * q[i];
+        }
+        if !v.is_empty() {
+            for i in 0..r {
+                acc[1][0] += bx[i] * v[i];
+                acc[1][1] += by[i] * v[i];
+            }
+        }
+        acc
+    }
+
+    /// Displacement and velocity `((x, y), (ẋ, ẏ))` (m, m/s) of node `node` in state `state`
+    /// (`[η, η̇]`).
+    pub fn motion(&self, state: &[f64], node: usize) -> [[f64; 2]; 2] {
+        let (q, v) = state.split_at(self.size());
+        self.motion_of(q, v, node)
+    }
+
+    /// [`Reduced::motion`] from the coordinates and their rates given apart.
+    pub fn motion_of(&self, eta: &[f64], rate: &[f64], node: usize) -> [[f64; 2]; 2] {
+        assert!(rate.len() >= self.size(), "{} rates for {} coordinates", rate.len(), self.size());
+        self.node_rows(node, 0, eta, rate)
     }
 
     /// Displacement `(x, y)` (m) of node `node` in state `state`.
     pub fn displacement(&self, state: &[f64], node: usize) -> [f64; 2] {
-        self.node_pair(node, &state[..self.size()], 0)
+        self.node_rows(node, 0, state, &[])[0]
     }
 
     /// Velocity `(ẋ, ẏ)` (m/s) of node `node`.
     pub fn velocity(&self, state: &[f64], node: usize) -> [f64; 2] {
-        self.node_pair(node, &state[self.size()..], 0)
+        self.node_rows(node, 0, &state[self.size()..], &[])[0]
     }
 
     /// Rotations `(α, β)` (rad) of node `node` (`β = dx/dz`, `α = −dy/dz`).
     pub fn rotation(&self, state: &[f64], node: usize) -> [f64; 2] {
-        self.node_pair(node, &state[..self.size()], 2)
+        self.node_rows(node, 2, state, &[])[0]
     }
 
     /// The full model's coordinates `q = Φ η` of a state.
