@@ -355,6 +355,11 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         self.inner.bearing_velocity(&split::<N, NA>(y).0, i)
     }
 
+    /// The model's contact state, the hardware at rest at it ([`Wired::initial`]).
+    fn contact_state(&self, levitated: &[f64; NA]) -> [f64; NA] {
+        self.initial(&self.inner.contact_state(&split::<N, NA>(levitated).0))
+    }
+
     /// The model's record with the commanded currents in the current columns and, with an
     /// amplifier, the coils' currents and voltages: with unipolar ones, the differential
     /// current `(i₊ − i₋)/2` and voltage `(v₊ − v₋)/2` in the coil columns and each magnet's

@@ -21,7 +21,7 @@
 //! other processes. On a two-plane rotor both bearing planes are 2 µm into their races.
 
 use crate::analysis::classify::MotionMode;
-use crate::config::{load_scene, Rotor, Scene};
+use crate::config::{load_scene, Scene};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
 use crate::machine::Machine;
@@ -106,59 +106,11 @@ pub struct TickRow {
     pub load_1min: f64,
 }
 
-/// Both bearing planes' controls for a contact tick: each plane's bias current, held.
+/// Each bearing plane's control for a contact tick: its bias current, held (a planar model reads
+/// the first).
 fn held_bias(scene: &Scene) -> anyhow::Result<[crate::model::Control; 2]> {
     let bias = crate::run::bias_of(scene, &crate::run::plane_gains(scene)?);
     Ok([crate::model::Control::Held([bias[0], bias[1]]), crate::model::Control::Held([bias[2], bias[3]])])
-}
-
-/// [`repeat_contact_tick`] for the two-plane rotor: both bearing planes 2 µm into their races
-/// (straight down, the rotor level where the gaps are equal, tilted where they differ), the
-/// races free.
-fn repeat_two_plane_contact_tick(
-    scene: &Scene,
-    params: &plant_physics::two_plane::Params,
-    repeats: u64,
-) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
-    use plant_physics::two_plane::Model;
-    let model =
-        Model { params: params.clone(), base: scene.base.clone(), control: held_bias(scene)?, race_parked: [false; 2] };
-    let y0 = two_plane_contact_state(scene, params);
-    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
-    time_repeated_tick(scene, &model, settings, y0, repeats)
-}
-
-/// [`repeat_two_plane_contact_tick`] for the flexible rotor: the two-plane contact state (its
-/// AMB nodes 2 µm into the races) as a rigid motion of the shaft, so where the touchdown nodes
-/// are the AMB nodes, both press into their races.
-fn repeat_flexible_contact_tick(
-    scene: &Scene,
-    params: &plant_physics::flex::machine::Params,
-    repeats: u64,
-) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
-    use plant_physics::flex::machine::Model;
-    let model =
-        Model { params: params.clone(), base: scene.base.clone(), control: held_bias(scene)?, race_parked: [false; 2] };
-    let y0 = Model::from_rigid(params, &two_plane_contact_state(scene, &params.machine));
-    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
-    time_repeated_tick(scene, &model, settings, y0, repeats)
-}
-
-/// The two-plane rotor's initial state with both bearing planes 2 µm into their races,
-/// straight down, and centred on them in x. Plane i's rotor position is `X + z_i a`,
-/// `Y + z_i b`: two planes, two unknowns per axis.
-fn two_plane_contact_state(
-    scene: &Scene,
-    params: &plant_physics::two_plane::Params,
-) -> plant_physics::two_plane::State {
-    use plant_physics::two_plane::ix;
-    let mut y = crate::initial::two_plane_initial_state(scene, params);
-    let [za, zb] = [params.planes[0].station, params.planes[1].station];
-    let line = |a: f64, b: f64| ((b - a) / (zb - za), a - za * (b - a) / (zb - za));
-    let want = |i: usize| y[ix::RACE[i] + 1] - params.planes[i].params.contact.gap - 2e-6;
-    (y[ix::SY], y[ix::Y]) = line(want(0), want(1));
-    (y[ix::SX], y[ix::X]) = line(y[ix::RACE_A], y[ix::RACE_B]);
-    y
 }
 
 /// Header of `repeat.csv`.
@@ -193,23 +145,30 @@ pub struct RepeatRow {
 }
 
 /// Integrates one contact tick of `scene` (the realtime setting) `repeats` times from the same
-/// state, timing each: identical work, so the spread is the host's.
-fn repeat_contact_tick(
-    scene: &Scene,
-    params: &crate::model::Params,
+/// state, timing each: identical work, so the spread is the host's. The scene's rotor model with
+/// each plane's bias current held, the races free, in its contact state
+/// ([`crate::machine::Machine::contact_state`]); the bare model, without the scene's hardware.
+fn repeat_contact_tick(scene: &Scene, repeats: u64) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
+    crate::stepper::with_machine(scene, held_bias(scene)?, RepeatContactTick { scene, repeats })
+}
+
+/// [`repeat_contact_tick`] on the scene's model, whichever it is.
+struct RepeatContactTick<'a> {
+    scene: &'a Scene,
     repeats: u64,
-) -> anyhow::Result<(crate::cosim::Percentiles, u64)> {
-    use crate::model::{ix, Control, Model};
-    let gains = crate::run::plane_gains(scene)?[0];
-    let bias = controller::saturate(gains.bias_a, params.current_limit);
-    let model =
-        Model { params: params.clone(), base: scene.base.clone(), control: Control::Held(bias), race_parked: false };
-    let mut y0 = crate::initial::initial_state(scene, params);
-    // The rotor 2 µm into its race, straight down (about a kilonewton of contact).
-    y0[ix::XR] = y0[ix::XB];
-    y0[ix::YR] = y0[ix::YB] - params.contact.gap - 2e-6;
-    let settings = crate::run::settings_with(scene, Model::atol(scene.integrator.atol_groups));
-    time_repeated_tick(scene, &model, settings, y0, repeats)
+}
+
+impl crate::stepper::WithMachine for RepeatContactTick<'_> {
+    type Output = anyhow::Result<(crate::cosim::Percentiles, u64)>;
+
+    fn with<M, const N: usize, const NE: usize, const NU: usize>(self, model: M, y: [f64; N]) -> Self::Output
+    where
+        M: Machine<N> + Clone + 'static,
+    {
+        let y0 = model.contact_state(&y);
+        let settings = crate::run::settings_with(self.scene, M::atol(self.scene.integrator.atol_groups));
+        time_repeated_tick(self.scene, &model, settings, y0, self.repeats)
+    }
 }
 
 /// Integrates one tick of `model` (the scene's period, its contact substeps) from `y0`
@@ -385,11 +344,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
 
     let (label, fixed) = &settings[0];
     let repeats = rows.first().map_or(1, |r| r.ticks.max(1));
-    let (p, rhs_evals) = match &fixed.rotor {
-        Rotor::Planar(params) => repeat_contact_tick(fixed, params, repeats)?,
-        Rotor::TwoPlane(params) => repeat_two_plane_contact_tick(fixed, params, repeats)?,
-        Rotor::Flexible(params) => repeat_flexible_contact_tick(fixed, params, repeats)?,
-    };
+    let (p, rhs_evals) = repeat_contact_tick(fixed, repeats)?;
     let repeat = RepeatRow {
         setting: format!("one contact tick repeated, {label}"),
         repeats: p.count,
@@ -420,32 +375,49 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::machine::CONTACT_DEPTH;
+    use crate::stepper::{with_machine, WithMachine};
 
-    /// The repeated tick of a two-plane rotor starts with both planes in contact, each about
-    /// 2 µm into its race (the asymmetric scene: gaps of 150 and 250 µm, so the rotor tilts).
+    /// Each plane's contact state: whether the rotor touches the race, how deep it is in (m) and
+    /// where the rotor is relative to the race (m).
+    struct Depths;
+
+    impl WithMachine for Depths {
+        type Output = Vec<(bool, f64, [f64; 2])>;
+
+        fn with<M, const N: usize, const NE: usize, const NU: usize>(self, model: M, y: [f64; N]) -> Self::Output
+        where
+            M: Machine<N> + Clone + 'static,
+        {
+            let y = model.contact_state(&y);
+            let mut planes = Vec::new();
+            model.plane_states(0.0, &y, &mut |i, p| {
+                let d = p.rotor.0 - p.race.0;
+                planes.push((model.touching(&y, i), d.norm() - p.params.contact.gap, [d.x, d.y]));
+            });
+            planes
+        }
+    }
+
+    /// The repeated tick starts with the rotor 2 µm into each plane's race, straight down and
+    /// centred in x, on every rotor model: the planar one, the two-plane rotor (the asymmetric
+    /// scene: gaps of 150 and 250 µm, so the rotor tilts) and the flexible rotor (the rigid
+    /// motion of the shaft, at its touchdown nodes, which are its AMB nodes).
     #[test]
-    fn the_two_plane_contact_tick_starts_with_both_planes_in_their_races() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
-        let scene = load_scene(&path, &[]).unwrap();
-        let Rotor::TwoPlane(params) = &scene.rotor else { panic!("a two-plane scene") };
-        let y = two_plane_contact_state(&scene, params);
-        let model = plant_physics::two_plane::Model {
-            params: params.clone(),
-            base: scene.base.clone(),
-            control: [crate::model::Control::Held([0.0; 2]); 2],
-            race_parked: [false; 2],
-        };
-        for i in 0..2 {
-            assert!(model.touching(&y, i), "plane {i} not in contact");
-            use plant_physics::two_plane::ix;
-            let z = params.planes[i].station;
-            let (x, yy) = (y[ix::X] + z * y[ix::SX], y[ix::Y] + z * y[ix::SY]);
-            let (dx, dy) = (x - y[ix::RACE[i]], yy - y[ix::RACE[i] + 1]);
-            let depth = dx.hypot(dy) - params.planes[i].params.contact.gap;
-            assert!(
-                (depth - 2e-6).abs() < 1e-9 && dx.abs() < 1e-12 && dy < 0.0,
-                "plane {i}: {depth} m in, ({dx}, {dy})"
-            );
+    fn the_contact_tick_starts_with_each_plane_in_its_race() {
+        for (file, planes, tolerance) in
+            [("cosim-10g.toml", 1, 1e-12), ("two-plane-asymmetric-10g.toml", 2, 1e-12), ("flexible-10g.toml", 2, 1e-9)]
+        {
+            let scene = crate::config::shipped(file, &[]);
+            let depths = with_machine(&scene, held_bias(&scene).unwrap(), Depths);
+            assert_eq!(depths.len(), planes, "{file}");
+            for (i, (touching, depth, [dx, dy])) in depths.into_iter().enumerate() {
+                assert!(touching, "{file}: plane {i} not in contact");
+                assert!(
+                    (depth - CONTACT_DEPTH).abs() < tolerance && dx.abs() < tolerance && dy < 0.0,
+                    "{file}: plane {i}: {depth} m in, ({dx}, {dy})"
+                );
+            }
         }
     }
 }

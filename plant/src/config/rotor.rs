@@ -6,10 +6,15 @@
 //! record) is answered by the model itself through [`crate::machine::Machine`].
 //! docs/ARCHITECTURE.md ("Adding a rotor model") lists what a new model touches.
 
-use super::RotorModel;
+use super::raw::RawScene;
+use super::validate::bearing::{bearing, Keys, Share};
+use super::validate::flexible_keys::{flexible_params, record_flexible, refuse_flexible_keys};
+use super::validate::two_plane_keys::{record_two_plane, refuse_two_plane_keys, two_plane_params};
+use super::{ConfigError, RotorModel};
 use crate::model::Params;
 use plant_physics::flex::machine as flexible;
 use plant_physics::two_plane;
+use std::path::Path;
 
 /// The rotor of a scene, validated (SI).
 #[derive(Clone, Debug)]
@@ -25,6 +30,36 @@ pub enum Rotor {
 }
 
 impl Rotor {
+    /// The rotor model `rotor.model` names, built from the raw scene (its keys validated, each
+    /// error naming the key, value and unit): its bearing planes from `[touchdown]`,
+    /// `[contact]` and `[amb]` with `whole`, the rotor's values from `[rotor]`. The keys of the
+    /// other models are refused by name. `base_dir` resolves a model's files.
+    pub(super) fn from_raw(raw: &RawScene, whole: &Share, base_dir: &Path) -> Result<Self, ConfigError> {
+        Ok(match raw.rotor.model {
+            RotorModel::Planar => {
+                refuse_two_plane_keys(raw)?;
+                refuse_flexible_keys(raw)?;
+                let keys = Keys { plane: None };
+                Rotor::Planar(bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &keys, whole)?)
+            }
+            RotorModel::TwoPlane => {
+                refuse_flexible_keys(raw)?;
+                Rotor::TwoPlane(two_plane_params(raw, whole)?)
+            }
+            RotorModel::Flexible => Rotor::Flexible(flexible_params(raw, whole, base_dir)?),
+        })
+    }
+
+    /// Writes the model's defaults into the raw scene it was built from (as the user would have
+    /// written them, in the file's units), so that the resolved `scene.toml` states them.
+    pub(super) fn record_defaults(&self, raw: &mut RawScene) {
+        match self {
+            Rotor::Planar(_) => {}
+            Rotor::TwoPlane(_) => record_two_plane(raw),
+            Rotor::Flexible(f) => record_flexible(raw, f),
+        }
+    }
+
     /// The model's name as `rotor.model` writes it.
     pub fn model(&self) -> RotorModel {
         match self {

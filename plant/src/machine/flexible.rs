@@ -123,6 +123,24 @@ impl Machine<N> for Model {
         trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y))
     }
 
+    /// The rigid two-plane rotor's contact state (its bearing planes, the AMB nodes, pressed into
+    /// the races) as a rigid motion of the shaft: where the touchdown nodes are the AMB nodes,
+    /// both press into their races. The shaft's rates, spin and races stay as `levitated` has them.
+    fn contact_state(&self, levitated: &State) -> State {
+        use plant_physics::two_plane::{self, ix as rigid_ix};
+        // The rigid rotor on the shaft's races, pressed into them: only its displacement
+        // (translation and slopes) is projected on the shaft's basis.
+        let mut rigid = [0.0; two_plane::N];
+        for (fx, rx) in ix::RACE.iter().zip(rigid_ix::RACE) {
+            rigid[rx..rx + 3].copy_from_slice(&levitated[*fx..*fx + 3]);
+        }
+        super::two_plane::press_into_races(&self.params.machine, &mut rigid);
+        let pressed = Model::from_rigid(&self.params, &rigid);
+        let mut y = *levitated;
+        y[..ix::TR].copy_from_slice(&pressed[..ix::TR]);
+        y
+    }
+
     fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {
         self.node(y, self.params.nodes[i].sensor).1.into()
     }

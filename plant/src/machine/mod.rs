@@ -24,6 +24,10 @@ use nalgebra::Vector2;
 use plant_physics::integrate::System;
 use serde::Serialize;
 
+/// How far [`Machine::contact_state`] presses the rotor into each race (m): about a kilonewton of
+/// contact on the study's bearing.
+pub const CONTACT_DEPTH: f64 = 2e-6;
+
 /// A whirl mode of a rotor linearised on its continuous PD ([`Linearised`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhirlMode {
@@ -124,6 +128,11 @@ pub trait Machine<const N: usize>: System<N> {
 
     /// The output sample of state `y` at time `t`.
     fn record(&self, t: f64, y: &[f64; N]) -> Record;
+
+    /// The state `levitated` (the model's initial state) with the rotor pressed [`CONTACT_DEPTH`]
+    /// into each bearing plane's race, straight down and centred on the race in x, everything
+    /// else as it was: the tick in contact that `plant bench tick` repeats ([`crate::bench`]).
+    fn contact_state(&self, levitated: &[f64; N]) -> [f64; N];
 
     /// Each bearing plane's state at time `t` in state `y` ([`PlaneState`]), handed to `visit`
     /// with the plane's index: what the touchdown bearing's duty reads

@@ -84,6 +84,13 @@ impl Machine<N> for Model {
         Record::planar(trace::row(self, t, y))
     }
 
+    fn contact_state(&self, levitated: &State) -> State {
+        let mut y = *levitated;
+        y[XR] = y[XB];
+        y[YR] = y[YB] - self.params.contact.gap - super::CONTACT_DEPTH;
+        y
+    }
+
     fn sensed_rate(&self, y: &State, _i: usize) -> [f64; 2] {
         [y[VXR], y[VYR]]
     }

@@ -43,6 +43,18 @@ pub struct TwoPlaneFailure {
     pub race_b: RaceFailure,
 }
 
+/// Moves the rotor of `y` so that both bearing planes press [`super::CONTACT_DEPTH`] into their
+/// races as `y` has them, straight down (the rotor level where the gaps are equal, tilted where
+/// they differ), centred on them in x. Plane i's rotor position is `X + z_i a`, `Y + z_i b`: two
+/// planes, two unknowns per axis.
+pub(super) fn press_into_races(params: &two_plane::Params, y: &mut State) {
+    let [za, zb] = [params.planes[0].station, params.planes[1].station];
+    let line = |a: f64, b: f64| ((b - a) / (zb - za), a - za * (b - a) / (zb - za));
+    let want = |i: usize| y[ix::RACE[i] + 1] - params.planes[i].params.contact.gap - super::CONTACT_DEPTH;
+    (y[ix::SY], y[ix::Y]) = line(want(0), want(1));
+    (y[ix::SX], y[ix::X]) = line(y[ix::RACE_A], y[ix::RACE_B]);
+}
+
 impl Machine<N> for Model {
     const PLANES: usize = 2;
 
@@ -108,6 +120,12 @@ impl Machine<N> for Model {
 
     fn record(&self, t: f64, y: &State) -> Record {
         trace::two_plane_record(self, t, y)
+    }
+
+    fn contact_state(&self, levitated: &State) -> State {
+        let mut y = *levitated;
+        press_into_races(&self.params, &mut y);
+        y
     }
 
     fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {

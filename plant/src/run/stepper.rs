@@ -80,32 +80,97 @@ impl std::fmt::Debug for Plant {
     }
 }
 
-/// The stepper of `model` (a [`Machine`] on `$n` states) from state `$y`, wrapped in the
-/// scene's hardware ([`Wired`]) when it has amplifiers or a sensor front end.
-macro_rules! stepper_of {
-    ($scene:expr, $model:expr, $y:expr, $n:expr, $controls:expr, $gains:expr, $timed:expr) => {{
-        const N: usize = $n;
-        let (scene, model, y) = ($scene, $model, $y);
+/// What is done with the scene's rotor model and its initial state, whichever the model
+/// ([`with_machine`]): [`Plant::new`] wraps it in the scene's hardware and steps it, `plant bench
+/// tick` repeats its tick in contact ([`Machine::contact_state`]).
+pub(crate) trait WithMachine {
+    /// What it gives.
+    type Output;
+
+    /// Does it with `model` (a [`Machine`] on `N` states) at state `y`. `NE` and `NU` are the
+    /// model's state lengths with the hardware's states appended, `N + EXTRA` and `N +
+    /// EXTRA_UNIPOLAR` ([`Wired`]): a sum of a generic constant is not a type's parameter in
+    /// stable Rust, so the caller, who knows `N`, adds them up.
+    fn with<M, const N: usize, const NE: usize, const NU: usize>(self, model: M, y: [f64; N]) -> Self::Output
+    where
+        M: Machine<N> + Clone + 'static;
+}
+
+/// The scene's rotor model built from its parameters with `controls` (one per plane; a planar
+/// model takes the first), at its initial state (levitated on the unbalance orbit, each race at
+/// rest), handed to `what`. The one place the plant tells the rotor models apart: a new model
+/// is an arm here.
+pub(crate) fn with_machine<W: WithMachine>(scene: &Scene, controls: [Control; 2], what: W) -> W::Output {
+    match &scene.rotor {
+        Rotor::Planar(params) => {
+            const N: usize = crate::model::N;
+            let model =
+                Model { params: params.clone(), base: scene.base.clone(), control: controls[0], race_parked: false };
+            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, initial_state(scene, params))
+        }
+        Rotor::TwoPlane(params) => {
+            const N: usize = two_plane::N;
+            let model = two_plane::Model {
+                params: params.clone(),
+                base: scene.base.clone(),
+                control: controls,
+                race_parked: [false; 2],
+            };
+            let y = crate::initial::two_plane_initial_state(scene, params);
+            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, y)
+        }
+        Rotor::Flexible(params) => {
+            use plant_physics::flex::machine as flexible;
+            const N: usize = flexible::N;
+            // The rigid two-plane rotor's initial state (levitated on the unbalance orbit),
+            // projected on the shaft's basis.
+            let rigid = crate::initial::two_plane_initial_state(scene, &params.machine);
+            let y = flexible::Model::from_rigid(params, &rigid);
+            let model = flexible::Model {
+                params: params.clone(),
+                base: scene.base.clone(),
+                control: controls,
+                race_parked: [false; 2],
+            };
+            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, y)
+        }
+    }
+}
+
+/// [`Plant::new`]'s [`WithMachine`]: the stepper of the model, wrapped in the scene's hardware
+/// ([`Wired`]) when it has amplifiers or a sensor front end.
+struct BuildCore<'a> {
+    scene: &'a Scene,
+    controls: [Control; 2],
+    gains: Vec<PdGains>,
+    timed: bool,
+}
+
+impl WithMachine for BuildCore<'_> {
+    type Output = Box<dyn Core>;
+
+    fn with<M, const N: usize, const NE: usize, const NU: usize>(self, model: M, y: [f64; N]) -> Box<dyn Core>
+    where
+        M: Machine<N> + Clone + 'static,
+    {
+        let Self { scene, controls, gains, timed } = self;
         let groups = scene.integrator.atol_groups;
         let hw = &scene.hardware;
-        let core: Box<dyn Core> = if hw.is_unipolar() {
-            const NA: usize = N + EXTRA_UNIPOLAR;
-            let wired = Wired::<_, N, NA>::new(model, $controls, hw.clone());
+        if hw.is_unipolar() {
+            let wired = Wired::<_, N, NU>::new(model, controls, hw.clone());
             let y = wired.initial(&y);
             let settings = settings_with(scene, atol_of(&wired, groups));
-            Box::new(Stepper::new(scene, wired, y, settings, $gains, $timed))
+            Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
         } else if hw.is_on() {
-            const NA: usize = N + EXTRA;
-            let wired = Wired::<_, N, NA>::new(model, $controls, hw.clone());
+            let wired = Wired::<_, N, NE>::new(model, controls, hw.clone());
             let y = wired.initial(&y);
             let settings = settings_with(scene, atol_of(&wired, groups));
-            Box::new(Stepper::new(scene, wired, y, settings, $gains, $timed))
+            Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
         } else {
             let settings = settings_with(scene, atol_of(&model, groups));
-            Box::new(Stepper::new(scene, model, y, settings, $gains, $timed))
-        };
-        core
-    }};
+            Box::new(Stepper::new(scene, model, y, settings, gains, timed))
+        }
+    }
 }
 
 impl Plant {
@@ -127,44 +192,9 @@ impl Plant {
         };
         let last = scene.planes() - 1;
         let controls: [Control; 2] = std::array::from_fn(|i| control(i.min(last)));
-        // The one place the plant tells the rotor models apart: each is built from the scene
-        // and wrapped in the hardware the scene has (the hardware's state length is a
-        // constant of the model's, hence a macro).
-        let core: Box<dyn Core> = match &scene.rotor {
-            Rotor::Planar(params) => {
-                let model = Model {
-                    params: params.clone(),
-                    base: scene.base.clone(),
-                    control: controls[0],
-                    race_parked: false,
-                };
-                stepper_of!(scene, model, initial_state(scene, params), crate::model::N, controls, gains, timed)
-            }
-            Rotor::TwoPlane(params) => {
-                let model = two_plane::Model {
-                    params: params.clone(),
-                    base: scene.base.clone(),
-                    control: controls,
-                    race_parked: [false; 2],
-                };
-                let y = crate::initial::two_plane_initial_state(scene, params);
-                stepper_of!(scene, model, y, two_plane::N, controls, gains, timed)
-            }
-            Rotor::Flexible(params) => {
-                use plant_physics::flex::machine as flexible;
-                // The rigid two-plane rotor's initial state (levitated on the unbalance orbit),
-                // projected on the shaft's basis.
-                let rigid = crate::initial::two_plane_initial_state(scene, &params.machine);
-                let y = flexible::Model::from_rigid(params, &rigid);
-                let model = flexible::Model {
-                    params: params.clone(),
-                    base: scene.base.clone(),
-                    control: controls,
-                    race_parked: [false; 2],
-                };
-                stepper_of!(scene, model, y, flexible::N, controls, gains, timed)
-            }
-        };
+        // The model of the scene's rotor (the one place the plant tells them apart,
+        // `with_machine`), wrapped in the hardware the scene has.
+        let core = with_machine(scene, controls, BuildCore { scene, controls, gains, timed });
         let fingerprint = Fingerprint::of(scene, core.state().len());
         let mut plant = Self { core, sample: RotorSample::default(), fingerprint };
         plant.sample = plant.core.read_sample();

@@ -5,7 +5,7 @@ use super::*;
 
 /// The rotor's values a bearing plane's planar parameters take: for the planar model the
 /// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
-pub(super) struct Share {
+pub(in crate::config) struct Share {
     pub(super) gravity: f64,
     pub(super) mass: f64,
     pub(super) eccentricity: f64,
@@ -17,9 +17,9 @@ pub(super) struct Share {
 
 /// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`
 /// where plane B's table sets it.
-pub(super) struct Keys<'a> {
+pub(in crate::config) struct Keys<'a> {
     /// The plane's letter and its own tables of `[touchdown]`, `[contact]`, `[amb]`.
-    pub(super) plane: Option<(&'static str, [Option<&'a toml::Table>; 3])>,
+    pub(in crate::config) plane: Option<(&'static str, [Option<&'a toml::Table>; 3])>,
 }
 
 impl Keys<'_> {
@@ -48,7 +48,7 @@ impl Keys<'_> {
 
 /// One bearing plane's parameters, validated: its touchdown bearing (`[touchdown]`), contact
 /// laws (`[contact]`) and AMB (`[amb]`, `controller.current_limit_a`), with the rotor's `share`.
-pub(super) fn bearing(
+pub(in crate::config) fn bearing(
     td: &RawTouchdown,
     ct: &RawContact,
     amb: &RawAmb,

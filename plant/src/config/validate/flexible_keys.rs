@@ -14,7 +14,7 @@ pub(super) const CUTOFF_HZ: f64 = 2000.0;
 pub(super) const MODAL_DAMPING: f64 = 0.005;
 
 /// The flexible rotor's keys given in a rigid scene, refused by name.
-pub(super) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
+pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
     let r = &raw.rotor;
     const WHY: &str = "is a key of the flexible rotor and this scene's rotor is rigid: set rotor.model = \
                        \"flexible\" or remove the key";
@@ -48,7 +48,11 @@ fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
 }
 
 /// The flexible machine of a scene, validated.
-pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) -> Result<machine::Params, ConfigError> {
+pub(in crate::config) fn flexible_params(
+    raw: &RawScene,
+    whole: &Share,
+    base_dir: &Path,
+) -> Result<machine::Params, ConfigError> {
     let r = &raw.rotor;
     const RIGID: &str = "is a key of the rigid two-plane rotor: a flexible rotor's geometry and inertia come from \
                          its shaft (rotor.shaft or rotor.ross_file) and its nodes (rotor.amb_a_node, …)";
@@ -157,7 +161,7 @@ pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) ->
     rr.end_a_mm = Some(z[0] * 1e3);
     rr.end_b_mm = Some(z[nodes - 1] * 1e3);
     let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
-    let machine = two_plane_params(&as_rigid, &share)?;
+    let machine = super::two_plane_keys::two_plane_params(&as_rigid, &share)?;
     let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
     Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z })
 }
@@ -165,7 +169,7 @@ pub(super) fn flexible_params(raw: &RawScene, whole: &Share, base_dir: &Path) ->
 /// Writes the flexible rotor's defaults into the raw scene, and the mass and polar inertia its
 /// shaft has (what the scene's `mass_kg` and `polar_inertia_kg_m2` are replaced by), so that the
 /// resolved `scene.toml` states them.
-pub(super) fn record_flexible(raw: &mut RawScene, params: &machine::Params) {
+pub(in crate::config) fn record_flexible(raw: &mut RawScene, params: &machine::Params) {
     let r = &mut raw.rotor;
     r.mass_kg = params.machine.rotor.mass;
     r.polar_inertia_kg_m2 = params.machine.rotor.polar_inertia;

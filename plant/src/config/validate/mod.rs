@@ -31,22 +31,21 @@ use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Fricti
 use crate::integrate::Method;
 use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
-use plant_physics::two_plane;
 use std::path::Path;
 
-mod bearing;
+// The rotor models' keys, each built by the model's arm of `Rotor::from_raw`
+// (config/rotor.rs) with the bearing planes of `bearing`.
+pub(super) mod bearing;
 mod checks;
 mod controller_keys;
-mod flexible_keys;
+pub(super) mod flexible_keys;
 mod hardware_keys;
-mod two_plane_keys;
+pub(super) mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
 pub use checks::{finite, non_negative, positive, range};
 use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
-use flexible_keys::{flexible_params, record_flexible, refuse_flexible_keys};
 use hardware_keys::hardware;
-use two_plane_keys::{record_two_plane, refuse_two_plane_keys, two_plane_params};
 
 /// Longest simulated time (s): about 11.6 days.
 pub const MAX_DURATION_S: f64 = 1e6;
@@ -111,8 +110,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
     resolve_command(&mut raw.controller, base_dir)?;
     let fmu = super::fmu::resolve(&mut raw.controller, base_dir)?;
-    let (r, td, ct, amb, ctl, int) =
-        (&raw.rotor, &raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &raw.integrator);
+    let (r, ctl, int) = (&raw.rotor, &raw.controller, &raw.integrator);
     let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
     let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;
     if duration > MAX_DURATION_S {
@@ -133,19 +131,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     };
     let whole =
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
-    // The rotor model: how each is built from the scene (a new model is an arm here).
-    let rotor = match r.model {
-        RotorModel::Planar => {
-            refuse_two_plane_keys(&raw)?;
-            refuse_flexible_keys(&raw)?;
-            Rotor::Planar(bearing(td, ct, amb, ctl, &Keys { plane: None }, &whole)?)
-        }
-        RotorModel::TwoPlane => {
-            refuse_flexible_keys(&raw)?;
-            Rotor::TwoPlane(two_plane_params(&raw, &whole)?)
-        }
-        RotorModel::Flexible => Rotor::Flexible(flexible_params(&raw, &whole, base_dir)?),
-    };
+    // The rotor model, built from the scene by its own arm of `Rotor::from_raw`.
+    let rotor = Rotor::from_raw(&raw, &whole, base_dir)?;
     // The sensor's and the controller's loop constants are the scene's (`[amb]`,
     // `[controller]`), the same on every plane.
     let loop_constants = rotor.plane(0).loop_constants;
@@ -285,13 +272,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let laws: Vec<AmbLaw> = rotor.bearings().map(|p| p.amb).collect();
     let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
-    // The resolved scene states the two-plane rotor's defaults.
-    if let Rotor::TwoPlane(_) = rotor {
-        record_two_plane(&mut raw);
-    }
-    if let Rotor::Flexible(m) = &rotor {
-        record_flexible(&mut raw, m);
-    }
+    // The resolved scene states the rotor model's defaults.
+    rotor.record_defaults(&mut raw);
     let scene = Scene {
         name: raw.scene.name.clone(),
         description: raw.scene.description.clone(),

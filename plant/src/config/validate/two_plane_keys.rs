@@ -2,6 +2,7 @@
 //! tables, and the two-plane keys refused in a planar scene.
 
 use super::*;
+use plant_physics::two_plane;
 
 /// The `[rotor]` keys of the rigid two-plane rotor's geometry and inertia, as given: key, value,
 /// unit.
@@ -22,7 +23,7 @@ pub(super) fn rigid_geometry_keys(raw: &RawScene) -> [(&'static str, Option<f64>
 
 /// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
 /// silently ignored otherwise.
-pub(super) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
+pub(in crate::config) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
     let mut given = rigid_geometry_keys(raw).to_vec();
     given.extend([
         ("initial.slope_x_urad", raw.initial.slope_x_urad, "µrad"),
@@ -80,7 +81,7 @@ pub(super) fn plane_table<T: serde::Serialize + serde::de::DeserializeOwned>(
 
 /// The two-plane rotor of a scene (`rotor.model = "two_plane"`), validated: its geometry and
 /// inertia from `[rotor]`, each plane's bearing from the shared tables and its own.
-pub(super) fn two_plane_params(raw: &RawScene, whole: &Share) -> Result<two_plane::Params, ConfigError> {
+pub(in crate::config) fn two_plane_params(raw: &RawScene, whole: &Share) -> Result<two_plane::Params, ConfigError> {
     let r = &raw.rotor;
     let mm = |key: &str, value: f64| finite(key, value, "mm");
     let za = mm("rotor.bearing_a_mm", r.bearing_a_mm.unwrap_or(-180.0))?;
@@ -173,7 +174,7 @@ pub(super) fn two_plane_params(raw: &RawScene, whole: &Share) -> Result<two_plan
 
 /// Writes the two-plane rotor's defaults into the raw scene (as the user would have written
 /// them, in the file's units), so that the resolved `scene.toml` states them.
-pub(super) fn record_two_plane(raw: &mut RawScene) {
+pub(in crate::config) fn record_two_plane(raw: &mut RawScene) {
     let r = &mut raw.rotor;
     r.transverse_inertia_kg_m2.get_or_insert(0.414);
     r.couple_unbalance_urad.get_or_insert(0.0);
