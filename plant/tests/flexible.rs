@@ -220,7 +220,8 @@ mod in_the_loop {
     /// The sensor across the bending mode's nodes: the sampled PD that is stable on the rigid
     /// rotor (a stiff shaft) is unstable on the flexible one, at the first bending mode; the
     /// notch at that mode restores stability: the closed loop's poles (plant, notch, PD, delay
-    /// line). `plant assess`'s measurement says the same (tests/tests/flexible.rs).
+    /// line). `plant assess`'s measurement says the same
+    /// (`assess_grades_the_non_collocated_pd_unstable_from_its_free_decay`).
     #[test]
     fn a_non_collocated_pd_is_unstable_at_the_bending_mode_and_the_notch_restores_it() {
         let pole = |scene: &Scene| {
@@ -256,6 +257,23 @@ mod in_the_loop {
         eprintln!("largest |z|: rigid {r}, flexible {f} at {f_hz} Hz, notched {n}");
         assert!(r < 1.0 && n < 1.0 && f > 1.0, "rigid {r}, flexible {f}, notched {n}");
         assert!((440.0..560.0).contains(&f_hz), "the unstable pole at {f_hz} Hz");
+    }
+
+    /// `plant assess`'s own measurement of the same loop: the probe's free decay (the rotor
+    /// 15 µm off on `x_A`, no shock, the scene's sampled `pd_delay`) grows at the bending mode,
+    /// so the axis is graded unstable, with no peak and no zone letter, and says why. The
+    /// closed form's pole (above) and this free decay are two independent routes to the grade.
+    #[test]
+    fn assess_grades_the_non_collocated_pd_unstable_from_its_free_decay() {
+        let scene = shipped("flexible-noncollocated.toml", &[]);
+        let settings = sensitivity::Settings::for_gap(scene.plane(0).contact.gap);
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let axis = measure_axis(&scene, 0, 0.0, &settings, &stop).expect("measured");
+        eprintln!("{axis:?}");
+        assert!(!axis.stable && axis.zone == "unstable" && axis.peak.is_none(), "{axis:?}");
+        assert!(axis.points.is_empty(), "an unstable loop is not swept: {axis:?}");
+        let note = axis.note.as_deref().unwrap_or_default();
+        assert!(note.contains("does not decay") || note.contains("reached the touchdown bearing"), "{note}");
     }
 
     /// The measured sensitivity of the notched loop (sampled, in the plant) is the closed form of
