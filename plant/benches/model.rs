@@ -8,6 +8,7 @@ use common::{contact_state, model, two_plane_contact_state, two_plane_model};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use plant::integrate::{Integrator, Method, Settings};
 use plant::machine::Machine;
+use plant::model::Control;
 use plant::run::settings_with;
 
 fn derivative(c: &mut Criterion) {
@@ -29,6 +30,41 @@ fn derivative(c: &mut Criterion) {
     c.bench_function("derivative/two_plane_levitated", |b| {
         b.iter(|| two.evaluate(black_box(0.002), black_box(&levitated)).dy)
     });
+}
+
+/// The flexible rotor's derivative in contact against the size of its reduced basis: the
+/// shipped `config/flexible-10g.toml` at several cutoffs (`derivative/flexible_contact_r{r}`,
+/// `r` the reduced coordinates), both touchdown nodes 15 µm into their races, the continuous
+/// PD at each plane. The slope over `r` is the cost per retained mode
+/// (docs/results/flexible-rotor.md, "Speed").
+fn flexible_derivative(c: &mut Criterion) {
+    use plant_physics::flex::machine::Model;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+    for cutoff_hz in [1000.0, 2000.0, 4000.0, 8000.0, 16000.0] {
+        let scene =
+            plant::config::load_scene(&path, &[format!("rotor.cutoff_hz={cutoff_hz}")]).expect("flexible scene");
+        let params = match &scene.rotor {
+            plant::config::Rotor::Flexible(p) => p.clone(),
+            other => panic!("a flexible scene, not {:?}", other.model()),
+        };
+        let gains = plant::run::plane_gains(&scene).expect("gains");
+        let y = Model::from_rigid(&params, &two_plane_contact_state());
+        let r = params.reduced.size();
+        let model = Model {
+            params,
+            base: scene.base.clone(),
+            control: [Control::Continuous(gains[0]), Control::Continuous(gains[1])],
+            race_parked: [false; 2],
+        };
+        let ev = model.evaluate(0.002, &y);
+        assert!(
+            ev.planes.iter().all(|p| p.contact.normal > 0.0 && p.balls.loaded >= 3),
+            "both planes in contact: {ev:?}"
+        );
+        c.bench_function(&format!("derivative/flexible_contact_r{r}"), |b| {
+            b.iter(|| model.evaluate(black_box(0.002), black_box(&y)).dy)
+        });
+    }
 }
 
 fn model_scene() -> plant::config::Scene {
@@ -64,5 +100,5 @@ fn macro_step(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, derivative, macro_step);
+criterion_group!(benches, derivative, flexible_derivative, macro_step);
 criterion_main!(benches);
