@@ -418,6 +418,10 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
     }
 
     /// The model's tolerances with the hardware's after them ([`atol`]).
+    fn used_components(&self) -> usize {
+        self.inner.used_components() + (NA - N)
+    }
+
     fn atol(groups: [f64; 4]) -> [f64; NA] {
         let [p, v, ..] = groups;
         let mut a = [0.0; NA];

@@ -166,7 +166,7 @@ impl crate::stepper::WithMachine for RepeatContactTick<'_> {
         M: Machine<N> + Clone + 'static,
     {
         let y0 = model.contact_state(&y);
-        let settings = crate::run::settings_with(self.scene, M::atol(self.scene.integrator.atol_groups));
+        let settings = crate::stepper::settings_of(self.scene, &model);
         time_repeated_tick(self.scene, &model, settings, y0, self.repeats)
     }
 }

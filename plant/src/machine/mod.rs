@@ -145,6 +145,13 @@ pub trait Machine<const N: usize>: System<N> {
     where
         Self: Sized;
 
+    /// The state components this model uses, counted by the integrator's RMS error norm
+    /// ([`crate::integrate::Settings::rms_count`]): all N, unless the state has slots the
+    /// model leaves at zero (the flexible rotor's reduced coordinates past its basis).
+    fn used_components(&self) -> usize {
+        N
+    }
+
     /// The failing state of a run stopped at time `t` in state `y` (`failure_state` in
     /// `summary.json`).
     fn failure(t: f64, y: &[f64; N]) -> FailureState

@@ -154,20 +154,19 @@ impl WithMachine for BuildCore<'_> {
         M: Machine<N> + Clone + 'static,
     {
         let Self { scene, controls, gains, timed } = self;
-        let groups = scene.integrator.atol_groups;
         let hw = &scene.hardware;
         if hw.is_unipolar() {
             let wired = Wired::<_, N, NU>::new(model, controls, hw.clone());
             let y = wired.initial(&y);
-            let settings = settings_with(scene, atol_of(&wired, groups));
+            let settings = settings_of(scene, &wired);
             Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
         } else if hw.is_on() {
             let wired = Wired::<_, N, NE>::new(model, controls, hw.clone());
             let y = wired.initial(&y);
-            let settings = settings_with(scene, atol_of(&wired, groups));
+            let settings = settings_of(scene, &wired);
             Box::new(Stepper::new(scene, wired, y, settings, gains, timed))
         } else {
-            let settings = settings_with(scene, atol_of(&model, groups));
+            let settings = settings_of(scene, &model);
             Box::new(Stepper::new(scene, model, y, settings, gains, timed))
         }
     }
@@ -639,9 +638,10 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
     }
 }
 
-/// `model`'s absolute tolerances from the scene's groups ([`Machine::atol`]).
-fn atol_of<const N: usize, M: Machine<N>>(_model: &M, groups: [f64; 4]) -> [f64; N] {
-    M::atol(groups)
+/// The integrator's settings for `model` in `scene`: the scene's, with the model's absolute
+/// tolerances and the components its error norm counts.
+pub(crate) fn settings_of<const N: usize, M: Machine<N>>(scene: &Scene, model: &M) -> Settings<N> {
+    Settings { rms_count: model.used_components(), ..settings_with(scene, M::atol(scene.integrator.atol_groups)) }
 }
 
 /// Hands the output sample of state `y` at time `t` to `sink`, then its bearing planes

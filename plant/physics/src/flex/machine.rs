@@ -31,7 +31,7 @@ use shock_table::Programme;
 use std::sync::Arc;
 
 /// Reduced coordinates the state has room for.
-pub const MAX_MODES: usize = 40;
+pub const MAX_MODES: usize = 24;
 /// State dimension.
 pub const N: usize = 2 * (MAX_MODES + 7);
 /// The state vector.

@@ -86,7 +86,7 @@ pub(crate) fn scaled_norms<const N: usize, const M: usize>(
                     acc[m] += q * q;
                 }
             }
-            let n = N.max(1) as f64;
+            let n = settings.rms_count.clamp(1, N.max(1)) as f64;
             acc.map(|a| (a / n).sqrt())
         }
         ErrorNorm::Max => {
@@ -237,4 +237,35 @@ pub(crate) fn run<M: EmbeddedPair, const N: usize, S: System<N>, F: FnMut(f64, &
     }
     carried.h = h;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Method;
+
+    /// Slots a model leaves at zero add nothing to the RMS norm's sum; with `rms_count` the
+    /// components it uses, the padded state's norm is the unpadded state's, bit for bit, and
+    /// without it the padding dilutes the norm by `sqrt(used / N)`.
+    #[test]
+    fn the_rms_norm_counts_the_components_the_model_uses() {
+        let y = [1e-4, -2e-5, 3.0];
+        let y_new = [1.1e-4, -2.2e-5, 3.1];
+        let err = [3e-9, 1e-10, 2e-7];
+        let compact = Settings::<3>::new(Method::Dp5);
+        let [want] = scaled_norms(&compact, 1e-5, &y, &y_new, [&err]);
+        let pad = |v: [f64; 3]| {
+            let mut p = [0.0; 8];
+            p[..3].copy_from_slice(&v);
+            p
+        };
+        let padded = Settings::<8> { rms_count: 3, ..Settings::new(Method::Dp5) };
+        let [got] = scaled_norms(&padded, 1e-5, &pad(y), &pad(y_new), [&pad(err)]);
+        assert_eq!(got, want);
+        let diluted = Settings::<8>::new(Method::Dp5);
+        let [loose] = scaled_norms(&diluted, 1e-5, &pad(y), &pad(y_new), [&pad(err)]);
+        assert!((loose / want - (3.0f64 / 8.0).sqrt()).abs() < 1e-12, "{loose} against {want}");
+        assert!(Settings::<8> { rms_count: 0, ..Settings::new(Method::Dp5) }.validate().is_err());
+        assert!(Settings::<8> { rms_count: 9, ..Settings::new(Method::Dp5) }.validate().is_err());
+    }
 }

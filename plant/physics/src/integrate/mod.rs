@@ -192,6 +192,11 @@ pub struct Settings<const N: usize> {
     pub atol: [f64; N],
     /// Adaptive methods: how the scaled errors are combined. Default [`ErrorNorm::Rms`].
     pub norm: ErrorNorm,
+    /// Adaptive methods, [`ErrorNorm::Rms`]: the number of components the mean is taken over,
+    /// 1 to N. Default N. A state with slots its model does not use (they stay zero and add
+    /// nothing to the sum: the flexible rotor's reduced coordinates past its basis) counts only
+    /// the components it uses, so that its tolerance does not depend on the padding.
+    pub rms_count: usize,
     /// Adaptive methods: smallest step, s, below which the controller gives up with
     /// [`IntegrationError::StepSizeUnderflow`]. The floor actually used is
     /// `max(h_min, 10·ε·|t|)` (ε the machine epsilon), so that `t + h ≠ t`. The last step of a
@@ -218,6 +223,7 @@ impl<const N: usize> Settings<N> {
             rtol: 1e-6,
             atol: [1e-9; N],
             norm: ErrorNorm::Rms,
+            rms_count: N,
             h_min: 1e-14,
             h_max: f64::INFINITY,
             h_init: 0.0,
@@ -265,6 +271,9 @@ impl<const N: usize> Settings<N> {
         }
         if !self.atol.iter().all(|&a| a >= 0.0 && a.is_finite() && a + self.rtol > 0.0) {
             return bad("each atol must be finite, non-negative, and atol + rtol > 0");
+        }
+        if self.rms_count == 0 || self.rms_count > N {
+            return bad("rms_count must be 1 to N, the components the RMS norm is taken over");
         }
         if !(self.h_min >= 0.0 && self.h_min.is_finite()) {
             return bad("h_min must be finite and non-negative");
