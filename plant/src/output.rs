@@ -146,11 +146,12 @@ impl RunFolder {
     /// Creates `dir/trace.csv` (header) for a run of `scene`.
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let path = dir.join("trace.csv");
-        let trace = TraceWriter::create_with_magnets(
+        let trace = TraceWriter::create_with_columns(
             &path,
             scene.planes(),
             scene.hardware.amplified(),
             scene.hardware.is_unipolar(),
+            matches!(scene.rotor, crate::config::Rotor::Flexible(_)),
         )
         .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })

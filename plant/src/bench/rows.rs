@@ -9,6 +9,7 @@
 //! | `stability.csv` | [`StabilityRow`] |
 //! | `reference_<scene>.csv` (read by the peer) | [`ReferenceRow`] |
 //! | `models.csv` | [`ModelRow`] |
+//! | `models_flexible.csv` | [`MachineRow`] |
 //! | `engineering.csv` | [`EngineeringRow`] |
 
 use super::IntegratorSetting;
@@ -164,6 +165,58 @@ pub struct ModelRow {
 
 fn four_decimals<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(&format_args!("{v:.4}"))
+}
+
+/// Header of `models_flexible.csv`.
+pub const MACHINE_HEADER: &str = "scene,model,plane,peak_contact_force_n,contact_time_s,contact_fraction,\
+     friction_energy_j,recovery_s,max_radius_m,first_contact_s,post_shock_mode,err_rms,err_max,wall_s_per_sim_s,speedup";
+
+/// One row of `models_flexible.csv`: one touchdown bearing of one model of the shipped flexible
+/// machine (the flexible rotor, or the rigid two-plane rotor of its rigid body), from its run
+/// of the whole scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MachineRow {
+    /// Scene.
+    pub scene: String,
+    /// `flexible` or `rigid two-plane`.
+    pub model: String,
+    /// `a` or `b`.
+    pub plane: String,
+    /// Peak rotor – race normal force (N).
+    #[serde(with = "sci_or_empty")]
+    pub peak_contact_force_n: Option<f64>,
+    /// Time in contact over the run (s).
+    #[serde(with = "sci")]
+    pub contact_time_s: f64,
+    /// Fraction of samples in contact over the steady window.
+    #[serde(with = "sci")]
+    pub contact_fraction: f64,
+    /// Friction energy dissipated at the rotor – race contact over the run (J).
+    #[serde(with = "sci")]
+    pub friction_energy_j: f64,
+    /// From the shock's start to the last sample in contact (s); empty if still touching.
+    #[serde(with = "sci_or_empty")]
+    pub recovery_s: Option<f64>,
+    /// Largest rotor radius at the touchdown bearing (m).
+    #[serde(with = "sci_or_empty")]
+    pub max_radius_m: Option<f64>,
+    /// First sample in contact (s); empty if the plane never touched.
+    #[serde(with = "sci_or_empty")]
+    pub first_contact_s: Option<f64>,
+    /// Post-shock mode of the plane.
+    pub post_shock_mode: crate::analysis::classify::MotionMode,
+    /// Scaled error of the plane's motion against the flexible rotor's over the window: RMS.
+    #[serde(with = "sci")]
+    pub err_rms: f64,
+    /// Max.
+    #[serde(with = "sci")]
+    pub err_max: f64,
+    /// Wall seconds per simulated second with the scene's integrator (the whole machine).
+    #[serde(with = "sci")]
+    pub wall_s_per_sim_s: f64,
+    /// Speed-up over the flexible rotor (four decimals).
+    #[serde(serialize_with = "four_decimals", deserialize_with = "sci::deserialize")]
+    pub speedup: f64,
 }
 
 /// Header of `engineering.csv`.
