@@ -151,7 +151,7 @@ impl RunFolder {
             scene.planes(),
             scene.hardware.amplified(),
             scene.hardware.is_unipolar(),
-            matches!(scene.rotor, crate::config::Rotor::Flexible(_)),
+            scene.rotor.bends(),
         )
         .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })

@@ -19,7 +19,7 @@
 use super::rows::{self, MachineRow, ModelRow};
 use super::{measure, with_integrator, BenchScene, IntegratorSetting, WINDOW};
 use crate::assess::duty::{Bearing, DutySink};
-use crate::config::{load_scene, Rotor, Scene};
+use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::plot::{self, PointGroup};
 use crate::run::{run, run_into, Quiet, RunResult};
@@ -231,11 +231,11 @@ pub const FLEXIBLE: &str = "flexible-10g.toml";
 /// other part of the scene (bearings, contact, loop, controller, shock, integrator) the same.
 /// `config/flexible-10g-rigid.toml` is the shipped machine's, to its printed digits.
 pub fn rigid_twin(flexible: &Scene) -> anyhow::Result<Scene> {
-    let Rotor::Flexible(f) = &flexible.rotor else {
+    let Some(twin) = flexible.rotor.rigid_twin() else {
         anyhow::bail!("scene `{}` has no flexible rotor (rotor.model = \"flexible\")", flexible.name)
     };
     let mut rigid = flexible.clone();
-    rigid.rotor = Rotor::TwoPlane(f.machine.clone());
+    rigid.rotor = twin;
     rigid.name = format!("{}-rigid", flexible.name);
     Ok(rigid)
 }

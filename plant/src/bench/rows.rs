@@ -310,6 +310,29 @@ mod tests {
             text(crate::table::to_bytes(&[m]).unwrap()),
             format!("{MODELS_HEADER}\nrub,full,0e0,0e0,3.8e-2,1.0000\n")
         );
+        let fx = MachineRow {
+            scene: "flexible-10g".into(),
+            model: "rigid two-plane".into(),
+            plane: "b".into(),
+            peak_contact_force_n: Some(7514.0),
+            contact_time_s: 0.24,
+            contact_fraction: 0.8,
+            friction_energy_j: 42.5,
+            recovery_s: None,
+            max_radius_m: Some(2.1e-4),
+            first_contact_s: Some(0.0226),
+            post_shock_mode: crate::analysis::classify::MotionMode::Rebound,
+            err_rms: 1.7,
+            err_max: 2.5,
+            wall_s_per_sim_s: 0.5,
+            speedup: 1.75,
+        };
+        assert_eq!(
+            text(crate::table::to_bytes(&[fx]).unwrap()),
+            format!(
+                "{MACHINE_HEADER}\nflexible-10g,rigid two-plane,b,7.514e3,2.4e-1,8e-1,4.25e1,,2.1e-4,2.26e-2,rebound,1.7e0,2.5e0,5e-1,1.7500\n"
+            )
+        );
         let r = ReferenceRow { t_s: 0.02, dx_m: -1e-6, dy_m: 0.0 };
         assert_eq!(text(crate::table::to_bytes(&[r]).unwrap()), format!("{REFERENCE_HEADER}\n2e-2,-1e-6,0e0\n"));
         let e = EngineeringRow {
@@ -397,6 +420,8 @@ mod tests {
         assert!(acc.iter().any(|r| r.implementation == "scipy") && acc.iter().any(|r| r.implementation == "rust"));
         round_trip::<StabilityRow>("stability.csv", STABILITY_HEADER);
         round_trip::<ModelRow>("models.csv", MODELS_HEADER);
+        let fx: Vec<MachineRow> = round_trip("models_flexible.csv", MACHINE_HEADER);
+        assert_eq!(fx.len(), 4);
         round_trip::<EngineeringRow>("engineering.csv", ENGINEERING_HEADER);
     }
 }

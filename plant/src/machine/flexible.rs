@@ -3,7 +3,8 @@
 //!
 //! Its trace is the two-plane rotor's layout: plane A's and B's rows are taken at each plane's
 //! touchdown-bearing node (where its race and contact are), and the "slopes" are those of the
-//! line through the two touchdown nodes (the rigid part of the motion there).
+//! line through the two touchdown nodes (the rigid part of the motion there); after them the
+//! rotor at mid-span ([`mid_span`], the trace's `mid_dx_m`, `mid_dy_m`).
 
 use super::two_plane::RaceFailure;
 use super::{FailureState, Linearised, Machine, PlaneState, WhirlMode};
