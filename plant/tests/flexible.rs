@@ -120,6 +120,14 @@ mod tests {
         let back = plant::trace::Trace::read_csv(&path).unwrap();
         assert_eq!(back.record(1), later);
         std::fs::remove_dir_all(&dir).unwrap();
+        // The run's charts draw the mid-span orbit (`orbit_mid.png`) from these columns; a rigid
+        // rotor's run has none.
+        let mut recorder = plant::record::Recorder::new(&scene, true);
+        trace.records().for_each(|r| recorder.push(&r));
+        let (x, y) = recorder.finish(None).mid_chart.expect("a mid-span chart").orbit();
+        assert_eq!((x[0], y[0]), (mid[0], mid[1]));
+        let twin = plant::bench::models::rigid_twin(&scene).unwrap();
+        assert!(plant::record::Recorder::new(&twin, true).finish(None).mid_chart.is_none());
     }
 
     /// Every slot past the basis' size stays zero under the derivative.
