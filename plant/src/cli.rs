@@ -261,12 +261,14 @@ pub enum BenchCommand {
         peer_rows: Option<PathBuf>,
     },
     /// Error and speed of each model simplification (lumped race support, fixed balls, speed
-    /// held, linear bearing) against the most detailed model, on the same three scenes.
+    /// held, linear bearing) against the most detailed model, on the same three scenes; then the
+    /// shipped flexible machine against the rigid two-plane rotor of its rigid body
+    /// (models_flexible.csv).
     Models {
         /// Output folder (default: runs/bench-models).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Scene folder holding paper-3g.toml and paper-10g.toml.
+        /// Scene folder holding paper-3g.toml, paper-10g.toml and flexible-10g.toml.
         #[arg(long, default_value = "config")]
         config: PathBuf,
         /// Timed runs per variant (1 to 1000); the minimum counts.

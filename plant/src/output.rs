@@ -41,6 +41,8 @@ pub const RUN_FILES: &[&str] = &[
     "orbit_a.png",
     "orbit_b.png",
     "tilt.png",
+    // A flexible run's: the orbit at mid-span.
+    "orbit_mid.png",
     "spectrum_a.png",
     "whirl_spectrum_a.png",
     "spectrogram_a.png",
@@ -146,11 +148,12 @@ impl RunFolder {
     /// Creates `dir/trace.csv` (header) for a run of `scene`.
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let path = dir.join("trace.csv");
-        let trace = TraceWriter::create_with_magnets(
+        let trace = TraceWriter::create_with_columns(
             &path,
             scene.planes(),
             scene.hardware.amplified(),
             scene.hardware.is_unipolar(),
+            scene.rotor.bends(),
         )
         .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })
@@ -191,6 +194,7 @@ impl RunFolder {
         };
         let recorded = self.recorder.finish(run.outcome.failure_time());
         let charts = scene.plots.then(|| (recorded.planes.clone(), recorded.tilt_chart.clone()));
+        let mid_chart = recorded.mid_chart.clone();
         interrupt(&mut run);
         let mut summary = Summary::from_parts(scene, &run, recorded);
         write_json(&dir.join("summary.json"), &summary)?;
@@ -198,6 +202,16 @@ impl RunFolder {
         let mut skipped = Vec::new();
         if let Some((planes, tilt)) = &charts {
             skipped.extend(write_charts(dir, scene, planes, tilt.as_ref()).context("writing charts")?);
+            if let Some(mid) = &mid_chart {
+                // The bearings' clearance drawn for scale: there is no touchdown bearing at mid-span.
+                let (x, y) = mid.orbit();
+                let title = format!("{} — rotor orbit at mid-span relative to housing", scene.name);
+                let path = dir.join("orbit_mid.png");
+                match plot::orbit(&path, &title, &x, &y, scene.plane(0).contact.gap) {
+                    Err(plot::PlotError::NoData { .. }) => skipped.push("orbit_mid.png"),
+                    other => other.context("writing orbit_mid.png")?,
+                }
+            }
             if let Some(tet) = &run.ticks.tet {
                 match write_tet_chart(&dir.join("tet.png"), scene, tet) {
                     Err(plot::PlotError::NoData { .. }) => skipped.push("tet.png"),

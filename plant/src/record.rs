@@ -99,6 +99,9 @@ struct PlaneRecorder {
 pub struct Recorder {
     planes: Vec<PlaneRecorder>,
     tilt: Option<(TiltAnalyzer, Option<MinMaxBins>)>,
+    /// The rotor at mid-span (a bending rotor's run with charts), for `orbit_mid.png`: its orbit
+    /// only, the row's `dx_m`, `dy_m` replaced by `mid_dx_m`, `mid_dy_m`.
+    mid: Option<ChartData>,
 }
 
 /// What a [`Recorder`] made of one bearing plane.
@@ -123,6 +126,8 @@ pub struct Recorded {
     pub tilt: Option<TiltAnalysis>,
     /// The tilt angle (µrad) against time (ms), for `tilt.png` (two-plane runs with charts).
     pub tilt_chart: Option<MinMaxBins>,
+    /// The rotor at mid-span, for `orbit_mid.png` (flexible runs with charts; its orbit only).
+    pub mid_chart: Option<ChartData>,
 }
 
 impl Recorded {
@@ -152,7 +157,8 @@ impl Recorder {
             let bins = charts.then(|| MinMaxBins::new(0.0, scene.duration * 1e3, CHART_BINS));
             (TiltAnalyzer::new(analysis_spec(scene)), bins)
         });
-        Self { planes, tilt }
+        let mid = (charts && scene.rotor.bends()).then(|| ChartData::new(scene.duration));
+        Self { planes, tilt, mid }
     }
 
     /// The next sample.
@@ -171,6 +177,12 @@ impl Recorder {
                 bins.push(r.a[col::T_S] * 1e3, a.hypot(b) * 1e6);
             }
         }
+        if let (Some(c), Some(m)) = (&mut self.mid, r.mid) {
+            let mut row = r.a;
+            row[col::DX_M] = m[0];
+            row[col::DY_M] = m[1];
+            c.push(&row);
+        }
     }
 
     /// What was recorded; rows at or after `failure_time` (s) are left out of the maxima.
@@ -187,6 +199,6 @@ impl Recorder {
             Some((t, bins)) => (Some(t.finish()), bins),
             None => (None, None),
         };
-        Recorded { planes, tilt, tilt_chart }
+        Recorded { planes, tilt, tilt_chart, mid_chart: self.mid }
     }
 }

@@ -68,8 +68,24 @@ columns! {
     housing_y_m: "Housing displacement, y (m).";
     b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model).",
     hw: Option<TraceHw>: "A run with amplifiers: the coils' currents and voltages (`None` without).",
-    magnets: Option<TraceMagnets>: "A run with unipolar amplifiers: each magnet's current and voltage (`None` without)."
+    magnets: Option<TraceMagnets>: "A run with unipolar amplifiers: each magnet's current and voltage (`None` without).",
+    mid: Option<TraceMid>: "A flexible run's rotor at mid-span (`None` for the rigid rotors)."
 }
+
+columns! {
+    /// A flexible run's rotor at mid-span, after all other columns in `trace.csv`: the shaft's
+    /// node nearest the middle between its two touchdown-bearing nodes (MODEL.md §13.6), where
+    /// the first bending mode's deflection is largest; the rigid rotors have no such columns.
+    TraceMid: RowMid;
+    mid_dx_m: "Rotor x at mid-span relative to the housing (m), flexible rotor.",
+    mid_dy_m: "Rotor y at mid-span relative to the housing (m), flexible rotor.";
+}
+
+/// Number of mid-span columns.
+pub const WIDTH_MID: usize = 2;
+
+/// A flexible sample's rotor at mid-span: [`TraceMid::COLUMNS`], in order.
+pub type RowMid = [f64; WIDTH_MID];
 
 columns! {
     /// The coils' real currents and voltages of a run with amplifiers (`amb.amplifier`), after
@@ -174,12 +190,14 @@ pub struct Record {
     pub hw: Option<RowHw>,
     /// Each magnet's current and voltage (runs with unipolar amplifiers).
     pub magnets: Option<RowMagnets>,
+    /// The rotor at mid-span (flexible runs).
+    pub mid: Option<RowMid>,
 }
 
 impl Record {
     /// A planar sample.
     pub fn planar(a: Row) -> Self {
-        Self { a, b: None, hw: None, magnets: None }
+        Self { a, b: None, hw: None, magnets: None, mid: None }
     }
 
     /// Bearing planes in the sample: 1 (planar) or 2.
@@ -364,7 +382,7 @@ pub fn two_bearing_record(
     let mut b = [0.0; WIDTH_B];
     b[..14].copy_from_slice(&planes[1]);
     b[colb::SLOPE..].copy_from_slice(&slopes);
-    Record { a, b: Some(b), hw: None, magnets: None }
+    Record { a, b: Some(b), hw: None, magnets: None, mid: None }
 }
 
 impl Trace {
@@ -394,6 +412,9 @@ impl Trace {
         if let Some(m) = &r.magnets {
             self.magnets.get_or_insert_with(|| TraceMagnets::with_capacity(room)).push_row(m);
         }
+        if let Some(m) = &r.mid {
+            self.mid.get_or_insert_with(|| TraceMid::with_capacity(room)).push_row(m);
+        }
     }
 
     /// Sample `i`.
@@ -403,6 +424,7 @@ impl Trace {
             b: self.b.as_ref().map(|b| b.row(i)),
             hw: self.hw.as_ref().map(|h| h.row(i)),
             magnets: self.magnets.as_ref().map(|m| m.row(i)),
+            mid: self.mid.as_ref().map(|m| m.row(i)),
         }
     }
 
@@ -436,7 +458,13 @@ impl Trace {
 
     /// Writes the trace as `trace.csv` (see the module docs).
     pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        let mut w = TraceWriter::create_with_magnets(path, self.planes(), self.hw.is_some(), self.magnets.is_some())?;
+        let mut w = TraceWriter::create_with_columns(
+            path,
+            self.planes(),
+            self.hw.is_some(),
+            self.magnets.is_some(),
+            self.mid.is_some(),
+        )?;
         for r in self.records() {
             w.write(&r)?;
         }
@@ -468,6 +496,8 @@ pub struct TraceWriter {
     coils: usize,
     /// Magnet columns written (0, or 8 per plane).
     magnets: usize,
+    /// Mid-span columns written (0 or [`WIDTH_MID`]).
+    mid: usize,
 }
 
 impl TraceWriter {
@@ -481,6 +511,19 @@ impl TraceWriter {
     /// [`TraceWriter::create`], with each magnet's columns after all the others when
     /// `unipolar` (a run with unipolar amplifiers, [`TraceMagnets`]).
     pub fn create_with_magnets(path: &Path, planes: usize, amplified: bool, unipolar: bool) -> std::io::Result<Self> {
+        Self::create_with_columns(path, planes, amplified, unipolar, false)
+    }
+
+    /// [`TraceWriter::create_with_magnets`], with the rotor's mid-span columns after all the
+    /// others when `mid_span` (a flexible run, [`TraceMid`]).
+    pub fn create_with_columns(
+        path: &Path,
+        planes: usize,
+        amplified: bool,
+        unipolar: bool,
+        mid_span: bool,
+    ) -> std::io::Result<Self> {
+        let mid = if mid_span { WIDTH_MID } else { 0 };
         let coils = if amplified { 4 * planes } else { 0 };
         let magnets = if unipolar { 8 * planes } else { 0 };
         let header: Vec<&str> = Trace::COLUMNS
@@ -488,6 +531,7 @@ impl TraceWriter {
             .chain(if planes == 2 { TraceB::COLUMNS } else { &[] })
             .chain(&TraceHw::COLUMNS[..coils])
             .chain(&TraceMagnets::COLUMNS[..magnets])
+            .chain(&TraceMid::COLUMNS[..mid])
             .copied()
             .collect();
         let rows = RowFile::create(path, &header)?;
@@ -497,6 +541,7 @@ impl TraceWriter {
             b_cols: if planes == 2 { WIDTH_B } else { 0 },
             coils,
             magnets,
+            mid,
         })
     }
 
@@ -507,7 +552,13 @@ impl TraceWriter {
         let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
         let hw = r.hw.unwrap_or([f64::NAN; WIDTH_HW]);
         let magnets = r.magnets.unwrap_or([f64::NAN; WIDTH_MAGNETS]);
-        let values = r.a.iter().chain(&b[..self.b_cols]).chain(&hw[..self.coils]).chain(&magnets[..self.magnets]);
+        let mid = r.mid.unwrap_or([f64::NAN; WIDTH_MID]);
+        let values =
+            r.a.iter()
+                .chain(&b[..self.b_cols])
+                .chain(&hw[..self.coils])
+                .chain(&magnets[..self.magnets])
+                .chain(&mid[..self.mid]);
         for (field, v) in self.fields.iter_mut().zip(values) {
             field.clear();
             let _ = write!(field, "{v:e}");
@@ -618,6 +669,22 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
     } else {
         None
     };
+    // A flexible trace's mid-span columns: both or none.
+    let index_mid = if TraceMid::COLUMNS.iter().any(|name| find(name).is_some()) {
+        let mut index_mid = [0usize; WIDTH_MID];
+        for (slot, name) in index_mid.iter_mut().zip(TraceMid::COLUMNS) {
+            *slot = find(name).ok_or_else(|| {
+                bad(
+                    1,
+                    Some(name),
+                    format!("the header has mid-span columns but not `{name}`: a flexible trace has both"),
+                )
+            })?;
+        }
+        Some(index_mid)
+    } else {
+        None
+    };
     let mut previous_t = f64::NEG_INFINITY;
     let mut last_line = 1;
     let mut values = [0.0; WIDTH];
@@ -648,6 +715,16 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
             }
             None => None,
         };
+        let mid = match &index_mid {
+            Some(index_mid) => {
+                let mut m = [0.0; WIDTH_MID];
+                for ((v, &i), name) in m.iter_mut().zip(index_mid).zip(TraceMid::COLUMNS) {
+                    *v = number(i, name)?;
+                }
+                Some(m)
+            }
+            None => None,
+        };
         let t = values[col::T_S];
         if !t.is_finite() {
             return Err(bad(line, Some("t_s"), format!("time {t} is not finite")));
@@ -657,7 +734,7 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        if !row(&Record { a: values, b, hw: None, magnets: None }) {
+        if !row(&Record { a: values, b, hw: None, magnets: None, mid }) {
             return Ok(false);
         }
     }

@@ -81,6 +81,55 @@ mod tests {
         assert_eq!(rec.b.unwrap()[9], 0.0, "no contact at B");
     }
 
+    /// The mid-span columns (`mid_dx_m`, `mid_dy_m`): a rigid motion reads at the mid-span node
+    /// (on the shipped shaft node 8, halfway between the touchdown nodes) as the rigid axis there,
+    /// and a written trace has them last and reads them back.
+    #[test]
+    fn the_record_has_the_rotor_at_mid_span() {
+        let scene = scene();
+        let m = model(&scene);
+        let node = plant::machine::mid_span(&m);
+        let z = &m.params.z;
+        let [za, zb] = [0, 1].map(|i| z[m.params.nodes[i].touchdown]);
+        assert_eq!(node, 8);
+        assert!((z[node] - 0.5 * (za + zb)).abs() < 1e-12, "{} against {za}, {zb}", z[node]);
+        let mut rigid = [0.0; plant_physics::two_plane::N];
+        use plant_physics::two_plane::ix as r;
+        rigid[r::X] = 3e-6;
+        rigid[r::Y] = -2e-6;
+        rigid[r::SX] = 1e-5;
+        rigid[r::SY] = -4e-5;
+        let y = Model::from_rigid(&m.params, &rigid);
+        let rec = m.record(0.0, &y);
+        let mid = rec.mid.expect("a flexible record has the mid-span columns");
+        assert!((mid[0] - (3e-6 + 1e-5 * z[node])).abs() < 1e-12, "{mid:?}");
+        assert!((mid[1] - (-2e-6 - 4e-5 * z[node])).abs() < 1e-12, "{mid:?}");
+        // Written and read back, after every other column.
+        let mut trace = plant::trace::Trace::default();
+        trace.push(&rec);
+        let mut later = rec;
+        later.a[0] = 1e-3;
+        trace.push(&later);
+        let dir = std::env::temp_dir().join(format!("flexible-mid-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("trace.csv");
+        trace.write_csv(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let header = text.lines().next().unwrap();
+        assert!(header.ends_with("slope_y_rate_rad_s,mid_dx_m,mid_dy_m"), "{header}");
+        let back = plant::trace::Trace::read_csv(&path).unwrap();
+        assert_eq!(back.record(1), later);
+        std::fs::remove_dir_all(&dir).unwrap();
+        // The run's charts draw the mid-span orbit (`orbit_mid.png`) from these columns; a rigid
+        // rotor's run has none.
+        let mut recorder = plant::record::Recorder::new(&scene, true);
+        trace.records().for_each(|r| recorder.push(&r));
+        let (x, y) = recorder.finish(None).mid_chart.expect("a mid-span chart").orbit();
+        assert_eq!((x[0], y[0]), (mid[0], mid[1]));
+        let twin = plant::bench::models::rigid_twin(&scene).unwrap();
+        assert!(plant::record::Recorder::new(&twin, true).finish(None).mid_chart.is_none());
+    }
+
     /// Every slot past the basis' size stays zero under the derivative.
     #[test]
     fn the_unused_slots_stay_at_rest() {
@@ -302,5 +351,74 @@ mod in_the_loop {
         assert!(axis.points.len() >= 2 && d < 0.5, "{d} dB over {:?}", axis.points);
         // The bending mode's peak is one of the closed form's.
         assert!(x_a.peaks.iter().any(|(f, _)| (470.0..530.0).contains(f)), "{:?}", x_a.peaks);
+    }
+}
+
+/// The shipped flexible machine against the rigid two-plane rotor of its rigid body (issue 30
+/// item 4, `plant bench models`' `models_flexible.csv`).
+mod against_rigid {
+    use plant::bench::models::{machine_against_rigid, rigid_twin};
+    use plant::config::{load_scene, Rotor, Scene};
+    use std::path::Path;
+
+    fn shipped(name: &str, sets: &[&str]) -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config").join(name);
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load_scene(&path, &sets).expect("a shipped scene")
+    }
+
+    /// `config/flexible-10g-rigid.toml` is the flexible machine's rigid twin (the rigid body the
+    /// flexible model computes from the shaft's elements, its stations) to its printed digits.
+    #[test]
+    fn the_shipped_rigid_scene_is_the_flexible_machines_rigid_body() {
+        let twin = rigid_twin(&shipped("flexible-10g.toml", &[])).expect("a twin");
+        let shipped = shipped("flexible-10g-rigid.toml", &[]);
+        let (Rotor::TwoPlane(a), Rotor::TwoPlane(b)) = (&twin.rotor, &shipped.rotor) else { panic!("two-plane") };
+        let close = |x: f64, y: f64, tol: f64, what: &str| assert!((x - y).abs() <= tol, "{what}: {x} against {y}");
+        close(a.rotor.mass, b.rotor.mass, 1e-3, "mass");
+        close(a.rotor.transverse_inertia, b.rotor.transverse_inertia, 1e-5, "I_t");
+        close(a.rotor.polar_inertia, b.rotor.polar_inertia, 1e-7, "I_p");
+        close(a.rotor.eccentricity, b.rotor.eccentricity, 1e-12, "e");
+        close(a.rotor.speed, b.rotor.speed, 1e-9, "speed");
+        for i in 0..2 {
+            close(a.planes[i].station, b.planes[i].station, 1e-5, "station");
+            close(a.planes[i].sensor, b.planes[i].sensor, 1e-5, "sensor");
+            close(a.load_share(i), b.load_share(i), 1e-3, "load share");
+        }
+        assert_eq!(shipped.duration, twin.duration);
+        assert_eq!(shipped.controller.law, twin.controller.law);
+    }
+
+    /// The bench's comparison on the first 30 ms of the shock: both models touch both
+    /// touchdown bearings, every figure is finite, the rigid rotor differs from the flexible one
+    /// (an error above zero), and with the shaft 1000 times stiffer that difference falls (the
+    /// stiff shaft is the rigid rotor).
+    #[test]
+    fn both_models_touch_both_bearings_and_a_stiff_shaft_is_the_rigid_rotor() {
+        let short = ["scene.duration_s=0.045", "output.plots=false"];
+        let stiff = [
+            "scene.duration_s=0.045",
+            "output.plots=false",
+            "rotor.shaft.materials.steel.modulus_pa=211e12",
+            "rotor.shaft.materials.steel.shear_modulus_pa=81.2e12",
+        ];
+        let mut log = |l: &str| eprintln!("{l}");
+        let (summary, planes) =
+            machine_against_rigid(&shipped("flexible-10g.toml", &short), 1, None, &mut log).expect("runs");
+        assert_eq!(planes.len(), 4);
+        for r in &planes {
+            assert!(r.peak_contact_force_n.is_some_and(|f| f > 0.0 && f.is_finite()), "{r:?}");
+            assert!(r.contact_time_s > 0.0 && r.friction_energy_j > 0.0 && r.friction_energy_j.is_finite(), "{r:?}");
+            assert!(r.first_contact_s.is_some_and(|t| t > 0.02), "{r:?}");
+            assert!(r.err_rms.is_finite() && r.err_max.is_finite() && r.speedup > 0.0, "{r:?}");
+        }
+        let models: Vec<(&str, &str)> = planes.iter().map(|r| (r.model.as_str(), r.plane.as_str())).collect();
+        assert_eq!(models, [("flexible", "a"), ("flexible", "b"), ("rigid two-plane", "a"), ("rigid two-plane", "b")]);
+        assert_eq!(summary.len(), 2);
+        let steel = summary[1].err_rms;
+        assert!(summary[0].err_rms == 0.0 && steel > 0.0, "{summary:?}");
+        let (stiff, _) = machine_against_rigid(&shipped("flexible-10g.toml", &stiff), 1, None, &mut log).expect("runs");
+        eprintln!("rigid against flexible, RMS / gap: steel {steel:.3e}, 1000 x steel {:.3e}", stiff[1].err_rms);
+        assert!(stiff[1].err_rms < 0.1 * steel, "steel {steel}, stiff {}", stiff[1].err_rms);
     }
 }

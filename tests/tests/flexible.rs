@@ -56,7 +56,7 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
 }
 
 /// The shipped scene, cut short: both planes touch, the trace has the two-plane rotor's 37
-/// columns, the summary names the model, `plant analyze` reads the trace back; a sampled run
+/// columns and the mid-span's two after them, the summary names the model, `plant analyze` reads the trace back; a sampled run
 /// and a lockstep co-simulation (4 axes on the wire) of the same law give the same trace (the
 /// continuous PD is the unit tests' `machine::flexible`).
 #[test]
@@ -70,8 +70,9 @@ fn flexible_scene_runs_in_every_mode_and_analyze_reads_it_back() {
         let run = output_within(&mut plant_run(&scene("flexible-10g.toml"), &out, &sets), RUN);
         assert_exit(&run, 0);
         let trace = Csv::read(&out.join("trace.csv"));
-        assert_eq!(trace.header.len(), 37, "{:?}", trace.header);
+        assert_eq!(trace.header.len(), 39, "{:?}", trace.header);
         assert_eq!(trace.header[19], "b_dx_m");
+        assert_eq!(trace.header[37..], ["mid_dx_m", "mid_dy_m"], "the rotor at mid-span, last");
         let summary = read_json(&out.join("summary.json"));
         assert_eq!(summary["model"]["rotor"], "flexible");
         assert_eq!(summary["status"], "completed", "{mode}: {summary:#}");

@@ -140,7 +140,7 @@ mod tests {
         rb[colb::DX + 1] = b[1];
         rb[colb::SLOPE] = slopes[0];
         rb[colb::SLOPE + 1] = slopes[1];
-        Record { a: ra, b: Some(rb), hw: None, magnets: None }
+        Record { a: ra, b: Some(rb), hw: None, magnets: None, mid: None }
     }
 
     fn shape_of(sign: f64) -> TiltAnalysis {

@@ -9,13 +9,21 @@
 //! Then what the second bearing plane changes ([`TWO_PLANE_VARIANTS`]): the study's planar model
 //! against the symmetric two-plane machine and each asymmetry on its own, the error the larger
 //! of the two planes' against the planar trace, the cost against the planar model's.
+//!
+//! Then what the bending adds ([`machine_against_rigid`], issue 30 item 4): the shipped flexible
+//! machine (`config/flexible-10g.toml`, the whole scene) against the rigid two-plane rotor of its
+//! rigid body ([`rigid_twin`]): each touchdown bearing's peak force, time in contact, friction
+//! energy and recovery (`models_flexible.csv`), and a row of `models.csv` (scene
+//! `flexible-10g`: the rigid rotor's error and speed-up against the flexible one).
 
-use super::rows::{self, ModelRow};
+use super::rows::{self, MachineRow, ModelRow};
 use super::{measure, with_integrator, BenchScene, IntegratorSetting, WINDOW};
-use crate::config::Scene;
+use crate::assess::duty::{Bearing, DutySink};
+use crate::config::{load_scene, Scene};
 use crate::integrate::Method;
 use crate::plot::{self, PointGroup};
-use crate::run::{run, Quiet};
+use crate::run::{run, run_into, Quiet, RunResult};
+use crate::summary::{PlaneSummary, Summary};
 use crate::trace::window_error;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -145,6 +153,11 @@ pub fn models(
     for b in super::scenes(config_dir)? {
         rows.extend(second_plane(&b, repeats, log)?);
     }
+    let flexible = load_scene(&config_dir.join(FLEXIBLE), &["output.plots=false".to_string()])
+        .with_context(|| format!("loading {}", config_dir.join(FLEXIBLE).display()))?;
+    let (summary_rows, machine_rows) = machine_against_rigid(&flexible, repeats, Some(1e-10), log)?;
+    rows.extend(summary_rows);
+    crate::table::write_with_header(&out.join("models_flexible.csv"), rows::MACHINE_HEADER, &machine_rows)?;
     crate::table::write_with_header(&out.join("models.csv"), rows::MODELS_HEADER, &rows)?;
     for scene in ["levitation", "impact", "rub"] {
         let here: Vec<&ModelRow> = rows
@@ -206,6 +219,154 @@ fn second_plane(b: &BenchScene, repeats: usize, log: &mut dyn FnMut(&str)) -> an
         });
     }
     Ok(rows)
+}
+
+/// The shipped flexible machine (in the config folder).
+pub const FLEXIBLE: &str = "flexible-10g.toml";
+
+/// The rigid two-plane rotor of a flexible scene's machine: the two-plane rotor
+/// (`rotor.model = "two_plane"`) with the shaft's rigid body as the flexible model computed it
+/// from its finite elements (mass, centre of mass, `I_t`, `I_p`, the unbalance), its AMBs and
+/// touchdown bearings at the AMB nodes' stations and its sensors at the sensor nodes'; every
+/// other part of the scene (bearings, contact, loop, controller, shock, integrator) the same.
+/// `config/flexible-10g-rigid.toml` is the shipped machine's, to its printed digits.
+pub fn rigid_twin(flexible: &Scene) -> anyhow::Result<Scene> {
+    let Some(twin) = flexible.rotor.rigid_twin() else {
+        anyhow::bail!("scene `{}` has no flexible rotor (rotor.model = \"flexible\")", flexible.name)
+    };
+    let mut rigid = flexible.clone();
+    rigid.rotor = twin;
+    rigid.name = format!("{}-rigid", flexible.name);
+    Ok(rigid)
+}
+
+/// One model's run of the whole scene: its trace, summary and the duty of each touchdown
+/// bearing, and the fastest wall time per simulated second of `repeats` runs.
+struct MachineRun {
+    result: RunResult,
+    summary: Summary,
+    friction_energy_j: [f64; 2],
+    wall_s_per_sim_s: f64,
+}
+
+fn machine_run(scene: &Scene, repeats: usize) -> anyhow::Result<MachineRun> {
+    let raw = scene.resolved()?;
+    let t = &raw.touchdown;
+    // The friction energy, time in contact and peak force do not depend on the materials.
+    let bearing =
+        Bearing::new(Default::default(), t.ball_diameter_mm * 1e-3, t.pitch_diameter_mm * 1e-3, t.width_mm * 1e-3, 0.1);
+    let mut trace = crate::trace::Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
+    let mut sink = DutySink::new(&mut trace, bearing, scene.plane(0).balls.count());
+    let run = run_into(scene, &Default::default(), &mut Quiet, &mut sink)?;
+    let duty = sink.finish();
+    let mut best = run.wall_time;
+    anyhow::ensure!(
+        run.outcome == crate::run::Outcome::Completed,
+        "scene `{}` did not complete: {:?}",
+        scene.name,
+        run.outcome
+    );
+    for _ in 1..repeats {
+        best = best.min(crate::run::run(scene, &mut Quiet)?.run.wall_time);
+    }
+    let result = RunResult { trace, run };
+    let summary = Summary::new(scene, &result);
+    let friction = |i: usize| duty.planes.get(i).map_or(0.0, |d| d.friction_energy_j);
+    Ok(MachineRun {
+        summary,
+        friction_energy_j: [friction(0), friction(1)],
+        wall_s_per_sim_s: best / scene.duration,
+        result,
+    })
+}
+
+/// What the bending adds: the flexible scene `flexible` (run whole, with its own integrator)
+/// against its [`rigid_twin`]. Returns the rows of `models.csv` (scene `flexible-10g`: the
+/// flexible rotor, speed-up 1, and the rigid rotor with its error, the larger of the two planes',
+/// and its speed-up) and of `models_flexible.csv` (each model's figures per touchdown bearing).
+/// The error is taken over the 50 ms after the shock (or to the scene's end) between runs at
+/// DP5 and `error_rtol` (`None`: the scene's own runs).
+pub fn machine_against_rigid(
+    flexible: &Scene,
+    repeats: usize,
+    error_rtol: Option<f64>,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<(Vec<ModelRow>, Vec<MachineRow>)> {
+    let rigid = rigid_twin(flexible)?;
+    let name = flexible.name.clone();
+    let t0 = flexible.first_shock_start();
+    let t1 = (t0 + WINDOW).min(flexible.duration);
+    let gap = flexible.plane(0).contact.gap;
+    let runs = [machine_run(flexible, repeats)?, machine_run(&rigid, repeats)?];
+    // The traces the error is measured on.
+    let accurate = |s: &Scene, rtol: f64| -> anyhow::Result<crate::trace::Trace> {
+        let short = {
+            let mut s = with_integrator(s, Method::Dp5, IntegratorSetting::Rtol(rtol));
+            s.duration = t1;
+            s
+        };
+        Ok(run(&short, &mut Quiet)?.trace)
+    };
+    let traces = match error_rtol {
+        Some(rtol) => [accurate(flexible, rtol)?, accurate(&rigid, rtol)?],
+        None => [runs[0].result.trace.clone(), runs[1].result.trace.clone()],
+    };
+    let errors: Vec<(f64, f64)> =
+        (0..2).map(|i| window_error(&traces[1].plane(i), &traces[0].plane(i), t0, t1, gap)).collect();
+    let models = ["flexible", "rigid two-plane"];
+    let mut machine_rows = Vec::new();
+    for (k, r) in runs.iter().enumerate() {
+        let planes = r.summary.planes.as_ref().context("a two-plane summary")?;
+        for (i, (plane, p)) in [("a", &planes.a), ("b", &planes.b)].into_iter().enumerate() {
+            let p: &PlaneSummary = p;
+            let (err_rms, err_max) = if k == 0 { (0.0, 0.0) } else { errors[i] };
+            machine_rows.push(MachineRow {
+                scene: name.clone(),
+                model: models[k].into(),
+                plane: plane.into(),
+                peak_contact_force_n: p.max_contact_force_n,
+                contact_time_s: p.contact_time_s,
+                contact_fraction: p.contact_fraction,
+                friction_energy_j: r.friction_energy_j[i],
+                recovery_s: p.recovery_s,
+                max_radius_m: p.max_radius_m,
+                first_contact_s: p.first_contact_s,
+                post_shock_mode: p.analysis.post_shock_mode,
+                err_rms,
+                err_max,
+                wall_s_per_sim_s: r.wall_s_per_sim_s,
+                speedup: runs[0].wall_s_per_sim_s / r.wall_s_per_sim_s,
+            });
+            log(&format!(
+                "{name}: {} plane {plane}: peak force {:.0} N, contact {:.1} ms, friction {:.3} J, recovery {}",
+                models[k],
+                p.max_contact_force_n.unwrap_or(f64::NAN),
+                p.contact_time_s * 1e3,
+                r.friction_energy_j[i],
+                p.recovery_s.map_or("none (still touching)".to_string(), |s| format!("{:.1} ms", s * 1e3)),
+            ));
+        }
+    }
+    let (rms, max) = errors.iter().fold((0.0f64, 0.0f64), |(a, b), (r, m)| (a.max(*r), b.max(*m)));
+    let summary_rows = vec![
+        ModelRow {
+            scene: name.clone(),
+            variant: "flexible rotor".into(),
+            err_rms: 0.0,
+            err_max: 0.0,
+            wall_s_per_sim_s: runs[0].wall_s_per_sim_s,
+            speedup: 1.0,
+        },
+        ModelRow {
+            scene: name,
+            variant: "rigid two-plane rotor".into(),
+            err_rms: rms,
+            err_max: max,
+            wall_s_per_sim_s: runs[1].wall_s_per_sim_s,
+            speedup: runs[0].wall_s_per_sim_s / runs[1].wall_s_per_sim_s,
+        },
+    ];
+    Ok((summary_rows, machine_rows))
 }
 
 /// `plant bench models`: runs the study into `out` (default `runs/bench-models`); returns the

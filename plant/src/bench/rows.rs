@@ -9,6 +9,7 @@
 //! | `stability.csv` | [`StabilityRow`] |
 //! | `reference_<scene>.csv` (read by the peer) | [`ReferenceRow`] |
 //! | `models.csv` | [`ModelRow`] |
+//! | `models_flexible.csv` | [`MachineRow`] |
 //! | `engineering.csv` | [`EngineeringRow`] |
 
 use super::IntegratorSetting;
@@ -166,6 +167,58 @@ fn four_decimals<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error>
     s.collect_str(&format_args!("{v:.4}"))
 }
 
+/// Header of `models_flexible.csv`.
+pub const MACHINE_HEADER: &str = "scene,model,plane,peak_contact_force_n,contact_time_s,contact_fraction,\
+     friction_energy_j,recovery_s,max_radius_m,first_contact_s,post_shock_mode,err_rms,err_max,wall_s_per_sim_s,speedup";
+
+/// One row of `models_flexible.csv`: one touchdown bearing of one model of the shipped flexible
+/// machine (the flexible rotor, or the rigid two-plane rotor of its rigid body), from its run
+/// of the whole scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MachineRow {
+    /// Scene.
+    pub scene: String,
+    /// `flexible` or `rigid two-plane`.
+    pub model: String,
+    /// `a` or `b`.
+    pub plane: String,
+    /// Peak rotor – race normal force (N).
+    #[serde(with = "sci_or_empty")]
+    pub peak_contact_force_n: Option<f64>,
+    /// Time in contact over the run (s).
+    #[serde(with = "sci")]
+    pub contact_time_s: f64,
+    /// Fraction of samples in contact over the steady window.
+    #[serde(with = "sci")]
+    pub contact_fraction: f64,
+    /// Friction energy dissipated at the rotor – race contact over the run (J).
+    #[serde(with = "sci")]
+    pub friction_energy_j: f64,
+    /// From the shock's start to the last sample in contact (s); empty if still touching.
+    #[serde(with = "sci_or_empty")]
+    pub recovery_s: Option<f64>,
+    /// Largest rotor radius at the touchdown bearing (m).
+    #[serde(with = "sci_or_empty")]
+    pub max_radius_m: Option<f64>,
+    /// First sample in contact (s); empty if the plane never touched.
+    #[serde(with = "sci_or_empty")]
+    pub first_contact_s: Option<f64>,
+    /// Post-shock mode of the plane.
+    pub post_shock_mode: crate::analysis::classify::MotionMode,
+    /// Scaled error of the plane's motion against the flexible rotor's over the window: RMS.
+    #[serde(with = "sci")]
+    pub err_rms: f64,
+    /// Max.
+    #[serde(with = "sci")]
+    pub err_max: f64,
+    /// Wall seconds per simulated second with the scene's integrator (the whole machine).
+    #[serde(with = "sci")]
+    pub wall_s_per_sim_s: f64,
+    /// Speed-up over the flexible rotor (four decimals).
+    #[serde(serialize_with = "four_decimals", deserialize_with = "sci::deserialize")]
+    pub speedup: f64,
+}
+
 /// Header of `engineering.csv`.
 pub const ENGINEERING_HEADER: &str = "scene,setting,status,peak_contact_force_n,max_radius_m,contact_fraction,\
      post_shock_mode,steady_class,wall_s_per_sim_s,peak_force_rel_diff,max_radius_rel_diff,contact_fraction_diff,\
@@ -257,6 +310,29 @@ mod tests {
             text(crate::table::to_bytes(&[m]).unwrap()),
             format!("{MODELS_HEADER}\nrub,full,0e0,0e0,3.8e-2,1.0000\n")
         );
+        let fx = MachineRow {
+            scene: "flexible-10g".into(),
+            model: "rigid two-plane".into(),
+            plane: "b".into(),
+            peak_contact_force_n: Some(7514.0),
+            contact_time_s: 0.24,
+            contact_fraction: 0.8,
+            friction_energy_j: 42.5,
+            recovery_s: None,
+            max_radius_m: Some(2.1e-4),
+            first_contact_s: Some(0.0226),
+            post_shock_mode: crate::analysis::classify::MotionMode::Rebound,
+            err_rms: 1.7,
+            err_max: 2.5,
+            wall_s_per_sim_s: 0.5,
+            speedup: 1.75,
+        };
+        assert_eq!(
+            text(crate::table::to_bytes(&[fx]).unwrap()),
+            format!(
+                "{MACHINE_HEADER}\nflexible-10g,rigid two-plane,b,7.514e3,2.4e-1,8e-1,4.25e1,,2.1e-4,2.26e-2,rebound,1.7e0,2.5e0,5e-1,1.7500\n"
+            )
+        );
         let r = ReferenceRow { t_s: 0.02, dx_m: -1e-6, dy_m: 0.0 };
         assert_eq!(text(crate::table::to_bytes(&[r]).unwrap()), format!("{REFERENCE_HEADER}\n2e-2,-1e-6,0e0\n"));
         let e = EngineeringRow {
@@ -344,6 +420,8 @@ mod tests {
         assert!(acc.iter().any(|r| r.implementation == "scipy") && acc.iter().any(|r| r.implementation == "rust"));
         round_trip::<StabilityRow>("stability.csv", STABILITY_HEADER);
         round_trip::<ModelRow>("models.csv", MODELS_HEADER);
+        let fx: Vec<MachineRow> = round_trip("models_flexible.csv", MACHINE_HEADER);
+        assert_eq!(fx.len(), 4);
         round_trip::<EngineeringRow>("engineering.csv", ENGINEERING_HEADER);
     }
 }

@@ -69,6 +69,22 @@ impl Rotor {
         }
     }
 
+    /// The rotor bends between its bearings (the flexible rotor): its trace has the rotor at
+    /// mid-span (`mid_dx_m`, `mid_dy_m`); a rigid rotor's mid-span is the mean of its planes'.
+    pub fn bends(&self) -> bool {
+        matches!(self, Rotor::Flexible(_))
+    }
+
+    /// The rigid two-plane rotor of a flexible rotor's rigid body: the mass, centre of mass,
+    /// `I_t`, `I_p` and unbalance the flexible model computed from the shaft's elements, its
+    /// planes (bearings, AMBs, sensors) at the nodes' stations; `None` for the rigid rotors.
+    pub fn rigid_twin(&self) -> Option<Rotor> {
+        match self {
+            Rotor::Flexible(f) => Some(Rotor::TwoPlane(f.machine.clone())),
+            _ => None,
+        }
+    }
+
     /// Bearing planes: each with its AMB, sensor and touchdown bearing.
     pub fn planes(&self) -> usize {
         match self {

@@ -3,7 +3,8 @@
 //!
 //! Its trace is the two-plane rotor's layout: plane A's and B's rows are taken at each plane's
 //! touchdown-bearing node (where its race and contact are), and the "slopes" are those of the
-//! line through the two touchdown nodes (the rigid part of the motion there).
+//! line through the two touchdown nodes (the rigid part of the motion there); after them the
+//! rotor at mid-span ([`mid_span`], the trace's `mid_dx_m`, `mid_dy_m`).
 
 use super::two_plane::RaceFailure;
 use super::{FailureState, Linearised, Machine, PlaneState, WhirlMode};
@@ -44,6 +45,14 @@ fn slopes(m: &Model, y: &State) -> [f64; 4] {
     let ((pa, va), (pb, vb)) = (touchdown(m, y, 0), touchdown(m, y, 1));
     let l = zb - za;
     [(pb.x - pa.x) / l, (pb.y - pa.y) / l, (vb.x - va.x) / l, (vb.y - va.y) / l]
+}
+
+/// The shaft's node at mid-span: the nearest to the middle between the two touchdown nodes (the
+/// trace's `mid_dx_m`, `mid_dy_m`).
+pub fn mid_span(m: &Model) -> usize {
+    let z = &m.params.z;
+    let middle = 0.5 * (z[m.params.nodes[0].touchdown] + z[m.params.nodes[1].touchdown]);
+    (0..z.len()).min_by(|&a, &b| (z[a] - middle).abs().total_cmp(&(z[b] - middle).abs())).unwrap_or(0)
 }
 
 /// The race of plane `i` in `y`: position and velocity relative to the housing.
@@ -120,7 +129,11 @@ impl Machine<N> for Model {
             let race = [y[race], y[race + 1], y[race + ix::V], y[race + 1 + ix::V], y[race + 2 + ix::V]];
             trace::plane_values([pos.x, pos.y], [vel.x, vel.y], race, &ev.planes[i])
         };
-        trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y))
+        let mut r =
+            trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y));
+        let (mid, _) = self.node(y, mid_span(self));
+        r.mid = Some([mid.x, mid.y]);
+        r
     }
 
     /// The rigid two-plane rotor's contact state (its bearing planes, the AMB nodes, pressed into
