@@ -797,6 +797,7 @@ mod tests {
                 ],
             ),
             scene("paper-10g.toml", &[]),
+            scene("flexible-10g.toml", &["controller.mode=\"sampled\""]),
         ];
         for s in &cases {
             let mut hooks = Saving { at: vec![0.004, 0.0123], saved: Vec::new() };
