@@ -203,14 +203,7 @@ impl RunFolder {
         if let Some((planes, tilt)) = &charts {
             skipped.extend(write_charts(dir, scene, planes, tilt.as_ref()).context("writing charts")?);
             if let Some(mid) = &mid_chart {
-                // The bearings' clearance drawn for scale: there is no touchdown bearing at mid-span.
-                let (x, y) = mid.orbit();
-                let title = format!("{} — rotor orbit at mid-span relative to housing", scene.name);
-                let path = dir.join("orbit_mid.png");
-                match plot::orbit(&path, &title, &x, &y, scene.plane(0).contact.gap) {
-                    Err(plot::PlotError::NoData { .. }) => skipped.push("orbit_mid.png"),
-                    other => other.context("writing orbit_mid.png")?,
-                }
+                skipped.extend(write_mid_orbit(dir, scene, mid)?);
             }
             if let Some(tet) = &run.ticks.tet {
                 match write_tet_chart(&dir.join("tet.png"), scene, tet) {
@@ -605,6 +598,11 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
             planes.insert("tilt".into(), to_json(tilt)?);
         }
     }
+    if let Some(mid) = &recorded.mid_chart {
+        // A bending rotor's mid-span (the trace's last two columns): its largest radius.
+        let largest = mid.radius_um.points().1.into_iter().filter(|r| r.is_finite()).fold(f64::NAN, f64::max);
+        map.insert("mid_span".into(), serde_json::json!({ "max_radius_m": largest * 1e-6 }));
+    }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
     if stopped() {
         return Err(AnalyzeError::Interrupted("summary.json was updated, the charts were not drawn"));
@@ -612,10 +610,25 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     write_analysis_charts(dir, &scene, &recorded.planes)
         .context("writing analysis charts")
         .map_err(AnalyzeError::Output)?;
+    if let Some(mid) = &recorded.mid_chart {
+        write_mid_orbit(dir, &scene, mid).map_err(AnalyzeError::Output)?;
+    }
     if stopped() {
         return Err(AnalyzeError::Interrupted("summary.json and the charts were written"));
     }
     Ok(analysis)
+}
+
+/// `orbit_mid.png`, the rotor's orbit at mid-span (a bending rotor's run), or the file's name
+/// when there was nothing to draw. The bearings' clearance is drawn for scale: there is no
+/// touchdown bearing at mid-span.
+fn write_mid_orbit(dir: &Path, scene: &Scene, mid: &ChartData) -> anyhow::Result<Option<&'static str>> {
+    let (x, y) = mid.orbit();
+    let title = format!("{} — rotor orbit at mid-span relative to housing", scene.name);
+    match plot::orbit(&dir.join("orbit_mid.png"), &title, &x, &y, scene.plane(0).contact.gap) {
+        Err(plot::PlotError::NoData { .. }) => Ok(Some("orbit_mid.png")),
+        other => other.map(|()| None).context("writing orbit_mid.png"),
+    }
 }
 
 /// A value as JSON, for `summary.json`.

@@ -56,7 +56,8 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
 }
 
 /// The shipped scene, cut short: both planes touch, the trace has the two-plane rotor's 37
-/// columns and the mid-span's two after them, the summary names the model, `plant analyze` reads the trace back; a sampled run
+/// columns and the mid-span's two after them, the summary names the model, `plant analyze` reads the trace back
+/// (and gives the mid-span orbit's largest radius and chart); a sampled run
 /// and a lockstep co-simulation (4 axes on the wire) of the same law give the same trace (the
 /// continuous PD is the unit tests' `machine::flexible`).
 #[test]
@@ -85,6 +86,12 @@ fn flexible_scene_runs_in_every_mode_and_analyze_reads_it_back() {
             assert_exit(&analyze, 0);
             let after = read_json(&out.join("summary.json"));
             assert_eq!(after["planes"]["a"]["post_shock_mode"], before["planes"]["a"]["post_shock_mode"]);
+            // The mid-span orbit: its largest radius from the trace's last two columns, and its chart.
+            let mid = |row: &Vec<f64>| row[37].hypot(row[38]);
+            let largest = trace.rows.iter().map(mid).fold(0.0, f64::max);
+            let got = after["mid_span"]["max_radius_m"].as_f64().expect("mid_span.max_radius_m");
+            assert!((got - largest).abs() <= 1e-9 * largest, "analyze {got}, trace {largest}");
+            assert!(out.join("orbit_mid.png").is_file(), "analyze draws the mid-span orbit");
         }
         traces.push(trace);
     }
