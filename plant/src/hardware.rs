@@ -417,11 +417,12 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         m.plane_states(t, &iy, visit);
     }
 
-    /// The model's tolerances with the hardware's after them ([`atol`]).
+    /// The model's used components and all of the hardware's.
     fn used_components(&self) -> usize {
         self.inner.used_components() + (NA - N)
     }
 
+    /// The model's tolerances with the hardware's after them ([`atol`]).
     fn atol(groups: [f64; 4]) -> [f64; NA] {
         let [p, v, ..] = groups;
         let mut a = [0.0; NA];

@@ -183,15 +183,15 @@ impl Machine<N> for Model {
         }
     }
 
-    /// The modal coordinates count as positions and their rates as velocities (the basis is
-    /// mass-normalised, so a coordinate's error moves a node by about that error / √M: for a
-    /// rotor heavier than 1 kg the tolerance at the nodes is tighter than the groups say).
     /// The reduced coordinates of the basis, the spin and both races, with their rates: the
     /// slots past the basis stay zero and are not counted.
     fn used_components(&self) -> usize {
         N - 2 * (MAX_MODES - self.params.reduced.size())
     }
 
+    /// The modal coordinates count as positions and their rates as velocities (the basis is
+    /// mass-normalised, so a coordinate's error moves a node by about that error / √M: for a
+    /// rotor heavier than 1 kg the tolerance at the nodes is tighter than the groups say).
     fn atol(groups: [f64; 4]) -> [f64; N] {
         let [p, v, a, w] = groups;
         let mut t = [p; N];
