@@ -599,9 +599,12 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
         }
     }
     if let Some(mid) = &recorded.mid_chart {
-        // A bending rotor's mid-span (the trace's last two columns): its largest radius.
+        // A bending rotor's mid-span (the trace's last two columns): its largest radius. A
+        // flexible trace written before those columns existed has none, and gets no entry.
         let largest = mid.radius_um.points().1.into_iter().filter(|r| r.is_finite()).fold(f64::NAN, f64::max);
-        map.insert("mid_span".into(), serde_json::json!({ "max_radius_m": largest * 1e-6 }));
+        if largest.is_finite() {
+            map.insert("mid_span".into(), serde_json::json!({ "max_radius_m": largest * 1e-6 }));
+        }
     }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
     if stopped() {
