@@ -1,8 +1,9 @@
-//! A sink on a thread of its own, for realtime runs: the loop hands each output sample
-//! over a bounded channel and goes on; the thread formats it, writes it out and feeds the
-//! recorder (`trace.csv` and the charts' data of `plant run`, the soak's monitor and files).
+//! A sink on a thread of its own, for realtime runs and for `plant run` on a host with a
+//! spare core ([`When`]): the loop hands each output sample over a bounded channel and goes
+//! on; the thread formats it, writes it out and feeds the recorder (`trace.csv` and the
+//! charts' data of `plant run`, the soak's monitor and files).
 //!
-//! Inside the tick these took more than a 20 kHz period: writing a 64 KiB chunk of
+//! Inside a realtime tick these took more than a 20 kHz period: writing a 64 KiB chunk of
 //! `trace.csv` took 50–200 µs every 170 rows, the recorder up to 100 µs every 256 rows,
 //! and formatting a row 2–3 µs of a tick whose integration takes 2 µs. What stays in the
 //! tick is a copy into the channel.
@@ -38,8 +39,21 @@ impl Sink for Handoff {
     }
 }
 
-/// [`run_into`]; a realtime run hands its samples to `sink` on a thread of its own
-/// ([`crate::offload`]), so that writing and analysing them stays out of its ticks.
+/// Which runs hand their samples to a thread of their own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum When {
+    /// Realtime runs only: their ticks must not format or write rows.
+    Realtime,
+    /// Realtime runs, and the others where the host has a second core for the thread: there
+    /// formatting and writing the rows overlaps the integration instead of following it (the
+    /// rows of `trace.csv` take about 12 % of the instructions of a flexible or two-plane run in
+    /// process, `callgrind`; docs/results/speed.md). The rows are the same, in the same order.
+    SpareCore,
+}
+
+/// [`run_into`]; a realtime run (and, with [`When::SpareCore`], any run on a host with more
+/// than one core) hands its samples to `sink` on a thread of its own ([`crate::offload`]), so
+/// that writing and analysing them stays out of its ticks.
 ///
 /// The run starts from `from` if given ([`run_into_from`]).
 pub fn run_into_offloaded<S: Sink + Send>(
@@ -48,8 +62,10 @@ pub fn run_into_offloaded<S: Sink + Send>(
     hooks: &mut dyn Hooks,
     sink: &mut S,
     from: Option<&Snapshot>,
+    when: When,
 ) -> Result<SinkRun, SetupError> {
-    if scene.controller.mode == ControlMode::Realtime {
+    let spare_core = || std::thread::available_parallelism().is_ok_and(|n| n.get() > 1);
+    if scene.controller.mode == ControlMode::Realtime || (when == When::SpareCore && spare_core()) {
         offload(sink, scene.controller.cosim.pinned_cores(), |s| run_into_from(scene, launch, hooks, s, from))
             .map_err(SetupError::Thread)?
     } else {

@@ -14,7 +14,7 @@ use crate::bounded::MinMaxBins;
 use crate::config::{ConfigError, Scene};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
-use crate::offload::run_into_offloaded;
+use crate::offload::{run_into_offloaded, When};
 use crate::plot::{self, Scale, Series};
 use crate::record::{ChartData, PlaneRecorded, Recorder};
 use crate::run::{Outcome, RunResult, SetupError, Sink, SinkRun};
@@ -279,7 +279,7 @@ pub fn run_to_dir_from(
     prepare(dir, scene).map_err(RunDirError::Output)?;
     let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
     let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
-    let run = run_into_offloaded(scene, &launch, hooks, &mut folder, from)?;
+    let run = run_into_offloaded(scene, &launch, hooks, &mut folder, from, When::SpareCore)?;
     // What an external controller ran differently from the scene goes into the record, so that
     // the folder reproduces the run.
     let recorded = match run.cosim.as_ref().and_then(|c| c.controller_overrides.as_ref()) {

@@ -8,7 +8,7 @@ use super::sink::{Checkpoints, RssSample, SoakSink};
 use super::{monitor, rss, ENVELOPE_BIN_S, ENVELOPE_CSV_HEADER, RSS_CSV_HEADER, SOAK_CSV_HEADER};
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
-use crate::offload::run_into_offloaded;
+use crate::offload::{run_into_offloaded, When};
 use crate::row_file::RowFile;
 use crate::run::SetupError;
 use crate::snapshot::Snapshot;
@@ -287,7 +287,14 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         snapshots,
     };
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
-    let mut result = match run_into_offloaded(scene, &launch, &mut hooks, &mut sink, saved.as_ref().map(|c| &c.plant)) {
+    let mut result = match run_into_offloaded(
+        scene,
+        &launch,
+        &mut hooks,
+        &mut sink,
+        saved.as_ref().map(|c| &c.plant),
+        When::Realtime,
+    ) {
         Ok(r) => r,
         Err(e) => {
             // The programme loaded: the folder records why the soak did not start.

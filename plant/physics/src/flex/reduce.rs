@@ -91,6 +91,11 @@ pub struct Reduced {
     /// 4 DOF) and bounds-checked element by element; the node readers walk such rows several
     /// times per evaluation, up to 271 evaluations per controller tick in contact.
     basis_rows: Vec<f64>,
+    /// `D + ω Gᵣ` at one spin speed ω (rad/s), column-major like `damping`: the rates' matrix
+    /// of a rotor whose spin is held there, formed once instead of in every evaluation
+    /// ([`Reduced::hold_speed`]). Each entry is `d + ω g` as the evaluation forms it, so the
+    /// derivative is the same to the bit with or without it.
+    held: Option<(f64, Vec<f64>)>,
 }
 
 /// The lowest modes of `K φ = ω² M φ`: `(ω², Φ)` ascending, Φ mass-normalised.
@@ -116,8 +121,8 @@ pub fn undamped_frequencies_hz(rotor: &Rotor) -> Result<Vec<f64>, FlexError> {
 }
 
 /// Rows `k .. k + L` of each column of `m` (column-major, `r` rows), as arrays.
-fn columns<const L: usize>(m: &DMatrix<f64>, r: usize, k: usize) -> impl Iterator<Item = &[f64; L]> {
-    m.as_slice().chunks_exact(r).map(move |c| <&[f64; L]>::try_from(&c[k..k + L]).expect("k + L <= r"))
+fn columns<const L: usize>(m: &[f64], r: usize, k: usize) -> impl Iterator<Item = &[f64; L]> {
+    m.chunks_exact(r).map(move |c| <&[f64; L]>::try_from(&c[k..k + L]).expect("k + L <= r"))
 }
 
 /// Rows of the derivative computed side by side ([`Reduced::rate_rows`]).
@@ -241,7 +246,17 @@ impl Reduced {
             frame,
             input,
             nodes,
+            held: None,
         })
+    }
+
+    /// Forms the rates' matrix `D + speed Gᵣ` once, for a rotor whose spin stays at `speed`
+    /// (rad/s): an evaluation at exactly that speed uses it, any other forms its terms as before.
+    pub fn hold_speed(mut self, speed: f64) -> Self {
+        let matrix =
+            self.damping.as_slice().iter().zip(self.gyroscopic.as_slice()).map(|(d, g)| d + speed * g).collect();
+        self.held = Some((speed, matrix));
+        self
     }
 
     /// Number of basis vectors r (the state has 2r entries).
@@ -307,8 +322,8 @@ impl Reduced {
     /// is the same to the bit; only the rows are interleaved.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn rate_rows<const L: usize>(
-        &self,
+    fn rate_rows<'a, const L: usize>(
+        &'a self,
         k: usize,
         eta: &[f64],
         rate: &[f64],
@@ -329,13 +344,24 @@ impl Reduced {
             acc[j] = -w2[j] * eta[j] - fx[j] * frame_accel[0] - fy[j] * frame_accel[1];
         }
         assert!(k + L <= r, "rows {k}..{} of {r}", k + L);
-        let columns = |m| columns::<L>(m, r, k);
-        for ((d, g), v) in columns(&self.damping).zip(columns(&self.gyroscopic)).zip(rate) {
-            for j in 0..L {
-                acc[j] -= (d[j] + speed * g[j]) * v;
+        let of = |m: &'a DMatrix<f64>| columns::<L>(m.as_slice(), r, k);
+        match &self.held {
+            Some((held, c)) if held.to_bits() == speed.to_bits() => {
+                for (c, v) in columns::<L>(c, r, k).zip(rate) {
+                    for j in 0..L {
+                        acc[j] -= c[j] * v;
+                    }
+                }
+            }
+            _ => {
+                for ((d, g), v) in of(&self.damping).zip(of(&self.gyroscopic)).zip(rate) {
+                    for j in 0..L {
+                        acc[j] -= (d[j] + speed * g[j]) * v;
+                    }
+                }
             }
         }
-        let mut input = columns(&self.input);
+        let mut input = of(&self.input);
         for f in forces {
             let (Some(bx), Some(by)) = (input.next(), input.next()) else {
                 unreachable!("two input columns per force node")
@@ -500,5 +526,27 @@ mod tests {
         let [a, b] = reduced.rotation(&state, 5);
         assert_eq!([x, y, a, b], [q[20], q[21], q[22], q[23]]);
         assert_eq!([vx, vy], [v[20], v[21]]);
+    }
+
+    /// The rates' matrix formed once at a held speed gives the derivative the terms formed at
+    /// each evaluation give, to the bit, at that speed; at any other speed the held matrix is
+    /// not used (the derivative is the unheld one's, and differs from the held speed's).
+    #[test]
+    fn a_held_speed_gives_the_same_derivative_to_the_bit() {
+        let rotor = free_rotor();
+        let plain = Reduced::new(&rotor, &spec(0.02)).unwrap();
+        let speed = 2.0 * std::f64::consts::PI * 300.0;
+        let held = plain.clone().hold_speed(speed);
+        let r = plain.size();
+        let state: Vec<f64> = (0..2 * r).map(|k| (k as f64 * 0.61).cos() * 1e-5).collect();
+        let forces = [[12.0, -3.0], [-7.5, 40.0]];
+        let run = |red: &Reduced, w: f64| {
+            let mut d = vec![0.0; 2 * r];
+            red.derivative(&state, w, &forces, [0.3, 9.81], &mut d);
+            d.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        };
+        assert_eq!(run(&held, speed), run(&plain, speed));
+        assert_eq!(run(&held, 0.5 * speed), run(&plain, 0.5 * speed));
+        assert_ne!(run(&held, 0.5 * speed), run(&held, speed), "the speed changes the rates' terms");
     }
 }

@@ -163,6 +163,9 @@ pub(in crate::config) fn flexible_params(
     let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
     let machine = super::two_plane_keys::two_plane_params(&as_rigid, &share)?;
     let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
+    // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
+    // forms its terms at each evaluation, as before; the result is the same to the bit).
+    let reduced = reduced.hold_speed(machine.rotor.speed);
     Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z })
 }
 
