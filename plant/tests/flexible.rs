@@ -422,3 +422,69 @@ mod against_rigid {
         assert!(stiff[1].err_rms < 0.1 * steel, "steel {steel}, stiff {}", stiff[1].err_rms);
     }
 }
+
+/// Where the shipped machine's first bending mode lies against its loop (issue 30 item 4):
+/// each axis' loop gain `L = 1 − 1/S` (the loop broken at that axis, the other three closed;
+/// `S` the coupled closed form's diagonal, `plant_physics::flex::linear`), continuous PD.
+mod bandwidth {
+    use plant::config::load_scene;
+    use plant_physics::flex::linear::PlanePd;
+    use std::f64::consts::TAU;
+    use std::path::Path;
+
+    /// `|L|` of axes x_A and x_B at `f` (Hz), rotor speed `speed_hz`.
+    fn loop_gains(scene: &plant::config::Scene, speed_hz: f64, f: &[f64]) -> Vec<[f64; 2]> {
+        let open = scene.rotor.open_loop().expect("a flexible scene's open loop");
+        let gains = plant::run::plane_gains(scene).expect("gains");
+        let designs = scene.plane_designs();
+        let pd = [0, 1].map(|i| PlanePd {
+            kp: gains[i].kp,
+            kd: gains[i].kd,
+            amp_gain: gains[i].amp_gain_a_per_v,
+            sensor_gain: designs[i].constants.sensor_gain_v_per_m,
+        });
+        let response = open.continuous(speed_hz * TAU);
+        f.iter()
+            .map(|&f| {
+                let s = response.sensitivity_continuous(&pd, f);
+                [0, 2].map(|k| (-s[(k, k)].inv() + 1.0).norm())
+            })
+            .collect()
+    }
+
+    /// The loop's gain crosses 0 dB among the rigid-body modes (46 to 71 Hz) and not above
+    /// 100 Hz but at the bending mode; at bearing A the gain at the bending mode's resonance
+    /// (near 500 Hz, 0.05 Hz grid) reaches 0 dB at rest: the loop acts on the mode there. At B,
+    /// whose AMB sits next to a node of the mode (it changes sign between 380 and 410 mm, the AMB
+    /// at 410 mm), the gain there is a tenth of A's or less.
+    #[test]
+    fn the_first_bending_mode_against_the_loop_gain() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+        let scene = load_scene(&path, &[]).expect("the shipped flexible scene");
+        let coarse: Vec<f64> = (0..300).map(|i| 20.0 * 1.02f64.powi(i)).filter(|f| *f < 400.0).collect();
+        let fine: Vec<f64> = (0..2400).map(|i| 440.0 + 0.05 * f64::from(i)).collect();
+        let mut peaks = Vec::new();
+        for speed in [0.0, 300.0] {
+            let l = loop_gains(&scene, speed, &coarse);
+            for ax in 0..2 {
+                let last_down = (1..coarse.len()).filter(|&i| l[i - 1][ax] >= 1.0 && l[i][ax] < 1.0).last();
+                let f = coarse[last_down.expect("the loop gain falls through 0 dB")];
+                assert!((40.0..80.0).contains(&f), "speed {speed} Hz, axis {ax}: last crossover at {f} Hz");
+                eprintln!("speed {speed} Hz, axis {ax}: |L| falls through 0 dB last at {f:.1} Hz");
+                let above = (0..coarse.len()).filter(|&i| coarse[i] > 100.0).map(|i| l[i][ax]).fold(0.0, f64::max);
+                assert!(above < 0.5, "speed {speed} Hz, axis {ax}: |L| {above} between 100 and 400 Hz");
+            }
+            let l = loop_gains(&scene, speed, &fine);
+            let peak = |ax: usize| {
+                let i = (0..fine.len()).max_by(|&a, &b| l[a][ax].total_cmp(&l[b][ax])).expect("points");
+                (fine[i], l[i][ax])
+            };
+            let (a, b) = (peak(0), peak(1));
+            eprintln!("speed {speed} Hz: |L| at the bending mode: x_A {:.3} at {:.2} Hz, x_B {:.3} at {:.2} Hz", a.1, a.0, b.1, b.0);
+            assert!((470.0..530.0).contains(&a.0), "x_A's peak at {} Hz", a.0);
+            assert!(b.1 < 0.1 * a.1, "x_B {b:?} against x_A {a:?}");
+            peaks.push(a.1);
+        }
+        assert!(peaks[0] >= 1.0, "at rest the loop gain at the bending mode reaches 0 dB at A: {}", peaks[0]);
+    }
+}
