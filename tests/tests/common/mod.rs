@@ -119,7 +119,7 @@ fn workspace_build(
 
 /// A file of the workspace library `target` (its target name, `plant_fmu`) with extension
 /// `ext` (`so`, `a`), built by the one `cargo build` ([`workspace_bins`]).
-#[allow(dead_code)] // used by c_api.rs and fmu_plant.rs only
+#[allow(dead_code)] // used by c_api.rs, fmu_plant.rs and flexible.rs only
 pub fn workspace_lib(target: &str, ext: &str) -> PathBuf {
     let files = workspace_build().1.get(target).unwrap_or_else(|| panic!("cargo built no library {target}"));
     files
