@@ -598,13 +598,10 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
             planes.insert("tilt".into(), to_json(tilt)?);
         }
     }
-    if let Some(mid) = &recorded.mid_chart {
-        // A bending rotor's mid-span (the trace's last two columns): its largest radius. A
-        // flexible trace written before those columns existed has none, and gets no entry.
-        let largest = mid.radius_um.points().1.into_iter().filter(|r| r.is_finite()).fold(f64::NAN, f64::max);
-        if largest.is_finite() {
-            map.insert("mid_span".into(), serde_json::json!({ "max_radius_m": largest * 1e-6 }));
-        }
+    if let Some(mid) = &recorded.mid_span {
+        // A bending rotor's mid-span (the trace's last two columns). A flexible trace written
+        // before those columns existed has none, and gets no entry.
+        map.insert("mid_span".into(), to_json(mid)?);
     }
     write_json(&summary_path, &summary).map_err(AnalyzeError::Output)?;
     if stopped() {

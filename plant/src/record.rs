@@ -9,6 +9,7 @@
 //! keeps at most four per column); the orbit as every k-th row, at most
 //! [`ORBIT_POINTS`].
 
+use crate::analysis::mid_span::{MidSpan, MidSpanAnalyzer};
 use crate::analysis::tilt::{TiltAnalysis, TiltAnalyzer};
 use crate::analysis::{Analysis, AnalysisData, Analyzer};
 use crate::bounded::{MinMaxBins, Strided};
@@ -102,6 +103,8 @@ pub struct Recorder {
     /// The rotor at mid-span (a bending rotor's run with charts), for `orbit_mid.png`: its orbit
     /// only, the row's `dx_m`, `dy_m` replaced by `mid_dx_m`, `mid_dy_m`.
     mid: Option<ChartData>,
+    /// The rotor at mid-span's figures (a bending rotor's run).
+    mid_span: Option<MidSpanAnalyzer>,
 }
 
 /// What a [`Recorder`] made of one bearing plane.
@@ -128,6 +131,9 @@ pub struct Recorded {
     pub tilt_chart: Option<MinMaxBins>,
     /// The rotor at mid-span, for `orbit_mid.png` (flexible runs with charts; its orbit only).
     pub mid_chart: Option<ChartData>,
+    /// A bending rotor's figures at mid-span (`None` for the rigid rotors, and for a trace
+    /// written before the mid-span's columns).
+    pub mid_span: Option<MidSpan>,
 }
 
 impl Recorded {
@@ -158,7 +164,8 @@ impl Recorder {
             (TiltAnalyzer::new(analysis_spec(scene)), bins)
         });
         let mid = (charts && scene.rotor.bends()).then(|| ChartData::new(scene.duration));
-        Self { planes, tilt, mid }
+        let mid_span = scene.rotor.mid_span_weight().map(MidSpanAnalyzer::new);
+        Self { planes, tilt, mid, mid_span }
     }
 
     /// The next sample.
@@ -176,6 +183,9 @@ impl Recorder {
             if let (Some(bins), Some([a, b])) = (bins, r.slopes()) {
                 bins.push(r.a[col::T_S] * 1e3, a.hypot(b) * 1e6);
             }
+        }
+        if let Some(m) = &mut self.mid_span {
+            m.push(r);
         }
         if let (Some(c), Some(m)) = (&mut self.mid, r.mid) {
             let mut row = r.a;
@@ -199,6 +209,7 @@ impl Recorder {
             Some((t, bins)) => (Some(t.finish()), bins),
             None => (None, None),
         };
-        Recorded { planes, tilt, tilt_chart, mid_chart: self.mid }
+        let mid_span = self.mid_span.and_then(|m| m.finish(failure_time));
+        Recorded { planes, tilt, tilt_chart, mid_chart: self.mid, mid_span }
     }
 }

@@ -177,6 +177,10 @@ pub struct Summary {
     /// the governing plane, `planes.governing`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub planes: Option<PlanesSummary>,
+    /// A bending rotor's run: the rotor at mid-span, its largest radius and the shaft's largest
+    /// bow there ([`crate::analysis::mid_span`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mid_span: Option<crate::analysis::mid_span::MidSpan>,
 }
 
 /// One bearing plane's figures in a two-plane run's `summary.json` (the planar summary's, for
@@ -268,6 +272,7 @@ impl Summary {
             }),
             _ => None,
         };
+        let mid_span = recorded.mid_span;
         let lead = recorded.planes.into_iter().nth(governing).expect("a recorded run has a plane");
         let (figures, analysis) = (lead.figures, lead.analysis);
         let c = &scene.controller;
@@ -319,6 +324,7 @@ impl Summary {
             analysis,
             cosim: run.cosim.clone(),
             planes,
+            mid_span,
         }
     }
 }

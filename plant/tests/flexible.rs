@@ -467,11 +467,12 @@ mod bandwidth {
         for speed in [0.0, 300.0] {
             let l = loop_gains(&scene, speed, &coarse);
             for ax in 0..2 {
-                let last_down = (1..coarse.len()).filter(|&i| l[i - 1][ax] >= 1.0 && l[i][ax] < 1.0).last();
+                let gain: Vec<f64> = l.iter().map(|g| g[ax]).collect();
+                let last_down = (1..coarse.len()).rev().find(|&i| gain[i - 1] >= 1.0 && gain[i] < 1.0);
                 let f = coarse[last_down.expect("the loop gain falls through 0 dB")];
                 assert!((40.0..80.0).contains(&f), "speed {speed} Hz, axis {ax}: last crossover at {f} Hz");
                 eprintln!("speed {speed} Hz, axis {ax}: |L| falls through 0 dB last at {f:.1} Hz");
-                let above = (0..coarse.len()).filter(|&i| coarse[i] > 100.0).map(|i| l[i][ax]).fold(0.0, f64::max);
+                let above = coarse.iter().zip(&gain).filter(|(f, _)| **f > 100.0).map(|(_, g)| *g).fold(0.0, f64::max);
                 assert!(above < 0.5, "speed {speed} Hz, axis {ax}: |L| {above} between 100 and 400 Hz");
             }
             let l = loop_gains(&scene, speed, &fine);
@@ -480,7 +481,10 @@ mod bandwidth {
                 (fine[i], l[i][ax])
             };
             let (a, b) = (peak(0), peak(1));
-            eprintln!("speed {speed} Hz: |L| at the bending mode: x_A {:.3} at {:.2} Hz, x_B {:.3} at {:.2} Hz", a.1, a.0, b.1, b.0);
+            eprintln!(
+                "speed {speed} Hz: |L| at the bending mode: x_A {:.3} at {:.2} Hz, x_B {:.3} at {:.2} Hz",
+                a.1, a.0, b.1, b.0
+            );
             assert!((470.0..530.0).contains(&a.0), "x_A's peak at {} Hz", a.0);
             assert!(b.1 < 0.1 * a.1, "x_B {b:?} against x_A {a:?}");
             peaks.push(a.1);

@@ -152,6 +152,16 @@ fn flexible_scene_runs_in_every_mode_and_analyze_reads_it_back() {
             let largest = trace.rows.iter().map(mid).fold(0.0, f64::max);
             let got = after["mid_span"]["max_radius_m"].as_f64().expect("mid_span.max_radius_m");
             assert!((got - largest).abs() <= 1e-9 * largest, "analyze {got}, trace {largest}");
+            // The shaft's bow there: off the line through the rotor at the touchdown bearings
+            // (nodes 2 and 14, 50 and 410 mm; mid-span node 8 at 230 mm, halfway: w = 0.5).
+            let col = |name: &str| trace.header.iter().position(|h| h == name).expect(name);
+            let (ax, ay, bx, by) = (col("dx_m"), col("dy_m"), col("b_dx_m"), col("b_dy_m"));
+            let bow = |r: &Vec<f64>| (r[37] - 0.5 * (r[ax] + r[bx])).hypot(r[38] - 0.5 * (r[ay] + r[by]));
+            let bowed = trace.rows.iter().map(bow).fold(0.0, f64::max);
+            let got = after["mid_span"]["max_bow_m"].as_f64().expect("mid_span.max_bow_m");
+            assert!(bowed > 1e-6 && (got - bowed).abs() <= 1e-9 * bowed, "analyze {got}, trace {bowed}");
+            // The run wrote the same figures into its summary.
+            assert_eq!(before["mid_span"], after["mid_span"], "plant run's mid_span against analyze's");
             assert!(out.join("orbit_mid.png").is_file(), "analyze draws the mid-span orbit");
         }
         traces.push(trace);

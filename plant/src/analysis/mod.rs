@@ -12,6 +12,7 @@
 //! a bounded spectrogram ([`spectrum::StftBuilder`]).
 
 pub mod classify;
+pub mod mid_span;
 pub mod poincare;
 pub mod spectrum;
 pub mod tilt;

@@ -75,6 +75,16 @@ impl Rotor {
         matches!(self, Rotor::Flexible(_))
     }
 
+    /// A bending rotor's mid-span node's place between its touchdown nodes, 0 at A's and 1 at
+    /// B's (its trace's `mid_dx_m`, `mid_dy_m`); `None` for the rigid rotors, which have no
+    /// mid-span columns.
+    pub fn mid_span_weight(&self) -> Option<f64> {
+        match self {
+            Rotor::Flexible(p) => Some(crate::machine::mid_span_weight(p)),
+            _ => None,
+        }
+    }
+
     /// The rigid two-plane rotor of a flexible rotor's rigid body: the mass, centre of mass,
     /// `I_t`, `I_p` and unbalance the flexible model computed from the shaft's elements, its
     /// planes (bearings, AMBs, sensors) at the nodes' stations; `None` for the rigid rotors.

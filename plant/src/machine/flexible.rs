@@ -50,9 +50,26 @@ fn slopes(m: &Model, y: &State) -> [f64; 4] {
 /// The shaft's node at mid-span: the nearest to the middle between the two touchdown nodes (the
 /// trace's `mid_dx_m`, `mid_dy_m`).
 pub fn mid_span(m: &Model) -> usize {
-    let z = &m.params.z;
-    let middle = 0.5 * (z[m.params.nodes[0].touchdown] + z[m.params.nodes[1].touchdown]);
+    mid_span_node(&m.params)
+}
+
+/// [`mid_span`] of the machine `p`.
+pub fn mid_span_node(p: &FlexParams) -> usize {
+    let z = &p.z;
+    let middle = 0.5 * (z[p.nodes[0].touchdown] + z[p.nodes[1].touchdown]);
     (0..z.len()).min_by(|&a, &b| (z[a] - middle).abs().total_cmp(&(z[b] - middle).abs())).unwrap_or(0)
+}
+
+/// Where the mid-span node lies between the touchdown nodes: 0 at A's, 1 at B's (the weight of
+/// the line through the rotor at the two touchdown bearings, [`crate::analysis::mid_span`]).
+pub fn mid_span_weight(p: &FlexParams) -> f64 {
+    let z = |n: usize| p.z[n];
+    let (a, b) = (z(p.nodes[0].touchdown), z(p.nodes[1].touchdown));
+    if b == a {
+        0.5
+    } else {
+        (z(mid_span_node(p)) - a) / (b - a)
+    }
 }
 
 /// The race of plane `i` in `y`: position and velocity relative to the housing.

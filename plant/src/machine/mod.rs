@@ -13,7 +13,7 @@ mod flexible;
 mod planar;
 mod two_plane;
 
-pub use flexible::{mid_span, FlexibleFailure, FlexibleLinear};
+pub use flexible::{mid_span, mid_span_weight, FlexibleFailure, FlexibleLinear};
 pub use planar::PlanarFailure;
 pub use two_plane::{RaceFailure, TwoPlaneFailure};
 

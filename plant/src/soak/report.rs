@@ -150,7 +150,7 @@ impl Report {
             })
         };
         format!(
-            "{} {:.1} of {:.1} s simulated in {:.1} s; recovered {}/{} shocks (recovery s: min {}, median {}, max {}); \
+            "{} {:.3} of {:.3} s simulated in {:.1} s; recovered {}/{} shocks (recovery s: min {}, median {}, max {}); \
              max contact force {:.0} N; sequence gaps {}, deadline misses {} ({:.2e}); RSS plant {}, controller {}",
             self.status,
             self.simulated_s,
