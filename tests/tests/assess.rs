@@ -435,8 +435,12 @@ fn a_blocked_lockstep_wait_is_ended_by_the_peer_and_lists_no_node() {
     let c = &s["cosim"];
     let ticks = num(c, "messages_sent");
     assert_eq!(ticks, 200.0, "{c:#}");
-    assert_eq!(num(c, "blocking_waits"), ticks, "every wait blocks for a reply 2 ms late: {c:#}");
-    assert!(num(c, "unwoken_waits") <= 0.05 * ticks, "waits that progressed only by a timed slice: {c:#}");
+    // Each wait blocks for a reply 2 ms late, unless the plant itself was kept off its core for
+    // those 2 ms between sending and waiting (a loaded machine: 196 of 200 were seen at a load
+    // of 8 to 10); a wait that does not block has nothing to be woken from.
+    let blocking = num(c, "blocking_waits");
+    assert!(blocking >= 0.9 * ticks && blocking <= ticks, "the waits block for a reply 2 ms late: {c:#}");
+    assert!(num(c, "unwoken_waits") <= 0.05 * blocking, "waits that progressed only by a timed slice: {c:#}");
     assert_eq!(num(c, "node_lookups"), 0.0, "{c:#}");
 }
 
