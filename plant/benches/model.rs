@@ -48,7 +48,10 @@ fn flexible_derivative(c: &mut Criterion) {
             other => panic!("a flexible scene, not {:?}", other.model()),
         };
         let gains = plant::run::plane_gains(&scene).expect("gains");
-        let y = Model::from_rigid(&params, &two_plane_contact_state());
+        let mut y = Model::from_rigid(&params, &two_plane_contact_state());
+        // Spinning at the scene's held speed, as its runs do (the contact state is the planar
+        // scene's, at its own speed).
+        y[plant_physics::flex::machine::ix::WR] = params.machine.rotor.speed;
         let r = params.reduced.size();
         let model = Model {
             params,
