@@ -287,6 +287,9 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         snapshots,
     };
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
+    // Offloaded in realtime only, as before `plant run` offloaded on a spare core: the soak's
+    // checkpoints pass from the loop's hooks to its sink, an order not examined with the sink on
+    // a thread of its own outside realtime (where no checkpoint is taken).
     let mut result = match run_into_offloaded(
         scene,
         &launch,
