@@ -163,30 +163,6 @@ fn unknown_law_in_compare_is_bad_input() {
     assert!(!dir.join("out").exists(), "a refused compare leaves no folder behind");
 }
 
-/// A CSV file of text fields with a header row.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn read(path: &std::path::Path) -> Self {
-        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-        let mut lines = text.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
-        let header = lines.next().unwrap_or_else(|| panic!("{} is empty", path.display()));
-        Self { header, rows: lines.collect() }
-    }
-
-    fn text(&self, row: usize, name: &str) -> &str {
-        let i = self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
-        &self.rows[row][i]
-    }
-
-    fn num(&self, row: usize, name: &str) -> f64 {
-        self.text(row, name).parse().unwrap_or_else(|e| panic!("{name}: {e}"))
-    }
-}
-
 /// Issue 22: `plant compare --realtime` runs the scene in realtime and once in lockstep on the
 /// same (realtime) integrator setting, and writes one row each. The lockstep row is its own
 /// reference; a realtime run without a deadline miss is the lockstep run bit for bit (the

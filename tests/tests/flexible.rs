@@ -13,9 +13,8 @@ mod common;
 
 use common::{
     assert_exit, controller_bin, num, output_within, plant_bin, plant_run, plant_sweep, read_json, read_text, refused,
-    scene, stderr, Csv, TempDir,
+    scene, stderr, Csv, Table, TempDir,
 };
-use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
@@ -52,30 +51,6 @@ fn with_sets<'a>(cmd: &'a mut Command, sets: &[&str]) -> &'a mut Command {
         cmd.args(["--set", s]);
     }
     cmd
-}
-
-/// A CSV of words and numbers, as text: header and rows of fields.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Self {
-        let text = read_text(path);
-        let mut lines = text.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
-        let header = lines.next().unwrap_or_else(|| panic!("{} is empty", path.display()));
-        Self { header, rows: lines.collect() }
-    }
-
-    fn text(&self, row: usize, name: &str) -> &str {
-        let i = self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
-        &self.rows[row][i]
-    }
-
-    fn num(&self, row: usize, name: &str) -> f64 {
-        self.text(row, name).parse().unwrap_or_else(|e| panic!("{name} of row {row}: {e}"))
-    }
 }
 
 #[test]

@@ -588,3 +588,33 @@ pub fn refused(name: &str, scene_file: &Path, set: &[&str], needles: &[&str]) {
     }
     assert!(!out.exists(), "{set:?}: bad input created {}", out.display());
 }
+
+/// A CSV file of text fields with a header row (`compare.rs`, `flexible.rs`): fields read by
+/// column name, as text or as numbers.
+pub struct Table {
+    /// The header's column names.
+    pub header: Vec<String>,
+    /// Each row's fields.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// Reads `path`; panics naming it if it cannot be read or is empty.
+    pub fn read(path: &Path) -> Self {
+        let text = read_text(path);
+        let mut lines = text.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
+        let header = lines.next().unwrap_or_else(|| panic!("{} is empty", path.display()));
+        Self { header, rows: lines.collect() }
+    }
+
+    /// Row `row`'s field in column `name`.
+    pub fn text(&self, row: usize, name: &str) -> &str {
+        let i = self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+        &self.rows[row][i]
+    }
+
+    /// The same, as a number.
+    pub fn num(&self, row: usize, name: &str) -> f64 {
+        self.text(row, name).parse().unwrap_or_else(|e| panic!("{name} of row {row}: {e}"))
+    }
+}
