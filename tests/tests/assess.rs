@@ -77,7 +77,21 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
         assert!(num(&d["peak_ball_pressure_mpa"], "max") > 0.0);
         assert!(num(&d["friction_energy_j"], "max") > 0.0);
     }
+    // Two members per rung cannot lift a rung's lower bound to 0.9 (35 are needed): said on the
+    // terminal (with --quiet too), in report.json and on the page; the verdict gives the interval.
+    let warning = "ladder.members = 2 cannot reach ladder.min_p = 0.9";
+    assert!(
+        stderr(&o).contains(&format!("warning: {warning}")) && stderr(&o).contains("at least 35 members"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(r["warnings"][0].as_str().expect("warnings").contains(warning), "{}", r["warnings"]);
+    for k in c {
+        let verdict = k["verdict"].as_str().expect("verdict");
+        assert!(verdict.contains("at no rung (at 3 G: ") && verdict.contains("/2 recovered, ["), "{verdict}");
+    }
     let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(html.contains("<b>Warning:</b> ladder.members = 2 cannot reach"), "the page warns");
     assert!(html.contains("data:image/png;base64,") && html.contains("damped") && html.contains("study pd"));
     assert!(!html.contains("http://") && !html.contains("https://") && !html.contains("<script"), "self-contained");
     for png in ["sensitivity_1.png", "ladder_probability.png", "duty_friction.png"] {

@@ -77,6 +77,57 @@ impl Default for Settings {
     }
 }
 
+impl Settings {
+    /// The fewest members per rung whose Wilson 95 % lower bound can reach `min_p` (all of them
+    /// recovered: the lower bound is then n / (n + z²)); `None` when no count can (`min_p` = 1).
+    pub fn members_needed(&self) -> Option<usize> {
+        members_needed(self.min_p)
+    }
+
+    /// Why the ladder's rungs cannot reach `min_p` with `members` per rung (a warning for the
+    /// report and the terminal), or `None` when they can.
+    pub fn unreachable(&self) -> Option<String> {
+        let best = wilson(self.members, self.members)[0];
+        if best >= self.min_p {
+            return None;
+        }
+        let needed = match self.members_needed() {
+            Some(n) => format!("at least {n} members per rung are needed"),
+            None => "no number of members can (lower ladder.min_p below 1)".into(),
+        };
+        Some(format!(
+            "ladder.members = {} cannot reach ladder.min_p = {}: even {} of {} recovered gives a Wilson 95 % \
+             lower bound of {best:.3}, so no rung can be called safe; {needed}",
+            self.members, self.min_p, self.members, self.members
+        ))
+    }
+}
+
+/// The fewest members `n` with `wilson(n, n)` lower bound ≥ `min_p`; `None` when none up to
+/// 10⁶ does (`min_p` at or too near 1).
+pub fn members_needed(min_p: f64) -> Option<usize> {
+    // The bound n / (n + z²) rises with n: the first n that reaches min_p, found by doubling
+    // then bisection on the same `wilson` the rungs are decided with.
+    let reaches = |n: usize| wilson(n, n)[0] >= min_p;
+    let (mut lo, mut hi) = (0usize, 1usize);
+    while !reaches(hi) {
+        if hi >= 1 << 20 {
+            return None;
+        }
+        lo = hi;
+        hi *= 2;
+    }
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if reaches(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
 /// The spread of one duty figure over a rung's counted members.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Spread {
@@ -571,6 +622,24 @@ pub fn ladder(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// All of n recovered gives the lower bound n / (n + z²) (the Wilson interval at p = 1), so
+    /// min_p = 0.9 needs n ≥ 9 z² = 34.57: 35 members; 16 of 16 reach only 16 / 19.84 = 0.806.
+    #[test]
+    fn the_members_a_rung_needs_to_reach_min_p() {
+        let z2 = 1.959_963_984_540_054_f64.powi(2);
+        assert_eq!(members_needed(0.9), Some(35));
+        assert_eq!(members_needed(0.95), Some((19.0 * z2).ceil() as usize));
+        assert_eq!(members_needed(0.5), Some(z2.ceil() as usize));
+        assert_eq!(members_needed(0.0), Some(1));
+        assert_eq!(members_needed(1.0), None);
+        let s = |members| Settings { members, ..Settings::default() };
+        let why = s(16).unreachable().expect("16 members cannot reach 0.9");
+        assert!(why.contains("ladder.members = 16") && why.contains("0.806") && why.contains("35"), "{why}");
+        assert_eq!(s(35).unreachable(), None);
+        assert!(s(34).unreachable().is_some());
+        assert!((16.0 / (16.0 + z2) - wilson(16, 16)[0]).abs() < 1e-12);
+    }
 
     /// A member ended once decided is graded as its full run: on the 10 G scene with a
     /// well-damped sampled PD (ξ = 0.1, stable), a rung without contact (1 G) and one every

@@ -703,7 +703,7 @@ fn assess_controller(
             }
         }
     }
-    report.verdict = report::verdict(&report, a.ladder.duty_g);
+    report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
     report.wall_s = started.elapsed().as_secs_f64();
     Ok(report)
 }
@@ -725,6 +725,10 @@ pub struct Report {
     pub bearing: Option<duty::Bearing>,
     /// The ladder's settings.
     pub ladder_settings: ladder::Settings,
+    /// What the settings cannot answer (a ladder whose members cannot reach `min_p`), said at
+    /// load time on the terminal too.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// One per controller.
     pub controllers: Vec<ControllerReport>,
     /// True when interrupted: the parts not measured say so.
@@ -742,6 +746,10 @@ pub struct Report {
 pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> {
     let started = Instant::now();
     let mut a = spec::load(&args.file, &args.set, &args.laws)?;
+    // A warning is said even with --quiet: it changes how the report reads.
+    for w in &a.warnings {
+        eprintln!("plant assess: warning: {w}");
+    }
     for c in a.controllers.iter_mut() {
         if load_scene(&a.scene, &c.sets)?.controller.mode == ControlMode::Lockstep {
             c.sets.insert(0, LOCKSTEP_WAIT.into());
@@ -812,6 +820,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
         bearing,
         ladder_settings: a.ladder.clone(),
+        warnings: a.warnings.clone(),
         controllers: Vec::new(),
         interrupted: false,
         wall_s: 0.0,

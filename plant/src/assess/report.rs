@@ -2,6 +2,7 @@
 //! `report.html`, one self-contained page (the charts embedded as data URIs, no script, no
 //! network) with the verdict line of each controller at the top, one column each.
 
+use super::ladder::{LadderResult, Rung};
 use super::{ControllerReport, Report};
 use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
 use anyhow::Context;
@@ -47,7 +48,7 @@ pub fn worst_axis(
 
 /// The verdict line of a controller: its worst zone, the vibration zone, the highest safe
 /// shock and the duty at the duty rung.
-pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
+pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
     let mut parts = Vec::new();
     match (&r.sensitivity.result, r.sensitivity.status) {
         (Some(s), _) => {
@@ -93,10 +94,7 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
             "measured" => String::new(),
             status => format!("ladder {status}, on the members run so far: "),
         };
-        parts.push(match l.safe_up_to_g {
-            Some(g) => format!("{so_far}P(recovered) ≥ 0.9 up to {g} G"),
-            None => format!("{so_far}P(recovered) ≥ 0.9 at no rung"),
-        });
+        parts.push(format!("{so_far}{}", safe_words(l, min_p)));
         if let Some(rung) = l.rungs.iter().find(|x| (x.peak_g - duty_g).abs() < 1e-9) {
             let d = &rung.duty;
             parts.push(format!(
@@ -114,6 +112,23 @@ pub fn verdict(r: &ControllerReport, duty_g: f64) -> String {
         parts.push(format!("ladder {}", r.ladder.status));
     }
     parts.join("; ")
+}
+
+/// The highest safe shock in words, with the interval that decides it: the safe rung's
+/// [lower, upper], or where none is safe the first rung's (the one that failed), and the counts.
+fn safe_words(l: &LadderResult, min_p: f64) -> String {
+    let interval = |x: &Rung| format!("{}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi);
+    match l.safe_up_to_g {
+        Some(g) => {
+            let at = l.rungs.iter().find(|x| x.peak_g == g).map(|x| format!(" ({} at {g} G)", interval(x)));
+            format!("P(recovered) ≥ {min_p} up to {g} G{}", at.unwrap_or_default())
+        }
+        None => {
+            let first =
+                l.rungs.iter().find(|x| x.members > 0).map(|x| format!(" (at {} G: {})", x.peak_g, interval(x)));
+            format!("P(recovered) ≥ {min_p} at no rung{}", first.unwrap_or_default())
+        }
+    }
 }
 
 /// A line of a chart.
@@ -551,6 +566,9 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             ""
         }
     );
+    for w in &r.warnings {
+        let _ = writeln!(h, "<p class=\"bad\"><b>Warning:</b> {}</p>", esc(w));
+    }
     // The verdict table: one column per controller.
     let _ = writeln!(h, "<h2>Verdict</h2>\n<table><tr><th></th>");
     for c in &r.controllers {
@@ -679,13 +697,25 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             Some(g) => {
                 // Coloured by its value: green only from the duty rung (the design shock) up.
                 let class = safe_class(g, r.ladder_settings.duty_g);
+                let at = l.rungs.iter().find(|x| x.peak_g == g).map_or(String::new(), |x| {
+                    format!("; at {g} G {}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi)
+                });
                 format!(
-                    "<b class=\"{class}\">{g} G</b> (every rung up to it: lower bound ≥ {})",
+                    "<b class=\"{class}\">{g} G</b> (every rung up to it: lower bound ≥ {}{at})",
                     r.ladder_settings.min_p
                 )
             }
             None => {
-                format!("<b class=\"bad\">none</b> (the first rung's lower bound is below {})", r.ladder_settings.min_p)
+                let first = l.rungs.iter().find(|x| x.members > 0).map_or(String::new(), |x| {
+                    format!(
+                        ": at {} G {}/{} recovered, [{:.2}, {:.2}]",
+                        x.peak_g, x.recovered, x.members, x.p_lo, x.p_hi
+                    )
+                });
+                format!(
+                    "<b class=\"bad\">none</b> (the first rung's lower bound is below {}{first})",
+                    r.ladder_settings.min_p
+                )
             }
         },
         None => {

@@ -89,6 +89,8 @@ pub struct Assessment {
     pub materials: Materials,
     /// Counted ball-load cycles have a range of at least this share of one ball's static capacity.
     pub capacity_fraction: f64,
+    /// What the settings cannot answer (`ladder::Settings::unreachable`).
+    pub warnings: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -384,6 +386,9 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         )? * 1e6,
     };
     let capacity_fraction = number("duty.capacity_fraction", du.capacity_fraction, 0.5, "", 0.0, 10.0)?;
+    // Warned, not refused: a short ladder still shows the shape of P(recovered) over the peaks,
+    // and quick checks run with few members; the report says what it cannot conclude.
+    let warnings = if parts.contains(&Part::Ladder) { ladder.unreachable().into_iter().collect() } else { Vec::new() };
     Ok(Assessment {
         scene: scene_path,
         controllers,
@@ -393,6 +398,7 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         ladder,
         materials,
         capacity_fraction,
+        warnings,
     })
 }
 
