@@ -142,6 +142,11 @@ pub struct Summary {
     /// Time from the first shock's start to the last trace sample with rotor – race contact (s):
     /// 0 without contact after the shock, `null` if the rotor is still touching at the end.
     pub recovery_s: Option<f64>,
+    /// A run started from a saved state: from its first row to its last sample with contact
+    /// (s), 0 without contact, `null` if still touching at the end; absent for a run from t = 0.
+    /// Its grading window is `takeover`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recovery_from_start_s: Option<Option<f64>>,
     /// Time in rotor – race contact over the whole run (s), counted on the trace samples.
     pub contact_time_s: f64,
     /// Fraction of macro steps run with the race parked (0 unless `race_when_clear = "parked"`).
@@ -250,7 +255,29 @@ impl Summary {
             self.realtime_factor,
             or_none(self.max_radius_m, 1e6, 1, "µm"),
             or_none(self.max_contact_force_n, 1.0, 0, "N"),
-        )
+        ) + &self.takeover_words()
+    }
+
+    /// A run from a saved state: what its grade covers (empty for a run from t = 0).
+    fn takeover_words(&self) -> String {
+        match &self.analysis.takeover {
+            None => String::new(),
+            Some(t) if t.settled => format!(
+                "; {} graded over {:.0} revolutions from {:.4} s, after {:.3} s of settling from the first row at {:.4} s",
+                self.analysis.post_shock_mode.name(),
+                t.window_revolutions,
+                t.window_s[0],
+                t.settle_s,
+                t.first_row_s
+            ),
+            Some(t) => format!(
+                "; {} graded over every row from {:.4} s: the run ended within its {:.3} s of settling \
+                 after the state (run it longer to grade the takeover)",
+                self.analysis.post_shock_mode.name(),
+                t.first_row_s,
+                t.settle_s
+            ),
+        }
     }
 
     /// Figures of a run whose trace is in memory.
@@ -294,6 +321,9 @@ impl Summary {
             max_contact_force_n: figures.max_contact_force_n,
             max_race_speed_rpm: figures.max_race_speed_rpm,
             recovery_s: figures.recovery_s,
+            recovery_from_start_s: analysis
+                .takeover
+                .map(|t| figures.recovery_s.map(|r| (scene.first_shock_start() + r - t.first_row_s).max(0.0))),
             contact_time_s: figures.contact_share() * run.span(),
             parked_fraction: {
                 let ticks = (run.span() / c.period).round() * run.planes as f64;

@@ -77,9 +77,18 @@ fn another_controller_takes_over_from_a_saved_state() {
         all.extend_from_slice(extra);
         let mut cmd = plant_run(&scene_path("cosim-10g.toml"), &out_dir, &all);
         cmd.arg("--from-state").arg(&state);
-        assert_exit(&output(&mut cmd), 0);
+        let out = output(&mut cmd);
+        assert_exit(&out, 0);
         let summary = read_json(&out_dir.join("summary.json"));
         assert_eq!(summary["status"], "completed");
+        // 20 ms after the state is within the takeover's settling (50 revolutions, 0.1 s): the
+        // grade covers every row after the start, and the run says so.
+        let takeover = &summary["takeover"];
+        assert_eq!(takeover["settled"], false, "{takeover}");
+        assert!(num(takeover, "first_row_s") > 0.02 && (num(takeover, "settle_s") - 0.1).abs() < 1e-12, "{takeover}");
+        assert!(summary.get("recovery_from_start_s").is_some(), "{summary}");
+        let said = format!("{}{}", String::from_utf8_lossy(&out.stdout), stderr(&out));
+        assert!(said.contains("the run ended within its 0.100 s of settling"), "{said}");
         let started = num(&summary, "started_s");
         assert!((started - 0.02).abs() < 5e-5, "started_s {started}");
         // The figures cover the time from the state on.

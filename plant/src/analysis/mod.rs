@@ -58,6 +58,45 @@ pub fn steady_window(end: f64, spec: &AnalysisSpec) -> [f64; 2] {
     [(end - spec.window_length()).max(0.0), end]
 }
 
+/// Revolutions a run started from a saved state (a takeover) settles for before its grading
+/// window may open: the new controller's own transient is not graded as the shock's.
+pub const TAKEOVER_SETTLE_REVOLUTIONS: f64 = 50.0;
+
+/// How a run that started from a saved state was graded (`summary.json`'s `takeover`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Takeover {
+    /// The first row's time (s): the first output after the saved state's time.
+    pub first_row_s: f64,
+    /// The settling allowed after it before the grading window may open (s):
+    /// [`TAKEOVER_SETTLE_REVOLUTIONS`] revolutions.
+    pub settle_s: f64,
+    /// The grading window `[start, end]` (s).
+    pub window_s: [f64; 2],
+    /// Its length in revolutions (a run from t = 0 is graded on its last 200).
+    pub window_revolutions: f64,
+    /// The run lasted past its settling, and the window lies after it; `false`: it ended within
+    /// its settling and is graded on every row after its start, the takeover's transient
+    /// included (run it longer to grade the takeover).
+    pub settled: bool,
+}
+
+/// The grading window of a trace whose first row is at `first` and last at `end`: the steady
+/// window, which for a run started from a saved state (`first > 0`) opens no earlier than the
+/// settling after its start ([`Takeover`]). A run from t = 0 keeps its steady window.
+pub fn graded_window(first: f64, end: f64, spec: &AnalysisSpec) -> ([f64; 2], Option<Takeover>) {
+    let steady = steady_window(end, spec);
+    if !(first > 0.0) {
+        return (steady, None);
+    }
+    let revolution = if spec.speed > 0.0 { std::f64::consts::TAU / spec.speed } else { 0.0 };
+    let settle_s = TAKEOVER_SETTLE_REVOLUTIONS * revolution;
+    let settled = first + settle_s < end;
+    let start = if settled { steady[0].max(first + settle_s) } else { steady[0] };
+    let window_revolutions = if revolution > 0.0 { (end - start.max(first)) / revolution } else { 0.0 };
+    let takeover = Takeover { first_row_s: first, settle_s, window_s: [start, end], window_revolutions, settled };
+    ([start, end], Some(takeover))
+}
+
 /// The analysis of one run, as it goes into `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Analysis {
@@ -83,6 +122,9 @@ pub struct Analysis {
     pub steady_max_radius_m: f64,
     /// Steady window (s).
     pub steady_window_s: [f64; 2],
+    /// A run started from a saved state: how its window was chosen ([`graded_window`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub takeover: Option<Takeover>,
     /// Poincaré points in the steady window.
     pub poincare_points: usize,
     /// The Poincaré section (not serialised): every point of the steady window, and the
@@ -124,6 +166,8 @@ pub struct Analyzer {
     recent: VecDeque<SectionPoint>,
     transient: Strided<SectionPoint>,
     stft: Option<spectrum::StftBuilder>,
+    /// The first row's time.
+    first: Option<f64>,
 }
 
 impl Analyzer {
@@ -143,12 +187,14 @@ impl Analyzer {
             recent: VecDeque::new(),
             transient: Strided::new(MAX_TRANSIENT_POINTS),
             stft,
+            first: None,
         }
     }
 
     /// The next row of the trace (times increasing).
     pub fn push(&mut self, r: &Row) {
         let t = r[col::T_S];
+        self.first.get_or_insert(t);
         let (x, y) = (r[col::DX_M], r[col::DY_M]);
         let sample = SectionSample {
             t_s: t,
@@ -179,7 +225,7 @@ impl Analyzer {
     pub fn finish(self) -> (Analysis, AnalysisData) {
         let s = &self.spec;
         let end = self.window.back().map_or(0.0, |w| w.t);
-        let [start, end] = steady_window(end, s);
+        let ([start, end], takeover) = graded_window(self.first.unwrap_or(0.0), end, s);
         let rows: Vec<WindowRow> = self.window.into_iter().filter(|w| w.t >= start).collect();
         let t: Vec<f64> = rows.iter().map(|w| w.t).collect();
         let x: Vec<f64> = rows.iter().map(|w| w.x).collect();
@@ -213,6 +259,7 @@ impl Analyzer {
             steady_contact_episodes: classify::contact_episodes(&contact),
             steady_max_radius_m: x.iter().zip(&y).map(|(a, b)| a.hypot(*b)).fold(0.0, f64::max),
             steady_window_s: [start, end],
+            takeover,
             poincare_points: steady.len(),
             section,
         };
@@ -348,4 +395,57 @@ pub fn write_plots(
     );
     skip_empty(r, f_poincare, &mut written)?;
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows at 10 kHz from `t0` to `t0 + 0.4` s of a rotor at 500 Hz on a 150 µm gap, touching
+    /// the race (5 N) for the first millisecond only.
+    fn graded(t0: f64) -> Analysis {
+        let spec = AnalysisSpec { gap: 1.5e-4, speed: std::f64::consts::TAU * 500.0, phase: 0.0, tolerance: 1e-3 };
+        let mut a = Analyzer::new(spec, None);
+        for k in 0..=4000 {
+            let t = t0 + k as f64 * 1e-4;
+            let mut r: Row = [0.0; crate::trace::WIDTH];
+            r[col::T_S] = t;
+            r[col::ROTOR_ANGLE_RAD] = spec.speed * t;
+            r[col::DX_M] = 2e-6 * (spec.speed * t).cos();
+            r[col::DY_M] = 2e-6 * (spec.speed * t).sin();
+            r[col::CONTACT_FORCE_N] = if k < 10 { 5.0 } else { 0.0 };
+            a.push(&r);
+        }
+        a.finish().0
+    }
+
+    /// A controller that takes over from a state saved at 1.1 s and lifts the rotor off within
+    /// 1 ms is graded on what follows its settling (50 revolutions, 0.1 s at 500 Hz):
+    /// `recovered`, over the 150 revolutions from 1.2 s; graded from its first row, as before, it
+    /// was `rebound`. A run from t = 0 keeps its steady window (the last 200 revolutions), so the
+    /// same contact at its start still counts there.
+    #[test]
+    fn a_takeover_is_graded_after_its_settling() {
+        let from_state = graded(1.1);
+        assert_eq!(from_state.post_shock_mode, classify::MotionMode::Recovered);
+        let t = from_state.takeover.expect("a run from a state says how it was graded");
+        assert!(t.settled && (t.first_row_s - 1.1).abs() < 1e-12 && (t.settle_s - 0.1).abs() < 1e-12, "{t:?}");
+        assert!((t.window_s[0] - 1.2).abs() < 1e-9 && (t.window_revolutions - 150.0).abs() < 1e-6, "{t:?}");
+        assert_eq!(from_state.steady_window_s, t.window_s);
+        let from_zero = graded(0.0);
+        assert_eq!(from_zero.post_shock_mode, classify::MotionMode::Rebound);
+        assert_eq!((from_zero.takeover, from_zero.steady_window_s[0]), (None, 0.0));
+    }
+
+    /// A run from a state that ends within its settling is graded on every row after its start
+    /// and says so (`settled: false`), rather than on an empty window (which would read as
+    /// `recovered`).
+    #[test]
+    fn a_takeover_that_ends_within_its_settling_says_so() {
+        let spec = AnalysisSpec { gap: 1.5e-4, speed: std::f64::consts::TAU * 500.0, phase: 0.0, tolerance: 1e-3 };
+        let (w, t) = graded_window(0.02, 0.04, &spec);
+        let t = t.expect("from a state");
+        assert!(!t.settled && w == steady_window(0.04, &spec) && w == t.window_s, "{t:?}");
+        assert!((t.window_revolutions - 10.0).abs() < 1e-9, "{t:?}");
+    }
 }

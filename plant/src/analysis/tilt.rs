@@ -13,7 +13,7 @@
 //! `cylindrical` for `ρ ≥ 0.5`, `conical` for `ρ ≤ −0.5`, `mixed` between, `none` when neither
 //! plane moves (a rotor at rest in the window).
 
-use super::{steady_window, AnalysisSpec};
+use super::{graded_window, AnalysisSpec};
 use crate::trace::Record;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -60,12 +60,14 @@ pub struct TiltAnalyzer {
     spec: AnalysisSpec,
     window: VecDeque<Row>,
     max_tilt: f64,
+    /// The first sample's time.
+    first: Option<f64>,
 }
 
 impl TiltAnalyzer {
     /// An analysis with the steady window of `spec`.
     pub fn new(spec: AnalysisSpec) -> Self {
-        Self { spec, window: VecDeque::new(), max_tilt: 0.0 }
+        Self { spec, window: VecDeque::new(), max_tilt: 0.0, first: None }
     }
 
     /// The next two-plane sample (a planar one is ignored).
@@ -76,6 +78,7 @@ impl TiltAnalyzer {
             self.max_tilt = self.max_tilt.max(tilt);
         }
         let t = r.a[crate::trace::col::T_S];
+        self.first.get_or_insert(t);
         let (dx, dy) = (crate::trace::col::DX_M, crate::trace::col::DY_M);
         self.window.push_back(Row { t, a: [r.a[dx], r.a[dy]], b: [b[dx], b[dy]], tilt });
         let cutoff = t - self.spec.window_length();
@@ -87,7 +90,7 @@ impl TiltAnalyzer {
     /// The figures of the samples pushed.
     pub fn finish(self) -> TiltAnalysis {
         let end = self.window.back().map_or(0.0, |w| w.t);
-        let [start, _] = steady_window(end, &self.spec);
+        let ([start, _], _) = graded_window(self.first.unwrap_or(0.0), end, &self.spec);
         let rows: Vec<Row> = self.window.into_iter().filter(|w| w.t >= start && w.tilt.is_finite()).collect();
         let n = rows.len().max(1) as f64;
         let mean = |f: &dyn Fn(&Row) -> [f64; 2]| {
