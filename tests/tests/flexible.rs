@@ -79,6 +79,14 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
     refused("cutoff-zero", &flex, &["rotor.cutoff_hz=0"], &["rotor.cutoff_hz = 0 Hz"]);
     refused("cutoff-high", &flex, &["rotor.cutoff_hz=1e6"], &["rotor.cutoff_hz = 1000000 Hz", "room for"]);
     refused("zeta", &flex, &["rotor.modal_damping=-0.1"], &["rotor.modal_damping = -0.1"]);
+    // A shaft past the element bound, refused before any element is made: 20 000 elements
+    // asked for 51 GB and aborted, 10^18 would not have been counted before allocating.
+    for (name, split) in [("split-big", "20000"), ("split-huge", "1000000000000000000")] {
+        let row = format!(
+            "rotor.shaft.element=[{{length_mm=460.0, outer_diameter_mm=40.0, material=\"steel\", split={split}}}]"
+        );
+        refused(name, &flex, &[&row], &["rotor.shaft", &format!("the shaft has {split} elements, more than the 200")]);
+    }
     // A ROSS file that is not there, and both descriptions at once.
     refused("ross-missing", &flex, &["rotor.ross_file=\"nowhere.toml\""], &["rotor.ross_file = nowhere.toml"]);
     // The rigid rotor's geometry in a flexible scene, and the flexible keys in a rigid one.

@@ -18,6 +18,13 @@ pub mod shaft;
 pub mod table;
 
 pub use modes::{Linear, Mode, Whirl};
+
+/// The most shaft elements a rotor may have (after splits). The model's full matrices are
+/// dense, `4 (n + 1)` coordinates square, and its modes come from a dense eigensolver, so
+/// building costs O(n³) time and O(n²) memory (`cargo bench -p plant-physics --bench shaft`;
+/// docs/results/flexible-rotor.md, "How big a shaft"). A slender rotor's lowest modes converge
+/// with a few elements per span; this bound leaves a wide margin over that.
+pub const MAX_ELEMENTS: usize = 200;
 pub use reduce::{Reduced, Reduction};
 pub use rotor::{Disk, LinearBearing, Rotor};
 pub use shaft::{Material, ShaftElement};
@@ -28,6 +35,17 @@ pub enum FlexError {
     /// The shaft has no elements.
     #[error("the shaft has no elements")]
     NoElements,
+    /// More shaft elements than the model builds in bounded time and memory.
+    #[error(
+        "the shaft has {count} elements, more than the {limit} this model takes (its full matrices are dense: \
+         {limit} elements build in seconds, 20 000 would need 51 GB); merge elements or split them less"
+    )]
+    TooManyElements {
+        /// The element count (after splits).
+        count: usize,
+        /// [`MAX_ELEMENTS`].
+        limit: usize,
+    },
     /// A length, diameter or inertia is zero, negative or not finite.
     #[error("{element}: {key} = {value} {unit} must be positive")]
     NotPositive {

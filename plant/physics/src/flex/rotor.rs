@@ -105,6 +105,9 @@ impl Rotor {
         if self.elements.is_empty() {
             return Err(FlexError::NoElements);
         }
+        if self.elements.len() > super::MAX_ELEMENTS {
+            return Err(FlexError::TooManyElements { count: self.elements.len(), limit: super::MAX_ELEMENTS });
+        }
         for (i, el) in self.elements.iter().enumerate() {
             let at = |key: &'static str| (format!("shaft element {i}"), key);
             let positive = |key: &'static str, v: f64| -> Result<(), FlexError> {

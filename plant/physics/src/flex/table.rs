@@ -160,6 +160,11 @@ impl MaterialRow {
 impl ShaftTable {
     /// The rotor the table describes (validated).
     pub fn rotor(&self) -> Result<Rotor, FlexError> {
+        // Counted before any element is made: `split = 10^12` must not allocate first.
+        let count = self.elements.iter().fold(0usize, |n, row| n.saturating_add(row.split.unwrap_or(1)));
+        if count > super::MAX_ELEMENTS {
+            return Err(FlexError::TooManyElements { count, limit: super::MAX_ELEMENTS });
+        }
         let mut elements = Vec::new();
         for (i, row) in self.elements.iter().enumerate() {
             let at = || format!("element[{i}]");
@@ -247,6 +252,24 @@ impl ShaftTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The element bound holds for a rotor however it is made: a table's splits are counted
+    /// before any element is made, a rotor given whole (a ROSS file's) is refused by `validate`.
+    #[test]
+    fn a_shaft_past_the_element_bound_is_refused() {
+        let steel = Material { density: 7810.0, modulus: 211e9, shear_modulus: 81.2e9 };
+        let rotor = |n: usize| Rotor {
+            elements: vec![ShaftElement::cylinder(1e-3, 0.0, 0.04, steel); n],
+            disks: Vec::new(),
+            bearings: Vec::new(),
+            alpha: 0.0,
+            beta: 0.0,
+        };
+        assert_eq!(rotor(super::super::MAX_ELEMENTS).validate(), Ok(()));
+        let e = rotor(super::super::MAX_ELEMENTS + 1).validate().unwrap_err();
+        assert_eq!(e, FlexError::TooManyElements { count: 201, limit: 200 });
+        assert!(e.to_string().contains("the shaft has 201 elements, more than the 200"), "{e}");
+    }
 
     const TABLE: &str = r#"
         [materials.steel]
