@@ -123,12 +123,12 @@ pub enum Command {
         /// Highest spin speed of the diagram (Hz).
         #[arg(long, default_value_t = 500.0)]
         max_speed_hz: f64,
-        /// Speeds of the diagram, from 0 to the highest.
-        #[arg(long, default_value_t = 51)]
+        /// Speeds of the diagram, from 0 to the highest (2 to 10000).
+        #[arg(long, default_value_t = 51, value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(2..=10_000))]
         points: usize,
-        /// Spin speeds of the free decays (Hz); empty: none.
-        #[arg(long, value_delimiter = ',', default_value = "0,250,500")]
-        decay_speeds_hz: Vec<f64>,
+        /// Spin speeds of the free decays (Hz), comma-separated; empty (`""`): none.
+        #[arg(long, default_value = "0,250,500", value_parser = parse_speeds)]
+        decay_speeds_hz: std::vec::Vec<f64>,
     },
     /// Write the scene's plant as an FMI 2.0 (or 3.0) co-simulation FMU for Linux x86-64 (Simulink's FMU
     /// block, OpenModelica/OMSimulator, FMPy): modelDescription.xml, the binary, the scene in
@@ -327,4 +327,19 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 3, value_parser = repeats())]
         repeats: usize,
     },
+}
+
+/// `--decay-speeds-hz`: speeds (Hz) separated by commas; the empty list (`""`) is none.
+/// (`std::vec::Vec` in the field: clap then takes the whole list as one value, so that the
+/// empty text reaches this parser.)
+fn parse_speeds(text: &str) -> Result<Vec<f64>, String> {
+    if text.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    text.split(',')
+        .map(|v| {
+            let v = v.trim();
+            v.parse::<f64>().map_err(|_| format!("`{v}` is not a speed in Hz (e.g. 0,250,500, or \"\" for none)"))
+        })
+        .collect()
 }

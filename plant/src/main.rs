@@ -8,7 +8,7 @@
 mod cli;
 
 use anyhow::Context;
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 use cli::{BenchCommand, Cli, Command, ControllerArg};
 use plant::config::{load_scene, Scene};
 use plant::cosim::Launch;
@@ -25,8 +25,19 @@ use std::time::{Duration, Instant};
 /// bytes of figures).
 const MAX_BENCH_SAMPLES: u64 = 10_000_000;
 
+/// The command line, with negative numbers taken as values on every verb (`--max-speed-hz -1`
+/// reaches the range check that names the flag and its bounds, rather than clap's
+/// "unexpected argument '-1'").
+fn parse_cli() -> Cli {
+    fn negative_numbers(cmd: clap::Command) -> clap::Command {
+        cmd.allow_negative_numbers(true).mut_subcommands(negative_numbers)
+    }
+    let matches = negative_numbers(Cli::command()).get_matches();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = parse_cli();
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -214,9 +214,33 @@ impl Snapshot {
     }
 
     /// The file name, in a run folder, of the snapshot asked for at `t_s` (`--save-state-at`):
-    /// `state-0.5.json` (the time in the fewest digits that read back to it).
+    /// `state-0.5.json` (the time in the fewest digits that read back to it, in plain or in
+    /// exponent form, whichever is shorter: `1e-300` made a name of 300 zeros, too long for the
+    /// file system).
     pub fn file_name(t_s: f64) -> String {
-        format!("state-{t_s}.json")
+        let (plain, exponent) = (format!("{t_s}"), format!("{t_s:e}"));
+        let t = if exponent.len() < plain.len() { exponent } else { plain };
+        format!("state-{t}.json")
+    }
+}
+
+#[cfg(test)]
+mod name_tests {
+    use super::*;
+
+    /// Every time a run takes has a short name that reads back to it (`is_file_name`).
+    #[test]
+    fn a_snapshot_name_is_short_and_reads_back() {
+        for (t, name) in [(0.5, "state-0.5.json"), (0.0301, "state-0.0301.json"), (1e-300, "state-1e-300.json")] {
+            assert_eq!(Snapshot::file_name(t), name);
+            assert!(is_file_name(name));
+        }
+        for t in [1e-300, 5e-324, 0.1 + 0.2, 1.5, 1e15, 123456.789] {
+            let name = Snapshot::file_name(t);
+            assert!(name.len() <= 40 && is_file_name(&name), "{name}");
+            let back: f64 = name["state-".len()..name.len() - ".json".len()].parse().expect("a number");
+            assert_eq!(back, t);
+        }
     }
 }
 

@@ -78,6 +78,13 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
     // cutoff keeps them), or one that keeps more modes than the state holds.
     refused("cutoff-zero", &flex, &["rotor.cutoff_hz=0"], &["rotor.cutoff_hz = 0 Hz"]);
     refused("cutoff-high", &flex, &["rotor.cutoff_hz=1e6"], &["rotor.cutoff_hz = 1000000 Hz", "room for"]);
+    // A cutoff far below the bending modes: the cutoff is named, not "the shaft".
+    refused(
+        "cutoff-tiny",
+        &flex,
+        &["rotor.cutoff_hz=1e-3"],
+        &["rotor.cutoff_hz = 0.001 Hz", "first bending mode is at 497.8 Hz"],
+    );
     refused("zeta", &flex, &["rotor.modal_damping=-0.1"], &["rotor.modal_damping = -0.1"]);
     // A shaft past the element bound, refused before any element is made: 20 000 elements
     // asked for 51 GB and aborted, 10^18 would not have been counted before allocating.
@@ -170,6 +177,24 @@ fn campbell_of_a_flexible_scene_shows_its_bending_modes() {
     );
     assert_exit(&run, 0);
     assert!(stderr(&run).contains("no free decays"), "{}", stderr(&run));
+    // `--decay-speeds-hz ""` is none, as --help says; a negative speed reaches the range check.
+    for (args, code, says) in [
+        (&["--points", "2", "--decay-speeds-hz", ""][..], 0, ""),
+        (&["--points", "2", "--max-speed-hz", "-1"][..], 2, "--max-speed-hz -1: must be between 0 and 1e5 Hz"),
+        (&["--points", "-3"][..], 2, "-3 is not in 2..=10000"),
+    ] {
+        let o = output_within(
+            Command::new(plant_bin())
+                .arg("campbell")
+                .arg(scene("flexible-10g.toml"))
+                .args(args)
+                .arg("--out")
+                .arg(dir.join("more")),
+            RUN,
+        );
+        assert_exit(&o, code);
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    }
     assert!(out.join("campbell.png").is_file());
     let text = std::fs::read_to_string(out.join("campbell.csv")).expect("campbell.csv");
     let mut lines = text.lines();

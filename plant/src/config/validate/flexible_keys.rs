@@ -134,6 +134,24 @@ pub(in crate::config) fn flexible_params(
     };
     let reduced = flex::Reduced::new(&shaft, &spec).map_err(|e| match e {
         flex::FlexError::CutoffBelowRigidModes { .. } => flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e),
+        // The free rotor's static correction is solved with the shift (2π f_c)²: a cutoff far
+        // below the first bending mode leaves it too small to solve with. The cutoff is at fault.
+        flex::FlexError::SingularStiffness => {
+            let first = flex::reduce::undamped_frequencies_hz(&shaft)
+                .ok()
+                .and_then(|f| f.get(flex::reduce::RIGID_MODES).copied());
+            let first = first.map_or(String::new(), |f| format!(" (the shaft's first bending mode is at {f:.1} Hz)"));
+            range(
+                "rotor.cutoff_hz",
+                cutoff,
+                "Hz",
+                &format!(
+                    "is too low: it keeps only the rigid-body modes, and the static correction cannot be \
+                     solved that far below the bending modes{first}; keep at least the first bending mode, or use \
+                     the rigid two-plane rotor"
+                ),
+            )
+        }
         e => flex_error("rotor.shaft", "the shaft", e),
     })?;
     if reduced.size() > MAX_BASIS {
