@@ -224,6 +224,11 @@ impl Snapshot {
     }
 }
 
+/// True for a name [`Snapshot::file_name`] makes: `state-T.json` with a number `T`.
+pub fn is_file_name(name: &str) -> bool {
+    name.strip_prefix("state-").and_then(|s| s.strip_suffix(".json")).is_some_and(|t| t.parse::<f64>().is_ok())
+}
+
 #[cfg(test)]
 mod name_tests {
     use super::*;
@@ -242,9 +247,4 @@ mod name_tests {
             assert_eq!(back, t);
         }
     }
-}
-
-/// True for a name [`Snapshot::file_name`] makes: `state-T.json` with a number `T`.
-pub fn is_file_name(name: &str) -> bool {
-    name.strip_prefix("state-").and_then(|s| s.strip_suffix(".json")).is_some_and(|t| t.parse::<f64>().is_ok())
 }

@@ -85,7 +85,7 @@ pub struct Takeover {
 /// settling after its start ([`Takeover`]). A run from t = 0 keeps its steady window.
 pub fn graded_window(first: f64, end: f64, spec: &AnalysisSpec) -> ([f64; 2], Option<Takeover>) {
     let steady = steady_window(end, spec);
-    if !(first > 0.0) {
+    if first.is_nan() || first <= 0.0 {
         return (steady, None);
     }
     let revolution = if spec.speed > 0.0 { std::f64::consts::TAU / spec.speed } else { 0.0 };
