@@ -412,6 +412,79 @@ fn drive_one(inst: &Instance, vr: &Vrs, k: u64, prev: [f64; 2]) -> (Vec<u64>, [f
     (inst.get(&vr.outputs).iter().map(|v| v.to_bits()).collect(), [s[0], s[1]])
 }
 
+/// Issue 40 item 5: a refused call changes nothing. An instance given, at tick 120, every kind
+/// of state `fmi2SetFMUstate` refuses (a time off its tick, a stepping state without its plant,
+/// a parameter out of its bounds, a state of other parameters whose plant refuses the
+/// snapshot) and other refused calls (inputs with one NaN among them, a parameter
+/// while stepping, a step off the time or off the tick grid) keeps its inputs and steps on
+/// writing, bit for bit, the outputs of an instance never given them.
+#[test]
+fn refused_calls_leave_the_instance_stepping_as_if_never_made() {
+    let dir = TempDir::new("fmu-refused");
+    let fmu = write_fmu(&dir, "plant.fmu", &[]);
+    let (xml, unpacked) = unpack(&fmu, &dir, "plant");
+    let bin = Binary::load(&xml, &unpacked);
+    let clean = bin.instantiate();
+    clean.initialise();
+    let vr = vrs(&xml, &clean);
+    let (_, prev) = drive(&clean, &vr, 0, 120, [0.0; 2]);
+    let (expected, _) = drive(&clean, &vr, 120, 200, prev);
+
+    let a = bin.instantiate();
+    a.initialise();
+    let (_, prev_a) = drive(&a, &vr, 0, 120, [0.0; 2]);
+    assert_eq!(prev_a, prev);
+    let s = a.get_state();
+    let bytes = a.serialize(s);
+    a.free_state(s);
+    let magic = &bytes[..bytes.iter().position(|&b| b == b'\n').unwrap() + 1];
+    let json: serde_json::Value =
+        serde_json::from_slice(&bytes[magic.len()..]).expect("a state is JSON after its magic");
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut j = json.clone();
+        f(&mut j);
+        [magic, serde_json::to_string(&j).unwrap().as_bytes()].concat()
+    };
+    let peak = vr.peak as usize;
+    let states: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("a time off its tick", edited(&|j| j["snapshot"]["t_s"] = 0.5.into()), "is not tick 120"),
+        (
+            "stepping without a plant",
+            edited(&|j| {
+                j["snapshot"] = serde_json::Value::Null;
+                j["outputs"] = serde_json::Value::Null;
+            }),
+            "without its plant",
+        ),
+        ("a parameter out of bounds", edited(&|j| j["values"][peak] = 5000.0.into()), "outside its bounds"),
+        (
+            "other parameters and a time off its tick",
+            edited(&|j| {
+                j["values"][peak] = 3.0.into();
+                j["snapshot"]["t_s"] = 0.5.into();
+            }),
+            "",
+        ),
+    ];
+    let inputs = a.get(&vr.inputs);
+    for (what, bytes, says) in &states {
+        let s = a.deserialize(bytes).unwrap_or_else(|e| panic!("{what}: well-formed, yet {e}: {:?}", a.log()));
+        assert_eq!(a.set_state(s), ERROR, "{what}");
+        let line = a.last_error();
+        assert!(line.contains("fmi2SetFMUstate") && line.contains(says), "{what}: {line}");
+        a.free_state(s);
+    }
+    assert_eq!(a.set(&vr.inputs, &[1.0, f64::NAN]), ERROR);
+    assert_eq!(a.set(&[vr.peak], &[5.0]), ERROR);
+    assert_eq!(a.get(&vr.inputs), inputs, "the refused calls took no input");
+    let t = 120.0 * 5e-5;
+    assert_eq!(a.step(t + 1e-3, 5e-5), ERROR);
+    assert_eq!(a.step(t, 0.5 * 5e-5), ERROR);
+    assert!(a.log().iter().all(|(_, line)| !line.contains("internal error")), "{:?}", a.log());
+    let (after, _) = drive(&a, &vr, 120, 200, prev);
+    assert_eq!(after, expected, "the instance steps on as one never given the refused calls");
+}
+
 /// Every bad call returns `fmi2Error` with a log line that says what was wrong, and the
 /// instance goes on where that is possible; a diverging plant returns `fmi2Error` with its time
 /// and state; the instantiation of another FMU's GUID or as model exchange is refused.

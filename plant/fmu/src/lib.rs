@@ -125,6 +125,17 @@ impl Sink for LastRow {
     }
 }
 
+/// Whether parameter `v` takes the value `x` (finite, within its bounds); else why not.
+fn in_bounds(v: &Variable, x: f64) -> Result<(), String> {
+    let unit = v.unit.map(|u| format!(" {u}")).unwrap_or_default();
+    let (lo, hi) = (v.min.unwrap_or(f64::NEG_INFINITY), v.max.unwrap_or(f64::INFINITY));
+    if x.is_finite() && x >= lo && x <= hi {
+        Ok(())
+    } else {
+        Err(format!("parameter {} = {x}{unit} is outside its bounds [{lo}, {hi}]{unit}", v.name))
+    }
+}
+
 /// Category names of the log.
 const CAT_ERROR: &CStr = c"logStatusError";
 const CAT_WARNING: &CStr = c"logStatusWarning";
@@ -265,7 +276,9 @@ impl Instance {
             _ => {
                 let mut last = LastRow(None);
                 plant.record(&mut last);
-                fresh = last.0.expect("a plant hands over its row");
+                // A plant always hands over its row; without one the outputs are NaN, which
+                // fmi2DoStep refuses as a diverged plant rather than a panic.
+                fresh = last.0.unwrap_or(Record::planar([f64::NAN; plant::trace::WIDTH]));
                 &fresh
             }
         };
@@ -311,7 +324,10 @@ impl Instance {
         })
     }
 
+    /// Sets the variables `vrs` to `values`: every value checked first, then all taken, so that
+    /// a refused call (one bad value among several) leaves the instance as it was.
     fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        let mut parameters = false;
         for (&vr, &x) in vrs.iter().zip(values) {
             let v = match self.variable(vr, "fmi2SetReal") {
                 Ok(v) => v.clone(),
@@ -343,21 +359,19 @@ impl Instance {
                     ) {
                         return s;
                     }
-                    let (lo, hi) = (v.min.unwrap_or(f64::NEG_INFINITY), v.max.unwrap_or(f64::INFINITY));
-                    if !(x.is_finite() && x >= lo && x <= hi) {
-                        return self.error(&format!(
-                            "fmi2SetReal: parameter {} = {x}{unit} is outside its bounds [{lo}, {hi}]{unit}; the value is \
-                             not taken",
-                            v.name
-                        ));
+                    if let Err(why) = in_bounds(&v, x) {
+                        return self.error(&format!("fmi2SetReal: {why}; the value is not taken"));
                     }
+                    parameters = true;
                 }
             }
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
             self.values[vr as usize] = x;
-            if matches!(v.role, Role::Parameter(_)) {
-                // Outputs read in initialization mode come from a plant of these parameters.
-                self.sim = None;
-            }
+        }
+        if parameters {
+            // Outputs read in initialization mode come from a plant of these parameters.
+            self.sim = None;
         }
         OK
     }
@@ -402,11 +416,13 @@ impl Instance {
                 Err(e) => return self.error(&format!("fmi2ExitInitializationMode: {e}")),
             }
         }
+        let Some(period) = self.sim.as_ref().map(|s| s.period) else {
+            return self.error("fmi2ExitInitializationMode: the plant was not built");
+        };
         self.phase = Phase::Stepping;
-        let sim = self.sim.as_ref().expect("built");
         self.info(&format!(
-            "initialized: {} bearing plane(s), tick {} s; communication steps are whole multiples of it",
-            self.model.planes, sim.period
+            "initialized: {} bearing plane(s), tick {period} s; communication steps are whole multiples of it",
+            self.model.planes
         ));
         OK
     }
@@ -416,7 +432,11 @@ impl Instance {
             return s;
         }
         let t = self.time();
-        let sim = self.sim.as_ref().expect("a stepping instance has its plant");
+        // Never the case: every call that leaves the FMU stepping leaves it with its plant
+        // (a refused fmi2SetFMUstate leaves the instance as it was). Said, not assumed.
+        let Some(sim) = self.sim.as_ref() else {
+            return self.error("fmi2DoStep: the FMU has no plant (a bug of the FMU, please report it); fmi2Reset");
+        };
         let p = sim.period;
         let rate = 1.0 / p;
         // Importers' rounding: a millionth of a tick, or a billionth of the time, whichever is
@@ -441,11 +461,9 @@ impl Instance {
                  (the scene's controller.rate_hz = {rate} Hz): use a step of {p:e} s{hint} or another whole multiple"
             ));
         }
-        let values = self.values.clone();
-        let sim_limits = sim.limits;
-        let command = self.command(&values, sim_limits);
+        let command = self.command(&self.values, sim.limits);
         let mut row = LastRow(None);
-        let sim = self.sim.as_mut().expect("a stepping instance has its plant");
+        let Some(sim) = self.sim.as_mut() else { return ERROR };
         for _ in 0..ticks as u64 {
             if let Err(e) = sim.plant.step(&Command::Held(command), &mut row) {
                 let what = e.to_string();
@@ -459,7 +477,7 @@ impl Instance {
                 ));
             }
         }
-        let sim = self.sim.as_ref().expect("a stepping instance has its plant");
+        let Some(sim) = self.sim.as_ref() else { return ERROR };
         let outputs = self.outputs_of(sim, row.0.as_ref());
         if let Some(bad) =
             outputs.iter().zip(&self.model.variables).find(|(x, v)| matches!(v.role, Role::Output(_)) && !x.is_finite())
@@ -473,7 +491,9 @@ impl Instance {
                 self.time()
             ));
         }
-        self.sim.as_mut().expect("stepping").outputs = outputs;
+        if let Some(sim) = self.sim.as_mut() {
+            sim.outputs = outputs;
+        }
         OK
     }
 
@@ -490,6 +510,9 @@ impl Instance {
         }
     }
 
+    /// Restores `state`: everything in it checked first (the GUID, the counts, every value, the
+    /// phase against the plant, the plant's snapshot against a plant of its parameters), then
+    /// all of it taken; a refused state leaves the instance as it was, stepping on if it was.
     fn set_state(&mut self, state: &State) -> Status {
         if state.guid != self.model.guid {
             return self.error(&format!(
@@ -504,36 +527,62 @@ impl Instance {
                 state.values.len()
             ));
         }
+        if !state.start_time.is_finite() {
+            return self.error(&format!("fmi2SetFMUstate: the state's start time is {} s", state.start_time));
+        }
         let values: Vec<f64> = state.values.iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-        for (v, x) in self.model.variables.iter().zip(&values) {
-            if !matches!(v.role, Role::Output(_)) && !x.is_finite() {
-                return self.error(&format!("fmi2SetFMUstate: the state's {} is not a number", v.name));
+        for (v, &x) in self.model.variables.iter().zip(&values) {
+            match v.role {
+                Role::Output(_) => {}
+                Role::Input(_) if !x.is_finite() => {
+                    return self.error(&format!("fmi2SetFMUstate: the state's {} is not a number", v.name))
+                }
+                Role::Input(_) => {}
+                Role::Parameter(_) => {
+                    if let Err(why) = in_bounds(v, x) {
+                        return self.error(&format!("fmi2SetFMUstate: the state's {why}"));
+                    }
+                }
             }
         }
-        let sim = match (&state.snapshot, &state.outputs) {
-            (Some(snapshot), Some(outputs)) => {
-                // The plant of the same parameters is kept: the restore replaces everything it
-                // evolves, and the inputs are each step's command (rebuilding it cost about
-                // 1 ms a call in an FMPy loop: docs/results/speed.md).
-                let mut sim = match self.sim.take() {
-                    Some(s) if self.same_parameters(&s.built_with, &values) => s,
-                    _ => match self.build(&values) {
-                        Ok(s) => s,
-                        Err(e) => return self.error(&format!("fmi2SetFMUstate: {e}")),
-                    },
-                };
-                if let Err(e) = sim.plant.restore(snapshot) {
-                    self.sim = None;
-                    return self.error(&format!("fmi2SetFMUstate: {e}"));
-                }
-                sim.outputs = outputs.iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-                Some(sim)
+        let outputs = match (&state.snapshot, &state.outputs) {
+            (Some(_), Some(outputs)) => Some(outputs.iter().map(|x| x.unwrap_or(f64::NAN)).collect::<Vec<f64>>()),
+            (None, None) if state.phase == Phase::Stepping => {
+                return self.error("fmi2SetFMUstate: a state of an initialized (stepping) FMU without its plant")
             }
             (None, None) => None,
             _ => return self.error("fmi2SetFMUstate: a state with a plant and no outputs, or outputs and no plant"),
         };
+        match (&state.snapshot, outputs) {
+            (Some(snapshot), Some(outputs)) => {
+                // The plant of the same parameters is kept: the restore replaces everything it
+                // evolves, and the inputs are each step's command (rebuilding it cost about
+                // 1 ms a call in an FMPy loop: docs/results/speed.md). `Plant::restore`
+                // checks the snapshot before it changes anything: refused, the plant is as it was.
+                let reuse = self.sim.as_ref().is_some_and(|s| self.same_parameters(&s.built_with, &values));
+                match self.sim.as_mut() {
+                    Some(sim) if reuse => {
+                        if let Err(e) = sim.plant.restore(snapshot) {
+                            return self.error(&format!("fmi2SetFMUstate: {e}"));
+                        }
+                        sim.outputs = outputs;
+                    }
+                    _ => {
+                        let mut sim = match self.build(&values) {
+                            Ok(s) => s,
+                            Err(e) => return self.error(&format!("fmi2SetFMUstate: {e}")),
+                        };
+                        if let Err(e) = sim.plant.restore(snapshot) {
+                            return self.error(&format!("fmi2SetFMUstate: {e}"));
+                        }
+                        sim.outputs = outputs;
+                        self.sim = Some(sim);
+                    }
+                }
+            }
+            _ => self.sim = None,
+        }
         self.values = values;
-        self.sim = sim;
         self.phase = state.phase;
         self.start_time = state.start_time;
         OK
@@ -575,7 +624,7 @@ impl StateBox {
             serde_json::to_writer(&mut b, &self.state).map_err(|e| e.to_string())?;
             self.bytes = Some(b);
         }
-        Ok(self.bytes.as_deref().expect("just made"))
+        Ok(self.bytes.as_deref().unwrap_or_default())
     }
 
     fn from_bytes(bytes: &[u8]) -> Result<State, String> {
