@@ -603,3 +603,42 @@ fn plant_assess_grades_an_fmu_controller_like_the_rust_pd() {
     assert_eq!(fmu["status"], "measured", "{fmu:#}");
     assert_eq!(rust["result"], fmu["result"], "the FMU's vibration figures differ from the Rust pd's");
 }
+
+/// Issue 40 item 5: in-process FMUs of an assessment's members cannot share what is the
+/// process's. The `pd` of `pd.c` with fault 7 holds a resource of the process from its first
+/// step and aborts when another instance holds it, as two pythonfmu FMUs (two Python hosts in
+/// one process) crashed the plant; `plant assess` in `sampled` mode measures both axes' sensitivity
+/// (in parallel, two threads at least) with it and finishes, each axis's figures the Rust `pd`'s
+/// to the bit.
+#[test]
+fn an_assessment_of_in_process_fmus_that_hold_the_process_finishes() {
+    let dir = TempDir::new("fmu-assess-one-at-a-time");
+    let paper = scene("paper-10g.toml");
+    let params = pd_params(&paper, &short("sampled", &[]));
+    let held = format!("{}, fault = 7, fault_tick = 0}}", params.strip_suffix('}').unwrap());
+    let fmu = pd_fmu(&dir, Kind::Cs2, 2);
+    let file = dir.join("assess.toml");
+    let quoted = |s: &str| format!("{s:?}");
+    let text = format!(
+        "scene = {}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\nparts = [\"sensitivity\"]\n\
+         [[controller]]\nlabel = \"rust\"\nset = [\"controller.law=\\\"pd\\\"\"]\n\
+         [[controller]]\nlabel = \"fmu\"\nset = [{}, {}]\n\
+         [sensitivity]\nf_min_hz = 20.0\nf_max_hz = 200.0\npoints = 4\nprobe_s = 0.3\nresolution = 0.05\nspeeds = [\"standstill\"]\n",
+        quoted(&paper.display().to_string()),
+        quoted(&fmu_set(&fmu)),
+        quoted(&held),
+    );
+    std::fs::write(&file, text).unwrap();
+    host_built();
+    let out = dir.join("report");
+    let ran =
+        output(Command::new(plant_bin()).env("RAYON_NUM_THREADS", "2").arg("assess").arg(&file).arg("--out").arg(&out));
+    assert_exit(&ran, 0);
+    let report = read_json(&out.join("report.json"));
+    let c = report["controllers"].as_array().unwrap();
+    let (rust, fmu) = (&c[0]["sensitivity"], &c[1]["sensitivity"]);
+    assert_eq!(fmu["status"], "measured", "{fmu:#}");
+    let axes = |s: &serde_json::Value| s["result"]["axes"].as_array().cloned().unwrap_or_default();
+    assert_eq!(axes(fmu).len(), 2, "{fmu:#}");
+    assert_eq!(axes(rust), axes(fmu), "the FMU's sensitivity differs from the Rust pd's");
+}

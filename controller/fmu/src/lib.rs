@@ -834,10 +834,71 @@ impl Drop for FmuLaw {
     }
 }
 
-/// Opens the FMU of `spec` and builds its law for `design`'s rotor (the plant's sampled mode).
+/// The turn of the in-process FMU laws of this process: one at a time (issue 40 item 5).
+///
+/// An FMU's library is the FMU's code in the plant's process, and an FMU may keep state that is
+/// the process's, not its instance's nor even its library copy's: a pythonfmu FMU hosts the
+/// Python interpreter, one per process, which it starts on loading and stops on unloading.
+/// Two such FMUs alive at once in the threads of one process (`plant assess`, `ensemble` or
+/// `sweep` members in `sampled` mode) crashed the plant (SIGSEGV, "double free or
+/// corruption"). So a law built by [`build`] waits for its turn and keeps it until it is
+/// dropped, its library unloaded with it: the members that run an in-process FMU run one
+/// after another, whatever the pool they run on; a member with another law does not wait.
+struct Turn;
+
+static TURN: (std::sync::Mutex<bool>, std::sync::Condvar) = (std::sync::Mutex::new(false), std::sync::Condvar::new());
+
+impl Turn {
+    /// Waits until no other in-process FMU law is alive, then takes the turn.
+    fn take() -> Self {
+        let (taken, freed) = &TURN;
+        let mut t = taken.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        while *t {
+            t = freed.wait(t).unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
+        *t = true;
+        Turn
+    }
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        let (taken, freed) = &TURN;
+        *taken.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = false;
+        freed.notify_one();
+    }
+}
+
+/// An in-process FMU law with its [`Turn`], given back once the FMU is freed and unloaded.
+struct Turned {
+    // First: dropped (the instance freed, the library unloaded) before the turn.
+    law: FmuLaw,
+    _turn: Turn,
+}
+
+impl RotorLaw for Turned {
+    fn name(&self) -> &'static str {
+        self.law.name()
+    }
+
+    fn update(&mut self, sample: &RotorSample) -> [f64; ROTOR_AXES] {
+        self.law.update(sample)
+    }
+
+    fn reset(&mut self) {
+        self.law.reset()
+    }
+}
+
+/// Opens the FMU of `spec` and builds its law for `design`'s rotor (the plant's sampled mode),
+/// once no other law built here is alive in the process ([`Turn`]).
 pub fn build(spec: &Spec, design: &RotorDesign, params: &Params) -> Result<Box<dyn RotorLaw>, LawError> {
+    let turn = Turn::take();
     let fmu = Fmu::open(spec).map_err(|e| LawError::Refused { law: LAW_NAME, why: e.to_string() })?;
-    Ok(Box::new(fmu.law(design, params)?))
+    let law = fmu.law(design, params)?;
+    // The law holds the only other handle on the FMU: dropping it unloads the library.
+    drop(fmu);
+    Ok(Box::new(Turned { law, _turn: turn }))
 }
 
 /// The file name of `path` (for messages).
