@@ -6,6 +6,7 @@
 //! holds the codes and the one map; `docs/guide/running.md` the table).
 
 mod cli;
+mod fmu_exit;
 
 use anyhow::Context;
 use clap::Parser;
@@ -26,6 +27,7 @@ use std::time::{Duration, Instant};
 const MAX_BENCH_SAMPLES: u64 = 10_000_000;
 
 fn main() -> ExitCode {
+    fmu_exit::keep();
     let cli = Cli::parse();
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     match run(cli) {

@@ -642,3 +642,33 @@ fn an_assessment_of_in_process_fmus_that_hold_the_process_finishes() {
     assert_eq!(axes(fmu).len(), 2, "{fmu:#}");
     assert_eq!(axes(rust), axes(fmu), "the FMU's sensitivity differs from the Rust pd's");
 }
+
+/// Issue 40 item 5: an FMU that ends the process (`_exit(0)` at step 100, `pd.c` fault 8) never
+/// leaves the plant ending with exit 0 and no summary. In sampled mode, inside the plant's
+/// process, the plant's own `_exit` sees it: one line naming the FMU and the call, exit 4 (a
+/// lost controller's); in lockstep `controller-fmu` ends and the plant goes on as for any lost
+/// controller: exit 4, `peer_lost`, summary.json and the trace up to the loss.
+#[test]
+fn an_fmu_that_ends_the_process_never_ends_the_plant_with_exit_0() {
+    let dir = TempDir::new("fmu-exit");
+    let paper = scene("paper-10g.toml");
+    let fmu = pd_fmu(&dir, Kind::Cs2, 2);
+    for mode in ["sampled", "lockstep"] {
+        let out = dir.join(mode);
+        let sets = short(
+            mode,
+            &[fmu_set(&fmu), "controller.params={fault = 8, fault_tick = 100}".into(), "scene.duration_s=0.01".into()],
+        );
+        let ran = run(&paper, &out, &sets);
+        assert_exit(&ran, 4);
+        if mode == "sampled" {
+            let err = stderr(&ran);
+            assert!(
+                err.contains("the controller FMU pd (pd-0-2-0.fmu, FMI 2.0 co-simulation) called _exit(0) inside the plant's process"),
+                "{err}"
+            );
+        } else {
+            assert_eq!(read_json(&out.join("summary.json"))["status"], "peer_lost");
+        }
+    }
+}

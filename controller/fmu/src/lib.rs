@@ -869,10 +869,48 @@ impl Drop for Turn {
     }
 }
 
+thread_local! {
+    /// How deep this thread is in the code of an in-process FMU ([`InFmu`]).
+    static IN_FMU: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+}
+
+/// The in-process FMU whose turn it is, in words (for the plant's last line when it ends the
+/// process: [`in_fmu_code`]).
+static CURRENT: std::sync::Mutex<String> = std::sync::Mutex::new(String::new());
+
+/// While alive, this thread runs the code of an in-process FMU: loading and instantiating it
+/// ([`build`]), a tick, freeing and unloading it.
+struct InFmu;
+
+impl InFmu {
+    fn enter() -> Self {
+        IN_FMU.with(|c| c.set(c.get() + 1));
+        InFmu
+    }
+}
+
+impl Drop for InFmu {
+    fn drop(&mut self) {
+        IN_FMU.with(|c| c.set(c.get().saturating_sub(1)));
+    }
+}
+
+/// Whether this thread is inside the code of an in-process FMU (its library loaded, an FMI call
+/// under way), and which FMU: the plant's `exit` and `_exit` ask, to tell an FMU that ends the
+/// process (which it cannot be stopped from doing) from the plant ending it
+/// (docs/guide/fmu-controller.md).
+pub fn in_fmu_code() -> Option<String> {
+    let inside = IN_FMU.try_with(|c| c.get() > 0).unwrap_or(false);
+    inside.then(|| match CURRENT.try_lock() {
+        Ok(s) if !s.is_empty() => s.clone(),
+        _ => "FMU being loaded".to_string(),
+    })
+}
+
 /// An in-process FMU law with its [`Turn`], given back once the FMU is freed and unloaded.
 struct Turned {
-    // First: dropped (the instance freed, the library unloaded) before the turn.
-    law: FmuLaw,
+    // Dropped (the instance freed, the library unloaded) before the turn, inside [`InFmu`].
+    law: std::mem::ManuallyDrop<FmuLaw>,
     _turn: Turn,
 }
 
@@ -882,6 +920,7 @@ impl RotorLaw for Turned {
     }
 
     fn update(&mut self, sample: &RotorSample) -> [f64; ROTOR_AXES] {
+        let _in = InFmu::enter();
         self.law.update(sample)
     }
 
@@ -890,15 +929,33 @@ impl RotorLaw for Turned {
     }
 }
 
+impl Drop for Turned {
+    fn drop(&mut self) {
+        let _in = InFmu::enter();
+        // SAFETY: dropped once, here; the field is not used after.
+        unsafe { std::mem::ManuallyDrop::drop(&mut self.law) };
+        if let Ok(mut s) = CURRENT.lock() {
+            s.clear();
+        }
+    }
+}
+
 /// Opens the FMU of `spec` and builds its law for `design`'s rotor (the plant's sampled mode),
 /// once no other law built here is alive in the process ([`Turn`]).
 pub fn build(spec: &Spec, design: &RotorDesign, params: &Params) -> Result<Box<dyn RotorLaw>, LawError> {
     let turn = Turn::take();
+    let _in = InFmu::enter();
+    if let Ok(mut s) = CURRENT.lock() {
+        *s = format!("FMU {}", file_name(&spec.path));
+    }
     let fmu = Fmu::open(spec).map_err(|e| LawError::Refused { law: LAW_NAME, why: e.to_string() })?;
+    if let Ok(mut s) = CURRENT.lock() {
+        *s = fmu.describe();
+    }
     let law = fmu.law(design, params)?;
     // The law holds the only other handle on the FMU: dropping it unloads the library.
     drop(fmu);
-    Ok(Box::new(Turned { law, _turn: turn }))
+    Ok(Box::new(Turned { law: std::mem::ManuallyDrop::new(law), _turn: turn }))
 }
 
 /// The file name of `path` (for messages).
