@@ -36,7 +36,7 @@
 //! plant reports a lost controller (exit 4), quoting its last output from
 //! `controller.log`, and writes its outputs. A law that closes the library's
 //! file descriptors: exit 1 at once with a line naming the law and the call
-//! ([`SENTINEL`]). Nothing unwinds across the
+//! (a descriptor of its own, checked after each call). Nothing unwinds across the
 //! boundary out of this library: [`amb_serve`] catches a panic of its own and
 //! returns an exit code.
 
