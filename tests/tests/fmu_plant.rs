@@ -485,6 +485,46 @@ fn refused_calls_leave_the_instance_stepping_as_if_never_made() {
     assert_eq!(after, expected, "the instance steps on as one never given the refused calls");
 }
 
+/// Issue 40 item 5: where the plant starts is the scene's, stated and chosen when the FMU is
+/// written. The rotor of `cosim-10g` (m = 11.5 kg, e = 2 µm, 500 Hz, phase 0) starts at t = 0 on
+/// the linear unbalance orbit of the scene's controller design, Z = m e ω² / (k_e − m ω² + j c_e ω)
+/// with c_e = 2 ξ_e √(k_e m) (x = Re Z, y = Im Z): k_e = 1e6 N/m, ξ_e = 0.026 as written, and
+/// another design with `--set`; at rest at the centre with `initial.unbalance_orbit = false`;
+/// shifted by `initial.rotor_x_um`. Each against the closed form, computed here.
+#[test]
+fn the_start_is_the_scenes_controller_designs_orbit_chosen_with_set() {
+    let dir = TempDir::new("fmu-start");
+    let (m, e, w) = (11.5, 2e-6, std::f64::consts::TAU * 500.0);
+    let orbit = |k: f64, xi: f64| {
+        let c = 2.0 * xi * (k * m).sqrt();
+        // m e ω² / (a + j b), a = k − m ω², b = c ω.
+        let (a, b) = (k - m * w * w, c * w);
+        let f = m * e * w * w / (a * a + b * b);
+        [f * a, -f * b]
+    };
+    let cases: [(&str, &[&str], [f64; 2]); 4] = [
+        ("as-written", &[], orbit(1e6, 0.026)),
+        ("other-design", &["controller.stiffness_n_per_m=4e6", "controller.damping_ratio=0.1"], orbit(4e6, 0.1)),
+        ("at-rest", &["initial.unbalance_orbit=false"], [0.0, 0.0]),
+        ("offset", &["initial.rotor_x_um=5"], {
+            let z = orbit(1e6, 0.026);
+            [z[0] + 5e-6, z[1]]
+        }),
+    ];
+    for (name, sets, expected) in cases {
+        let fmu = write_fmu(&dir, &format!("{name}.fmu"), sets);
+        let (xml, unpacked) = unpack(&fmu, &dir, name);
+        let bin = Binary::load(&xml, &unpacked);
+        let a = bin.instantiate();
+        a.initialise();
+        let m = value_references(&xml);
+        let got = a.get(&[m["rotor_x_A"], m["rotor_y_A"]]);
+        for (g, x) in got.iter().zip(expected) {
+            assert!((g - x).abs() <= 1e-12 * e, "{name}: the start is {got:?} m, the closed form {expected:?} m");
+        }
+    }
+}
+
 /// Every bad call returns `fmi2Error` with a log line that says what was wrong, and the
 /// instance goes on where that is possible; a diverging plant returns `fmi2Error` with its time
 /// and state; the instantiation of another FMU's GUID or as model exchange is refused.

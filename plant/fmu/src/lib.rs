@@ -100,6 +100,8 @@ struct Sim {
     outputs: Vec<f64>,
     /// The scene's `scene.duration_s` override that puts its end on the tick grid, if any.
     period: f64,
+    /// Where the plant starts, in words (docs/guide/fmu-plant.md, "Where the plant starts").
+    start: String,
 }
 
 /// One FMU instance.
@@ -238,7 +240,8 @@ impl Instance {
         let limits = scene.rotor_design().current_limits();
         let command = self.command(values, limits);
         let plant = Plant::new(&scene, &Command::Held(command)).map_err(|e| format!("the plant: {e}"))?;
-        let mut sim = Sim { plant, built_with: values.to_vec(), limits, outputs: Vec::new(), period: p };
+        let start = start_words(&scene);
+        let mut sim = Sim { plant, built_with: values.to_vec(), limits, outputs: Vec::new(), period: p, start };
         let mut row = LastRow(None);
         sim.plant.record(&mut row);
         sim.outputs = self.outputs_of(&sim, row.0.as_ref());
@@ -416,12 +419,12 @@ impl Instance {
                 Err(e) => return self.error(&format!("fmi2ExitInitializationMode: {e}")),
             }
         }
-        let Some(period) = self.sim.as_ref().map(|s| s.period) else {
+        let Some((period, start)) = self.sim.as_ref().map(|s| (s.period, s.start.clone())) else {
             return self.error("fmi2ExitInitializationMode: the plant was not built");
         };
         self.phase = Phase::Stepping;
         self.info(&format!(
-            "initialized: {} bearing plane(s), tick {period} s; communication steps are whole multiples of it",
+            "initialized: {} bearing plane(s), tick {period} s; communication steps are whole multiples of it; {start}",
             self.model.planes
         ));
         OK
@@ -587,6 +590,31 @@ impl Instance {
         self.start_time = state.start_time;
         OK
     }
+}
+
+/// Where the plant of `scene` starts, in words: `plant run`'s initial state of the scene, which
+/// the scene's controller design sets (docs/guide/fmu-plant.md, "Where the plant starts").
+fn start_words(scene: &plant::config::Scene) -> String {
+    let c = &scene.controller;
+    let i = &scene.initial;
+    let orbit = if i.unbalance_orbit {
+        format!(
+            "on the unbalance orbit of the scene's controller design (controller.stiffness_n_per_m = {} N/m, \
+             controller.damping_ratio = {}{})",
+            c.stiffness,
+            c.damping_ratio,
+            if scene.planes() > 1 { ", each plane's on its load share" } else { "" }
+        )
+    } else {
+        "at rest at the centre (initial.unbalance_orbit = false)".to_string()
+    };
+    let sag = if c.gravity_bias { "" } else { ", sagged by m g / k_e (controller.gravity_bias = false)" };
+    format!(
+        "the plant starts {orbit}{sag}, offset by initial.rotor_x_um = {}, initial.rotor_y_um = {} um \
+         (plant fmu SCENE --set KEY=VALUE chooses another start)",
+        i.rotor_offset[0] * 1e6,
+        i.rotor_offset[1] * 1e6
+    )
 }
 
 /// The serialised state's format.
