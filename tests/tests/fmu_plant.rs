@@ -525,6 +525,28 @@ fn the_start_is_the_scenes_controller_designs_orbit_chosen_with_set() {
     }
 }
 
+/// Issue 40 item 7: the FMU's `resources/scene.toml` replaced by a FIFO (or a file of `/proc`)
+/// is refused at `fmi2Instantiate` at once, with a log line naming it: it blocked the importer.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_fifo_as_the_fmus_scene_is_refused_at_once() {
+    let dir = TempDir::new("fmu-scene-fifo");
+    let fmu = write_fmu(&dir, "plant.fmu", &[]);
+    let (xml, unpacked) = unpack(&fmu, &dir, "plant");
+    let scene_file = unpacked.join("resources/scene.toml");
+    for (what, make) in [
+        ("a FIFO", &(|p: &Path| assert!(Command::new("mkfifo").arg(p).status().unwrap().success())) as &dyn Fn(&Path)),
+        ("a file of /proc", &|p: &Path| std::os::unix::fs::symlink("/proc/self/status", p).unwrap()),
+    ] {
+        std::fs::remove_file(&scene_file).unwrap();
+        make(&scene_file);
+        let bin = Binary::load(&xml, &unpacked);
+        let log = bin.instantiate_as(1, &bin.guid).err().unwrap_or_else(|| panic!("{what}: instantiated"));
+        let line = &log.last().expect("a log line").1;
+        assert!(line.contains("scene.toml") && line.contains("not a regular file"), "{what}: {line}");
+    }
+}
+
 /// Every bad call returns `fmi2Error` with a log line that says what was wrong, and the
 /// instance goes on where that is possible; a diverging plant returns `fmi2Error` with its time
 /// and state; the instantiation of another FMU's GUID or as model exchange is refused.
