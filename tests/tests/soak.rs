@@ -322,7 +322,8 @@ fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted
         "max_contact_force_n": 0.0, "contact_time_s": 0.0, "contact_episodes": 0, "max_radius_m": 1e-5,
         "complete": true
     });
-    let edits: [(&str, &dyn Fn(&mut serde_json::Value)); 4] = [
+    type Edit<'a> = (&'a str, &'a dyn Fn(&mut serde_json::Value));
+    let edits: [Edit; 4] = [
         ("figures[0].index = 99", &|c| c["figures"] = serde_json::json!([figure])),
         ("tracker.current = 99", &|c| c["tracker"]["current"] = 99.into()),
         ("tracker.starts has 1 shock starts", &|c| c["tracker"]["starts"] = serde_json::json!([0.02])),
