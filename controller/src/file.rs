@@ -216,13 +216,43 @@ const MAX_FILE_BYTES: u64 = 16 << 20;
 /// Reads a `--config` file without trusting it: a regular file of at most [`MAX_FILE_BYTES`]
 /// (a device such as `/dev/zero` or a FIFO is refused before it is read; the plant's files go
 /// through `shock_table::input`, which this crate does not depend on).
+///
+/// Opened with `O_NONBLOCK` (issue 40 item 7): a regular file of `/proc` such as `/proc/kmsg`
+/// would wait in its read; a file whose size is 0 but which reads bytes or would wait is refused.
 fn read_input(path: &Path) -> std::io::Result<String> {
     use std::io::{Error, ErrorKind, Read};
+    let refuse = |why: &str| Error::new(ErrorKind::InvalidInput, why.to_string());
     if !std::fs::metadata(path)?.is_file() {
-        return Err(Error::new(ErrorKind::InvalidInput, "not a regular file (a device, a FIFO or a folder)"));
+        return Err(refuse("not a regular file (a device, a FIFO or a folder)"));
+    }
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // Linux's O_NONBLOCK, written here: this crate's libc is only in its `ipc` feature.
+        const O_NONBLOCK: i32 = 0o4000;
+        options.custom_flags(O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(refuse("not a regular file (a device, a FIFO or a folder)"));
     }
     let mut text = String::new();
-    std::fs::File::open(path)?.take(MAX_FILE_BYTES + 1).read_to_string(&mut text)?;
+    match file.take(MAX_FILE_BYTES + 1).read_to_string(&mut text) {
+        Err(e) if e.kind() == ErrorKind::WouldBlock => {
+            return Err(refuse(
+                "not a regular file with a size: reading it would wait (a file of /proc such as /proc/kmsg)",
+            ))
+        }
+        r => r?,
+    };
+    if meta.len() == 0 && !text.is_empty() {
+        return Err(refuse(
+            "not a regular file with a size: its size is 0 but reading it gives bytes (a file of /proc or /sys)",
+        ));
+    }
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(Error::new(ErrorKind::InvalidInput, format!("more than {MAX_FILE_BYTES} bytes")));
     }

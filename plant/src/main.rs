@@ -6,6 +6,7 @@
 //! holds the codes and the one map; `docs/guide/running.md` the table).
 
 mod cli;
+mod fmu_exit;
 
 use anyhow::Context;
 use clap::{CommandFactory, FromArgMatches};
@@ -37,6 +38,7 @@ fn parse_cli() -> Cli {
 }
 
 fn main() -> ExitCode {
+    fmu_exit::keep();
     let cli = parse_cli();
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Fatal);
     match run(cli) {

@@ -4,6 +4,8 @@
  *   nan      update answers NaN from sample 100 on
  *   inf      update answers +inf on x and -inf on y from sample 100 on
  *   abort    update aborts at sample 100 (after a line on stderr)
+ *   closefds update closes every file descriptor from 3 to 1023 at sample 100 (the library's
+ *            own: its IPC's, its lock's) after a line on stderr, and answers on
  *   null     the law's update pointer is NULL
  *   refuse   build refuses the design with a message
  *   version  the law says it was built against ABI version 99
@@ -13,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "amb_testbed_controller.h"
 
@@ -44,6 +47,13 @@ static void faulty_update(void *state, const amb_sample *s, double *current_a) {
         fprintf(stderr, "faulty: aborting at sample %llu\n", (unsigned long long)s->seq);
         fflush(stderr);
         abort();
+    }
+    if (s->seq == 100 && strcmp(law->fault, "closefds") == 0) {
+        fprintf(stderr, "faulty: closing the file descriptors 3 to 1023 at sample 100\n");
+        fflush(stderr);
+        for (int fd = 3; fd < 1024; fd++) {
+            close(fd);
+        }
     }
     if (s->seq >= 100 && strcmp(law->fault, "inf") == 0) {
         current_a[0] = INFINITY;

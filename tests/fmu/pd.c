@@ -13,8 +13,11 @@
  *
  * Parameters: kp, kd, amp_gain, bias_y (plane A; the planar model's), kp_b, kd_b, amp_gain_b,
  * bias_y_b (plane B), tau (model exchange), and the misbehaviours the tests need: fault
- * (0 none, 1 Discard, 2 Error, 3 Fatal from the step, 4 NaN currents, 5 SIGSEGV, 6 hang)
- * from step fault_tick on.
+ * (0 none, 1 Discard, 2 Error, 3 Fatal from the step, 4 NaN currents, 5 SIGSEGV, 6 hang,
+ * 7 one per process, 8 _exit(0)) from step fault_tick on. "One per process" is an FMU that
+ * takes what is the process's, as a pythonfmu FMU takes the Python interpreter: from its
+ * step it holds an abstract socket named after the process, and aborts (as two Python hosts
+ * in one process crash) when another instance of it, in any copy of the library, holds it.
  *
  * The FMI types: with -DFMI_HEADERS the headers FMPy ships (fmpy/c-code/fmi2Functions.h,
  * fmi3Functions.h; the include path given with -I), so that the compiler checks every
@@ -25,6 +28,9 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #ifndef AXES
@@ -42,6 +48,7 @@ typedef struct {
     double speed, angle, time;
     double kp[2], kd[2], amp[2], bias[2], tau;
     int fault, fault_tick, ticks, first;
+    int held; /* fault 7: the process's socket, or -1 */
 } Pd;
 
 static double *real_of(Pd *c, unsigned vr) {
@@ -70,7 +77,24 @@ static Pd *create(void) {
     for (int p = 0; p < 2; p++) { c->kp[p] = 1.0; c->kd[p] = 0.0; c->amp[p] = 1.0; }
     c->tau = 1e-4;
     c->first = 1;
+    c->held = -1;
     return c;
+}
+
+/* Fault 7: binds the process's abstract socket; abort() when another instance holds it. */
+static void hold_the_process(Pd *c) {
+    struct sockaddr_un a;
+    memset(&a, 0, sizeof a);
+    a.sun_family = AF_UNIX;
+    int n = snprintf(a.sun_path + 1, sizeof a.sun_path - 1, "amb-testbed-pd-fmu-%d", (int)getpid());
+    c->held = socket(AF_UNIX, SOCK_STREAM, 0);
+    if (c->held < 0 || bind(c->held, (struct sockaddr *)&a, (socklen_t)(offsetof(struct sockaddr_un, sun_path) + 1 + n)))
+        abort();
+}
+
+static void destroy(Pd *c) {
+    if (c && c->held >= 0) close(c->held);
+    free(c);
 }
 
 /* i = bias - A_a (k_p u + k_d u_dot), per axis; bias on y only (as PdGains::current). */
@@ -92,6 +116,8 @@ static int misbehave(Pd *c) {
     case 4: for (int k = 0; k < AXES; k++) c->out[k] = NAN; return 0;
     case 5: { volatile int *nowhere = NULL; *nowhere = 1; return 0; }
     case 6: for (;;) sleep(1);
+    case 7: if (c->held < 0) hold_the_process(c); return 0;
+    case 8: _exit(0);
     default: return 0;
     }
 }
@@ -148,7 +174,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     if (c && logger) logger(f->componentEnvironment, name, 0, "logAll", "pd: instantiated");
     return c;
 }
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT void fmi2FreeInstance(fmi2Component c) { destroy(c); }
 EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean a, fmi2Real b, fmi2Real d, fmi2Boolean e,
                                       fmi2Real g) {
     (void)c; (void)a; (void)b; (void)d; (void)e; (void)g; return 0; }
@@ -255,7 +281,7 @@ EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String toke
     if (c && log) log(env, 0, "logAll", "pd: instantiated (FMI 3.0)");
     return c;
 }
-EXPORT void fmi3FreeInstance(fmi3Instance c) { free(c); }
+EXPORT void fmi3FreeInstance(fmi3Instance c) { destroy(c); }
 EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean a, fmi3Float64 b, fmi3Float64 d, fmi3Boolean e,
                                               fmi3Float64 g) {
     (void)c; (void)a; (void)b; (void)d; (void)e; (void)g; return 0; }

@@ -227,6 +227,60 @@ fn keys_of_a_choice_not_made_and_absurd_stiffness_are_refused_at_load() {
     }
 }
 
+/// Issue 40 item 7: a regular file of `/proc` waits in its read (`/proc/kmsg`) or reads bytes
+/// though its size is 0 (`/proc/self/status`), and a FIFO waits in its opening. At each entry
+/// that reads a user's file (the scene, `--from-state`, a soak programme, an assessment, the
+/// controller's `--config`), a FIFO and `/proc/self/status` are refused at once, exit 2, named
+/// (the bounded reader opens with `O_NONBLOCK` and wants a regular file with a size).
+#[cfg(target_os = "linux")]
+#[test]
+fn every_entry_refuses_a_fifo_and_a_size_0_file_of_proc_at_once() {
+    let dir = TempDir::new("bounds-entries");
+    let fifo = dir.join("fifo");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let status = Path::new("/proc/self/status");
+    let paper = scene("paper-10g.toml");
+    let controller = common::controller_bin();
+    for input in [fifo.as_path(), status] {
+        let shown = input.display().to_string();
+        let out = dir.join("out");
+        let cases: Vec<(&str, Command)> = vec![
+            ("run", {
+                let mut c = Command::new(plant_bin());
+                c.arg("run").arg(input).arg("--out").arg(&out);
+                c
+            }),
+            ("from-state", {
+                let mut c = Command::new(plant_bin());
+                c.arg("run").arg(&paper).arg("--from-state").arg(input).arg("--out").arg(&out);
+                c
+            }),
+            ("soak", {
+                let mut c = Command::new(plant_bin());
+                c.arg("soak").arg(input).arg("--out").arg(&out);
+                c
+            }),
+            ("assess", {
+                let mut c = Command::new(plant_bin());
+                c.arg("assess").arg(input).arg("--out").arg(&out);
+                c
+            }),
+            ("controller --config", {
+                let mut c = Command::new(controller);
+                c.arg("--config").arg(input).args(["--run-id", "bounds-entries"]);
+                c
+            }),
+        ];
+        for (name, mut cmd) in cases {
+            let o = output_within(&mut cmd, QUICK);
+            assert_exit(&o, 2);
+            let err = stderr(&o);
+            assert!(err.contains(&shown) && err.contains("not a regular file"), "{name} {shown}: {err}");
+            assert!(!out.exists(), "{name} {shown}: bad input wrote {}", out.display());
+        }
+    }
+}
+
 /// Issue 31 item 8: `plant assess` read its file without a bound (`/dev/zero` grew without
 /// end, a FIFO blocked for ever, both deaf to SIGTERM), and a sweep its unit files likewise.
 /// Every file a command reads goes through the one bounded reader: what is not a regular

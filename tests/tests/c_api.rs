@@ -244,6 +244,17 @@ fn faults_of_a_c_law_are_named_with_their_exit_codes() {
             "peer_lost",
             vec!["controller lost", "SIGABRT", "faulty: aborting at sample 100", "controller.log"],
         ),
+        // Issue 40 item 7: a law that closes the library's descriptors ends the controller with
+        // an exit code of its own, not an abort.
+        (
+            "closefds",
+            &faulty,
+            "closefds",
+            vec![],
+            4,
+            "peer_lost",
+            vec!["controller lost", "law `faulty` closed the library's file descriptors in its `update`", "exiting 1"],
+        ),
         (
             "throw",
             &throwing,
@@ -293,6 +304,7 @@ fn faults_of_a_c_law_are_named_with_their_exit_codes() {
         for n in &needles {
             assert!(err.contains(n), "{name}: no {n:?} in\n{err}");
         }
+        assert!(name != "closefds" || !err.contains("SIGABRT"), "{name}: the controller aborted:\n{err}");
         let s = read_json(&out.join("summary.json"));
         assert_eq!(s["status"], status, "{name}: {s:#}");
         assert!(out.join("scene.toml").is_file(), "{name}");

@@ -603,3 +603,174 @@ fn plant_assess_grades_an_fmu_controller_like_the_rust_pd() {
     assert_eq!(fmu["status"], "measured", "{fmu:#}");
     assert_eq!(rust["result"], fmu["result"], "the FMU's vibration figures differ from the Rust pd's");
 }
+
+/// Issue 40 item 5: in-process FMUs of an assessment's members cannot share what is the
+/// process's. The `pd` of `pd.c` with fault 7 holds a resource of the process from its first
+/// step and aborts when another instance holds it, as two pythonfmu FMUs (two Python hosts in
+/// one process) crashed the plant; `plant assess` in `sampled` mode measures both axes' sensitivity
+/// (in parallel, two threads at least) with it and finishes, each axis's figures the Rust `pd`'s
+/// to the bit.
+#[test]
+fn an_assessment_of_in_process_fmus_that_hold_the_process_finishes() {
+    let dir = TempDir::new("fmu-assess-one-at-a-time");
+    let paper = scene("paper-10g.toml");
+    let params = pd_params(&paper, &short("sampled", &[]));
+    let held = format!("{}, fault = 7, fault_tick = 0}}", params.strip_suffix('}').unwrap());
+    let fmu = pd_fmu(&dir, Kind::Cs2, 2);
+    let file = dir.join("assess.toml");
+    let quoted = |s: &str| format!("{s:?}");
+    let text = format!(
+        "scene = {}\nset = [\"controller.mode=\\\"sampled\\\"\", \"scene.duration_s=0.3\"]\nparts = [\"sensitivity\"]\n\
+         [[controller]]\nlabel = \"rust\"\nset = [\"controller.law=\\\"pd\\\"\"]\n\
+         [[controller]]\nlabel = \"fmu\"\nset = [{}, {}]\n\
+         [sensitivity]\nf_min_hz = 20.0\nf_max_hz = 200.0\npoints = 4\nprobe_s = 0.3\nresolution = 0.05\nspeeds = [\"standstill\"]\n",
+        quoted(&paper.display().to_string()),
+        quoted(&fmu_set(&fmu)),
+        quoted(&held),
+    );
+    std::fs::write(&file, text).unwrap();
+    host_built();
+    let out = dir.join("report");
+    let ran =
+        output(Command::new(plant_bin()).env("RAYON_NUM_THREADS", "2").arg("assess").arg(&file).arg("--out").arg(&out));
+    assert_exit(&ran, 0);
+    let report = read_json(&out.join("report.json"));
+    let c = report["controllers"].as_array().unwrap();
+    let (rust, fmu) = (&c[0]["sensitivity"], &c[1]["sensitivity"]);
+    assert_eq!(fmu["status"], "measured", "{fmu:#}");
+    let axes = |s: &serde_json::Value| s["result"]["axes"].as_array().cloned().unwrap_or_default();
+    assert_eq!(axes(fmu).len(), 2, "{fmu:#}");
+    assert_eq!(axes(rust), axes(fmu), "the FMU's sensitivity differs from the Rust pd's");
+}
+
+/// Issue 40 item 5: an FMU that ends the process (`_exit(0)` at step 100, `pd.c` fault 8) never
+/// leaves the plant ending with exit 0 and no summary. In sampled mode, inside the plant's
+/// process, the plant's own `_exit` sees it: one line naming the FMU and the call, exit 4 (a
+/// lost controller's); in lockstep `controller-fmu` ends and the plant goes on as for any lost
+/// controller: exit 4, `peer_lost`, summary.json and the trace up to the loss.
+#[test]
+fn an_fmu_that_ends_the_process_never_ends_the_plant_with_exit_0() {
+    let dir = TempDir::new("fmu-exit");
+    let paper = scene("paper-10g.toml");
+    let fmu = pd_fmu(&dir, Kind::Cs2, 2);
+    for mode in ["sampled", "lockstep"] {
+        let out = dir.join(mode);
+        let sets = short(
+            mode,
+            &[fmu_set(&fmu), "controller.params={fault = 8, fault_tick = 100}".into(), "scene.duration_s=0.01".into()],
+        );
+        let ran = run(&paper, &out, &sets);
+        assert_exit(&ran, 4);
+        if mode == "sampled" {
+            let err = stderr(&ran);
+            assert!(
+                err.contains("the controller FMU pd (pd-0-2-0.fmu, FMI 2.0 co-simulation) called _exit(0) inside the plant's process"),
+                "{err}"
+            );
+        } else {
+            assert_eq!(read_json(&out.join("summary.json"))["status"], "peer_lost");
+        }
+    }
+}
+
+/// Issue 40 item 5: what an FMU file can do to its host before any of its code runs. A zip bomb
+/// (an entry that unpacks past the limit) and an archive of too many entries are refused naming
+/// the limit, before anything is written; a FIFO given as the FMU is refused at once (it blocked
+/// the plant and `controller-fmu`), exit 2; the copy a killed `controller-fmu` leaves behind is
+/// removed by the next run that opens an FMU, which removes its own too.
+#[cfg(target_os = "linux")]
+#[test]
+fn bombs_fifos_and_leaked_copies() {
+    let dir = TempDir::new("fmu-bombs");
+    let paper = scene("paper-10g.toml");
+    let so = compile(&dir.join(""), Kind::Cs2, 2);
+    let md = model_description(Kind::Cs2, 2, "2.0", "");
+    std::fs::write(dir.join("pd.so"), &so).unwrap();
+    std::fs::write(dir.join("md.xml"), &md).unwrap();
+    // Python's zlib writes 600 MiB of zeros as about 600 kB in a second or two.
+    let python = |out: &str, body: &str| {
+        let code = format!(
+            "import zipfile\nz = zipfile.ZipFile({out:?}, 'w', zipfile.ZIP_DEFLATED)\n\
+             z.write({md:?}, 'modelDescription.xml')\nz.write({so:?}, 'binaries/linux64/pd.so')\n{body}\nz.close()\n",
+            out = dir.join(out).display().to_string(),
+            md = dir.join("md.xml").display().to_string(),
+            so = dir.join("pd.so").display().to_string(),
+        );
+        let ran = output(Command::new("python3").arg("-c").arg(code));
+        assert_exit(&ran, 0);
+        dir.join(out)
+    };
+    let bomb = python(
+        "bomb.fmu",
+        "with z.open('resources/zeros.bin', 'w', force_zip64=True) as f:\n    for _ in range(600):\n        f.write(bytes(1 << 20))",
+    );
+    assert!(std::fs::metadata(&bomb).unwrap().len() < 8 << 20);
+    let many = python("many.fmu", "for i in range(10001):\n    z.writestr('resources/%d' % i, b'')");
+    let tmp = dir.join("tmp");
+    std::fs::create_dir_all(&tmp).unwrap();
+    let run_in = |name: &str, fmu: &Path| {
+        host_built();
+        let mut cmd = Command::new(plant_bin());
+        cmd.env("TMPDIR", &tmp).arg("run").arg(&paper).arg("--out").arg(dir.join(name));
+        for s in short(
+            "sampled",
+            &[fmu_set(fmu), pd_params(&paper, &short("sampled", &[])), "scene.duration_s=0.002".into()],
+        ) {
+            cmd.args(["--set", &s]);
+        }
+        output(&mut cmd)
+    };
+    let copies = || -> Vec<String> {
+        std::fs::read_dir(&tmp)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with("amb-testbed-fmu-"))
+            .collect()
+    };
+    for (name, fmu, needle) in [
+        ("bomb", &bomb, "unpacked, it holds more than 512 MiB (the limit of an FMU's unpacked size"),
+        ("many", &many, "10003 entries in the archive; an FMU may hold at most 10000"),
+    ] {
+        let ran = run_in(name, fmu);
+        assert_exit(&ran, 2);
+        assert!(stderr(&ran).contains(needle), "{name}: no {needle:?} in\n{}", stderr(&ran));
+        assert_eq!(copies(), Vec::<String>::new(), "{name}: the refused FMU's copy is removed");
+    }
+
+    // A FIFO: refused at once by the plant (the scene's check) and by controller-fmu.
+    let fifo = dir.join("fifo.fmu");
+    let c = std::ffi::CString::new(fifo.display().to_string()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let ran = run_in("fifo", &fifo);
+    assert_exit(&ran, 2);
+    assert!(stderr(&ran).contains("a FIFO, not a regular file"), "{}", stderr(&ran));
+    let host = plant_bin().with_file_name("controller-fmu");
+    let ran = output(Command::new(&host).arg("--fmu").arg(&fifo).args(["--run-id", "fifo"]));
+    assert_exit(&ran, 2);
+    assert!(stderr(&ran).contains("a FIFO, not a regular file"), "{}", stderr(&ran));
+
+    // A controller-fmu killed while it serves leaves its copy; the next run removes it.
+    let good = pd_fmu(&dir, Kind::Cs2, 2);
+    let mut child = Command::new(&host)
+        .env("TMPDIR", &tmp)
+        .arg("--fmu")
+        .arg(&good)
+        .args(["--run-id", "leaked-copy"])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + LIMIT;
+    while copies().is_empty() {
+        assert!(child.try_wait().unwrap().is_none(), "controller-fmu ended before it unpacked the FMU");
+        assert!(std::time::Instant::now() < deadline, "controller-fmu never unpacked the FMU");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let leaked = copies();
+    assert_eq!(leaked.len(), 1, "the killed controller-fmu's copy is left: {leaked:?}");
+    let ran = run_in("after", &good);
+    assert_exit(&ran, 0);
+    assert_eq!(copies(), Vec::<String>::new(), "the next run removed the leaked copy and its own");
+}

@@ -412,6 +412,141 @@ fn drive_one(inst: &Instance, vr: &Vrs, k: u64, prev: [f64; 2]) -> (Vec<u64>, [f
     (inst.get(&vr.outputs).iter().map(|v| v.to_bits()).collect(), [s[0], s[1]])
 }
 
+/// Issue 40 item 5: a refused call changes nothing. An instance given, at tick 120, every kind
+/// of state `fmi2SetFMUstate` refuses (a time off its tick, a stepping state without its plant,
+/// a parameter out of its bounds, a state of other parameters whose plant refuses the
+/// snapshot) and other refused calls (inputs with one NaN among them, a parameter
+/// while stepping, a step off the time or off the tick grid) keeps its inputs and steps on
+/// writing, bit for bit, the outputs of an instance never given them.
+#[test]
+fn refused_calls_leave_the_instance_stepping_as_if_never_made() {
+    let dir = TempDir::new("fmu-refused");
+    let fmu = write_fmu(&dir, "plant.fmu", &[]);
+    let (xml, unpacked) = unpack(&fmu, &dir, "plant");
+    let bin = Binary::load(&xml, &unpacked);
+    let clean = bin.instantiate();
+    clean.initialise();
+    let vr = vrs(&xml, &clean);
+    let (_, prev) = drive(&clean, &vr, 0, 120, [0.0; 2]);
+    let (expected, _) = drive(&clean, &vr, 120, 200, prev);
+
+    let a = bin.instantiate();
+    a.initialise();
+    let (_, prev_a) = drive(&a, &vr, 0, 120, [0.0; 2]);
+    assert_eq!(prev_a, prev);
+    let s = a.get_state();
+    let bytes = a.serialize(s);
+    a.free_state(s);
+    let magic = &bytes[..bytes.iter().position(|&b| b == b'\n').unwrap() + 1];
+    let json: serde_json::Value =
+        serde_json::from_slice(&bytes[magic.len()..]).expect("a state is JSON after its magic");
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut j = json.clone();
+        f(&mut j);
+        [magic, serde_json::to_string(&j).unwrap().as_bytes()].concat()
+    };
+    let peak = vr.peak as usize;
+    let states: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("a time off its tick", edited(&|j| j["snapshot"]["t_s"] = 0.5.into()), "is not tick 120"),
+        (
+            "stepping without a plant",
+            edited(&|j| {
+                j["snapshot"] = serde_json::Value::Null;
+                j["outputs"] = serde_json::Value::Null;
+            }),
+            "without its plant",
+        ),
+        ("a parameter out of bounds", edited(&|j| j["values"][peak] = 5000.0.into()), "outside its bounds"),
+        (
+            "other parameters and a time off its tick",
+            edited(&|j| {
+                j["values"][peak] = 3.0.into();
+                j["snapshot"]["t_s"] = 0.5.into();
+            }),
+            "",
+        ),
+    ];
+    let inputs = a.get(&vr.inputs);
+    for (what, bytes, says) in &states {
+        let s = a.deserialize(bytes).unwrap_or_else(|e| panic!("{what}: well-formed, yet {e}: {:?}", a.log()));
+        assert_eq!(a.set_state(s), ERROR, "{what}");
+        let line = a.last_error();
+        assert!(line.contains("fmi2SetFMUstate") && line.contains(says), "{what}: {line}");
+        a.free_state(s);
+    }
+    assert_eq!(a.set(&vr.inputs, &[1.0, f64::NAN]), ERROR);
+    assert_eq!(a.set(&[vr.peak], &[5.0]), ERROR);
+    assert_eq!(a.get(&vr.inputs), inputs, "the refused calls took no input");
+    let t = 120.0 * 5e-5;
+    assert_eq!(a.step(t + 1e-3, 5e-5), ERROR);
+    assert_eq!(a.step(t, 0.5 * 5e-5), ERROR);
+    assert!(a.log().iter().all(|(_, line)| !line.contains("internal error")), "{:?}", a.log());
+    let (after, _) = drive(&a, &vr, 120, 200, prev);
+    assert_eq!(after, expected, "the instance steps on as one never given the refused calls");
+}
+
+/// Issue 40 item 5: where the plant starts is the scene's, stated and chosen when the FMU is
+/// written. The rotor of `cosim-10g` (m = 11.5 kg, e = 2 µm, 500 Hz, phase 0) starts at t = 0 on
+/// the linear unbalance orbit of the scene's controller design, Z = m e ω² / (k_e − m ω² + j c_e ω)
+/// with c_e = 2 ξ_e √(k_e m) (x = Re Z, y = Im Z): k_e = 1e6 N/m, ξ_e = 0.026 as written, and
+/// another design with `--set`; at rest at the centre with `initial.unbalance_orbit = false`;
+/// shifted by `initial.rotor_x_um`. Each against the closed form, computed here.
+#[test]
+fn the_start_is_the_scenes_controller_designs_orbit_chosen_with_set() {
+    let dir = TempDir::new("fmu-start");
+    let (m, e, w) = (11.5, 2e-6, std::f64::consts::TAU * 500.0);
+    let orbit = |k: f64, xi: f64| {
+        let c = 2.0 * xi * (k * m).sqrt();
+        // m e ω² / (a + j b), a = k − m ω², b = c ω.
+        let (a, b) = (k - m * w * w, c * w);
+        let f = m * e * w * w / (a * a + b * b);
+        [f * a, -f * b]
+    };
+    let cases: [(&str, &[&str], [f64; 2]); 4] = [
+        ("as-written", &[], orbit(1e6, 0.026)),
+        ("other-design", &["controller.stiffness_n_per_m=4e6", "controller.damping_ratio=0.1"], orbit(4e6, 0.1)),
+        ("at-rest", &["initial.unbalance_orbit=false"], [0.0, 0.0]),
+        ("offset", &["initial.rotor_x_um=5"], {
+            let z = orbit(1e6, 0.026);
+            [z[0] + 5e-6, z[1]]
+        }),
+    ];
+    for (name, sets, expected) in cases {
+        let fmu = write_fmu(&dir, &format!("{name}.fmu"), sets);
+        let (xml, unpacked) = unpack(&fmu, &dir, name);
+        let bin = Binary::load(&xml, &unpacked);
+        let a = bin.instantiate();
+        a.initialise();
+        let m = value_references(&xml);
+        let got = a.get(&[m["rotor_x_A"], m["rotor_y_A"]]);
+        for (g, x) in got.iter().zip(expected) {
+            assert!((g - x).abs() <= 1e-12 * e, "{name}: the start is {got:?} m, the closed form {expected:?} m");
+        }
+    }
+}
+
+/// Issue 40 item 7: the FMU's `resources/scene.toml` replaced by a FIFO (or a file of `/proc`)
+/// is refused at `fmi2Instantiate` at once, with a log line naming it: it blocked the importer.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_fifo_as_the_fmus_scene_is_refused_at_once() {
+    let dir = TempDir::new("fmu-scene-fifo");
+    let fmu = write_fmu(&dir, "plant.fmu", &[]);
+    let (xml, unpacked) = unpack(&fmu, &dir, "plant");
+    let scene_file = unpacked.join("resources/scene.toml");
+    for (what, make) in [
+        ("a FIFO", &(|p: &Path| assert!(Command::new("mkfifo").arg(p).status().unwrap().success())) as &dyn Fn(&Path)),
+        ("a file of /proc", &|p: &Path| std::os::unix::fs::symlink("/proc/self/status", p).unwrap()),
+    ] {
+        std::fs::remove_file(&scene_file).unwrap();
+        make(&scene_file);
+        let bin = Binary::load(&xml, &unpacked);
+        let log = bin.instantiate_as(1, &bin.guid).err().unwrap_or_else(|| panic!("{what}: instantiated"));
+        let line = &log.last().expect("a log line").1;
+        assert!(line.contains("scene.toml") && line.contains("not a regular file"), "{what}: {line}");
+    }
+}
+
 /// Every bad call returns `fmi2Error` with a log line that says what was wrong, and the
 /// instance goes on where that is possible; a diverging plant returns `fmi2Error` with its time
 /// and state; the instantiation of another FMU's GUID or as model exchange is refused.

@@ -207,7 +207,8 @@ fn a_soak_whose_controller_never_starts_leaves_soak_json() {
 /// header and whole rows only (no torn last row, no missing header). Issue 28 item 5: it
 /// continues from its last checkpoint (`plant soak --resume`), and its `soak.csv` and
 /// `envelope.csv` are then byte for byte those of the soak that never stopped; a resume under
-/// another programme, or on a folder without a checkpoint, is refused with exit 2 and touches
+/// another programme, on a folder without a checkpoint, or from a checkpoint whose monitor was
+/// edited (a shock index out of range, issue 40 item 7) is refused with exit 2 and touches
 /// nothing.
 #[cfg(target_os = "linux")]
 #[test]
@@ -312,6 +313,35 @@ fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted
     let out = output_within(soak(&file, &dir.join("nothing"), &[]).arg("--resume"), LIMIT);
     assert_exit(&out, 2);
     assert!(stderr(&out).contains("no checkpoint"), "{}", stderr(&out));
+
+    // An edited checkpoint's monitor (issue 40 item 7: a shock index out of range panicked):
+    // each refused with exit 2, naming the field, nothing touched.
+    let saved: serde_json::Value = read_json(&cut.join("soak-state.json"));
+    let figure = serde_json::json!({
+        "index": 99, "start_s": 0.02, "end_s": 0.1, "recovered": true, "recovery_s": 0.01,
+        "max_contact_force_n": 0.0, "contact_time_s": 0.0, "contact_episodes": 0, "max_radius_m": 1e-5,
+        "complete": true
+    });
+    type Edit<'a> = (&'a str, &'a dyn Fn(&mut serde_json::Value));
+    let edits: [Edit; 4] = [
+        ("figures[0].index = 99", &|c| c["figures"] = serde_json::json!([figure])),
+        ("tracker.current = 99", &|c| c["tracker"]["current"] = 99.into()),
+        ("tracker.starts has 1 shock starts", &|c| c["tracker"]["starts"] = serde_json::json!([0.02])),
+        ("envelope.bin is 0.5 s", &|c| c["envelope"]["bin"] = 0.5.into()),
+    ];
+    for (says, edit) in edits {
+        let mut c = saved.clone();
+        edit(&mut c);
+        std::fs::write(cut.join("soak-state.json"), serde_json::to_string(&c).unwrap()).unwrap();
+        let out = output_within(soak(&file, &cut, &[]).arg("--resume"), LIMIT);
+        assert_exit(&out, 2);
+        assert!(stderr(&out).contains(says) && stderr(&out).contains("edited or foreign"), "{says}: {}", stderr(&out));
+        for (name, bytes) in before.iter().filter(|(n, _)| n != "soak-state.json") {
+            assert_eq!(&std::fs::read(cut.join(name)).unwrap(), bytes, "{name} was touched by a refused resume");
+        }
+    }
+    let original = &before.iter().find(|(n, _)| n == "soak-state.json").unwrap().1;
+    std::fs::write(cut.join("soak-state.json"), original).unwrap();
 
     // The resume goes on from the checkpoint to the uninterrupted soak's files.
     let out = output_within(soak(&file, &cut, &[]).arg("--resume"), LIMIT);

@@ -34,7 +34,9 @@
 //! escapes it: the functions are `C-unwind`, and Rust cannot catch a foreign
 //! exception, so the process aborts with a message) ends the process: the
 //! plant reports a lost controller (exit 4), quoting its last output from
-//! `controller.log`, and writes its outputs. Nothing unwinds across the
+//! `controller.log`, and writes its outputs. A law that closes the library's
+//! file descriptors: exit 1 at once with a line naming the law and the call
+//! (a descriptor of its own, checked after each call). Nothing unwinds across the
 //! boundary out of this library: [`amb_serve`] catches a panic of its own and
 //! returns an exit code.
 
@@ -334,6 +336,7 @@ fn build(
             error.len(),
         )
     };
+    check_descriptors(law.name, "build");
     if state.is_null() {
         if let Some(e) = handle.error {
             return Err(e);
@@ -351,6 +354,52 @@ fn build(
     }
     handle.reader.finish()?; // refuses the keys the law did not read (the adapter drops the state)
     Ok(Box::new(adapter))
+}
+
+/// A descriptor of the library's own, `/dev/null` opened when [`amb_serve`] starts, with its
+/// device and inode: a law that closes the library's descriptors (a daemon's
+/// `for (fd = 3; fd < 1024; fd++) close(fd);`) closes it too. The library looks after each of
+/// the law's calls, before its IPC uses descriptors that are gone: iceoryx2 then panicked and a
+/// destructor panicked again while unwinding, which aborts the process (issue 40 item 7).
+static SENTINEL: OnceLock<(c_int, u64, u64)> = OnceLock::new();
+
+/// Opens [`SENTINEL`] (once per process; without it nothing is checked).
+fn open_sentinel() {
+    SENTINEL.get_or_init(|| {
+        // SAFETY: a NUL-terminated path; the descriptor is kept for the process's life.
+        let fd = unsafe { libc::open(c"/dev/null".as_ptr(), libc::O_RDONLY | libc::O_CLOEXEC) };
+        identity(fd).map_or((-1, 0, 0), |(dev, ino)| (fd, dev, ino))
+    });
+}
+
+/// The device and inode of the open descriptor `fd`, or `None` if it is not open.
+fn identity(fd: c_int) -> Option<(u64, u64)> {
+    if fd < 0 {
+        return None;
+    }
+    // SAFETY: fstat into a zeroed struct of the right type.
+    let mut st: libc::stat = unsafe { std::mem::zeroed() };
+    (unsafe { libc::fstat(fd, &mut st) } == 0).then_some((st.st_dev, st.st_ino))
+}
+
+/// After the law's `call`: if the library's descriptors were closed, one line and the process
+/// ends at once with exit 1 (an IPC failure), without running the destructors of its IPC
+/// (they would abort on the closed descriptors). The plant's lost-controller handling takes over.
+fn check_descriptors(law: &str, call: &str) {
+    let Some(&(fd, dev, ino)) = SENTINEL.get() else { return };
+    if fd < 0 || identity(fd) == Some((dev, ino)) {
+        return;
+    }
+    let code = controller::serve::exit::IO;
+    let line = format!(
+        "amb_serve: error: law `{law}` closed the library's file descriptors in its `{call}` (the library's \
+         descriptor {fd} is closed or another file): its IPC with the plant is gone; exiting {code} at once\n"
+    );
+    // SAFETY: a write of our buffer to stderr, then the process ends without unwinding.
+    unsafe {
+        libc::write(2, line.as_ptr().cast(), line.len());
+        libc::_exit(c_int::from(code))
+    }
 }
 
 /// A C law as a `RotorLaw`.
@@ -374,6 +423,7 @@ impl RotorLaw for Adapter {
         let mut current = [0.0; MAX_AXES];
         // SAFETY: the state is the one `build` returned; `current` has room for MAX_AXES.
         unsafe { (self.law.update)(self.state, &sample, current.as_mut_ptr()) };
+        check_descriptors(self.law.name, "update");
         let mut i = [0.0; ROTOR_AXES];
         i.copy_from_slice(&current[..ROTOR_AXES]);
         let used = &i[..sample.axes as usize];
@@ -391,14 +441,16 @@ impl RotorLaw for Adapter {
 
     fn reset(&mut self) {
         // SAFETY: the state `build` returned.
-        unsafe { (self.law.reset)(self.state) }
+        unsafe { (self.law.reset)(self.state) };
+        check_descriptors(self.law.name, "reset");
     }
 }
 
 impl Drop for Adapter {
     fn drop(&mut self) {
         // SAFETY: the state `build` returned, dropped once.
-        unsafe { (self.law.drop)(self.state) }
+        unsafe { (self.law.drop)(self.state) };
+        check_descriptors(self.law.name, "drop");
     }
 }
 
@@ -490,6 +542,7 @@ unsafe fn register(laws: *const Law, count: usize) -> Result<Vec<Registered>, St
 #[no_mangle]
 pub unsafe extern "C" fn amb_serve(laws: *const Law, count: usize, argc: c_int, argv: *const *const c_char) -> c_int {
     let run = std::panic::AssertUnwindSafe(|| {
+        open_sentinel();
         // SAFETY: the caller's promise.
         let args: Vec<OsString> = if argv.is_null() {
             std::env::args_os().collect()

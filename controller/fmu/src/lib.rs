@@ -183,17 +183,67 @@ pub fn inspect(spec: &Spec, axes: usize) -> Result<Inspected, FmuError> {
     Ok(Inspected { description, interface, binding })
 }
 
+/// The most an FMU may hold unpacked (bytes): every file of it together. A Simulink or
+/// pythonfmu controller is a few MB; a zip bomb (2 MB that unpack to 2 GiB) is refused.
+pub const MAX_UNPACKED_BYTES: u64 = 512 << 20;
+
+/// The most entries (files and folders) an FMU may hold.
+pub const MAX_ENTRIES: usize = 10_000;
+
+/// The largest `modelDescription.xml` read (bytes).
+const MAX_DESCRIPTION_BYTES: u64 = 64 << 20;
+
+/// Opens `path` for reading if it is a regular file, without blocking: opened with
+/// `O_NONBLOCK` (a FIFO or a device opens at once instead of waiting for a writer) and
+/// refused unless the opened file is a regular one (`fstat` of what was opened, not of the
+/// name).
+pub fn open_regular(path: &Path) -> Result<std::fs::File, String> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| format!("cannot open it: {e}"))?;
+    let meta = file.metadata().map_err(|e| format!("cannot read its metadata: {e}"))?;
+    if !meta.is_file() {
+        let kind = {
+            use std::os::unix::fs::FileTypeExt;
+            let t = meta.file_type();
+            if t.is_dir() {
+                "a folder"
+            } else if t.is_fifo() {
+                "a FIFO"
+            } else if t.is_char_device() || t.is_block_device() {
+                "a device"
+            } else if t.is_socket() {
+                "a socket"
+            } else {
+                "not a regular file"
+            }
+        };
+        return Err(format!("{kind}, not a regular file: an FMU is a file (a zip archive)"));
+    }
+    Ok(file)
+}
+
 /// [`inspect`] without the signals (the rotor's axes not known yet).
 pub fn inspect_archive(spec: &Spec) -> Result<(Description, Interface), FmuError> {
     let fail = |why: String| FmuError { path: spec.path.clone(), why };
-    let file = std::fs::File::open(&spec.path).map_err(|e| fail(format!("cannot open it: {e}")))?;
+    let file = open_regular(&spec.path).map_err(fail)?;
     let mut zip = zip::ZipArchive::new(file)
         .map_err(|e| fail(format!("not an FMU: an FMU is a zip archive, and this file is not one ({e})")))?;
     let mut xml = String::new();
     zip.by_name("modelDescription.xml")
         .map_err(|_| fail("not an FMU: the archive has no modelDescription.xml".into()))?
+        .take(MAX_DESCRIPTION_BYTES + 1)
         .read_to_string(&mut xml)
         .map_err(|e| fail(format!("modelDescription.xml cannot be read: {e}")))?;
+    if xml.len() as u64 > MAX_DESCRIPTION_BYTES {
+        return Err(fail(format!(
+            "modelDescription.xml is larger than {} MiB unpacked (the limit of a model description)",
+            MAX_DESCRIPTION_BYTES >> 20
+        )));
+    }
     let description = Description::parse(&xml).map_err(fail)?;
     let (interface, id) = interface_of(&description).map_err(fail)?;
     let binary = format!("binaries/{}/{id}.so", description.version.platform());
@@ -220,6 +270,98 @@ pub fn inspect_archive(spec: &Spec) -> Result<(Description, Interface), FmuError
         return Err(fail(format!("no binary for this platform (Linux x86-64: {binary}); the FMU has {has}{sources}")));
     }
     Ok((description, interface))
+}
+
+/// Unpacks `zip` into the new folder `dir`, within [`MAX_ENTRIES`] entries and
+/// [`MAX_UNPACKED_BYTES`] bytes counted as they are written (an entry's declared size may lie);
+/// refused past either, naming the limit, and for an entry that points outside `dir` or is a
+/// symbolic link. Written by hand: the zip crate's `extract` has no limit.
+fn unpack(zip: &mut zip::ZipArchive<std::fs::File>, dir: &Path) -> Result<(), String> {
+    if zip.len() > MAX_ENTRIES {
+        return Err(format!(
+            "{} entries in the archive; an FMU may hold at most {MAX_ENTRIES} (a zip bomb?)",
+            zip.len()
+        ));
+    }
+    let limit = || {
+        format!(
+            "unpacked, it holds more than {} MiB (the limit of an FMU's unpacked size, {MAX_UNPACKED_BYTES} bytes):              a zip bomb, or an FMU far larger than a controller's",
+            MAX_UNPACKED_BYTES >> 20
+        )
+    };
+    let mut left = MAX_UNPACKED_BYTES;
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    for i in 0..zip.len() {
+        let mut entry = zip.by_index(i).map_err(|e| format!("entry {i} of the archive cannot be read: {e}"))?;
+        let name = entry.name().to_string();
+        let Some(relative) = entry.enclosed_name() else {
+            return Err(format!("the archive's entry {name:?} points outside the FMU's folder"));
+        };
+        let out = dir.join(relative);
+        if entry.is_dir() {
+            std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+            continue;
+        }
+        if entry.is_symlink() {
+            return Err(format!("the archive's entry {name:?} is a symbolic link; an FMU's files are regular files"));
+        }
+        if entry.size() > left {
+            return Err(limit());
+        }
+        if let Some(parent) = out.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| format!("cannot create {}: {e}", parent.display()))?;
+        }
+        let mut file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&out)
+            .map_err(|e| format!("cannot unpack {name:?} into {}: {e}", out.display()))?;
+        let written = std::io::copy(&mut (&mut entry).take(left + 1), &mut file)
+            .map_err(|e| format!("cannot unpack {name:?}: {e}"))?;
+        if written > left {
+            return Err(limit());
+        }
+        left -= written;
+        if let Some(mode) = entry.unix_mode() {
+            use std::os::unix::fs::PermissionsExt;
+            // The archive's permission bits (an executable among the resources), no others.
+            let _ = file.set_permissions(std::fs::Permissions::from_mode(mode & 0o777));
+        }
+    }
+    Ok(())
+}
+
+/// The prefix of the folders FMUs are unpacked into, in the temporary folder.
+const COPY_PREFIX: &str = "amb-testbed-fmu-";
+
+/// Removes the unpacked copies left by processes that are gone (killed before they could
+/// remove theirs: SIGKILL, a crash inside the FMU): each copy's name holds its process's id,
+/// and a copy is removed when that process no longer exists and the copy is the user's.
+/// Run each time an FMU is opened, so a leaked copy lives until the next run that opens one.
+fn remove_stale_copies() {
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else { return };
+    // SAFETY: getuid cannot fail.
+    let uid = unsafe { libc::getuid() };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(COPY_PREFIX))
+            .and_then(|rest| rest.split('-').next())
+            .and_then(|p| p.parse::<libc::pid_t>().ok())
+        else {
+            continue;
+        };
+        use std::os::unix::fs::MetadataExt;
+        let ours = entry.metadata().is_ok_and(|m| m.is_dir() && m.uid() == uid);
+        // SAFETY: signal 0 only checks whether the process exists.
+        let gone = pid > 0
+            && unsafe { libc::kill(pid, 0) } != 0
+            && std::io::Error::last_os_error().raw_os_error() == Some(libc::ESRCH);
+        if ours && gone {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
 }
 
 /// A folder removed with everything in it when dropped.
@@ -280,15 +422,16 @@ impl Fmu {
         let fail = |why: String| FmuError { path: spec.path.clone(), why };
         static COUNT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
-            "amb-testbed-fmu-{}-{}-{}",
+            "{COPY_PREFIX}{}-{}-{}",
             std::process::id(),
             COUNT.fetch_add(1, Ordering::Relaxed),
             monotonic_ns()
         ));
+        remove_stale_copies();
         let dir = TempDir(dir);
-        let file = std::fs::File::open(&spec.path).map_err(|e| fail(format!("cannot open it: {e}")))?;
+        let file = open_regular(&spec.path).map_err(fail)?;
         let mut zip = zip::ZipArchive::new(file).map_err(|e| fail(format!("not a zip archive: {e}")))?;
-        zip.extract(&dir.0).map_err(|e| fail(format!("cannot unpack it into {}: {e}", dir.0.display())))?;
+        unpack(&mut zip, &dir.0).map_err(fail)?;
         let id = match interface {
             Interface::CoSimulation => description.co_simulation.clone(),
             Interface::ModelExchange => description.model_exchange.clone(),
@@ -834,10 +977,128 @@ impl Drop for FmuLaw {
     }
 }
 
-/// Opens the FMU of `spec` and builds its law for `design`'s rotor (the plant's sampled mode).
+/// The turn of the in-process FMU laws of this process: one at a time (issue 40 item 5).
+///
+/// An FMU's library is the FMU's code in the plant's process, and an FMU may keep state that is
+/// the process's, not its instance's nor even its library copy's: a pythonfmu FMU hosts the
+/// Python interpreter, one per process, which it starts on loading and stops on unloading.
+/// Two such FMUs alive at once in the threads of one process (`plant assess`, `ensemble` or
+/// `sweep` members in `sampled` mode) crashed the plant (SIGSEGV, "double free or
+/// corruption"). So a law built by [`build`] waits for its turn and keeps it until it is
+/// dropped, its library unloaded with it: the members that run an in-process FMU run one
+/// after another, whatever the pool they run on; a member with another law does not wait.
+struct Turn;
+
+static TURN: (std::sync::Mutex<bool>, std::sync::Condvar) = (std::sync::Mutex::new(false), std::sync::Condvar::new());
+
+impl Turn {
+    /// Waits until no other in-process FMU law is alive, then takes the turn.
+    fn take() -> Self {
+        let (taken, freed) = &TURN;
+        let mut t = taken.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        while *t {
+            t = freed.wait(t).unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
+        *t = true;
+        Turn
+    }
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        let (taken, freed) = &TURN;
+        *taken.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = false;
+        freed.notify_one();
+    }
+}
+
+thread_local! {
+    /// How deep this thread is in the code of an in-process FMU ([`InFmu`]).
+    static IN_FMU: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+}
+
+/// The in-process FMU whose turn it is, in words (for the plant's last line when it ends the
+/// process: [`in_fmu_code`]).
+static CURRENT: std::sync::Mutex<String> = std::sync::Mutex::new(String::new());
+
+/// While alive, this thread runs the code of an in-process FMU: loading and instantiating it
+/// ([`build`]), a tick, freeing and unloading it.
+struct InFmu;
+
+impl InFmu {
+    fn enter() -> Self {
+        IN_FMU.with(|c| c.set(c.get() + 1));
+        InFmu
+    }
+}
+
+impl Drop for InFmu {
+    fn drop(&mut self) {
+        IN_FMU.with(|c| c.set(c.get().saturating_sub(1)));
+    }
+}
+
+/// Whether this thread is inside the code of an in-process FMU (its library loaded, an FMI call
+/// under way), and which FMU: the plant's `exit` and `_exit` ask, to tell an FMU that ends the
+/// process (which it cannot be stopped from doing) from the plant ending it
+/// (docs/guide/fmu-controller.md).
+pub fn in_fmu_code() -> Option<String> {
+    let inside = IN_FMU.try_with(|c| c.get() > 0).unwrap_or(false);
+    inside.then(|| match CURRENT.try_lock() {
+        Ok(s) if !s.is_empty() => s.clone(),
+        _ => "FMU being loaded".to_string(),
+    })
+}
+
+/// An in-process FMU law with its [`Turn`], given back once the FMU is freed and unloaded.
+struct Turned {
+    // Dropped (the instance freed, the library unloaded) before the turn, inside [`InFmu`].
+    law: std::mem::ManuallyDrop<FmuLaw>,
+    _turn: Turn,
+}
+
+impl RotorLaw for Turned {
+    fn name(&self) -> &'static str {
+        self.law.name()
+    }
+
+    fn update(&mut self, sample: &RotorSample) -> [f64; ROTOR_AXES] {
+        let _in = InFmu::enter();
+        self.law.update(sample)
+    }
+
+    fn reset(&mut self) {
+        self.law.reset()
+    }
+}
+
+impl Drop for Turned {
+    fn drop(&mut self) {
+        let _in = InFmu::enter();
+        // SAFETY: dropped once, here; the field is not used after.
+        unsafe { std::mem::ManuallyDrop::drop(&mut self.law) };
+        if let Ok(mut s) = CURRENT.lock() {
+            s.clear();
+        }
+    }
+}
+
+/// Opens the FMU of `spec` and builds its law for `design`'s rotor (the plant's sampled mode),
+/// once no other law built here is alive in the process ([`Turn`]).
 pub fn build(spec: &Spec, design: &RotorDesign, params: &Params) -> Result<Box<dyn RotorLaw>, LawError> {
+    let turn = Turn::take();
+    let _in = InFmu::enter();
+    if let Ok(mut s) = CURRENT.lock() {
+        *s = format!("FMU {}", file_name(&spec.path));
+    }
     let fmu = Fmu::open(spec).map_err(|e| LawError::Refused { law: LAW_NAME, why: e.to_string() })?;
-    Ok(Box::new(fmu.law(design, params)?))
+    if let Ok(mut s) = CURRENT.lock() {
+        *s = fmu.describe();
+    }
+    let law = fmu.law(design, params)?;
+    // The law holds the only other handle on the FMU: dropping it unloads the library.
+    drop(fmu);
+    Ok(Box::new(Turned { law: std::mem::ManuallyDrop::new(law), _turn: turn }))
 }
 
 /// The file name of `path` (for messages).

@@ -100,6 +100,8 @@ struct Sim {
     outputs: Vec<f64>,
     /// The scene's `scene.duration_s` override that puts its end on the tick grid, if any.
     period: f64,
+    /// Where the plant starts, in words (docs/guide/fmu-plant.md, "Where the plant starts").
+    start: String,
 }
 
 /// One FMU instance.
@@ -122,6 +124,17 @@ struct LastRow(Option<Record>);
 impl Sink for LastRow {
     fn sample(&mut self, record: &Record) {
         self.0 = Some(*record);
+    }
+}
+
+/// Whether parameter `v` takes the value `x` (finite, within its bounds); else why not.
+fn in_bounds(v: &Variable, x: f64) -> Result<(), String> {
+    let unit = v.unit.map(|u| format!(" {u}")).unwrap_or_default();
+    let (lo, hi) = (v.min.unwrap_or(f64::NEG_INFINITY), v.max.unwrap_or(f64::INFINITY));
+    if x.is_finite() && x >= lo && x <= hi {
+        Ok(())
+    } else {
+        Err(format!("parameter {} = {x}{unit} is outside its bounds [{lo}, {hi}]{unit}", v.name))
     }
 }
 
@@ -227,7 +240,8 @@ impl Instance {
         let limits = scene.rotor_design().current_limits();
         let command = self.command(values, limits);
         let plant = Plant::new(&scene, &Command::Held(command)).map_err(|e| format!("the plant: {e}"))?;
-        let mut sim = Sim { plant, built_with: values.to_vec(), limits, outputs: Vec::new(), period: p };
+        let start = start_words(&scene);
+        let mut sim = Sim { plant, built_with: values.to_vec(), limits, outputs: Vec::new(), period: p, start };
         let mut row = LastRow(None);
         sim.plant.record(&mut row);
         sim.outputs = self.outputs_of(&sim, row.0.as_ref());
@@ -265,7 +279,9 @@ impl Instance {
             _ => {
                 let mut last = LastRow(None);
                 plant.record(&mut last);
-                fresh = last.0.expect("a plant hands over its row");
+                // A plant always hands over its row; without one the outputs are NaN, which
+                // fmi2DoStep refuses as a diverged plant rather than a panic.
+                fresh = last.0.unwrap_or(Record::planar([f64::NAN; plant::trace::WIDTH]));
                 &fresh
             }
         };
@@ -311,7 +327,10 @@ impl Instance {
         })
     }
 
+    /// Sets the variables `vrs` to `values`: every value checked first, then all taken, so that
+    /// a refused call (one bad value among several) leaves the instance as it was.
     fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        let mut parameters = false;
         for (&vr, &x) in vrs.iter().zip(values) {
             let v = match self.variable(vr, "fmi2SetReal") {
                 Ok(v) => v.clone(),
@@ -343,21 +362,19 @@ impl Instance {
                     ) {
                         return s;
                     }
-                    let (lo, hi) = (v.min.unwrap_or(f64::NEG_INFINITY), v.max.unwrap_or(f64::INFINITY));
-                    if !(x.is_finite() && x >= lo && x <= hi) {
-                        return self.error(&format!(
-                            "fmi2SetReal: parameter {} = {x}{unit} is outside its bounds [{lo}, {hi}]{unit}; the value is \
-                             not taken",
-                            v.name
-                        ));
+                    if let Err(why) = in_bounds(&v, x) {
+                        return self.error(&format!("fmi2SetReal: {why}; the value is not taken"));
                     }
+                    parameters = true;
                 }
             }
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
             self.values[vr as usize] = x;
-            if matches!(v.role, Role::Parameter(_)) {
-                // Outputs read in initialization mode come from a plant of these parameters.
-                self.sim = None;
-            }
+        }
+        if parameters {
+            // Outputs read in initialization mode come from a plant of these parameters.
+            self.sim = None;
         }
         OK
     }
@@ -402,11 +419,13 @@ impl Instance {
                 Err(e) => return self.error(&format!("fmi2ExitInitializationMode: {e}")),
             }
         }
+        let Some((period, start)) = self.sim.as_ref().map(|s| (s.period, s.start.clone())) else {
+            return self.error("fmi2ExitInitializationMode: the plant was not built");
+        };
         self.phase = Phase::Stepping;
-        let sim = self.sim.as_ref().expect("built");
         self.info(&format!(
-            "initialized: {} bearing plane(s), tick {} s; communication steps are whole multiples of it",
-            self.model.planes, sim.period
+            "initialized: {} bearing plane(s), tick {period} s; communication steps are whole multiples of it; {start}",
+            self.model.planes
         ));
         OK
     }
@@ -416,7 +435,11 @@ impl Instance {
             return s;
         }
         let t = self.time();
-        let sim = self.sim.as_ref().expect("a stepping instance has its plant");
+        // Never the case: every call that leaves the FMU stepping leaves it with its plant
+        // (a refused fmi2SetFMUstate leaves the instance as it was). Said, not assumed.
+        let Some(sim) = self.sim.as_ref() else {
+            return self.error("fmi2DoStep: the FMU has no plant (a bug of the FMU, please report it); fmi2Reset");
+        };
         let p = sim.period;
         let rate = 1.0 / p;
         // Importers' rounding: a millionth of a tick, or a billionth of the time, whichever is
@@ -441,11 +464,9 @@ impl Instance {
                  (the scene's controller.rate_hz = {rate} Hz): use a step of {p:e} s{hint} or another whole multiple"
             ));
         }
-        let values = self.values.clone();
-        let sim_limits = sim.limits;
-        let command = self.command(&values, sim_limits);
+        let command = self.command(&self.values, sim.limits);
         let mut row = LastRow(None);
-        let sim = self.sim.as_mut().expect("a stepping instance has its plant");
+        let Some(sim) = self.sim.as_mut() else { return ERROR };
         for _ in 0..ticks as u64 {
             if let Err(e) = sim.plant.step(&Command::Held(command), &mut row) {
                 let what = e.to_string();
@@ -459,7 +480,7 @@ impl Instance {
                 ));
             }
         }
-        let sim = self.sim.as_ref().expect("a stepping instance has its plant");
+        let Some(sim) = self.sim.as_ref() else { return ERROR };
         let outputs = self.outputs_of(sim, row.0.as_ref());
         if let Some(bad) =
             outputs.iter().zip(&self.model.variables).find(|(x, v)| matches!(v.role, Role::Output(_)) && !x.is_finite())
@@ -473,7 +494,9 @@ impl Instance {
                 self.time()
             ));
         }
-        self.sim.as_mut().expect("stepping").outputs = outputs;
+        if let Some(sim) = self.sim.as_mut() {
+            sim.outputs = outputs;
+        }
         OK
     }
 
@@ -490,6 +513,9 @@ impl Instance {
         }
     }
 
+    /// Restores `state`: everything in it checked first (the GUID, the counts, every value, the
+    /// phase against the plant, the plant's snapshot against a plant of its parameters), then
+    /// all of it taken; a refused state leaves the instance as it was, stepping on if it was.
     fn set_state(&mut self, state: &State) -> Status {
         if state.guid != self.model.guid {
             return self.error(&format!(
@@ -504,40 +530,91 @@ impl Instance {
                 state.values.len()
             ));
         }
+        if !state.start_time.is_finite() {
+            return self.error(&format!("fmi2SetFMUstate: the state's start time is {} s", state.start_time));
+        }
         let values: Vec<f64> = state.values.iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-        for (v, x) in self.model.variables.iter().zip(&values) {
-            if !matches!(v.role, Role::Output(_)) && !x.is_finite() {
-                return self.error(&format!("fmi2SetFMUstate: the state's {} is not a number", v.name));
+        for (v, &x) in self.model.variables.iter().zip(&values) {
+            match v.role {
+                Role::Output(_) => {}
+                Role::Input(_) if !x.is_finite() => {
+                    return self.error(&format!("fmi2SetFMUstate: the state's {} is not a number", v.name))
+                }
+                Role::Input(_) => {}
+                Role::Parameter(_) => {
+                    if let Err(why) = in_bounds(v, x) {
+                        return self.error(&format!("fmi2SetFMUstate: the state's {why}"));
+                    }
+                }
             }
         }
-        let sim = match (&state.snapshot, &state.outputs) {
-            (Some(snapshot), Some(outputs)) => {
-                // The plant of the same parameters is kept: the restore replaces everything it
-                // evolves, and the inputs are each step's command (rebuilding it cost about
-                // 1 ms a call in an FMPy loop: docs/results/speed.md).
-                let mut sim = match self.sim.take() {
-                    Some(s) if self.same_parameters(&s.built_with, &values) => s,
-                    _ => match self.build(&values) {
-                        Ok(s) => s,
-                        Err(e) => return self.error(&format!("fmi2SetFMUstate: {e}")),
-                    },
-                };
-                if let Err(e) = sim.plant.restore(snapshot) {
-                    self.sim = None;
-                    return self.error(&format!("fmi2SetFMUstate: {e}"));
-                }
-                sim.outputs = outputs.iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-                Some(sim)
+        let outputs = match (&state.snapshot, &state.outputs) {
+            (Some(_), Some(outputs)) => Some(outputs.iter().map(|x| x.unwrap_or(f64::NAN)).collect::<Vec<f64>>()),
+            (None, None) if state.phase == Phase::Stepping => {
+                return self.error("fmi2SetFMUstate: a state of an initialized (stepping) FMU without its plant")
             }
             (None, None) => None,
             _ => return self.error("fmi2SetFMUstate: a state with a plant and no outputs, or outputs and no plant"),
         };
+        match (&state.snapshot, outputs) {
+            (Some(snapshot), Some(outputs)) => {
+                // The plant of the same parameters is kept: the restore replaces everything it
+                // evolves, and the inputs are each step's command (rebuilding it cost about
+                // 1 ms a call in an FMPy loop: docs/results/speed.md). `Plant::restore`
+                // checks the snapshot before it changes anything: refused, the plant is as it was.
+                let reuse = self.sim.as_ref().is_some_and(|s| self.same_parameters(&s.built_with, &values));
+                match self.sim.as_mut() {
+                    Some(sim) if reuse => {
+                        if let Err(e) = sim.plant.restore(snapshot) {
+                            return self.error(&format!("fmi2SetFMUstate: {e}"));
+                        }
+                        sim.outputs = outputs;
+                    }
+                    _ => {
+                        let mut sim = match self.build(&values) {
+                            Ok(s) => s,
+                            Err(e) => return self.error(&format!("fmi2SetFMUstate: {e}")),
+                        };
+                        if let Err(e) = sim.plant.restore(snapshot) {
+                            return self.error(&format!("fmi2SetFMUstate: {e}"));
+                        }
+                        sim.outputs = outputs;
+                        self.sim = Some(sim);
+                    }
+                }
+            }
+            _ => self.sim = None,
+        }
         self.values = values;
-        self.sim = sim;
         self.phase = state.phase;
         self.start_time = state.start_time;
         OK
     }
+}
+
+/// Where the plant of `scene` starts, in words: `plant run`'s initial state of the scene, which
+/// the scene's controller design sets (docs/guide/fmu-plant.md, "Where the plant starts").
+fn start_words(scene: &plant::config::Scene) -> String {
+    let c = &scene.controller;
+    let i = &scene.initial;
+    let orbit = if i.unbalance_orbit {
+        format!(
+            "on the unbalance orbit of the scene's controller design (controller.stiffness_n_per_m = {} N/m, \
+             controller.damping_ratio = {}{})",
+            c.stiffness,
+            c.damping_ratio,
+            if scene.planes() > 1 { ", each plane's on its load share" } else { "" }
+        )
+    } else {
+        "at rest at the centre (initial.unbalance_orbit = false)".to_string()
+    };
+    let sag = if c.gravity_bias { "" } else { ", sagged by m g / k_e (controller.gravity_bias = false)" };
+    format!(
+        "the plant starts {orbit}{sag}, offset by initial.rotor_x_um = {}, initial.rotor_y_um = {} um \
+         (plant fmu SCENE --set KEY=VALUE chooses another start)",
+        i.rotor_offset[0] * 1e6,
+        i.rotor_offset[1] * 1e6
+    )
 }
 
 /// The serialised state's format.
@@ -575,7 +652,7 @@ impl StateBox {
             serde_json::to_writer(&mut b, &self.state).map_err(|e| e.to_string())?;
             self.bytes = Some(b);
         }
-        Ok(self.bytes.as_deref().expect("just made"))
+        Ok(self.bytes.as_deref().unwrap_or_default())
     }
 
     fn from_bytes(bytes: &[u8]) -> Result<State, String> {

@@ -146,6 +146,42 @@ impl ShockTracker {
         self.last_t = t;
     }
 
+    /// Why this tracker, read from a checkpoint, cannot go on as `fresh` (the one the programme
+    /// makes) would: a setting that differs, or a window that is not one of the programme's
+    /// shocks (an edited checkpoint; `plant soak --resume` refuses it before it touches a file).
+    pub fn check_resumable(&self, fresh: &ShockTracker) -> Result<(), String> {
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        let settings = [
+            ("end", self.end, fresh.end),
+            ("dt", self.dt, fresh.dt),
+            ("clear_radius", self.clear_radius, fresh.clear_radius),
+            ("hold", self.hold, fresh.hold),
+        ];
+        if let Some((key, saved, now)) = settings.iter().find(|(_, a, b)| !same(*a, *b)) {
+            return Err(format!("tracker.{key} is {saved:?}, the programme's is {now:?}"));
+        }
+        if self.starts.len() != fresh.starts.len() || !self.starts.iter().zip(&fresh.starts).all(|(a, b)| same(*a, *b))
+        {
+            return Err(format!(
+                "tracker.starts has {} shock starts, not the programme's {} ({:?})",
+                self.starts.len(),
+                fresh.starts.len(),
+                fresh.starts
+            ));
+        }
+        match self.current {
+            Some(j) if j >= self.starts.len() => Err(format!(
+                "tracker.current = {j}: the programme has {} shocks (0 to {})",
+                self.starts.len(),
+                self.starts.len().saturating_sub(1)
+            )),
+            _ if !(self.last_t.is_finite() && self.clear_since.is_none_or(f64::is_finite)) => {
+                Err(format!("tracker.last_t = {:?}, clear_since = {:?}: not times", self.last_t, self.clear_since))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// Closes the window in progress at the end of the run (or where it stopped).
     pub fn finish(&mut self) -> Option<ShockFigures> {
         let j = self.current.take()?;
@@ -197,6 +233,15 @@ impl Envelope {
     /// Bins of `bin` seconds from t = 0.
     pub fn new(bin: f64) -> Self {
         Self { bin, index: 0, max_radius: 0.0, max_force: 0.0, any: false }
+    }
+
+    /// Why this envelope, read from a checkpoint, cannot go on as `fresh` would: another bin.
+    pub fn check_resumable(&self, fresh: &Envelope) -> Result<(), String> {
+        if self.bin.to_bits() == fresh.bin.to_bits() {
+            Ok(())
+        } else {
+            Err(format!("envelope.bin is {:?} s, the soak's is {:?} s", self.bin, fresh.bin))
+        }
     }
 
     /// One sample; returns the bin it completes, if any.

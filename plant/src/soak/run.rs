@@ -380,6 +380,30 @@ pub fn default_dir(programme_file: &Path) -> PathBuf {
 /// checkpoint was taken. Nothing is written.
 fn resumable(dir: &Path, prog: &Programme) -> Result<Checkpoint, SoakError> {
     let c = Checkpoint::read(dir, prog)?;
+    // The monitor's parts against the programme's (an edited checkpoint's shock index out of
+    // range made the plots panic, issue 40 item 7): refused here, naming the field.
+    let refuse = |message: String| ResumeError::File {
+        path: checkpoint::path(dir).display().to_string(),
+        message: format!("{message}: an edited or foreign checkpoint; run without --resume to start afresh"),
+    };
+    let n = prog.shocks.len();
+    if let Some((i, f)) = c.figures.iter().enumerate().find(|(i, f)| f.index != *i) {
+        return Err(refuse(format!(
+            "figures[{i}].index = {}: the closed shocks are the programme's first ones in order (it has {n}, 0 to {})",
+            f.index,
+            n.saturating_sub(1)
+        ))
+        .into());
+    }
+    if c.figures.len() > n {
+        return Err(refuse(format!("{} closed shocks, but the programme has {n}", c.figures.len())).into());
+    }
+    let scene = &prog.scene;
+    let starts = prog.shocks.iter().map(|s| s.start_s).collect();
+    let fresh =
+        monitor::ShockTracker::new(starts, scene.duration, scene.output_interval, prog.clear_radius[0], prog.hold);
+    c.tracker.check_resumable(&fresh).map_err(refuse)?;
+    c.envelope.check_resumable(&monitor::Envelope::new(ENVELOPE_BIN_S)).map_err(refuse)?;
     crate::run::check_start(&prog.scene, &c.plant)?;
     for (name, len) in [("soak.csv", c.soak_csv_bytes), ("envelope.csv", c.envelope_csv_bytes), ("rss.csv", 0)] {
         let path = dir.join(name);
