@@ -3,8 +3,9 @@
 For each rotor: builds it in ROSS, saves it with ``Rotor.save()`` (the file our reader takes),
 runs ``run_modal`` (at rest and at each Campbell speed) and ``run_campbell`` (0 to 500 Hz, the
 first six modes, damped natural frequencies, forward and backward), and writes ROSS's figures
-to ``<name>.json`` beside the ``.toml``. Run by ``scripts/ross/fixture.sh``; nothing here is
-computed by the testbed.
+to ``<name>.json`` beside the ``.toml``. Run by ``scripts/ross/fixture.sh`` with ROSS 3.1.0 and
+with ROSS 2.3.0 (the same rotors, each version's file and figures); nothing here is computed by
+the testbed.
 """
 
 import json
@@ -78,6 +79,7 @@ def figures(rotor):
     whirl_code = {0.0: "forward", 1.0: "backward", 0.5: "mixed"}
     return {
         "ross_version": rs.__version__,
+        "python_version": sys.version.split()[0],
         "mass_kg": float(rotor.m),
         "rest": {
             "wn_rad_s": [float(v) for v in at_rest.wn],
