@@ -142,6 +142,91 @@ mod tests {
     }
 }
 
+mod at_rest {
+    use plant::config::{load_scene, Rotor, Scene};
+    use plant::model::Control;
+    use plant_physics::flex::machine::{Model, State, N};
+    use plant_physics::integrate::{Integrator, Method, Settings};
+    use std::path::Path;
+
+    /// A 1 m slender rotor (issue 38 item 5): the shipped flexible scene's machine and loop
+    /// with a 40 mm steel shaft of 1 m in 20 elements, a 5 kg disk at mid-span, AMBs at 100 and
+    /// 900 mm; no shock, no unbalance.
+    fn slender() -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+        let sets = [
+            "rotor.shaft.element=[{length_mm=1000.0, outer_diameter_mm=40.0, material=\"steel\", split=20}]",
+            "rotor.shaft.disk=[{node=10, mass_kg=5.0, diametral_inertia_kg_m2=0.01, polar_inertia_kg_m2=0.02}]",
+            "rotor.amb_a_node=2",
+            "rotor.amb_b_node=18",
+            "rotor.cutoff_hz=1000",
+            "rotor.eccentricity_um=0",
+            "shock=[]",
+            "scene.duration_s=0.5",
+            "output.plots=false",
+        ]
+        .map(String::from);
+        load_scene(&path, &sets).expect("the slender rotor loads")
+    }
+
+    /// The largest displacement of any node from where it started (m), over 0.5 s of the
+    /// continuous PD from `y`, sampled every millisecond.
+    fn largest_motion(scene: &Scene, y: State) -> f64 {
+        let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
+        let gains = plant::run::plane_gains(scene).expect("gains");
+        let m = Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [Control::Continuous(gains[0]), Control::Continuous(gains[1])],
+            race_parked: [false; 2],
+        };
+        let nodes = params.z.len();
+        let start: Vec<_> = (0..nodes).map(|n| m.node(&y, n).0).collect();
+        let mut settings = Settings::<N>::adaptive(Method::Dp5, 1e-9, 1e-13);
+        settings.h_max = 1e-4;
+        let mut integrator = Integrator::new(settings);
+        let (mut y, mut worst) = (y, 0.0_f64);
+        for k in 0..500 {
+            let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+            integrator.advance(&m, t0, t1, &mut y).expect("integrates");
+            for (n, s) in start.iter().enumerate() {
+                worst = worst.max((m.node(&y, n).0 - s).norm());
+            }
+        }
+        worst
+    }
+
+    /// With no shock and no unbalance nothing moves: every node of the 1 m slender rotor stays
+    /// within 0.1 µm of where it starts over 0.5 s (it starts sagged: by several µm at
+    /// mid-span). From the straight shaft the rigid start had (the shaft projected from the
+    /// rigid rotor's levitated state), the same rotor swings by micrometres.
+    #[test]
+    fn a_flexible_rotor_starts_at_rest() {
+        let scene = slender();
+        let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
+        let y = plant::initial::flexible_initial_state(&scene, params);
+        let m = Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [Control::Held([0.0; 2]); 2],
+            race_parked: [false; 2],
+        };
+        let sag = m.node(&y, 10).0.y;
+        let moved = largest_motion(&scene, y);
+        eprintln!(
+            "slender rotor: mid-span sag {:.3} µm; largest motion of a node over 0.5 s {:.2e} m",
+            sag * 1e6,
+            moved
+        );
+        assert!(sag < -1e-6, "the shaft starts sagged under gravity: {sag} m at mid-span");
+        assert!(moved < 1e-7, "a node moved by {moved} m");
+        let straight = Model::from_rigid(params, &plant::initial::two_plane_initial_state(&scene, &params.machine));
+        let swung = largest_motion(&scene, straight);
+        eprintln!("from the straight shaft: {:.2e} m", swung);
+        assert!(swung > 1e-6, "the straight start swings: {swung} m");
+    }
+}
+
 mod convergence {
     use plant::config::{load_scene, Rotor, Scene};
     use std::path::Path;

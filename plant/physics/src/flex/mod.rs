@@ -8,6 +8,7 @@
 //! [`machine`] is the rotor the plant steps (`rotor.model = "flexible"`): the reduced shaft
 //! with two AMBs, two sensors and two touchdown bearings at its nodes.
 
+pub mod initial;
 pub mod linear;
 pub mod machine;
 pub mod modes;
