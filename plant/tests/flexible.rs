@@ -227,6 +227,77 @@ mod at_rest {
     }
 }
 
+mod ross_bearings {
+    use plant::config::{load_scene, Rotor};
+    use plant_physics::flex::ross::BearingUse;
+    use std::path::Path;
+
+    /// The shipped flexible scene with its shaft from the AMB machine's ROSS file (bearings of
+    /// 1e6 N/m at nodes 2 and 14, the scene's AMB nodes), and `extra` added to the file.
+    fn scene_with(extra: &str, sets: &[&str]) -> Result<plant::config::Scene, plant::config::ConfigError> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let dir = std::env::temp_dir().join(format!("ross-bearings-{}-{}", std::process::id(), extra.len()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ross = std::fs::read_to_string(root.join("physics/tests/fixtures/ross/amb_machine.toml")).unwrap();
+        std::fs::write(dir.join("machine.toml"), ross + extra).unwrap();
+        let mut table: toml::Table =
+            std::fs::read_to_string(root.join("../config/flexible-10g.toml")).unwrap().parse().unwrap();
+        let rotor = table["rotor"].as_table_mut().unwrap();
+        rotor.remove("shaft");
+        rotor.insert("ross_file".into(), "machine.toml".into());
+        std::fs::write(dir.join("scene.toml"), toml::to_string(&table).unwrap()).unwrap();
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = load_scene(&dir.join("scene.toml"), &sets);
+        std::fs::remove_dir_all(&dir).unwrap();
+        scene
+    }
+
+    /// `rotor.ross_bearings` through the scene's keys: none refused under its key, "ignore"
+    /// leaves the shaft without the file's springs (and says nothing), "parallel" keeps both
+    /// (and says so first among the scene's warnings), a seal elsewhere is added either way.
+    #[test]
+    fn the_choice_places_the_files_bearings() {
+        let err = scene_with("", &[]).unwrap_err().to_string();
+        assert!(
+            err.starts_with("rotor.ross_bearings = none:") && err.contains("\"BearingElement_AMB A\" at node 2"),
+            "{err}"
+        );
+        let shaft_bearings = |scene: &plant::config::Scene| {
+            let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+            (f.shaft.bearings.iter().map(|b| b.node).collect::<Vec<_>>(), f.file_bearings.clone())
+        };
+        let ignored = scene_with("", &["rotor.ross_bearings=\"ignore\""]).unwrap();
+        let (nodes, used) = shaft_bearings(&ignored);
+        assert!(nodes.is_empty(), "{nodes:?}");
+        assert!(used.iter().all(|u| u.used == BearingUse::Ignored));
+        assert!(ignored.warnings.iter().all(|w| !w.contains("ross_file")), "{:?}", ignored.warnings);
+        let parallel = scene_with("", &["rotor.ross_bearings=\"parallel\""]).unwrap();
+        assert_eq!(shaft_bearings(&parallel).0, [2, 14]);
+        assert!(
+            parallel.warnings[0].contains(
+                "\"BearingElement_AMB A\" at node 2 (k_xx = 1e6 N/m, k_yy = 1e6 N/m) in parallel with the AMB"
+            ),
+            "{:?}",
+            parallel.warnings
+        );
+        let seal = "\n[\"BearingElement_seal\"]\nn = 8\nkxx = [ 2e5,]\nkyy = [ 2e5,]\n";
+        let with_seal = scene_with(seal, &["rotor.ross_bearings=\"ignore\""]).unwrap();
+        assert_eq!(shaft_bearings(&with_seal).0, [8]);
+        assert!(with_seal.warnings[0].contains("\"BearingElement_seal\" at node 8"), "{:?}", with_seal.warnings);
+        // The stiffer shaft of "parallel": its rigid-body modes rise (the springs add to the loop).
+        let frequencies = |scene: &plant::config::Scene| {
+            let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+            f.reduced.frequencies_hz()
+        };
+        assert!(
+            frequencies(&parallel)[0] > frequencies(&ignored)[0] + 1.0,
+            "{:?} {:?}",
+            frequencies(&parallel),
+            frequencies(&ignored)
+        );
+    }
+}
+
 mod convergence {
     use plant::config::{load_scene, Rotor, Scene};
     use std::path::Path;
