@@ -3,7 +3,8 @@
 # ROSS 3.1.0 (ross-rotordynamics 3.1.0 needs Python >= 3.13) and ROSS 2.3.0 (what pip installs
 # on Python 3.11). For each, a venv under target/ with ROSS and plotly < 6 (with which ROSS
 # imports), then fixture.py, which saves ROSS's example rotor and an AMB machine rotor with
-# Rotor.save() and writes ROSS's run_modal and run_campbell figures beside them.
+# Rotor.save() and writes ROSS's run_modal and run_campbell figures beside them, and saves a
+# shaft with one of ROSS's MagneticBearingElements (amb_element.toml: its equivalent coefficients).
 #
 #   scripts/ross/fixture.sh [OUT]     # OUT defaults to plant/physics/tests/fixtures/ross
 #
@@ -45,7 +46,7 @@ run_fixture() {
         cat "$log" >&2
         exit 1
     fi
-    grep -E '^(rotor_example|amb_machine):' "$log"
+    grep -E '^(rotor_example|amb_machine|amb_element):' "$log"
 }
 
 python=${PYTHON:-$(find_python '3, 13' '4, 0' python3.13 python3.14 "$HOME/.pyenv/versions/3.13.0/bin/python3" python3)}

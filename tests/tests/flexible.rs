@@ -747,4 +747,22 @@ fn a_ross_files_bearings_at_the_amb_nodes_need_a_choice() {
     assert_eq!(of("BearingElement_seal")["node"], 8);
     assert_eq!(of("BearingElement_seal")["stiffness_n_per_m"][0][0], 2e5);
     assert_eq!(summary["status"], "completed", "{summary:#}");
+    // ROSS's MagneticBearingElement: with a zero gap refused naming it; whole, refused with the
+    // constants it stands for (not yet the plane's AMB).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let amb = read_text(&root.join("plant/physics/tests/fixtures/ross/amb_element.toml"));
+    std::fs::write(dir.join("machine.toml"), amb.replacen("g0 = 0.001", "g0 = 0.0", 1)).unwrap();
+    refused(
+        "ross-amb-gap",
+        &file,
+        &["rotor.ross_bearings=\"ignore\""],
+        &["rotor.ross_file = machine.toml", "element \"BearingElement_AMB\": g0 = 0 m must be positive"],
+    );
+    std::fs::write(dir.join("machine.toml"), amb).unwrap();
+    refused(
+        "ross-amb",
+        &file,
+        &["rotor.ross_bearings=\"ignore\""],
+        &["is ROSS's MagneticBearingElement", "k_i = 4.643925e0 N/A", "k_s = 4.643925e3 N/m"],
+    );
 }

@@ -380,10 +380,10 @@ fn bad_ross_files_are_refused_naming_the_element() {
             text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, 2000000.0,]\nfrequency = [ 0.0, 100.0,]", 1),
             "(node 0): frequency = [0.0, 100.0]: its coefficients vary with frequency",
         ),
-        // ROSS's AMB element (a BearingElement table with its parameters): named, not listed.
+        // ROSS's AMB element (a BearingElement table with its parameters) with some missing.
         (
             text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0,]\ng0 = 0.001\ni0 = 1.0", 1),
-            "element \"BearingElement_Bearing 0\" (node 0) is ROSS's MagneticBearingElement (g0 = 0.001)",
+            "element \"BearingElement_Bearing 0\": ag (m²) is missing",
         ),
         (
             text.clone() + "\n[\"PointMass_0\"]\nn = 1\nm = 2.0\n",
@@ -463,4 +463,84 @@ fn the_files_bearings_at_the_amb_nodes_need_a_choice() {
     assert!(used.iter().all(|u| u.used == BearingUse::Added), "{used:?}");
     // What `parse` (every bearing kept, as ROSS has the rotor) reads is the "parallel" rotor.
     assert_eq!(ross::parse(&text, "amb_machine.toml").unwrap(), parallel);
+}
+
+/// ROSS's MagneticBearingElement (issue 38 item 1, not yet the plane's AMB; MODEL.md §13.8): its
+/// parameters read and checked, and its constants by ROSS's formulas against the equivalent
+/// coefficients ROSS itself wrote into the file (`kxx`, `cxx` over `frequency`, from `k_i`,
+/// `k_s`, the gains and the PID with its derivative filter), for ROSS 3.1 and 2.3; the element
+/// is refused naming it with what it stands for; bad parameters are refused naming the element,
+/// key, value and unit.
+#[test]
+fn ross_magnetic_bearing_element_is_read_by_rosss_formulas_and_refused_with_its_constants() {
+    use plant_physics::flex::ross_amb::magnetic;
+    for dir in ["", V23] {
+        let text = std::fs::read_to_string(fixture(&format!("{dir}amb_element.toml"))).unwrap();
+        let table: toml::Table = text.parse().unwrap();
+        let el = table["BearingElement_AMB"].as_table().unwrap();
+        let amb = magnetic(el, "BearingElement_AMB", "element", "amb_element.toml").unwrap();
+        assert_eq!((amb.node, amb.sensor_node), (1, 1), "{dir}");
+        // The closed forms by hand: μ₀ nw² ag i0 cos(22.5°) / g0² and / g0³.
+        // The file's alpha, ROSS's decimals (not π/8 exactly).
+        let alpha = el["alpha"].as_float().unwrap();
+        assert_eq!(alpha.to_string(), "0.39269908");
+        let k = 4e-7 * std::f64::consts::PI * 200.0 * 200.0 * 1e-4 * alpha.cos();
+        assert!((amb.ki_n_per_a() - k / 1e-6).abs() < 1e-12 * k / 1e-6, "{}", amb.ki_n_per_a());
+        assert!((amb.ks_n_per_m() - k / 1e-9).abs() < 1e-12 * k / 1e-9, "{}", amb.ks_n_per_m());
+        // ROSS's own equivalent coefficients, at each of its 50 frequencies.
+        let list = |key: &str| floats(&serde_json::to_value(&el[key]).unwrap());
+        let (w, kxx, cxx) = (list("frequency"), list("kxx"), list("cxx"));
+        assert_eq!(w.len(), 50);
+        let c_scale = cxx.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        for i in 0..w.len() {
+            let (k_eq, c_eq) = amb.equivalent_at(w[i]);
+            assert!(
+                (k_eq - kxx[i]).abs() < 1e-9 * kxx[i].abs(),
+                "{dir} at {} rad/s: k {k_eq} against ROSS's {}",
+                w[i],
+                kxx[i]
+            );
+            assert!(
+                (c_eq - cxx[i]).abs() < 1e-9 * c_scale,
+                "{dir} at {} rad/s: c {c_eq} against ROSS's {}",
+                w[i],
+                cxx[i]
+            );
+            // Isotropic: ROSS's rotation of the axes changes nothing in them (to its round-off).
+            let (kyy, kxy) = (list("kyy")[i], list("kxy")[i]);
+            assert!((kyy - kxx[i]).abs() < 1e-12 * kxx[i].abs() && kxy.abs() < 1e-12 * kxx[i].abs(), "{kyy} {kxy}");
+        }
+        // The file is refused naming the element and what it stands for.
+        let err = ross::parse(&text, "amb_element.toml").unwrap_err().to_string();
+        for part in [
+            "element \"BearingElement_AMB\" (node 1) is ROSS's MagneticBearingElement",
+            "k_i = 4.643925e0 N/A",
+            "k_s = 4.643925e3 N/m",
+            "sensor at node 1",
+            "amplifier gain 1.5 A/V and sensor gain 2000 V/m",
+            "kp = 2, ki = 30 1/s, kd = 0.003 s",
+            "n_f = 5000 rad/s",
+            "axes turned by 45.0°",
+        ] {
+            assert!(err.contains(part), "{dir}: {err}\nshould contain: {part}");
+        }
+    }
+    // Bad parameters, each named with its element, key, value and unit.
+    let text = std::fs::read_to_string(fixture("amb_element.toml")).unwrap();
+    let cases = [
+        ("g0 = 0.001", "g0 = 0.0", "element \"BearingElement_AMB\": g0 = 0 m must be positive"),
+        ("i0 = 1.0", "i0 = -1.0", "i0 = -1 A must be positive"),
+        ("ag = 0.0001", "ag = 0", "ag = 0 m² must be positive"),
+        ("nw = 200", "nw = 0", "nw = 0 turns must be positive"),
+        ("alpha = 0.39269908", "alpha = 1.6", "alpha = 1.6 rad (91.7°): the pole angle must be between 0 and 90°"),
+        ("alpha = 0.39269908", "alpha = 0.0", "alpha = 0 rad"),
+        ("sensor_node = 1", "sensor_node = 9", "element \"BearingElement_AMB\" sensor_node: node 9 is out of range"),
+        ("kp_pid = 2.0", "kp_pid = \"high\"", "kp_pid = \"high\" is not a number"),
+        ("i0 = 1.0", "i0 = [ 1.0, 2.0,]", "i0 = [1.0, 2.0] A: one value per axis, which differ"),
+    ];
+    for (from, to, expect) in cases {
+        assert!(text.contains(from), "{from}");
+        let err = ross::parse(&text.replacen(from, to, 1), "amb_element.toml").unwrap_err().to_string();
+        assert!(err.contains(expect), "{to}: {err}\nshould contain: {expect}");
+    }
 }

@@ -14,6 +14,7 @@ pub mod machine;
 pub mod modes;
 pub mod reduce;
 pub mod ross;
+pub mod ross_amb;
 pub mod rotor;
 pub mod shaft;
 pub mod table;

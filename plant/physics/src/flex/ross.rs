@@ -18,8 +18,9 @@
 //!
 //! What this model cannot represent is refused, naming the element: other element classes
 //! (point masses, seals, ball or fluid-film bearings saved as their own class, motors), ROSS's
-//! `MagneticBearingElement` (saved as a `BearingElement` with `g0, i0, ag, nw, …`: not read yet;
-//! the scene's `[amb]` and `[controller]` give the AMBs), bearings linked to a support node
+//! `MagneticBearingElement` (saved as a `BearingElement` with `g0, i0, ag, nw, …`: its parameters
+//! are read and checked, [`super::ross_amb`], and the element is refused with the constants it
+//! stands for by ROSS's formulas; the scene's `[amb]` and `[controller]` give the AMBs), bearings linked to a support node
 //! (`n_link`) or with coefficients that vary with frequency (a `frequency` list: refused by
 //! name rather than evaluated at one speed, since the run's speed changes in a free spin and
 //! a fluid-film bearing's coefficients at one speed are not its behaviour under a shock),
@@ -71,7 +72,7 @@ const MATERIAL_KEYS: &[&str] = &["name", "rho", "E", "G_s", "Poisson", "color", 
 const DISK_KEYS: &[&str] = &["n", "m", "Id", "Ip", "tag", "color", "scale_factor"];
 /// The keys of a plain `BearingElement` table (`n_link` and `frequency` are known, and refused
 /// with their reasons).
-const BEARING_KEYS: &[&str] = &[
+pub(super) const BEARING_KEYS: &[&str] = &[
     "n",
     "n_link",
     "frequency",
@@ -97,7 +98,7 @@ const BEARING_KEYS: &[&str] = &[
 ];
 /// The parameters ROSS's `MagneticBearingElement` saves in its `BearingElement` table (2.3 has
 /// all but `sensor_node`).
-const MAGNETIC_KEYS: &[&str] = &[
+pub(super) const MAGNETIC_KEYS: &[&str] = &[
     "g0",
     "i0",
     "ag",
@@ -251,7 +252,7 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
 }
 
 /// The key of `table` (of `at`) that this reader does not know, refused by name.
-fn unknown_key(table: &Table, known: &[&str], at: &str, file: &str) -> Result<(), FlexError> {
+pub(super) fn unknown_key(table: &Table, known: &[&str], at: &str, file: &str) -> Result<(), FlexError> {
     match table.keys().find(|k| !known.contains(&k.as_str())) {
         None => Ok(()),
         Some(k) => Err(FlexError::Ross {
@@ -307,6 +308,7 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
     let mut shafts: Vec<(usize, String, ShaftElement)> = Vec::new();
     let mut disks: Vec<(String, Disk)> = Vec::new();
     let mut bearings: Vec<(String, LinearBearing)> = Vec::new();
+    let mut magnetics: Vec<super::ross_amb::MagneticBearing> = Vec::new();
     for (name, value) in &table {
         if name == "ross_version" || name == "parameters" || name.starts_with('_') {
             continue;
@@ -332,16 +334,12 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
                 disks.push((at, disk));
             }
             "BearingElement" => {
-                if let Some(key) = MAGNETIC_KEYS.iter().find(|k| el.contains_key(**k) && **k != "alpha") {
+                if MAGNETIC_KEYS.iter().any(|k| el.contains_key(*k) && *k != "alpha") {
                     // ROSS's AMB element, saved as a BearingElement with its parameters (its
-                    // frequency-dependent equivalent coefficients beside them): named, not listed.
-                    let n = el.get("n").map(|v| v.to_string()).unwrap_or_else(|| "?".into());
-                    return Err(err(format!(
-                        "{at} (node {n}) is ROSS's MagneticBearingElement ({key} = {}): this reader does not read it \
-                         yet; remove it from the rotor before saving and give the AMB in the scene (rotor.amb_a_node \
-                         or amb_b_node, [amb], [controller])",
-                        short(&el[*key])
-                    )));
+                    // frequency-dependent equivalent coefficients beside them): its parameters
+                    // checked here, the element refused once the nodes are known.
+                    magnetics.push(super::ross_amb::magnetic(el, name, &at, file)?);
+                    continue;
                 }
                 unknown_key(el, BEARING_KEYS, &at, file)?;
                 bearings.push((name.clone(), bearing(el, &at, file)?));
@@ -376,6 +374,18 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
             return Err(FlexError::NodeOutOfRange { what: format!("{file}: {at}"), node: n, nodes });
         }
     }
+    if let Some(m) = magnetics.first() {
+        for (key, n) in [("n", m.node), ("sensor_node", m.sensor_node)] {
+            if n >= nodes {
+                return Err(FlexError::NodeOutOfRange {
+                    what: format!("{file}: element \"{}\" {key}", m.element),
+                    node: n,
+                    nodes,
+                });
+            }
+        }
+        return Err(err(m.refusal()));
+    }
     let rotor =
         Rotor { elements, disks: disks.into_iter().map(|(_, d)| d).collect(), bearings: Vec::new(), alpha, beta };
     rotor.validate().map_err(|e| err(e.to_string()))?;
@@ -383,7 +393,7 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
     Ok(RossFile { version, rotor, bearings })
 }
 
-fn as_number(v: &Value) -> Option<f64> {
+pub(super) fn as_number(v: &Value) -> Option<f64> {
     match v {
         Value::Float(f) => Some(*f),
         Value::Integer(i) => Some(*i as f64),
@@ -406,7 +416,7 @@ fn number(t: &Table, key: &str, at: &str, file: &str) -> Result<f64, FlexError> 
         .ok_or_else(|| FlexError::Ross { file: file.into(), message: format!("{at}: {key} is missing") })
 }
 
-fn node(t: &Table, at: &str, file: &str) -> Result<usize, FlexError> {
+pub(super) fn node(t: &Table, at: &str, file: &str) -> Result<usize, FlexError> {
     match t.get("n") {
         Some(Value::Integer(n)) if *n >= 0 => Ok(*n as usize),
         Some(v) => Err(FlexError::Ross { file: file.into(), message: format!("{at}: n = {v} is not a node number") }),
