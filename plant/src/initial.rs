@@ -41,3 +41,43 @@ pub fn two_plane_initial_state(
 pub fn initial_state(scene: &Scene, params: &crate::model::Params) -> State {
     plant_physics::initial::initial_state(params, &initial_conditions(scene))
 }
+
+/// The initial state of a flexible scene whose machine is `params`: at rest on its bearings
+/// (the shaft sagged under gravity, the bias currents and the levitation design's loop:
+/// [`plant_physics::flex::initial::static_sag`]), with the two-plane rotor's unbalance orbit
+/// and the scene's `[initial]` offsets as a rigid motion of the shaft on top of it.
+pub fn flexible_initial_state(
+    scene: &Scene,
+    params: &plant_physics::flex::machine::Params,
+) -> plant_physics::flex::machine::State {
+    use plant_physics::flex::machine::Model;
+    // The rigid rotor's start without its sag under gravity (the shaft's own is solved for
+    // below, with or without the gravity bias): its unbalance orbit, offsets and races.
+    let ic = initial_conditions(scene);
+    let rigid = plant_physics::two_plane::initial::initial_state(
+        &params.machine,
+        &plant_physics::two_plane::initial::InitialConditions {
+            unbalance_orbit: ic.unbalance_orbit,
+            unbalance_phase: ic.unbalance_phase,
+            stiffness: ic.stiffness,
+            damping_ratio: ic.damping_ratio,
+            gravity_bias: true,
+            rotor_offset: ic.rotor_offset,
+            slope_offset: scene.initial.slope_offset,
+        },
+    );
+    let mut y = Model::from_rigid(params, &rigid);
+    let design = controller::PdDesign {
+        stiffness_n_per_m: scene.controller.stiffness,
+        damping_ratio: scene.controller.damping_ratio,
+        gravity_bias: scene.controller.gravity_bias,
+    };
+    // A shaft the levitation design cannot hold still has no equilibrium to start from: it
+    // starts straight (the rigid start), and the run shows it move.
+    if let Some(sag) = plant_physics::flex::initial::static_sag(params, &design, &y) {
+        for (k, s) in sag.iter().enumerate() {
+            y[k] += s;
+        }
+    }
+    y
+}

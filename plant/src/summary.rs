@@ -54,6 +54,10 @@ pub struct ModelInfo {
     pub controller_rate_hz: f64,
     /// Command delay (samples), sampled modes.
     pub delay_samples: u32,
+    /// A flexible rotor from a ROSS file: the file's plain bearings and what became of each
+    /// (`added`, `ignored`, `parallel`; `rotor.ross_bearings`); not written when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ross_bearings: Vec<plant_physics::flex::ross::UsedBearing>,
 }
 
 impl ModelInfo {
@@ -76,6 +80,10 @@ impl ModelInfo {
             law: c.law.clone(),
             controller_rate_hz: 1.0 / c.period,
             delay_samples: c.delay_samples,
+            ross_bearings: match &scene.rotor {
+                crate::config::Rotor::Flexible(f) => f.file_bearings.clone(),
+                _ => Vec::new(),
+            },
         }
     }
 }

@@ -142,6 +142,162 @@ mod tests {
     }
 }
 
+mod at_rest {
+    use plant::config::{load_scene, Rotor, Scene};
+    use plant::model::Control;
+    use plant_physics::flex::machine::{Model, State, N};
+    use plant_physics::integrate::{Integrator, Method, Settings};
+    use std::path::Path;
+
+    /// A 1 m slender rotor (issue 38 item 5): the shipped flexible scene's machine and loop
+    /// with a 40 mm steel shaft of 1 m in 20 elements, a 5 kg disk at mid-span, AMBs at 100 and
+    /// 900 mm; no shock, no unbalance.
+    fn slender() -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/flexible-10g.toml");
+        let sets = [
+            "rotor.shaft.element=[{length_mm=1000.0, outer_diameter_mm=40.0, material=\"steel\", split=20}]",
+            "rotor.shaft.disk=[{node=10, mass_kg=5.0, diametral_inertia_kg_m2=0.01, polar_inertia_kg_m2=0.02}]",
+            "rotor.amb_a_node=2",
+            "rotor.amb_b_node=18",
+            "rotor.cutoff_hz=1000",
+            "rotor.eccentricity_um=0",
+            "shock=[]",
+            "scene.duration_s=0.5",
+            "output.plots=false",
+        ]
+        .map(String::from);
+        load_scene(&path, &sets).expect("the slender rotor loads")
+    }
+
+    /// The largest displacement of any node from where it started (m), over 0.5 s of the
+    /// continuous PD from `y`, sampled every millisecond.
+    fn largest_motion(scene: &Scene, y: State) -> f64 {
+        let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
+        let gains = plant::run::plane_gains(scene).expect("gains");
+        let m = Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [Control::Continuous(gains[0]), Control::Continuous(gains[1])],
+            race_parked: [false; 2],
+        };
+        let nodes = params.z.len();
+        let start: Vec<_> = (0..nodes).map(|n| m.node(&y, n).0).collect();
+        let mut settings = Settings::<N>::adaptive(Method::Dp5, 1e-9, 1e-13);
+        settings.h_max = 1e-4;
+        let mut integrator = Integrator::new(settings);
+        let (mut y, mut worst) = (y, 0.0_f64);
+        for k in 0..500 {
+            let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+            integrator.advance(&m, t0, t1, &mut y).expect("integrates");
+            for (n, s) in start.iter().enumerate() {
+                worst = worst.max((m.node(&y, n).0 - s).norm());
+            }
+        }
+        worst
+    }
+
+    /// With no shock and no unbalance nothing moves: every node of the 1 m slender rotor stays
+    /// within 0.1 µm of where it starts over 0.5 s (it starts sagged: by several µm at
+    /// mid-span). From the straight shaft the rigid start had (the shaft projected from the
+    /// rigid rotor's levitated state), the same rotor swings by micrometres.
+    #[test]
+    fn a_flexible_rotor_starts_at_rest() {
+        let scene = slender();
+        let Rotor::Flexible(params) = &scene.rotor else { panic!("a flexible scene") };
+        let y = plant::initial::flexible_initial_state(&scene, params);
+        let m = Model {
+            params: params.clone(),
+            base: scene.base.clone(),
+            control: [Control::Held([0.0; 2]); 2],
+            race_parked: [false; 2],
+        };
+        let sag = m.node(&y, 10).0.y;
+        let moved = largest_motion(&scene, y);
+        eprintln!(
+            "slender rotor: mid-span sag {:.3} µm; largest motion of a node over 0.5 s {:.2e} m",
+            sag * 1e6,
+            moved
+        );
+        assert!(sag < -1e-6, "the shaft starts sagged under gravity: {sag} m at mid-span");
+        assert!(moved < 1e-7, "a node moved by {moved} m");
+        let straight = Model::from_rigid(params, &plant::initial::two_plane_initial_state(&scene, &params.machine));
+        let swung = largest_motion(&scene, straight);
+        eprintln!("from the straight shaft: {:.2e} m", swung);
+        assert!(swung > 1e-6, "the straight start swings: {swung} m");
+    }
+}
+
+mod ross_bearings {
+    use plant::config::{load_scene, Rotor};
+    use plant_physics::flex::ross::BearingUse;
+    use std::path::Path;
+
+    /// The shipped flexible scene with its shaft from the AMB machine's ROSS file (bearings of
+    /// 1e6 N/m at nodes 2 and 14, the scene's AMB nodes), and `extra` added to the file.
+    fn scene_with(extra: &str, sets: &[&str]) -> Result<plant::config::Scene, plant::config::ConfigError> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let dir = std::env::temp_dir().join(format!("ross-bearings-{}-{}", std::process::id(), extra.len()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ross = std::fs::read_to_string(root.join("physics/tests/fixtures/ross/amb_machine.toml")).unwrap();
+        std::fs::write(dir.join("machine.toml"), ross + extra).unwrap();
+        let mut table: toml::Table =
+            std::fs::read_to_string(root.join("../config/flexible-10g.toml")).unwrap().parse().unwrap();
+        let rotor = table["rotor"].as_table_mut().unwrap();
+        rotor.remove("shaft");
+        rotor.insert("ross_file".into(), "machine.toml".into());
+        std::fs::write(dir.join("scene.toml"), toml::to_string(&table).unwrap()).unwrap();
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = load_scene(&dir.join("scene.toml"), &sets);
+        std::fs::remove_dir_all(&dir).unwrap();
+        scene
+    }
+
+    /// `rotor.ross_bearings` through the scene's keys: none refused under its key, "ignore"
+    /// leaves the shaft without the file's springs (and says nothing), "parallel" keeps both
+    /// (and says so first among the scene's warnings), a seal elsewhere is added either way.
+    #[test]
+    fn the_choice_places_the_files_bearings() {
+        let err = scene_with("", &[]).unwrap_err().to_string();
+        assert!(
+            err.starts_with("rotor.ross_bearings = none:") && err.contains("\"BearingElement_AMB A\" at node 2"),
+            "{err}"
+        );
+        let shaft_bearings = |scene: &plant::config::Scene| {
+            let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+            (f.shaft.bearings.iter().map(|b| b.node).collect::<Vec<_>>(), f.file_bearings.clone())
+        };
+        let ignored = scene_with("", &["rotor.ross_bearings=\"ignore\""]).unwrap();
+        let (nodes, used) = shaft_bearings(&ignored);
+        assert!(nodes.is_empty(), "{nodes:?}");
+        assert!(used.iter().all(|u| u.used == BearingUse::Ignored));
+        assert!(ignored.warnings.iter().all(|w| !w.contains("ross_file")), "{:?}", ignored.warnings);
+        let parallel = scene_with("", &["rotor.ross_bearings=\"parallel\""]).unwrap();
+        assert_eq!(shaft_bearings(&parallel).0, [2, 14]);
+        assert!(
+            parallel.warnings[0].contains(
+                "\"BearingElement_AMB A\" at node 2 (k_xx = 1e6 N/m, k_yy = 1e6 N/m) in parallel with the AMB"
+            ),
+            "{:?}",
+            parallel.warnings
+        );
+        let seal = "\n[\"BearingElement_seal\"]\nn = 8\nkxx = [ 2e5,]\nkyy = [ 2e5,]\n";
+        let with_seal = scene_with(seal, &["rotor.ross_bearings=\"ignore\""]).unwrap();
+        assert_eq!(shaft_bearings(&with_seal).0, [8]);
+        assert!(with_seal.warnings[0].contains("\"BearingElement_seal\" at node 8"), "{:?}", with_seal.warnings);
+        // The stiffer shaft of "parallel": its rigid-body modes rise (the springs add to the loop).
+        let frequencies = |scene: &plant::config::Scene| {
+            let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+            f.reduced.frequencies_hz()
+        };
+        assert!(
+            frequencies(&parallel)[0] > frequencies(&ignored)[0] + 1.0,
+            "{:?} {:?}",
+            frequencies(&parallel),
+            frequencies(&ignored)
+        );
+    }
+}
+
 mod convergence {
     use plant::config::{load_scene, Rotor, Scene};
     use std::path::Path;

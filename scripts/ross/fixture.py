@@ -3,8 +3,9 @@
 For each rotor: builds it in ROSS, saves it with ``Rotor.save()`` (the file our reader takes),
 runs ``run_modal`` (at rest and at each Campbell speed) and ``run_campbell`` (0 to 500 Hz, the
 first six modes, damped natural frequencies, forward and backward), and writes ROSS's figures
-to ``<name>.json`` beside the ``.toml``. Run by ``scripts/ross/fixture.sh``; nothing here is
-computed by the testbed.
+to ``<name>.json`` beside the ``.toml``. Run by ``scripts/ross/fixture.sh`` with ROSS 3.1.0 and
+with ROSS 2.3.0 (the same rotors, each version's file and figures); nothing here is computed by
+the testbed.
 """
 
 import json
@@ -52,6 +53,22 @@ def machine():
     return rs.Rotor(shaft, disks, bearings)
 
 
+def amb_element():
+    """A shaft with one of ROSS's MagneticBearingElements (its own doctest's actuator: g0 = 1 mm,
+    i0 = 1 A, ag = 1 cm², 200 turns, 22.5° poles, a PID with its derivative filter, amplifier
+    and sensor gains) and a plain bearing: the file keeps ROSS's frequency-dependent equivalent
+    coefficients of the AMB, which the reader's formulas are checked against. Only saved."""
+    steel = rs.Material(name="Steel", rho=7810.0, E=211e9, G_s=81.2e9)
+    shaft = [rs.ShaftElement(L=0.1, idl=0.0, odl=0.05, material=steel) for _ in range(4)]
+    bearings = [
+        rs.MagneticBearingElement(n=1, g0=1e-3, i0=1.0, ag=1e-4, nw=200, alpha=0.39269908, kp_pid=2.0,
+                                  ki_pid=30.0, kd_pid=3e-3, n_f=5000.0, k_amp=1.5, k_sense=2000.0,
+                                  tag="AMB"),
+        rs.BearingElement(n=4, kxx=1e6, cxx=10.0, tag="support"),
+    ]
+    return rs.Rotor(shaft, [], bearings)
+
+
 def whirl_names(modal):
     names = []
     for shape in modal.shapes:
@@ -78,6 +95,7 @@ def figures(rotor):
     whirl_code = {0.0: "forward", 1.0: "backward", 0.5: "mixed"}
     return {
         "ross_version": rs.__version__,
+        "python_version": sys.version.split()[0],
         "mass_kg": float(rotor.m),
         "rest": {
             "wn_rad_s": [float(v) for v in at_rest.wn],
@@ -97,6 +115,10 @@ def main(out):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     warnings.simplefilter("ignore")
+    toml = out / "amb_element.toml"
+    toml.unlink(missing_ok=True)
+    amb_element().save(toml)
+    print(f"amb_element: {toml}")
     for name, rotor in (("rotor_example", rs.rotor_example()), ("amb_machine", machine())):
         toml = out / f"{name}.toml"
         toml.unlink(missing_ok=True)  # save() adds to an existing file

@@ -709,3 +709,93 @@ mod fmi2 {
         }
     }
 }
+
+/// The shipped flexible scene with its shaft from a ROSS file (`rotor.ross_file`, the AMB
+/// machine saved by ROSS 3.1, `plant/physics/tests/fixtures/ross/amb_machine.toml`) instead of
+/// its `[rotor.shaft]` table, cut to 5 ms; `extra` is TOML added to the file's text: another
+/// bearing table, say. Writes the scene and the file into `dir` and returns the scene's path.
+fn ross_scene(dir: &TempDir, extra: &str) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let ross = read_text(&root.join("plant/physics/tests/fixtures/ross/amb_machine.toml")) + extra;
+    std::fs::write(dir.join("machine.toml"), ross).unwrap();
+    let mut table: toml::Table = read_text(&scene("flexible-10g.toml")).parse().unwrap();
+    let rotor = table["rotor"].as_table_mut().unwrap();
+    rotor.remove("shaft");
+    rotor.insert("ross_file".into(), "machine.toml".into());
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+    path
+}
+
+/// Issue 38 item 4: the file's plain bearings at the AMB nodes (the AMB machine models each AMB
+/// as a 1e6 N/m spring at nodes 2 and 14, where the scene puts its AMBs) are never counted
+/// twice silently. With no `rotor.ross_bearings` the run is refused (exit 2, nothing written)
+/// naming the bearings (element, node, stiffness) and the choices; with "ignore" it runs, with
+/// no word of them on its first line and each recorded as ignored in summary.json; a bearing
+/// elsewhere (a seal at node 8) is added, said on the run's first line and in summary.json.
+#[test]
+fn a_ross_files_bearings_at_the_amb_nodes_need_a_choice() {
+    let dir = TempDir::new("ross-bearings");
+    let file = ross_scene(&dir, "");
+    refused(
+        "ross-bearings-none",
+        &file,
+        TINY,
+        &[
+            "rotor.ross_bearings = none",
+            "\"BearingElement_AMB A\" at node 2 (k_xx = 1e6 N/m, k_yy = 1e6 N/m)",
+            "\"BearingElement_AMB B\" at node 14",
+            "rotor.ross_bearings = \"ignore\"",
+            "\"parallel\"",
+        ],
+    );
+    refused("ross-bearings-bad", &file, &["rotor.ross_bearings=\"both\""], &["ross_bearings", "both"]);
+    // The choice with a shaft table (no file): a key with no effect, refused.
+    refused(
+        "ross-bearings-table",
+        &scene("flexible-10g.toml"),
+        &["rotor.ross_bearings=\"ignore\""],
+        &["rotor.ross_bearings = \"ignore\"", "no rotor.ross_file"],
+    );
+    // "ignore", and a seal at mid-span.
+    let seal = "\n[\"BearingElement_seal\"]\nn = 8\nkxx = [ 2e5,]\nkyy = [ 2e5,]\ncxx = [ 10.0,]\ncyy = [ 10.0,]\n";
+    let file = ross_scene(&dir, seal);
+    let out = dir.join("run");
+    let sets: Vec<&str> = TINY.iter().copied().chain(["rotor.ross_bearings=\"ignore\""]).collect();
+    let run = output_within(&mut plant_run(&file, &out, &sets), RUN);
+    assert_exit(&run, 0);
+    let first = stderr(&run).lines().next().unwrap_or_default().to_string();
+    assert!(
+        first.contains("rotor.ross_file = machine.toml")
+            && first.contains("\"BearingElement_seal\" at node 8 (k_xx = 2e5 N/m, k_yy = 2e5 N/m) added")
+            && !first.contains("AMB A"),
+        "first line: {first}"
+    );
+    let summary = read_json(&out.join("summary.json"));
+    let used = summary["model"]["ross_bearings"].as_array().expect("model.ross_bearings");
+    let of = |name: &str| used.iter().find(|b| b["element"] == name).unwrap_or_else(|| panic!("{name}: {used:?}"));
+    assert_eq!(of("BearingElement_AMB A")["use"], "ignored");
+    assert_eq!(of("BearingElement_AMB B")["use"], "ignored");
+    assert_eq!(of("BearingElement_seal")["use"], "added");
+    assert_eq!(of("BearingElement_seal")["node"], 8);
+    assert_eq!(of("BearingElement_seal")["stiffness_n_per_m"][0][0], 2e5);
+    assert_eq!(summary["status"], "completed", "{summary:#}");
+    // ROSS's MagneticBearingElement: with a zero gap refused naming it; whole, refused with the
+    // constants it stands for (not yet the plane's AMB).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let amb = read_text(&root.join("plant/physics/tests/fixtures/ross/amb_element.toml"));
+    std::fs::write(dir.join("machine.toml"), amb.replacen("g0 = 0.001", "g0 = 0.0", 1)).unwrap();
+    refused(
+        "ross-amb-gap",
+        &file,
+        &["rotor.ross_bearings=\"ignore\""],
+        &["rotor.ross_file = machine.toml", "element \"BearingElement_AMB\": g0 = 0 m must be positive"],
+    );
+    std::fs::write(dir.join("machine.toml"), amb).unwrap();
+    refused(
+        "ross-amb",
+        &file,
+        &["rotor.ross_bearings=\"ignore\""],
+        &["is ROSS's MagneticBearingElement", "k_i = 4.643925e0 N/A", "k_s = 4.643925e3 N/m"],
+    );
+}

@@ -1,14 +1,15 @@
 //! The flexible rotor against ROSS itself (docs/results/flexible-rotor.md): for ROSS's own
 //! example rotor and an AMB machine rotor, both saved by ROSS's `Rotor.save()`, the natural
 //! frequencies (`run_modal`) and the Campbell diagram (`run_campbell`, forward and backward,
-//! the first six modes, 0 to 500 Hz) that ROSS 3.1.0 computed (`scripts/ross/fixture.sh`
-//! committed them under `tests/fixtures/ross/`) against this crate's from the same files,
-//! within 0.5 %; the reduced model against the full one within 0.1 % below the cutoff; a very
+//! the first six modes, 0 to 500 Hz) that ROSS 3.1.0 and ROSS 2.3.0 computed
+//! (`scripts/ross/fixture.sh` committed them under `tests/fixtures/ross/`, 2.3's in `v2.3/`)
+//! against this crate's from each version's file, within 0.5 %; the reduced model against the full one within 0.1 % below the cutoff; a very
 //! stiff shaft against the rigid two-plane rotor.
 
 use nalgebra::DVector;
 use plant_physics::flex::modes::{Linear, Whirl};
 use plant_physics::flex::reduce::{Kind, Reduced, Reduction};
+use plant_physics::flex::ross::{AtAmbs, BearingUse};
 use plant_physics::flex::{ross, FlexError, LinearBearing, Rotor};
 use plant_physics::two_plane::linear::{LinearRotor, PlaneLoop};
 use serde_json::Value;
@@ -18,6 +19,9 @@ use std::path::PathBuf;
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/ross").join(name)
 }
+
+/// ROSS 2.3.0's file and figures of the same rotor.
+const V23: &str = "v2.3/";
 
 fn load(name: &str) -> (Rotor, Value) {
     let rotor = ross::read(&fixture(&format!("{name}.toml"))).expect("the ROSS file reads");
@@ -136,6 +140,19 @@ fn ross_example_rotor_matches_ross_modal_and_campbell() {
 #[test]
 fn amb_machine_rotor_matches_ross_modal_and_campbell() {
     compare_with_ross("amb_machine");
+}
+
+/// ROSS 2.3.0's files (saved by the same script on Python 3.11) against ROSS 2.3.0's own
+/// figures: the same check, each version's file read by the same reader.
+#[test]
+fn ross_2_3_files_match_ross_2_3_modal_and_campbell() {
+    for name in ["rotor_example", "amb_machine"] {
+        let (_, ross) = load(&format!("{V23}{name}"));
+        assert_eq!(ross["ross_version"], "2.3.0", "{name}: the fixture is ROSS 2.3's");
+        let text = std::fs::read_to_string(fixture(&format!("{V23}{name}.toml"))).unwrap();
+        assert!(text.contains("ross_version = \"2.3.0\""), "{name}: the file is ROSS 2.3's");
+        compare_with_ross(&format!("{V23}{name}"));
+    }
 }
 
 /// The reduced model's whirl modes against the full model's over the Campbell speeds (0 to
@@ -339,7 +356,17 @@ fn stiff_shaft_converges_to_the_rigid_two_plane_rotor() {
 fn bad_ross_files_are_refused_naming_the_element() {
     let text = std::fs::read_to_string(fixture("rotor_example.toml")).unwrap();
     let cases: Vec<(String, &str)> = vec![
-        (text.replace("ross_version = \"3.1.0\"", "ross_version = \"2.3.0\""), "ross_version = \"2.3.0\""),
+        (text.replace("ross_version = \"3.1.0\"", "ross_version = \"4.0.0\""), "ross_version = \"4.0.0\""),
+        (text.replace("ross_version = \"3.1.0\"", "ross_version = \"1.5.0\""), "files of ROSS 2.x and 3.x"),
+        // What a version adds that this reader does not know: refused by element and key.
+        (
+            text.replacen("shear_method_calc = \"cowper\"", "shear_method_calc = \"cowper\"\nfoo = 3", 1),
+            "element \"ShaftElement_Shaft Element 0\": key \"foo\" = 3 is not one this reader knows",
+        ),
+        (text.replacen("beta = 0.0\n", "beta = 0.0\nnew_damping = 1.0\n", 1), "[parameters]: key \"new_damping\""),
+        (text.replacen("Ip = ", "offset = 0.1\nIp = ", 1), "key \"offset\" = 0.1"),
+        (text.replacen("rho = 7810.0", "rho = 7810.0\nyield = 1e9", 1), ".material: key \"yield\""),
+        (text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0,]\nkzx = [ 1.0,]", 1), "key \"kzx\" = [1.0]"),
         (text.replacen("L = 0.25", "L = -0.25", 1), "L = -0.25 m must be positive"),
         (text.replacen("odl = 0.05", "odl = 0.0", 1), "odl = 0 m must be positive"),
         (text.replacen("rho = 7810.0", "", 1), "rho (density, kg/m³) is missing"),
@@ -347,7 +374,16 @@ fn bad_ross_files_are_refused_naming_the_element() {
         (text.replacen("n = 4\nm =", "n = 40\nm =", 1), "node 40 is out of range"),
         (
             text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, 2000000.0,]", 1),
-            "kxx = [1000000.0, 2000000.0] N/m varies with frequency",
+            "(node 0): kxx = [1000000.0, 2000000.0] N/m varies with frequency",
+        ),
+        (
+            text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, 2000000.0,]\nfrequency = [ 0.0, 100.0,]", 1),
+            "(node 0): frequency = [0.0, 100.0]: its coefficients vary with frequency",
+        ),
+        // ROSS's AMB element (a BearingElement table with its parameters) with some missing.
+        (
+            text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0,]\ng0 = 0.001\ni0 = 1.0", 1),
+            "element \"BearingElement_Bearing 0\": ag (m²) is missing",
         ),
         (
             text.clone() + "\n[\"PointMass_0\"]\nn = 1\nm = 2.0\n",
@@ -384,4 +420,127 @@ fn cutoff_below_the_rigid_body_modes_and_nodes_out_of_range_are_refused() {
     };
     let err = Reduced::new(&rotor, &spec).unwrap_err().to_string();
     assert!(err.contains("node 7 is out of range (the shaft has nodes 0 to 6)"), "{err}");
+}
+
+/// The file's plain bearings and the scene's AMBs (issue 38 item 4): the AMB machine's file
+/// models each AMB as a 1e6 N/m spring at nodes 2 and 14. With AMBs there and no choice, the
+/// file is refused naming both bearings (element, node, stiffness) and the choices; "ignore"
+/// drops them, "parallel" keeps them; with the AMBs elsewhere they are added.
+#[test]
+fn the_files_bearings_at_the_amb_nodes_need_a_choice() {
+    let text = std::fs::read_to_string(fixture("amb_machine.toml")).unwrap();
+    let file = ross::parse_file(&text, "amb_machine.toml").unwrap();
+    assert_eq!(file.version, "3.1.0");
+    assert!(file.rotor.bearings.is_empty(), "the bearings are apart");
+    assert_eq!(file.bearings.len(), 2);
+    let err = file.bearings_with_ambs([2, 14], None).unwrap_err();
+    for part in [
+        "\"BearingElement_AMB A\" at node 2 (k_xx = 1e6 N/m, k_yy = 1e6 N/m)",
+        "\"BearingElement_AMB B\" at node 14 (k_xx = 1e6 N/m, k_yy = 1e6 N/m)",
+        "rotor.ross_bearings = \"ignore\"",
+        "\"parallel\"",
+    ] {
+        assert!(err.contains(part), "{err}\nshould contain: {part}");
+    }
+    let (ignored, used) = file.bearings_with_ambs([2, 14], Some(AtAmbs::Ignore)).unwrap();
+    assert!(ignored.bearings.is_empty());
+    assert!(used.iter().all(|u| u.used == BearingUse::Ignored), "{used:?}");
+    let (parallel, used) = file.bearings_with_ambs([2, 14], Some(AtAmbs::Parallel)).unwrap();
+    assert_eq!(parallel.bearings.iter().map(|b| b.node).collect::<Vec<_>>(), [2, 14]);
+    assert_eq!(parallel.bearings[0].stiffness, [[1e6, 0.0], [0.0, 1e6]]);
+    assert_eq!(parallel.bearings[0].damping, [[68.0, 0.0], [0.0, 68.0]]);
+    assert!(used.iter().all(|u| u.used == BearingUse::Parallel), "{used:?}");
+    // One AMB at a bearing's node, the other elsewhere: that one needs the choice, the other
+    // bearing is added whatever the choice.
+    let err = file.bearings_with_ambs([2, 13], None).unwrap_err();
+    assert!(err.contains("AMB A") && !err.contains("AMB B"), "{err}");
+    let (rotor, used) = file.bearings_with_ambs([2, 13], Some(AtAmbs::Ignore)).unwrap();
+    assert_eq!(rotor.bearings.iter().map(|b| b.node).collect::<Vec<_>>(), [14]);
+    assert_eq!(used.iter().map(|u| u.used).collect::<Vec<_>>(), [BearingUse::Ignored, BearingUse::Added]);
+    // The AMBs elsewhere: both bearings are supports, added with no choice asked.
+    let (rotor, used) = file.bearings_with_ambs([3, 13], None).unwrap();
+    assert_eq!(rotor.bearings.len(), 2);
+    assert!(used.iter().all(|u| u.used == BearingUse::Added), "{used:?}");
+    // What `parse` (every bearing kept, as ROSS has the rotor) reads is the "parallel" rotor.
+    assert_eq!(ross::parse(&text, "amb_machine.toml").unwrap(), parallel);
+}
+
+/// ROSS's MagneticBearingElement (issue 38 item 1, not yet the plane's AMB; MODEL.md §13.8): its
+/// parameters read and checked, and its constants by ROSS's formulas against the equivalent
+/// coefficients ROSS itself wrote into the file (`kxx`, `cxx` over `frequency`, from `k_i`,
+/// `k_s`, the gains and the PID with its derivative filter), for ROSS 3.1 and 2.3; the element
+/// is refused naming it with what it stands for; bad parameters are refused naming the element,
+/// key, value and unit.
+#[test]
+fn ross_magnetic_bearing_element_is_read_by_rosss_formulas_and_refused_with_its_constants() {
+    use plant_physics::flex::ross_amb::magnetic;
+    for dir in ["", V23] {
+        let text = std::fs::read_to_string(fixture(&format!("{dir}amb_element.toml"))).unwrap();
+        let table: toml::Table = text.parse().unwrap();
+        let el = table["BearingElement_AMB"].as_table().unwrap();
+        let amb = magnetic(el, "BearingElement_AMB", "element", "amb_element.toml").unwrap();
+        assert_eq!((amb.node, amb.sensor_node), (1, 1), "{dir}");
+        // The closed forms by hand: μ₀ nw² ag i0 cos(22.5°) / g0² and / g0³.
+        // The file's alpha, ROSS's decimals (not π/8 exactly).
+        let alpha = el["alpha"].as_float().unwrap();
+        assert_eq!(alpha.to_string(), "0.39269908");
+        let k = 4e-7 * std::f64::consts::PI * 200.0 * 200.0 * 1e-4 * alpha.cos();
+        assert!((amb.ki_n_per_a() - k / 1e-6).abs() < 1e-12 * k / 1e-6, "{}", amb.ki_n_per_a());
+        assert!((amb.ks_n_per_m() - k / 1e-9).abs() < 1e-12 * k / 1e-9, "{}", amb.ks_n_per_m());
+        // ROSS's own equivalent coefficients, at each of its 50 frequencies.
+        let list = |key: &str| floats(&serde_json::to_value(&el[key]).unwrap());
+        let (w, kxx, cxx) = (list("frequency"), list("kxx"), list("cxx"));
+        assert_eq!(w.len(), 50);
+        let c_scale = cxx.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        for i in 0..w.len() {
+            let (k_eq, c_eq) = amb.equivalent_at(w[i]);
+            assert!(
+                (k_eq - kxx[i]).abs() < 1e-9 * kxx[i].abs(),
+                "{dir} at {} rad/s: k {k_eq} against ROSS's {}",
+                w[i],
+                kxx[i]
+            );
+            assert!(
+                (c_eq - cxx[i]).abs() < 1e-9 * c_scale,
+                "{dir} at {} rad/s: c {c_eq} against ROSS's {}",
+                w[i],
+                cxx[i]
+            );
+            // Isotropic: ROSS's rotation of the axes changes nothing in them (to its round-off).
+            let (kyy, kxy) = (list("kyy")[i], list("kxy")[i]);
+            assert!((kyy - kxx[i]).abs() < 1e-12 * kxx[i].abs() && kxy.abs() < 1e-12 * kxx[i].abs(), "{kyy} {kxy}");
+        }
+        // The file is refused naming the element and what it stands for.
+        let err = ross::parse(&text, "amb_element.toml").unwrap_err().to_string();
+        for part in [
+            "element \"BearingElement_AMB\" (node 1) is ROSS's MagneticBearingElement",
+            "k_i = 4.643925e0 N/A",
+            "k_s = 4.643925e3 N/m",
+            "sensor at node 1",
+            "amplifier gain 1.5 A/V and sensor gain 2000 V/m",
+            "kp = 2, ki = 30 1/s, kd = 0.003 s",
+            "n_f = 5000 rad/s",
+            "axes turned by 45.0°",
+        ] {
+            assert!(err.contains(part), "{dir}: {err}\nshould contain: {part}");
+        }
+    }
+    // Bad parameters, each named with its element, key, value and unit.
+    let text = std::fs::read_to_string(fixture("amb_element.toml")).unwrap();
+    let cases = [
+        ("g0 = 0.001", "g0 = 0.0", "element \"BearingElement_AMB\": g0 = 0 m must be positive"),
+        ("i0 = 1.0", "i0 = -1.0", "i0 = -1 A must be positive"),
+        ("ag = 0.0001", "ag = 0", "ag = 0 m² must be positive"),
+        ("nw = 200", "nw = 0", "nw = 0 turns must be positive"),
+        ("alpha = 0.39269908", "alpha = 1.6", "alpha = 1.6 rad (91.7°): the pole angle must be between 0 and 90°"),
+        ("alpha = 0.39269908", "alpha = 0.0", "alpha = 0 rad"),
+        ("sensor_node = 1", "sensor_node = 9", "element \"BearingElement_AMB\" sensor_node: node 9 is out of range"),
+        ("kp_pid = 2.0", "kp_pid = \"high\"", "kp_pid = \"high\" is not a number"),
+        ("i0 = 1.0", "i0 = [ 1.0, 2.0,]", "i0 = [1.0, 2.0] A: one value per axis, which differ"),
+    ];
+    for (from, to, expect) in cases {
+        assert!(text.contains(from), "{from}");
+        let err = ross::parse(&text.replacen(from, to, 1), "amb_element.toml").unwrap_err().to_string();
+        assert!(err.contains(expect), "{to}: {err}\nshould contain: {expect}");
+    }
 }

@@ -133,6 +133,11 @@ pub struct RawRotor {
     /// `shaft`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ross_file: Option<String> = None,
+    /// Flexible, with `ross_file`: what to do with the file's plain bearings at the AMB nodes
+    /// (the engineer's model of the AMBs): `ignore` (the scene's AMBs replace them) or
+    /// `parallel` (kept as springs beside the AMBs); none: such a file is refused.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ross_bearings: Option<plant_physics::flex::ross::AtAmbs> = None,
     /// Flexible: the node of AMB A (on the −z side of the centre of mass).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub amb_a_node: Option<usize> = None,

@@ -158,7 +158,8 @@ impl Rotor {
         let machine = match self {
             Rotor::Planar(_) => return vec![format!("initial.rotor_{xy}_um={offset_um:?}")],
             Rotor::TwoPlane(m) => m,
-            // The rigid motion that moves the sensor node: the flexible rotor starts rigid.
+            // The rigid motion that moves the sensor node: the flexible rotor's offsets are a rigid
+            // motion of the shaft on top of its start at rest.
             Rotor::Flexible(f) => &f.machine,
         };
         let (own, other) = (machine.planes[axis / 2].sensor, machine.planes[1 - axis / 2].sensor);

@@ -122,10 +122,9 @@ pub(crate) fn with_machine<W: WithMachine>(scene: &Scene, controls: [Control; 2]
         Rotor::Flexible(params) => {
             use plant_physics::flex::machine as flexible;
             const N: usize = flexible::N;
-            // The rigid two-plane rotor's initial state (levitated on the unbalance orbit),
-            // projected on the shaft's basis.
-            let rigid = crate::initial::two_plane_initial_state(scene, &params.machine);
-            let y = flexible::Model::from_rigid(params, &rigid);
+            // At rest on its bearings under gravity (the sagged shaft), the two-plane rotor's
+            // unbalance orbit and offsets on top as a rigid motion of the shaft.
+            let y = crate::initial::flexible_initial_state(scene, params);
             let model = flexible::Model {
                 params: params.clone(),
                 base: scene.base.clone(),

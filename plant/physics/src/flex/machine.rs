@@ -81,6 +81,9 @@ pub struct Params {
     pub shaft: Arc<super::Rotor>,
     /// Each node's axial position from the centre of mass (m).
     pub z: Vec<f64>,
+    /// A ROSS file's plain bearings and what became of each (added to the shaft, ignored for
+    /// the AMB at their node, or kept beside it); empty for a shaft given as a table.
+    pub file_bearings: Vec<super::ross::UsedBearing>,
 }
 
 /// What one plane does during an evaluation.

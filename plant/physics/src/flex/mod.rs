@@ -8,11 +8,13 @@
 //! [`machine`] is the rotor the plant steps (`rotor.model = "flexible"`): the reduced shaft
 //! with two AMBs, two sensors and two touchdown bearings at its nodes.
 
+pub mod initial;
 pub mod linear;
 pub mod machine;
 pub mod modes;
 pub mod reduce;
 pub mod ross;
+pub mod ross_amb;
 pub mod rotor;
 pub mod shaft;
 pub mod table;

@@ -1,5 +1,12 @@
-//! Reading a rotor saved by ROSS's `Rotor.save()` (a TOML file; ROSS 3.1's format, checked
-//! against ROSS 3.1.0 itself by `scripts/ross/fixture.sh`).
+//! Reading a rotor saved by ROSS's `Rotor.save()` (a TOML file; the format of ROSS 2.x and 3.x,
+//! checked against ROSS 2.3.0 and 3.1.0 themselves by `scripts/ross/fixture.sh`).
+//!
+//! **Versions.** A file of ROSS 2.x or 3.x is read when its tables and keys are the ones this
+//! reader knows (those ROSS 2.3 and 3.1 write: 3.1 adds `[parameters]` `alpha, beta,
+//! default_damping_ratio` and a bearing's `interpolation`, and writes zeros as floats); a key it
+//! does not know is refused by its element and name, so that what a version changes is never
+//! read silently. Another major version is refused by its number (the format was never checked
+//! against it).
 //!
 //! The file holds `ross_version`, a `[parameters]` table (`alpha`, `beta`: the rotor's
 //! proportional damping; `modal_damping_ratio` when modal damping is set) and one table per
@@ -10,10 +17,22 @@
 //! constant coefficients). SI throughout.
 //!
 //! What this model cannot represent is refused, naming the element: other element classes
-//! (point masses, seals, magnetic, ball or fluid-film bearings saved as their own class, motors),
-//! bearings linked to a support node (`n_link`) or with coefficients that vary with frequency,
+//! (point masses, seals, ball or fluid-film bearings saved as their own class, motors), ROSS's
+//! `MagneticBearingElement` (saved as a `BearingElement` with `g0, i0, ag, nw, …`: its parameters
+//! are read and checked, [`super::ross_amb`], and the element is refused with the constants it
+//! stands for by ROSS's formulas; the scene's `[amb]` and `[controller]` give the AMBs), bearings linked to a support node
+//! (`n_link`) or with coefficients that vary with frequency (a `frequency` list: refused by
+//! name rather than evaluated at one speed, since the run's speed changes in a free spin and
+//! a fluid-film bearing's coefficients at one speed are not its behaviour under a shock),
 //! shaft elements under axial force or torque, two shaft elements at one node (a layered shaft),
-//! and modal damping.
+//! and modal damping. The axial coefficients `kzz, czz, mzz` are not read (the model is lateral).
+//!
+//! **The file's bearings and the scene's AMBs** ([`RossFile::bearings_with_ambs`]): a plain
+//! bearing at a node the scene gives an AMB is the engineer's model of that AMB (a spring of
+//! the closed loop's stiffness, ROSS's usual way); the scene says whether it is dropped for the
+//! AMB ([`AtAmbs::Ignore`]) or kept in parallel with it ([`AtAmbs::Parallel`]), and without that
+//! choice the file is refused, naming those bearings. Bearings elsewhere (seals, supports) are
+//! added to the shaft.
 
 use super::rotor::{Disk, LinearBearing, Rotor};
 use super::shaft::{Material, ShaftElement, ShearMethod};
@@ -21,10 +40,200 @@ use super::FlexError;
 use std::path::Path;
 use toml::{Table, Value};
 
-/// The ROSS versions (major.minor) whose files this reader takes.
-pub const SUPPORTED_VERSIONS: &[&str] = &["3.1"];
+/// The ROSS major versions whose files this reader takes (checked against 2.3.0 and 3.1.0).
+pub const SUPPORTED_MAJORS: &[&str] = &["2", "3"];
 
-/// Reads the ROSS file at `path`.
+/// The keys of `[parameters]` this reader knows (`modal_damping_ratio` is known, and refused).
+const PARAMETER_KEYS: &[&str] = &["alpha", "beta", "default_damping_ratio", "modal_damping_ratio"];
+/// The keys of a `ShaftElement` table (`material` is its sub-table).
+const SHAFT_KEYS: &[&str] = &[
+    "L",
+    "idl",
+    "odl",
+    "idr",
+    "odr",
+    "n",
+    "axial_force",
+    "torque",
+    "shear_effects",
+    "rotary_inertia",
+    "gyroscopic",
+    "shear_method_calc",
+    "alpha",
+    "beta",
+    "material",
+    "tag",
+    "color",
+    "scale_factor",
+];
+/// The keys of a shaft element's `material` table.
+const MATERIAL_KEYS: &[&str] = &["name", "rho", "E", "G_s", "Poisson", "color", "tag"];
+/// The keys of a `DiskElement` table.
+const DISK_KEYS: &[&str] = &["n", "m", "Id", "Ip", "tag", "color", "scale_factor"];
+/// The keys of a plain `BearingElement` table (`n_link` and `frequency` are known, and refused
+/// with their reasons).
+pub(super) const BEARING_KEYS: &[&str] = &[
+    "n",
+    "n_link",
+    "frequency",
+    "kxx",
+    "kxy",
+    "kyx",
+    "kyy",
+    "kzz",
+    "cxx",
+    "cxy",
+    "cyx",
+    "cyy",
+    "czz",
+    "mxx",
+    "mxy",
+    "myx",
+    "myy",
+    "mzz",
+    "interpolation",
+    "tag",
+    "color",
+    "scale_factor",
+];
+/// The parameters ROSS's `MagneticBearingElement` saves in its `BearingElement` table (2.3 has
+/// all but `sensor_node`).
+pub(super) const MAGNETIC_KEYS: &[&str] = &[
+    "g0",
+    "i0",
+    "ag",
+    "nw",
+    "alpha",
+    "k_amp",
+    "k_sense",
+    "kp_pid",
+    "kd_pid",
+    "ki_pid",
+    "n_f",
+    "sensors_axis_rotation",
+    "sensor_node",
+];
+
+/// A plain bearing of the file: its element's table name and its coefficients.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FileBearing {
+    /// The element, as the file names its table (`"BearingElement_<tag>"`).
+    pub element: String,
+    /// Its coefficients at its node.
+    pub bearing: LinearBearing,
+}
+
+/// A ROSS file as read: the shaft and disks, and the file's plain bearings apart (what is done
+/// with them depends on where the scene puts its AMBs: [`RossFile::bearings_with_ambs`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RossFile {
+    /// `ross_version` as the file writes it.
+    pub version: String,
+    /// The rotor without the file's bearings.
+    pub rotor: Rotor,
+    /// The file's plain bearings, in the file's order.
+    pub bearings: Vec<FileBearing>,
+}
+
+/// What the scene does with the file's plain bearings at the AMB nodes (`rotor.ross_bearings`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AtAmbs {
+    /// They were the engineer's model of the AMBs: the scene's AMBs replace them.
+    Ignore,
+    /// They are kept as springs in parallel with the scene's AMBs.
+    Parallel,
+}
+
+/// What became of one of the file's bearings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingUse {
+    /// Away from the AMBs: added to the shaft.
+    Added,
+    /// At an AMB node, dropped for the AMB (`rotor.ross_bearings = "ignore"`).
+    Ignored,
+    /// At an AMB node, kept beside the AMB (`rotor.ross_bearings = "parallel"`).
+    Parallel,
+}
+
+/// One of the file's bearings and what became of it (the run's record, `summary.json`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct UsedBearing {
+    /// The element, as the file names its table.
+    pub element: String,
+    /// Its node.
+    pub node: usize,
+    /// Stiffness `[[k_xx, k_xy], [k_yx, k_yy]]` (N/m).
+    pub stiffness_n_per_m: [[f64; 2]; 2],
+    /// Damping `[[c_xx, c_xy], [c_yx, c_yy]]` (N·s/m).
+    pub damping_n_s_per_m: [[f64; 2]; 2],
+    /// What the run does with it.
+    #[serde(rename = "use")]
+    pub used: BearingUse,
+}
+
+impl FileBearing {
+    /// `"<element>" at node n (k_xx = …, k_yy = … N/m)`, for messages.
+    pub fn describe(&self) -> String {
+        let k = self.bearing.stiffness;
+        let mut s = format!(
+            "\"{}\" at node {} (k_xx = {:e} N/m, k_yy = {:e} N/m",
+            self.element, self.bearing.node, k[0][0], k[1][1]
+        );
+        if k[0][1] != 0.0 || k[1][0] != 0.0 {
+            s += &format!(", k_xy = {:e} N/m, k_yx = {:e} N/m", k[0][1], k[1][0]);
+        }
+        s + ")"
+    }
+}
+
+impl RossFile {
+    /// The rotor with the file's bearings as the scene's AMBs at `amb_nodes` and its choice
+    /// `choice` (`rotor.ross_bearings`) have them, and what became of each. Bearings at an AMB
+    /// node with no choice: the error names them and lists the choices (the message is the
+    /// `Err`'s text, for the caller to put under its key).
+    pub fn bearings_with_ambs(
+        &self,
+        amb_nodes: [usize; 2],
+        choice: Option<AtAmbs>,
+    ) -> Result<(Rotor, Vec<UsedBearing>), String> {
+        let at_amb: Vec<&FileBearing> = self.bearings.iter().filter(|b| amb_nodes.contains(&b.bearing.node)).collect();
+        if !at_amb.is_empty() && choice.is_none() {
+            let named: Vec<String> = at_amb.iter().map(|b| b.describe()).collect();
+            return Err(format!(
+                "the file has plain bearings at the AMB nodes {} and {}: {}. They are the engineer's model of the \
+                 AMBs and would count the AMBs twice: say what to do with them, rotor.ross_bearings = \"ignore\" \
+                 (the scene's AMBs replace them) or \"parallel\" (kept as springs beside the AMBs)",
+                amb_nodes[0],
+                amb_nodes[1],
+                named.join(", ")
+            ));
+        }
+        let mut rotor = self.rotor.clone();
+        let mut used = Vec::with_capacity(self.bearings.len());
+        for b in &self.bearings {
+            let how = match (amb_nodes.contains(&b.bearing.node), choice) {
+                (false, _) => BearingUse::Added,
+                (true, Some(AtAmbs::Parallel)) => BearingUse::Parallel,
+                (true, _) => BearingUse::Ignored,
+            };
+            if how != BearingUse::Ignored {
+                rotor.bearings.push(b.bearing);
+            }
+            used.push(UsedBearing {
+                element: b.element.clone(),
+                node: b.bearing.node,
+                stiffness_n_per_m: b.bearing.stiffness,
+                damping_n_s_per_m: b.bearing.damping,
+                used: how,
+            });
+        }
+        Ok((rotor, used))
+    }
+}
+
+/// Reads the ROSS file at `path`, every bearing of it kept (as ROSS has the rotor).
 pub fn read(path: &Path) -> Result<Rotor, FlexError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path)
@@ -32,8 +241,44 @@ pub fn read(path: &Path) -> Result<Rotor, FlexError> {
     parse(&text, &file)
 }
 
-/// Parses the text of a ROSS file (`file` names it in errors).
+/// Parses the text of a ROSS file (`file` names it in errors), every bearing of it kept (as
+/// ROSS has the rotor).
 pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
+    let f = parse_file(text, file)?;
+    let mut rotor = f.rotor;
+    rotor.bearings = f.bearings.into_iter().map(|b| b.bearing).collect();
+    rotor.validate().map_err(|e| FlexError::Ross { file: file.to_string(), message: e.to_string() })?;
+    Ok(rotor)
+}
+
+/// The key of `table` (of `at`) that this reader does not know, refused by name.
+pub(super) fn unknown_key(table: &Table, known: &[&str], at: &str, file: &str) -> Result<(), FlexError> {
+    match table.keys().find(|k| !known.contains(&k.as_str())) {
+        None => Ok(()),
+        Some(k) => Err(FlexError::Ross {
+            file: file.to_string(),
+            message: format!(
+                "{at}: key \"{k}\" = {} is not one this reader knows (it reads the keys ROSS 2.3 and 3.1 write: {})",
+                short(&table[k]),
+                known.join(", ")
+            ),
+        }),
+    }
+}
+
+/// A value as a message shows it: a long list by its length, first and last values.
+fn short(v: &Value) -> String {
+    match v {
+        Value::Array(a) if a.len() > 4 => {
+            format!("[{}, …, {}] ({} values)", a[0], a[a.len() - 1], a.len())
+        }
+        v => v.to_string(),
+    }
+}
+
+/// Parses the text of a ROSS file (`file` names it in errors): the shaft and disks, and the
+/// plain bearings apart.
+pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
     let err = |message: String| FlexError::Ross { file: file.to_string(), message };
     let table: Table = text.parse().map_err(|e| err(format!("is not TOML: {e}")))?;
     let version = match table.get("ross_version") {
@@ -41,16 +286,17 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
         Some(other) => return Err(err(format!("ross_version = {other} is not a version string"))),
         None => return Err(err("has no ross_version: not a file saved by ROSS's Rotor.save()".into())),
     };
-    let major_minor: String = version.split('.').take(2).collect::<Vec<_>>().join(".");
-    if !SUPPORTED_VERSIONS.contains(&major_minor.as_str()) {
+    let major = version.split('.').next().unwrap_or_default();
+    if !SUPPORTED_MAJORS.contains(&major) {
         return Err(err(format!(
-            "ross_version = \"{version}\": this reader takes files of ROSS {} (save the rotor again with that version)",
-            SUPPORTED_VERSIONS.join(", ")
+            "ross_version = \"{version}\": this reader takes files of ROSS 2.x and 3.x (checked against 2.3 and 3.1; save \
+             the rotor again with one of them)"
         )));
     }
     let (mut alpha, mut beta) = (0.0, 0.0);
     if let Some(p) = table.get("parameters") {
         let p = p.as_table().ok_or_else(|| err("[parameters] is not a table".into()))?;
+        unknown_key(p, PARAMETER_KEYS, "[parameters]", file)?;
         if let Some(v) = p.get("modal_damping_ratio") {
             return Err(err(format!(
                 "[parameters] modal_damping_ratio = {v}: ROSS's modal damping is not represented (give the scene's modal damping ratio instead)"
@@ -62,6 +308,7 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
     let mut shafts: Vec<(usize, String, ShaftElement)> = Vec::new();
     let mut disks: Vec<(String, Disk)> = Vec::new();
     let mut bearings: Vec<(String, LinearBearing)> = Vec::new();
+    let mut magnetics: Vec<super::ross_amb::MagneticBearing> = Vec::new();
     for (name, value) in &table {
         if name == "ross_version" || name == "parameters" || name.starts_with('_') {
             continue;
@@ -71,10 +318,12 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
         let at = format!("element \"{name}\"");
         match class {
             "ShaftElement" => {
+                unknown_key(el, SHAFT_KEYS, &at, file)?;
                 let (n, shaft) = shaft_element(el, &at, file)?;
                 shafts.push((n, name.clone(), shaft));
             }
             "DiskElement" => {
+                unknown_key(el, DISK_KEYS, &at, file)?;
                 let n = node(el, &at, file)?;
                 let disk = Disk {
                     node: n,
@@ -85,7 +334,15 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
                 disks.push((at, disk));
             }
             "BearingElement" => {
-                bearings.push((at.clone(), bearing(el, &at, file)?));
+                if MAGNETIC_KEYS.iter().any(|k| el.contains_key(*k) && *k != "alpha") {
+                    // ROSS's AMB element, saved as a BearingElement with its parameters (its
+                    // frequency-dependent equivalent coefficients beside them): its parameters
+                    // checked here, the element refused once the nodes are known.
+                    magnetics.push(super::ross_amb::magnetic(el, name, &at, file)?);
+                    continue;
+                }
+                unknown_key(el, BEARING_KEYS, &at, file)?;
+                bearings.push((name.clone(), bearing(el, &at, file)?));
             }
             other => {
                 return Err(err(format!(
@@ -111,23 +368,32 @@ pub fn parse(text: &str, file: &str) -> Result<Rotor, FlexError> {
         return Err(err("has no ShaftElement".into()));
     }
     let nodes = elements.len() + 1;
-    for (at, n) in disks.iter().map(|(a, d)| (a, d.node)).chain(bearings.iter().map(|(a, b)| (a, b.node))) {
+    let bearing_at: Vec<(String, usize)> = bearings.iter().map(|(a, b)| (format!("element \"{a}\""), b.node)).collect();
+    for (at, n) in disks.iter().map(|(a, d)| (a.clone(), d.node)).chain(bearing_at) {
         if n >= nodes {
             return Err(FlexError::NodeOutOfRange { what: format!("{file}: {at}"), node: n, nodes });
         }
     }
-    let rotor = Rotor {
-        elements,
-        disks: disks.into_iter().map(|(_, d)| d).collect(),
-        bearings: bearings.into_iter().map(|(_, b)| b).collect(),
-        alpha,
-        beta,
-    };
+    if let Some(m) = magnetics.first() {
+        for (key, n) in [("n", m.node), ("sensor_node", m.sensor_node)] {
+            if n >= nodes {
+                return Err(FlexError::NodeOutOfRange {
+                    what: format!("{file}: element \"{}\" {key}", m.element),
+                    node: n,
+                    nodes,
+                });
+            }
+        }
+        return Err(err(m.refusal()));
+    }
+    let rotor =
+        Rotor { elements, disks: disks.into_iter().map(|(_, d)| d).collect(), bearings: Vec::new(), alpha, beta };
     rotor.validate().map_err(|e| err(e.to_string()))?;
-    Ok(rotor)
+    let bearings = bearings.into_iter().map(|(element, bearing)| FileBearing { element, bearing }).collect();
+    Ok(RossFile { version, rotor, bearings })
 }
 
-fn as_number(v: &Value) -> Option<f64> {
+pub(super) fn as_number(v: &Value) -> Option<f64> {
     match v {
         Value::Float(f) => Some(*f),
         Value::Integer(i) => Some(*i as f64),
@@ -150,7 +416,7 @@ fn number(t: &Table, key: &str, at: &str, file: &str) -> Result<f64, FlexError> 
         .ok_or_else(|| FlexError::Ross { file: file.into(), message: format!("{at}: {key} is missing") })
 }
 
-fn node(t: &Table, at: &str, file: &str) -> Result<usize, FlexError> {
+pub(super) fn node(t: &Table, at: &str, file: &str) -> Result<usize, FlexError> {
     match t.get("n") {
         Some(Value::Integer(n)) if *n >= 0 => Ok(*n as usize),
         Some(v) => Err(FlexError::Ross { file: file.into(), message: format!("{at}: n = {v} is not a node number") }),
@@ -204,6 +470,7 @@ fn shaft_element(t: &Table, at: &str, file: &str) -> Result<(usize, ShaftElement
     }
     let mat_at = format!("{at}.material");
     let m = t.get("material").and_then(Value::as_table).ok_or_else(|| err(format!("{mat_at} is missing")))?;
+    unknown_key(m, MATERIAL_KEYS, &mat_at, file)?;
     let rho = opt_number(m, "rho", &mat_at, file)?;
     let e = opt_number(m, "E", &mat_at, file)?;
     let g = opt_number(m, "G_s", &mat_at, file)?;
@@ -260,6 +527,13 @@ fn bearing(t: &Table, at: &str, file: &str) -> Result<LinearBearing, FlexError> 
             )))
         }
     }
+    if let Some(f) = t.get("frequency").filter(|f| !matches!(f, Value::Array(a) if a.len() <= 1)) {
+        return Err(err(format!(
+            "{at} (node {n}): frequency = {}: its coefficients vary with frequency, which this model cannot \
+             represent (it takes constant coefficients; it does not evaluate them at one speed)",
+            short(f)
+        )));
+    }
     // One coefficient: a single value, or a list of equal values (constant over frequency).
     let coefficient = |key: &str, unit: &str| -> Result<f64, FlexError> {
         let values: Vec<f64> = match t.get(key) {
@@ -274,7 +548,9 @@ fn bearing(t: &Table, at: &str, file: &str) -> Result<LinearBearing, FlexError> 
             None => Ok(0.0),
             Some(&first) if values.iter().all(|&v| v == first) && first.is_finite() => Ok(first),
             Some(_) => Err(err(format!(
-                "{at}: {key} = {values:?} {unit} varies with frequency, which this model cannot represent (it takes constant coefficients)"
+                "{at} (node {n}): {key} = {} {unit} varies with frequency, which this model cannot represent (it takes \
+                 constant coefficients; it does not evaluate them at one speed)",
+                short(&t[key])
             ))),
         }
     };

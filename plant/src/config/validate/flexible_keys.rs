@@ -24,6 +24,9 @@ pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), Conf
     if let Some(f) = &r.ross_file {
         return Err(range("rotor.ross_file", f, "", WHY));
     }
+    if let Some(b) = r.ross_bearings {
+        return Err(range("rotor.ross_bearings", at_ambs_name(b), "", WHY));
+    }
     let nodes = [
         ("rotor.amb_a_node", r.amb_a_node),
         ("rotor.amb_b_node", r.amb_b_node),
@@ -60,7 +63,7 @@ pub(in crate::config) fn flexible_params(
     if let Some((key, value, unit)) = rigid_keys.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
         return Err(range(key, value, unit, RIGID));
     }
-    let shaft = match (&r.shaft, &r.ross_file) {
+    let (shaft, file) = match (&r.shaft, &r.ross_file) {
         (Some(_), Some(f)) => {
             return Err(range("rotor.ross_file", f, "", "a flexible rotor has either rotor.shaft or rotor.ross_file"))
         }
@@ -72,12 +75,25 @@ pub(in crate::config) fn flexible_params(
                 "a flexible rotor needs its shaft: a [rotor.shaft] table or rotor.ross_file (neither is given)",
             ))
         }
-        (Some(table), None) => table.rotor().map_err(|e| flex_error("rotor.shaft", "the table", e))?,
+        (Some(table), None) => {
+            if let Some(b) = r.ross_bearings {
+                return Err(range(
+                    "rotor.ross_bearings",
+                    at_ambs_name(b),
+                    "",
+                    "says what to do with a ROSS file's bearings, and this scene has no rotor.ross_file: remove it",
+                ));
+            }
+            (table.rotor().map_err(|e| flex_error("rotor.shaft", "the table", e))?, None)
+        }
         (None, Some(file)) => {
             let path = base_dir.join(file);
             let text = shock_table::input::read_text(&path, shock_table::input::MAX_TOML_BYTES)
                 .map_err(|e| range("rotor.ross_file", file, "", &format!("cannot read {}: {e}", path.display())))?;
-            flex::ross::parse(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?
+            // The shaft and disks first: the AMB nodes are checked on them, then the file's
+            // bearings are placed as the AMB nodes and rotor.ross_bearings say.
+            let read = flex::ross::parse_file(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?;
+            (read.rotor.clone(), Some((file, read)))
         }
     };
     shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
@@ -120,6 +136,16 @@ pub(in crate::config) fn flexible_params(
             &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
         ));
     }
+    let (shaft, file_bearings) = match file {
+        None => (shaft, Vec::new()),
+        Some((name, read)) => {
+            let (rotor, used) = read
+                .bearings_with_ambs(amb, r.ross_bearings)
+                .map_err(|why| range("rotor.ross_bearings", "none", "", &format!("rotor.ross_file = {name}: {why}")))?;
+            rotor.validate().map_err(|e| flex_error("rotor.ross_file", name, e))?;
+            (rotor, used)
+        }
+    };
     let cutoff = positive("rotor.cutoff_hz", r.cutoff_hz.unwrap_or(CUTOFF_HZ), "Hz")?;
     let zeta = non_negative("rotor.modal_damping", r.modal_damping.unwrap_or(MODAL_DAMPING), "")?;
     if zeta >= 1.0 {
@@ -184,7 +210,41 @@ pub(in crate::config) fn flexible_params(
     // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
     // forms its terms at each evaluation, as before; the result is the same to the bit).
     let reduced = reduced.hold_speed(machine.rotor.speed);
-    Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z })
+    Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z, file_bearings })
+}
+
+/// `rotor.ross_bearings`'s value as the scene writes it.
+fn at_ambs_name(b: flex::ross::AtAmbs) -> &'static str {
+    match b {
+        flex::ross::AtAmbs::Ignore => "\"ignore\"",
+        flex::ross::AtAmbs::Parallel => "\"parallel\"",
+    }
+}
+
+/// The line the run starts with when a ROSS file's bearings add stiffness to the shaft besides
+/// the scene's AMBs (supports and seals away from the AMBs, or bearings at the AMB nodes kept in
+/// parallel): which, where and how stiff; `None` when none does.
+pub(in crate::config) fn file_bearings_note(raw: &RawScene, params: &machine::Params) -> Option<String> {
+    use flex::ross::BearingUse;
+    let kept: Vec<String> = params
+        .file_bearings
+        .iter()
+        .filter(|b| b.used != BearingUse::Ignored)
+        .map(|b| {
+            let k = b.stiffness_n_per_m;
+            let how = if b.used == BearingUse::Parallel { "in parallel with the AMB" } else { "added" };
+            format!("\"{}\" at node {} (k_xx = {:e} N/m, k_yy = {:e} N/m) {how}", b.element, b.node, k[0][0], k[1][1])
+        })
+        .collect();
+    if kept.is_empty() {
+        return None;
+    }
+    let file = raw.rotor.ross_file.as_deref().unwrap_or("the ROSS file");
+    Some(format!(
+        "rotor.ross_file = {file}: the file's bearings act on the shaft besides the scene's AMBs: {} \
+         (summary.json model.ross_bearings)",
+        kept.join(", ")
+    ))
 }
 
 /// Writes the flexible rotor's defaults into the raw scene, and the mass and polar inertia its

@@ -133,6 +133,12 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
     // The rotor model, built from the scene by its own arm of `Rotor::from_raw`.
     let rotor = Rotor::from_raw(&raw, &whole, base_dir)?;
+    // A ROSS file's bearings that act besides the AMBs: the run's first line says so.
+    if let Rotor::Flexible(f) = &rotor {
+        if let Some(note) = flexible_keys::file_bearings_note(&raw, f) {
+            warnings.insert(0, note);
+        }
+    }
     // The sensor's and the controller's loop constants are the scene's (`[amb]`,
     // `[controller]`), the same on every plane.
     let loop_constants = rotor.plane(0).loop_constants;
