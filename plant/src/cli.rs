@@ -49,6 +49,11 @@ pub enum Command {
         /// programme may differ): `trace.csv` then holds the rows after that state's time.
         #[arg(long, value_name = "FILE")]
         from_state: Option<PathBuf>,
+        /// Also run N perturbed copies (the unbalance's angle by ±k·1e-9 rad, the rotor's start by
+        /// ±k pm), in parallel, and say how robust the outcome is (summary.json `robustness`; the
+        /// same as `--set robustness.members=N`).
+        #[arg(long, value_name = "N")]
+        robustness: Option<u32>,
     },
     /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
     /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.

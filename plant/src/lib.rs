@@ -46,6 +46,7 @@ pub mod output;
 pub mod plot;
 pub mod record;
 pub mod rng;
+pub mod robustness;
 pub mod row_file;
 pub mod run;
 pub mod sensor;

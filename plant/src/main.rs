@@ -84,8 +84,11 @@ fn warn(message: &str) {
 /// Runs one command.
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, out, set, quiet, controller, run_id, save_state_at, from_state } => {
+        Command::Run { scene, out, mut set, quiet, controller, run_id, save_state_at, from_state, robustness } => {
             let states = States { save_at: save_state_at, from: from_state };
+            if let Some(n) = robustness {
+                set.push(format!("robustness.members={n}"));
+            }
             run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
         }
         Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
@@ -368,6 +371,18 @@ fn run_scene(
     let scene = load_scene(path, set)?;
     load_checked(&scene)?;
     let from = states.check(&scene)?;
+    let robustness = plant::robustness::members(&scene)?;
+    if robustness > 0 && from.is_some() {
+        let why = "a run from a saved state starts from that state, which the perturbations (the unbalance's angle \
+                   and the rotor's start at t = 0) do not reach: save the state from a run with robustness instead";
+        return Err(plant::config::ConfigError::Range {
+            key: "robustness.members".into(),
+            value: robustness.to_string(),
+            unit: String::new(),
+            why: why.into(),
+        }
+        .into());
+    }
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
     let mut hooks = CliHooks {
@@ -382,7 +397,7 @@ fn run_scene(
         save_error: None,
         pace_said: false,
     };
-    let written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
+    let mut written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
@@ -400,6 +415,9 @@ fn run_scene(
         eprintln!("plant: {chart} not drawn: nothing to draw");
     }
     eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
+    if robustness > 0 && written.run.outcome != Outcome::Interrupted {
+        robustness_of(path, set, &scene, &mut written, robustness, &dir, quiet)?;
+    }
     if let Some(c) = written.summary.cosim.as_ref().filter(|c| c.schedule_held == Some(false)) {
         warn(&format!(
             "the realtime schedule did not hold: {} deadline misses ({:.3} % of the ticks with a reply due, \
@@ -418,6 +436,36 @@ fn run_scene(
     match hooks.save_error {
         Some(e) => Err(e.into()),
         None => Ok(()),
+    }
+}
+
+/// Runs the `n` perturbed members of a written run and adds their verdict to its
+/// `summary.json` (written again, whole) and its last line.
+fn robustness_of(
+    path: &Path,
+    set: &[String],
+    scene: &Scene,
+    written: &mut plant::output::Written,
+    n: usize,
+    dir: &Path,
+    quiet: bool,
+) -> anyhow::Result<()> {
+    if !quiet {
+        eprintln!("plant: robustness: {n} perturbed runs in parallel …");
+    }
+    let own = plant::ensemble::member::Figures::of_summary(&written.summary);
+    let stop = plant::interrupt::stop_flag();
+    match plant::robustness::assess(path, set, scene, &own, n, &stop).context("the robustness runs")? {
+        Some(r) => {
+            eprintln!("plant: {}", r.headline());
+            written.summary.robustness = Some(r);
+            plant::output::write_json(&dir.join("summary.json"), &written.summary)
+        }
+        None => {
+            warn("robustness: interrupted; summary.json has the run without it");
+            let why = "interrupted during the robustness runs".to_string();
+            Err(Ending::Stopped { kind: StopKind::Interrupted, why, simulated_s: written.summary.simulated_s }.into())
+        }
     }
 }
 

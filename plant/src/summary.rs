@@ -183,6 +183,10 @@ pub struct Summary {
     /// Spectra, Poincaré section and classification of the response.
     #[serde(flatten)]
     pub analysis: Analysis,
+    /// How robust the outcome is: the run repeated with perturbations (`plant run --robustness
+    /// N`, `[robustness] members`); absent unless asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robustness: Option<crate::robustness::Robustness>,
     /// Co-simulation figures (`lockstep`, `realtime` modes only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cosim: Option<crate::cosim::CosimReport>,
@@ -360,6 +364,7 @@ impl Summary {
                 max_rhs_evals_per_tick: run.ticks.max_rhs_evals,
             },
             analysis,
+            robustness: None,
             cosim: run.cosim.clone(),
             planes,
             mid_span,

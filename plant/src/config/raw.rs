@@ -733,6 +733,15 @@ pub struct RawOutput {
 }
 }
 
+scene_table! {
+/// `[robustness]`: `plant run` repeats the run with perturbations far below the model's own
+/// uncertainty and says how robust its outcome is (`plant::robustness`); other commands ignore it.
+pub struct RawRobustness {
+    /// Perturbed runs beside the run (0: none; at most 256).
+    pub members: i64 = 0,
+}
+}
+
 /// A whole scene file as written.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -761,6 +770,9 @@ pub struct RawScene {
     pub output: RawOutput,
     /// `[[shock]]`: the shock programme.
     pub shock: Vec<ShockSpec>,
+    /// `[robustness]`: read by `plant run` ([`RawRobustness`]); absent unless given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robustness: Option<RawRobustness>,
     /// `[ensemble]`: read by `plant ensemble`; scene validation ignores it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ensemble: Option<toml::Table>,

@@ -100,21 +100,29 @@ impl MemberResult {
 pub fn figures(scene: &Scene, result: &RunResult) -> (Figures, Vec<(i64, f64, f64)>) {
     let s = Summary::new(scene, result);
     let a = &s.analysis;
-    let f = Figures {
-        status: s.status,
-        mode: Mode::of_run(s.status, a.post_shock_mode),
-        steady_class: a.steady_class,
-        period_k: a.period_k,
-        recovery_s: s.recovery_s,
-        contact_fraction: s.contact_fraction,
-        whirl_hz: a.whirl_hz,
-        max_radius_m: s.max_radius_m.unwrap_or(0.0), // stored as a number (null would not read back)
-        max_contact_force_n: s.max_contact_force_n.unwrap_or(0.0),
-        steady_window_start_s: s.steady_window_start_s,
-        wall_time_s: s.wall_time_s,
-    };
+    let f = Figures::of_summary(&s);
     let poincare = a.section.iter().filter(|p| p.t_s >= a.steady_window_s[0]).map(|p| (p.n, p.x_m, p.y_m)).collect();
     (f, poincare)
+}
+
+impl Figures {
+    /// The figures a run's [`Summary`] gives.
+    pub fn of_summary(s: &Summary) -> Self {
+        let a = &s.analysis;
+        Figures {
+            status: s.status,
+            mode: Mode::of_run(s.status, a.post_shock_mode),
+            steady_class: a.steady_class,
+            period_k: a.period_k,
+            recovery_s: s.recovery_s,
+            contact_fraction: s.contact_fraction,
+            whirl_hz: a.whirl_hz,
+            max_radius_m: s.max_radius_m.unwrap_or(0.0), // stored as a number (null would not read back)
+            max_contact_force_n: s.max_contact_force_n.unwrap_or(0.0),
+            steady_window_start_s: s.steady_window_start_s,
+            wall_time_s: s.wall_time_s,
+        }
+    }
 }
 
 /// `--set` overrides of the members' setting for a point's scene (empty for `scene`).
