@@ -1,0 +1,111 @@
+//! `plant linear`: the plant of a scene linearised about its levitated state at a spin speed,
+//! written for a control engineer's tools (python-control, MATLAB, numpy): from each axis'
+//! current command (A) to each axis' sensor signal (V), as a continuous state-space system
+//! ([`model`]) and as the discrete system the digital controller sees (zero-order hold at the
+//! controller's rate, its command delay as states: [`discrete`]); `linear.json` and
+//! `linear.npz` ([`files`]; docs/guide/linear.md). The law's linear form on it ([`law`]) gives
+//! the closed loop's sensitivity, the very one `plant assess`'s closed forms draw.
+
+pub mod discrete;
+pub mod files;
+pub mod law;
+pub mod model;
+
+use crate::config::load_scene;
+use crate::exit::BadArgument;
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+
+/// What `plant linear` is asked.
+pub struct Request<'a> {
+    /// The scene file.
+    pub scene: &'a Path,
+    /// `--set` overrides.
+    pub set: &'a [String],
+    /// Spin speed (Hz); `None`: the scene's `rotor.speed_hz`.
+    pub speed_hz: Option<f64>,
+    /// Output folder (default `runs/linear-<scene name>`).
+    pub out: Option<&'a Path>,
+}
+
+/// The model of a request, computed whole before anything is written.
+pub struct Built {
+    /// The continuous plant.
+    pub plant: model::LinearPlant,
+    /// The discrete system and its states.
+    pub discrete: (model::System, Vec<model::Signal>),
+    /// Its period (s) and delay (ticks).
+    pub period: f64,
+    /// Command delay (ticks).
+    pub delay: u32,
+}
+
+/// The linear model of `scene` at `speed_hz` (Hz): bad input named.
+pub fn build(scene: &crate::config::Scene, speed_hz: f64) -> anyhow::Result<Built> {
+    let plant = model::continuous(scene, speed_hz).map_err(|e| BadArgument(e.to_string()))?;
+    let (period, delay) = (scene.controller.period, scene.controller.delay_samples);
+    let discrete = discrete::zoh(&plant, period, delay);
+    Ok(Built { plant, discrete, period, delay })
+}
+
+/// Refuses an output folder that is a file or a link (nothing is written through a link).
+fn check_out(dir: &Path) -> anyhow::Result<()> {
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => Err(BadArgument(format!(
+            "--out {}: a symbolic link; give a folder (the files are not written through a link)",
+            dir.display()
+        ))
+        .into()),
+        Ok(m) if !m.is_dir() => {
+            Err(BadArgument(format!("--out {}: a file, not a folder; give a folder", dir.display())).into())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Runs `plant linear`: the files written.
+pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
+    let scene = load_scene(req.scene, req.set)?;
+    let speed_hz = req.speed_hz.unwrap_or_else(|| {
+        // The scene holds rad/s: `500 Hz` comes back as 499.99999999999994; said as given.
+        let hz = scene.rotor.speed() / std::f64::consts::TAU;
+        let round = (hz * 1e6).round() / 1e6;
+        if (round - hz).abs() <= 1e-12 * hz.abs() {
+            round
+        } else {
+            hz
+        }
+    });
+    let built = build(&scene, speed_hz)?;
+    let dir =
+        req.out.map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("runs").join(format!("linear-{}", scene.name)));
+    check_out(&dir)?;
+    if let Some(file) = dir.ancestors().skip(1).find(|d| std::fs::metadata(d).is_ok_and(|m| !m.is_dir())) {
+        return Err(BadArgument(format!(
+            "--out {}: {} is a file, not a folder; give a folder",
+            dir.display(),
+            file.display()
+        ))
+        .into());
+    }
+    let export = files::Export {
+        plant: &built.plant,
+        discrete: &built.discrete.0,
+        discrete_states: &built.discrete.1,
+        period: built.period,
+        delay: built.delay,
+    };
+    let json = files::json(&export);
+    let npz = files::npz(&export).context("packing linear.npz")?;
+    let _claim = crate::claim::claim(&dir, true)?;
+    let mut written = Vec::new();
+    for (name, bytes) in [("linear.json", json), ("linear.npz", npz)] {
+        let path = dir.join(name);
+        crate::outfile::write(&path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests;
