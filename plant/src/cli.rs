@@ -138,7 +138,7 @@ pub enum Command {
         /// Scene file (TOML).
         scene: PathBuf,
         /// Spin speed to linearise at (Hz); default: the scene's rotor.speed_hz.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         speed_hz: Option<f64>,
         /// Output folder (default: runs/linear-<scene name>).
         #[arg(long)]
