@@ -24,6 +24,30 @@ pub struct Export<'a> {
     pub period: f64,
     /// Its command delay (ticks).
     pub delay: u32,
+    /// The scene's law as a linear form, where it has one, with its name.
+    pub law: Option<(&'a str, &'a super::law::LinearLaw)>,
+    /// Each axis' margins with that law.
+    pub margins: &'a [super::margins::AxisMargins],
+}
+
+#[derive(Serialize)]
+struct JsonLaw<'a> {
+    name: &'a str,
+    form: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dt: Option<f64>,
+    axes: Vec<super::law::Transfer>,
+}
+
+#[derive(Serialize)]
+struct JsonMargins<'a> {
+    axis: &'a str,
+    gain_margin_db: Option<f64>,
+    gain_margin_f_hz: Option<f64>,
+    phase_margin_deg: Option<f64>,
+    phase_margin_f_hz: Option<f64>,
+    phase_crossovers: &'a [super::margins::Crossing],
+    gain_crossovers: &'a [super::margins::Crossing],
 }
 
 /// A matrix as its rows.
@@ -61,6 +85,8 @@ struct Json<'a> {
     outputs: &'a [Signal],
     continuous: JsonSystem<'a>,
     discrete: JsonSystem<'a>,
+    law: Option<JsonLaw<'a>>,
+    margins: Vec<JsonMargins<'a>>,
 }
 
 /// What the model is linearised about, in both files.
@@ -98,6 +124,25 @@ pub fn json(e: &Export<'_>) -> Vec<u8> {
             c: rows(&e.discrete.c),
             d: rows(&e.discrete.d),
         },
+        law: e.law.map(|(name, law)| JsonLaw {
+            name,
+            form: law.form(),
+            dt: matches!(law, super::law::LinearLaw::Sampled { .. }).then_some(e.period),
+            axes: law.transfers(),
+        }),
+        margins: e
+            .margins
+            .iter()
+            .map(|m| JsonMargins {
+                axis: e.plant.outputs.get(m.axis).map_or("", |o| o.name.strip_prefix("v_").unwrap_or(&o.name)),
+                gain_margin_db: m.gain_margin_db.map(|g| g.0),
+                gain_margin_f_hz: m.gain_margin_db.map(|g| g.1),
+                phase_margin_deg: m.phase_margin_deg.map(|p| p.0),
+                phase_margin_f_hz: m.phase_margin_deg.map(|p| p.1),
+                phase_crossovers: &m.phase_crossovers,
+                gain_crossovers: &m.gain_crossovers,
+            })
+            .collect(),
     };
     let mut text = serde_json::to_string_pretty(&doc).expect("serialisable");
     text.push('\n');

@@ -48,6 +48,50 @@ impl LinearLaw {
     }
 }
 
+/// One axis' law as a transfer function in the usual form of python-control's and MATLAB's
+/// `tf(num, den)` / `tf(num, den, dt)`: coefficients in descending powers of `s` (continuous)
+/// or of `z` (sampled, numerator and denominator of the same length), A/V.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Transfer {
+    /// Numerator.
+    pub num: Vec<f64>,
+    /// Denominator.
+    pub den: Vec<f64>,
+}
+
+impl LinearLaw {
+    /// Each axis' transfer ([`Transfer`]).
+    pub fn transfers(&self) -> Vec<Transfer> {
+        match self {
+            LinearLaw::Continuous(pds) => pds
+                .iter()
+                .map(|g| Transfer { num: vec![-g.amp_gain * g.kd, -g.amp_gain * g.kp], den: vec![1.0] })
+                .collect(),
+            LinearLaw::Sampled { laws, .. } => laws
+                .iter()
+                .map(|l| {
+                    // Σ n_i z^{−i} / (1 + Σ d_i z^{−i}), times z^L over z^L.
+                    let len = l.num.len().max(l.den.len() + 1);
+                    let mut num = l.num.clone();
+                    num.resize(len, 0.0);
+                    let mut den = vec![1.0];
+                    den.extend(&l.den);
+                    den.resize(len, 0.0);
+                    Transfer { num, den }
+                })
+                .collect(),
+        }
+    }
+
+    /// `continuous` or `sampled`.
+    pub fn form(&self) -> &'static str {
+        match self {
+            LinearLaw::Continuous(_) => "continuous",
+            LinearLaw::Sampled { .. } => "sampled",
+        }
+    }
+}
+
 /// The scene's law as a linear form, `None` where it has none (module doc).
 pub fn of(scene: &Scene) -> Option<LinearLaw> {
     let c = &scene.controller;

@@ -4,17 +4,23 @@
 //! ([`model`]) and as the discrete system the digital controller sees (zero-order hold at the
 //! controller's rate, its command delay as states: [`discrete`]); `linear.json` and
 //! `linear.npz` ([`files`]; docs/guide/linear.md). The law's linear form on it ([`law`]) gives
-//! the closed loop's sensitivity, the very one `plant assess`'s closed forms draw.
+//! the closed loop's sensitivity, the very one `plant assess`'s closed forms draw, and each
+//! axis' gain and phase margins ([`margins`]), written into `linear.json` beside the law.
 
 pub mod discrete;
 pub mod files;
 pub mod law;
+pub mod margins;
 pub mod model;
 
 use crate::config::load_scene;
 use crate::exit::BadArgument;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
+
+/// The band the margins are looked for in (Hz): from near DC (a PD's open loop is real there)
+/// to 20 kHz (a sampled law's to just below its Nyquist frequency).
+pub const MARGIN_BAND_HZ: (f64, f64) = (0.01, 2e4);
 
 /// What `plant linear` is asked.
 pub struct Request<'a> {
@@ -88,12 +94,19 @@ pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
         ))
         .into());
     }
+    let law = law::of(&scene);
+    let margins = law
+        .as_ref()
+        .map(|l| margins::margins(l, &built.plant.system, &built.discrete.0, MARGIN_BAND_HZ.0, MARGIN_BAND_HZ.1))
+        .unwrap_or_default();
     let export = files::Export {
         plant: &built.plant,
         discrete: &built.discrete.0,
         discrete_states: &built.discrete.1,
         period: built.period,
         delay: built.delay,
+        law: law.as_ref().map(|l| (scene.controller.law.as_str(), l)),
+        margins: &margins,
     };
     let json = files::json(&export);
     let npz = files::npz(&export).context("packing linear.npz")?;
