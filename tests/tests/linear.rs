@@ -228,8 +228,9 @@ fn bad_input_is_refused_by_name_and_nothing_is_written() {
     let dir = TempDir::new("linear-bad");
     let paper = scene("paper-10g.toml");
     let out = dir.join("out");
-    let cases: [(&[&str], &[&str]); 5] = [
-        (&["--speed-hz", "-5"], &["--speed-hz -5 Hz", "0 or more"]),
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--speed-hz", "-5"], &["--speed-hz -5 Hz", "from 0 to 100000 Hz"]),
+        (&["--speed-hz", "1e300"], &["--speed-hz 1e300 Hz"]),
         (&["--speed-hz", "NaN"], &["--speed-hz NaN Hz"]),
         (&["--speed-hz", "inf"], &["--speed-hz inf Hz"]),
         (&["--set", "rotor.speed_hz=-3"], &["speed_hz"]),

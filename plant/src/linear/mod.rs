@@ -51,6 +51,13 @@ pub fn build(scene: &crate::config::Scene, speed_hz: f64) -> anyhow::Result<Buil
     let plant = model::continuous(scene, speed_hz).map_err(|e| BadArgument(e.to_string()))?;
     let (period, delay) = (scene.controller.period, scene.controller.delay_samples);
     let discrete = discrete::zoh(&plant, period, delay);
+    let finite = |m: &nalgebra::DMatrix<f64>| m.iter().all(|v| v.is_finite());
+    for (what, sys) in [("continuous", &plant.system), ("discrete", &discrete.0)] {
+        if ![&sys.a, &sys.b, &sys.c, &sys.d].into_iter().all(finite) {
+            let e = model::LinearError::NotFinite { scene: scene.name.clone(), speed_hz, what };
+            return Err(BadArgument(e.to_string()).into());
+        }
+    }
     Ok(Built { plant, discrete, period, delay })
 }
 

@@ -85,12 +85,38 @@ pub struct LinearPlant {
     pub parts: Vec<String>,
 }
 
+/// The highest spin speed linearised at (Hz): 6 million rpm, past any AMB rotor's (the
+/// gyroscopic terms grow with it until the discretisation overflows).
+pub const MAX_SPEED_HZ: f64 = 1e5;
+
+/// A number as said in a message: in full, or in scientific notation when very large or small.
+fn show(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e7).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 /// Why a scene has no linear plant here.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LinearError {
-    /// The speed is negative or not finite.
-    #[error("--speed-hz {0} Hz: must be a finite spin speed, 0 or more")]
+    /// The speed is negative, not finite or beyond any machine's.
+    #[error(
+        "--speed-hz {} Hz (by default the scene's rotor.speed_hz): must be a spin speed from 0 to {MAX_SPEED_HZ} Hz",
+        show(*.0)
+    )]
     Speed(f64),
+    /// The model came out with a non-finite entry.
+    #[error("the linear model of {scene} at {speed_hz} Hz has a non-finite entry ({what}); nothing written")]
+    NotFinite {
+        /// The scene.
+        scene: String,
+        /// The speed (Hz).
+        speed_hz: f64,
+        /// Which system.
+        what: &'static str,
+    },
 }
 
 /// The mechanical part: `ẋ = A x + B i` on `x = [q, q̇]`, the sensors' displacements `C_s x`,
@@ -114,7 +140,7 @@ pub fn axis_names(rotor: &Rotor) -> Vec<&'static str> {
 /// The plant of `scene` linearised about its levitated state at spin speed `speed_hz` (Hz)
 /// (module doc).
 pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearError> {
-    if !(speed_hz.is_finite() && speed_hz >= 0.0) {
+    if !(speed_hz.is_finite() && (0.0..=MAX_SPEED_HZ).contains(&speed_hz)) {
         return Err(LinearError::Speed(speed_hz));
     }
     let omega = TAU * speed_hz;
