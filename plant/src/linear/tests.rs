@@ -262,3 +262,21 @@ fn a_bad_speed_is_refused_by_name() {
         assert!(e.contains("--speed-hz") && e.contains("Hz"), "{e}");
     }
 }
+
+/// A unipolar drive about its bias is the bipolar one on the differential current with each
+/// magnet's half of `k_b` (MODEL.md §12.3; tests/tests/unipolar.rs runs the two to 1e-6 of each
+/// other): the unipolar scene at `k_b = 432` is the bipolar one at 216, matrix for matrix.
+#[test]
+fn a_unipolar_drive_is_the_bipolar_one_with_half_the_back_emf() {
+    let common = ["amb.force_law=\"nonlinear\""];
+    let bipolar = model("realistic-10g.toml", &[common[0], "amb.back_emf_v_s_per_m=216"], 500.0);
+    let unipolar = model(
+        "realistic-10g.toml",
+        &[common[0], "amb.amplifier_topology=\"unipolar\"", "amb.back_emf_v_s_per_m=432"],
+        500.0,
+    );
+    assert_eq!(unipolar.plant.system, bipolar.plant.system);
+    assert!(unipolar.plant.parts.iter().any(|p| p.contains("unipolar")), "{:?}", unipolar.plant.parts);
+    let other = model("realistic-10g.toml", &[common[0], "amb.back_emf_v_s_per_m=432"], 500.0);
+    assert_ne!(other.plant.system, bipolar.plant.system, "k_b is in the model");
+}
