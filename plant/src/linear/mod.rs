@@ -40,7 +40,7 @@ pub struct Built {
     pub plant: model::LinearPlant,
     /// The discrete system and its states.
     pub discrete: (model::System, Vec<model::Signal>),
-    /// Its period (s) and delay (ticks).
+    /// Its period (s).
     pub period: f64,
     /// Command delay (ticks).
     pub delay: u32,
@@ -112,7 +112,12 @@ pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
         discrete_states: &built.discrete.1,
         period: built.period,
         delay: built.delay,
-        law: law.as_ref().map(|l| (scene.controller.law.as_str(), l)),
+        // In `controller.mode = "continuous"` the law is the continuous PD whatever
+        // `controller.law` names.
+        law: law.as_ref().map(|l| match l {
+            law::LinearLaw::Continuous(_) => ("continuous_pd", l),
+            law::LinearLaw::Sampled { .. } => (scene.controller.law.as_str(), l),
+        }),
         margins: &margins,
     };
     let json = files::json(&export);
