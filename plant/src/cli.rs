@@ -135,6 +135,23 @@ pub enum Command {
         #[arg(long, default_value = "0,250,500", value_parser = parse_speeds)]
         decay_speeds_hz: std::vec::Vec<f64>,
     },
+    /// The scene's plant linearised about its levitated state at a spin speed, for
+    /// python-control, MATLAB or numpy: from each axis' current command (A) to its sensor signal
+    /// (V), continuous and as the controller sees it (zero-order hold at its rate, its delay);
+    /// writes linear.json and linear.npz (docs/guide/linear.md).
+    Linear {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Spin speed to linearise at (Hz); default: the scene's rotor.speed_hz.
+        #[arg(long, allow_negative_numbers = true)]
+        speed_hz: Option<f64>,
+        /// Output folder (default: runs/linear-<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene key (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Write the scene's plant as an FMI 2.0 (or 3.0) co-simulation FMU for Linux x86-64 (Simulink's FMU
     /// block, OpenModelica/OMSimulator, FMPy): modelDescription.xml, the binary, the scene in
     /// resources/ (docs/guide/fmu-plant.md).

@@ -39,6 +39,7 @@ pub mod initial;
 pub mod input;
 pub mod interrupt;
 pub mod invalid;
+pub mod linear;
 pub mod machine;
 pub mod offload;
 pub mod outfile;

@@ -124,6 +124,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Linear { scene, speed_hz, out, set } => {
+            let req = plant::linear::Request { scene: &scene, set: &set, speed_hz, out: out.as_deref() };
+            for f in plant::linear::command(&req)? {
+                eprintln!("plant linear: wrote {}", f.display());
+            }
+            Ok(())
+        }
         Command::Sweep(args) => plant::sweep::command(&args),
         Command::Overlay(args) => plant::sweep::overlay::command(&args),
         Command::Ensemble(args) => plant::ensemble::command(&args),

@@ -118,6 +118,16 @@ pub fn closed_form_axes(scene: &Scene, settings: &Settings, speeds_hz: &[f64]) -
     Some(out)
 }
 
+/// The closed form's `S` (all axes) at spin speed `speed_hz` (Hz) and frequency `f_hz` (Hz),
+/// `None` where [`closed_form_axes`] has none: what `plant linear`'s export is checked against.
+pub fn sensitivity_at(scene: &Scene, speed_hz: f64, f_hz: f64) -> Option<nalgebra::DMatrix<nalgebra::Complex<f64>>> {
+    let open = scene.rotor.open_loop()?;
+    Some(match law_of(scene)? {
+        Law::Continuous(pd) => open.continuous(speed_hz * TAU).sensitivity_continuous(&pd, f_hz),
+        Law::Sampled(lp) => open.discretise(speed_hz * TAU, lp.period).sensitivity(&lp, f_hz),
+    })
+}
+
 /// The open loop at `speed` (rad/s) as the law needs it, the least stable pole, stability and
 /// the highest frequency of the band.
 fn loop_at(open: &OpenLoop, law: &Law, speed: f64, settings: &Settings) -> (Response, f64, bool, f64) {

@@ -49,12 +49,28 @@ pub struct OpenLoop {
     input: DMatrix<f64>,
     /// `Φ_s` (4 × r).
     output: DMatrix<f64>,
+    /// `Φ_a` (4 × r): each axis' displacement at its AMB node (its rate, on `η̇`, is what an
+    /// amplifier's back-EMF sees).
+    actuator: DMatrix<f64>,
     /// Each node's `x`, `y` rows of the basis (for the whirl and the shape of a mode).
     node_xy: Vec<(DVector<f64>, DVector<f64>)>,
     /// Each node's axial position from the centre of mass (m).
     node_z: Vec<f64>,
     /// Half the AMB span (m).
     half_span: f64,
+}
+
+/// The open loop as a state-space system ([`OpenLoop::state_space`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateSpace {
+    /// `A` (2r × 2r) on `x = [η, η̇]`.
+    pub a: DMatrix<f64>,
+    /// `B` (2r × 4): the AMB currents (A) in.
+    pub b: DMatrix<f64>,
+    /// `C` (4 × 2r): the sensor nodes' displacements (m) out.
+    pub c: DMatrix<f64>,
+    /// `C_a` (4 × 2r): the AMB nodes' displacements (m).
+    pub actuator: DMatrix<f64>,
 }
 
 /// The PD of one bearing plane in volts: `i = −A_a (k_p v + k_d v̇)` on its sensor voltage `v`.
@@ -224,6 +240,7 @@ impl OpenLoop {
             gyroscopic: red.gyroscopic.clone(),
             input,
             output,
+            actuator: amb,
             node_xy,
             node_z: p.z.clone(),
             half_span: 0.5 * (zb - za).abs(),
@@ -245,14 +262,26 @@ impl OpenLoop {
         a
     }
 
-    /// The open loop `P(s)` (m/A, 4 × 4) at spin speed `speed` (rad/s), ready for many `s`.
+    /// The open loop `P(s)` (m/A, 4 × 4) at spin speed `speed` (rad/s), ready for many `s`:
+    /// [`OpenLoop::state_space`]'s matrices.
     pub fn continuous(&self, speed: f64) -> Response {
+        let ss = self.state_space(speed);
+        Response::new(ss.a, ss.b, ss.c)
+    }
+
+    /// The open loop at spin speed `speed` (rad/s) as a state-space system on `x = [η, η̇]`:
+    /// `ẋ = A x + B i`, `y = C x` (the four AMB currents in A, the four sensor displacements in
+    /// m), with the AMB nodes' displacements `C_a x` beside it. The one source of the continuous
+    /// [`Response`] and of `plant linear`'s export.
+    pub fn state_space(&self, speed: f64) -> StateSpace {
         let r = self.size();
         let mut b = DMatrix::zeros(2 * r, AXES);
         b.view_mut((r, 0), (r, AXES)).copy_from(&self.input);
         let mut c = DMatrix::zeros(AXES, 2 * r);
         c.view_mut((0, 0), (AXES, r)).copy_from(&self.output);
-        Response::new(self.state_matrix(speed), b, c)
+        let mut actuator = DMatrix::zeros(AXES, 2 * r);
+        actuator.view_mut((0, 0), (AXES, r)).copy_from(&self.actuator);
+        StateSpace { a: self.state_matrix(speed), b, c, actuator }
     }
 
     /// The open loop discretised under a zero-order hold of period `period` (s) at spin speed

@@ -1,0 +1,269 @@
+//! The linear plant's files: `linear.json` (every matrix, name and unit; the schema is
+//! docs/guide/linear.md's) and `linear.npz` (numpy's zip of `.npy` arrays, the same keys).
+//! Pure: each returns the bytes, the command writes them.
+
+use super::model::{LinearPlant, Signal, System};
+use nalgebra::DMatrix;
+use serde::Serialize;
+use std::io::Write;
+
+/// The format's name and version, in both files.
+pub const FORMAT: &str = "plant-linear";
+/// Its version: a key added keeps it; a key renamed or removed would bump it.
+pub const VERSION: u32 = 1;
+
+/// The exported model: the continuous plant and its discrete form.
+pub struct Export<'a> {
+    /// The continuous plant.
+    pub plant: &'a LinearPlant,
+    /// The discrete system (zero-order hold, the delay states appended).
+    pub discrete: &'a System,
+    /// Its states.
+    pub discrete_states: &'a [Signal],
+    /// Its period (s).
+    pub period: f64,
+    /// Its command delay (ticks).
+    pub delay: u32,
+    /// The scene's law as a linear form, where it has one, with its name.
+    pub law: Option<(&'a str, &'a super::law::LinearLaw)>,
+    /// Each axis' margins with that law.
+    pub margins: &'a [super::margins::AxisMargins],
+}
+
+#[derive(Serialize)]
+struct JsonLaw<'a> {
+    name: &'a str,
+    form: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dt: Option<f64>,
+    axes: Vec<super::law::Transfer>,
+}
+
+#[derive(Serialize)]
+struct JsonMargins<'a> {
+    axis: &'a str,
+    gain_margin_db: Option<f64>,
+    gain_margin_f_hz: Option<f64>,
+    phase_margin_deg: Option<f64>,
+    phase_margin_f_hz: Option<f64>,
+    phase_crossovers: &'a [super::margins::Crossing],
+    gain_crossovers: &'a [super::margins::Crossing],
+}
+
+/// A matrix as its rows.
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+}
+
+#[derive(Serialize)]
+struct JsonSystem<'a> {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dt: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    delay_samples: Option<u32>,
+    states: &'a [Signal],
+    #[serde(rename = "A")]
+    a: Vec<Vec<f64>>,
+    #[serde(rename = "B")]
+    b: Vec<Vec<f64>>,
+    #[serde(rename = "C")]
+    c: Vec<Vec<f64>>,
+    #[serde(rename = "D")]
+    d: Vec<Vec<f64>>,
+}
+
+#[derive(Serialize)]
+struct Json<'a> {
+    format: &'static str,
+    version: u32,
+    scene: &'a str,
+    rotor_model: &'a str,
+    speed_hz: f64,
+    about: &'static str,
+    parts: &'a [String],
+    inputs: &'a [Signal],
+    outputs: &'a [Signal],
+    continuous: JsonSystem<'a>,
+    discrete: JsonSystem<'a>,
+    law: Option<JsonLaw<'a>>,
+    margins: Vec<JsonMargins<'a>>,
+}
+
+/// What the model is linearised about, in both files.
+pub const ABOUT: &str = "the rotor centred and levitated, clear of the touchdown bearings, its spin held at speed_hz; \
+    inputs and outputs are deviations from that state (the bias currents left out)";
+
+/// `linear.json`.
+pub fn json(e: &Export<'_>) -> Vec<u8> {
+    let s = &e.plant.system;
+    let doc = Json {
+        format: FORMAT,
+        version: VERSION,
+        scene: &e.plant.scene,
+        rotor_model: e.plant.rotor_model,
+        speed_hz: e.plant.speed_hz,
+        about: ABOUT,
+        parts: &e.plant.parts,
+        inputs: &e.plant.inputs,
+        outputs: &e.plant.outputs,
+        continuous: JsonSystem {
+            dt: None,
+            delay_samples: None,
+            states: &e.plant.states,
+            a: rows(&s.a),
+            b: rows(&s.b),
+            c: rows(&s.c),
+            d: rows(&s.d),
+        },
+        discrete: JsonSystem {
+            dt: Some(e.period),
+            delay_samples: Some(e.delay),
+            states: e.discrete_states,
+            a: rows(&e.discrete.a),
+            b: rows(&e.discrete.b),
+            c: rows(&e.discrete.c),
+            d: rows(&e.discrete.d),
+        },
+        law: e.law.map(|(name, law)| JsonLaw {
+            name,
+            form: law.form(),
+            dt: matches!(law, super::law::LinearLaw::Sampled { .. }).then_some(e.period),
+            axes: law.transfers(),
+        }),
+        margins: e
+            .margins
+            .iter()
+            .map(|m| JsonMargins {
+                axis: e.plant.outputs.get(m.axis).map_or("", |o| o.name.strip_prefix("v_").unwrap_or(&o.name)),
+                gain_margin_db: m.gain_margin_db.map(|g| g.0),
+                gain_margin_f_hz: m.gain_margin_db.map(|g| g.1),
+                phase_margin_deg: m.phase_margin_deg.map(|p| p.0),
+                phase_margin_f_hz: m.phase_margin_deg.map(|p| p.1),
+                phase_crossovers: &m.phase_crossovers,
+                gain_crossovers: &m.gain_crossovers,
+            })
+            .collect(),
+    };
+    let mut text = serde_json::to_string_pretty(&doc).expect("serialisable");
+    text.push('\n');
+    text.into_bytes()
+}
+
+/// One `.npy` file (format version 1.0): the magic, the header's length, the header (a Python
+/// dict literal padded with spaces to a multiple of 64 bytes, ending in a newline), the data.
+/// Written by hand: the format is a page long (numpy's `format.py`), and a crate for it
+/// (`ndarray-npy`) would bring `ndarray` for nothing else.
+fn npy(descr: &str, shape: &[usize], data: &[u8]) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+    let shape = match dims.len() {
+        1 => format!("({},)", dims[0]),
+        _ => format!("({})", dims.join(", ")),
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat((64 - total % 64) % 64));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + data.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(data);
+    out
+}
+
+/// A matrix as a C-ordered `<f8` array.
+fn npy_matrix(m: &DMatrix<f64>) -> Vec<u8> {
+    let mut data = Vec::with_capacity(8 * m.len());
+    for i in 0..m.nrows() {
+        for v in m.row(i).iter() {
+            data.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    npy("<f8", &[m.nrows(), m.ncols()], &data)
+}
+
+/// A scalar as a 0-dimensional `<f8` array.
+fn npy_scalar(v: f64) -> Vec<u8> {
+    npy("<f8", &[], &v.to_le_bytes())
+}
+
+/// Strings as a `<U{n}` array (UTF-32, little endian, each padded with NULs to the longest).
+fn npy_strings(items: &[&str]) -> Vec<u8> {
+    let width = items.iter().map(|s| s.chars().count()).max().unwrap_or(0).max(1);
+    let mut data = Vec::with_capacity(4 * width * items.len());
+    for s in items {
+        let n = s.chars().count();
+        for ch in s.chars() {
+            data.extend_from_slice(&(ch as u32).to_le_bytes());
+        }
+        data.extend(std::iter::repeat_n(0u8, 4 * (width - n)));
+    }
+    npy(&format!("<U{width}"), &[items.len()], &data)
+}
+
+/// `linear.npz`: `A`, `B`, `C`, `D` (continuous), `Ad`, `Bd`, `Cd`, `Dd`, `dt`,
+/// `delay_samples`, `speed_hz`, and the names and units (`inputs`, `input_units`, `outputs`,
+/// `output_units`, `states`, `state_units`, `states_d`, `state_units_d`).
+pub fn npz(e: &Export<'_>) -> anyhow::Result<Vec<u8>> {
+    let s = &e.plant.system;
+    let names = |v: &[Signal]| npy_strings(&v.iter().map(|s| s.name.as_str()).collect::<Vec<_>>());
+    let units = |v: &[Signal]| npy_strings(&v.iter().map(|s| s.unit.as_str()).collect::<Vec<_>>());
+    let arrays: Vec<(&str, Vec<u8>)> = vec![
+        ("A", npy_matrix(&s.a)),
+        ("B", npy_matrix(&s.b)),
+        ("C", npy_matrix(&s.c)),
+        ("D", npy_matrix(&s.d)),
+        ("Ad", npy_matrix(&e.discrete.a)),
+        ("Bd", npy_matrix(&e.discrete.b)),
+        ("Cd", npy_matrix(&e.discrete.c)),
+        ("Dd", npy_matrix(&e.discrete.d)),
+        ("dt", npy_scalar(e.period)),
+        ("delay_samples", npy_scalar(f64::from(e.delay))),
+        ("speed_hz", npy_scalar(e.plant.speed_hz)),
+        ("inputs", names(&e.plant.inputs)),
+        ("input_units", units(&e.plant.inputs)),
+        ("outputs", names(&e.plant.outputs)),
+        ("output_units", units(&e.plant.outputs)),
+        ("states", names(&e.plant.states)),
+        ("state_units", units(&e.plant.states)),
+        ("states_d", names(e.discrete_states)),
+        ("state_units_d", units(e.discrete_states)),
+        ("format", npy_strings(&[FORMAT])),
+    ];
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    // Stored, as numpy's own `savez`; a fixed time so that the same model gives the same bytes.
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Stored)
+        .last_modified_time(zip::DateTime::default())
+        .unix_permissions(0o644);
+    for (name, bytes) in arrays {
+        zip.start_file(format!("{name}.npy"), options)?;
+        zip.write_all(&bytes)?;
+    }
+    Ok(zip.finish()?.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The header numpy's `format.py` writes for a 2 × 3 float array, byte for byte (its
+    /// length padded so that the data starts at 64).
+    #[test]
+    fn an_npy_header_is_numpys() {
+        let m = DMatrix::from_row_slice(2, 3, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        let b = npy_matrix(&m);
+        let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }";
+        assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
+        let len = u16::from_le_bytes([b[8], b[9]]) as usize;
+        assert_eq!((10 + len) % 64, 0);
+        assert_eq!(&b[10..10 + header.len()], header.as_bytes());
+        assert_eq!(b[10 + len - 1], b'\n');
+        assert_eq!(b.len(), 10 + len + 48);
+        assert_eq!(f64::from_le_bytes(b[10 + len + 8..10 + len + 16].try_into().unwrap()), 2.0);
+        let s = npy_strings(&["ab", "c"]);
+        let len = u16::from_le_bytes([s[8], s[9]]) as usize;
+        assert!(String::from_utf8_lossy(&s[10..10 + len]).contains("'descr': '<U2'"));
+        assert_eq!(&s[10 + len..], &[97, 0, 0, 0, 98, 0, 0, 0, 99, 0, 0, 0, 0, 0, 0, 0]);
+    }
+}

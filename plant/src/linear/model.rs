@@ -1,0 +1,425 @@
+//! The plant of a scene linearised about its levitated state, as a continuous state-space
+//! system: a pure function of the scene and a spin speed ([`continuous`]).
+//!
+//! **About what.** The rotor centred in its bearings, the races clear of it (no contact), the
+//! spin held at the speed asked for. Every input and output is a deviation from that state:
+//! the bias currents (the gravity bias among them) and the offsets they hold are left out. The
+//! AMB's force is `F = k_i i + k_s Δ` at the actuator (the linear law; the nonlinear law has
+//! the same `k_i`, `k_s` at the centre, MODEL.md §7).
+//!
+//! **The mechanics** `ẋ_m = A_m x_m + B_m i`, `x_m = [q, q̇]`:
+//!
+//! * planar (one plane, axes x, y): `m ẍ = k_i i_x + k_s x`, the same in y;
+//! * two-plane rigid rotor (axes x_A, y_A, x_B, y_B; MODEL.md §10): `q = (x, y, a, b)` at the
+//!   centre of mass, `M q̈ + Ω G q̇ = Φ_aᵀ (K_i i + K_s Φ_a q)` with `M = diag(M, M, I_t, I_t)`,
+//!   `G` the gyroscopic coupling `(a, b)` rows `(+I_p ḃ, −I_p ȧ)`, `Φ_a` the axes' rows at the
+//!   actuators' stations (`x + z_i a`), the sensors read `Φ_s q` at theirs;
+//! * flexible: the reduced shaft's [`plant_physics::flex::linear::OpenLoop::state_space`] (its
+//!   retained modes, damping and gyroscopics at the speed).
+//!
+//! **The hardware** (MODEL.md §12), where the scene has it: each axis' amplifier and coil
+//! (bipolar: the PI current loop `L i̇ = K_p (r − i) + q − R i − k_b v_a`, `q̇ = K_I (r − i)`,
+//! `v_a` the rotor's velocity at the actuator: the back-EMF) between the command `r` and the
+//! current the bearing sees, and the sensor's low-pass (first order `ż₀ = ω (u − z₀)`, second
+//! order Butterworth `ż₀ = z₁`, `ż₁ = ω² (u − z₀) − √2 ω z₁`) between the displacement `u` and
+//! what is read. A unipolar drive about its bias is the bipolar one on the differential current
+//! `(i₊ − i₋)/2` with each magnet's half of the back-EMF (MODEL.md §12.3). The output is the
+//! sensor's voltage `A_s z₀` (`A_s u` without a filter). The voltage limit, the current limit, the range's clip, the noise and the ADC are not linear
+//! and are left out (the loop stays inside them at small motion); the runout is an input the
+//! rotor does not see and is left out too.
+
+use crate::config::{Rotor, Scene};
+use nalgebra::DMatrix;
+use serde::Serialize;
+use std::f64::consts::{SQRT_2, TAU};
+
+/// A named signal or state with its unit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Signal {
+    /// Name (an identifier: letters, digits, `_`).
+    pub name: String,
+    /// SI unit.
+    pub unit: String,
+    /// What it is.
+    pub description: String,
+}
+
+impl Signal {
+    fn new(name: impl Into<String>, unit: &str, description: impl Into<String>) -> Self {
+        Signal { name: name.into(), unit: unit.into(), description: description.into() }
+    }
+}
+
+/// A linear time-invariant system `ẋ = A x + B u`, `y = C x + D u` (or `x⁺ = A x + B u`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct System {
+    /// `A` (n × n).
+    pub a: DMatrix<f64>,
+    /// `B` (n × m).
+    pub b: DMatrix<f64>,
+    /// `C` (p × n).
+    pub c: DMatrix<f64>,
+    /// `D` (p × m).
+    pub d: DMatrix<f64>,
+}
+
+/// The linear plant of a scene at a spin speed: continuous, inputs the axes' current commands
+/// (A), outputs their sensor voltages (V).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearPlant {
+    /// The scene's name.
+    pub scene: String,
+    /// `planar`, `two_plane` or `flexible`.
+    pub rotor_model: &'static str,
+    /// Spin speed (Hz).
+    pub speed_hz: f64,
+    /// The system.
+    pub system: System,
+    /// The states, in order.
+    pub states: Vec<Signal>,
+    /// The inputs: each axis' current command.
+    pub inputs: Vec<Signal>,
+    /// The outputs: each axis' sensor voltage.
+    pub outputs: Vec<Signal>,
+    /// What the model holds (the parts of the scene in it), for the reader.
+    pub parts: Vec<String>,
+}
+
+/// The highest spin speed linearised at (Hz): 6 million rpm, past any AMB rotor's (the
+/// gyroscopic terms grow with it until the discretisation overflows).
+pub const MAX_SPEED_HZ: f64 = 1e5;
+
+/// A number as said in a message: in full, or in scientific notation when very large or small.
+fn show(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e7).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
+/// Why a scene has no linear plant here.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LinearError {
+    /// The speed is negative, not finite or beyond any machine's.
+    #[error(
+        "--speed-hz {} Hz (by default the scene's rotor.speed_hz): must be a spin speed from 0 to {MAX_SPEED_HZ} Hz",
+        show(*.0)
+    )]
+    Speed(f64),
+    /// The model came out with a non-finite entry.
+    #[error("the linear model of {scene} at {speed_hz} Hz has a non-finite entry ({what}); nothing written")]
+    NotFinite {
+        /// The scene.
+        scene: String,
+        /// The speed (Hz).
+        speed_hz: f64,
+        /// Which system.
+        what: &'static str,
+    },
+}
+
+/// The mechanical part: `ẋ = A x + B i` on `x = [q, q̇]`, the sensors' displacements `C_s x`,
+/// the actuators' `C_a x` (both m, one row per axis).
+struct Mechanics {
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
+    sensor: DMatrix<f64>,
+    actuator: DMatrix<f64>,
+    states: Vec<Signal>,
+}
+
+/// The axes' names: `x`, `y` (planar) or `x_A`, `y_A`, `x_B`, `y_B`.
+pub fn axis_names(rotor: &Rotor) -> Vec<&'static str> {
+    match rotor.planes() {
+        1 => vec!["x", "y"],
+        _ => vec!["x_A", "y_A", "x_B", "y_B"],
+    }
+}
+
+/// The plant of `scene` linearised about its levitated state at spin speed `speed_hz` (Hz)
+/// (module doc).
+pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearError> {
+    if !(speed_hz.is_finite() && (0.0..=MAX_SPEED_HZ).contains(&speed_hz)) {
+        return Err(LinearError::Speed(speed_hz));
+    }
+    let omega = TAU * speed_hz;
+    let mech = mechanics(&scene.rotor, omega);
+    let names = axis_names(&scene.rotor);
+    let m = names.len();
+    let plane_of = |k: usize| k / 2;
+    let mut parts = vec![match scene.rotor {
+        Rotor::Planar(_) => "planar rotor: mass, AMB negative stiffness k_s and current gain k_i".to_string(),
+        Rotor::TwoPlane(_) => {
+            "rigid two-plane rotor: mass, transverse and polar inertia (gyroscopics at the speed), each plane's \
+             AMB k_s and k_i at its station, its sensor at its own"
+                .to_string()
+        }
+        Rotor::Flexible(ref f) => format!(
+            "flexible shaft reduced to {} coordinates (its retained modes and static corrections), damping and \
+             gyroscopics at the speed, each plane's AMB k_s and k_i at its node, the sensors at theirs",
+            f.reduced.size()
+        ),
+    }];
+    let hw = &scene.hardware;
+    // A unipolar drive about its bias, both magnets conducting and neither amplifier limited:
+    // the differential current `(i₊ − i₋)/2` obeys the bipolar coil's equation with each
+    // magnet's share of the back-EMF, `k_b/2` (MODEL.md §12.3; tests/tests/unipolar.rs runs it).
+    let amp = |k: usize| {
+        hw.amplifiers[plane_of(k)].map(|mut a| {
+            if hw.unipolar[plane_of(k)].is_some() {
+                a.back_emf *= 0.5;
+            }
+            a
+        })
+    };
+    let amplified: Vec<usize> = (0..m).filter(|&k| amp(k).is_some()).collect();
+    let filter = hw.front_end.low_pass;
+    let filter_states = match filter {
+        None => 0,
+        Some(crate::sensor::LowPass::First { .. }) => 1,
+        Some(crate::sensor::LowPass::Second { .. }) => 2,
+    };
+    let nm = mech.a.nrows();
+    let (i0, q0, z0) = (nm, nm + amplified.len(), nm + 2 * amplified.len());
+    let n = z0 + filter_states * m;
+    let mut a = DMatrix::zeros(n, n);
+    let mut b = DMatrix::zeros(n, m);
+    let mut c = DMatrix::zeros(m, n);
+    let mut states = mech.states;
+    a.view_mut((0, 0), (nm, nm)).copy_from(&mech.a);
+    // The current each axis' bearing sees: the coil's, or the command itself.
+    for k in 0..m {
+        match amplified.iter().position(|&j| j == k) {
+            None => {
+                for r in 0..nm {
+                    b[(r, k)] += mech.b[(r, k)];
+                }
+            }
+            Some(slot) => {
+                let (ci, cq) = (i0 + slot, q0 + slot);
+                for r in 0..nm {
+                    a[(r, ci)] += mech.b[(r, k)];
+                }
+                let p = amp(k).expect("amplified axis");
+                let l = p.inductance;
+                // L i̇ = K_p (r − i) + q − R i − k_b v_a;  q̇ = K_I (r − i).
+                a[(ci, ci)] = -(p.kp + p.resistance) / l;
+                a[(ci, cq)] = 1.0 / l;
+                b[(ci, k)] = p.kp / l;
+                let half = nm / 2;
+                for col in 0..half {
+                    // v_a: the actuator's displacement row on the rates.
+                    a[(ci, half + col)] -= p.back_emf / l * mech.actuator[(k, col)];
+                }
+                a[(cq, ci)] = -p.ki;
+                b[(cq, k)] = p.ki;
+            }
+        }
+    }
+    for &k in &amplified {
+        states.push(Signal::new(format!("i_{}", names[k]), "A", format!("coil current of axis {}", names[k])));
+    }
+    for &k in &amplified {
+        states.push(Signal::new(
+            format!("q_{}", names[k]),
+            "V",
+            format!("integral of the current loop's PI, axis {}", names[k]),
+        ));
+    }
+    if !amplified.is_empty() {
+        let p = amp(amplified[0]).expect("amplified axis");
+        let unipolar = if hw.is_unipolar() {
+            " (unipolar: the differential current about the bias, each magnet's k_b/2)"
+        } else {
+            ""
+        };
+        parts.push(format!(
+            "amplifier and coil of {} axes{unipolar}: PI current loop (bandwidth {:.6} Hz), coil L = {} H, R = {} ohm, \
+             back-EMF k_b = {} V s/m; its voltage limit left out",
+            amplified.len(),
+            p.bandwidth / TAU,
+            p.inductance,
+            p.resistance,
+            p.back_emf
+        ));
+    }
+    let gain = |k: usize| scene.plane(plane_of(k)).loop_constants.sensor_gain_v_per_m;
+    match filter {
+        None => {
+            for k in 0..m {
+                for col in 0..nm {
+                    c[(k, col)] = gain(k) * mech.sensor[(k, col)];
+                }
+            }
+        }
+        Some(lp) => {
+            let w = lp.corner();
+            for k in 0..m {
+                let z = z0 + k;
+                c[(k, z)] = gain(k);
+                match lp {
+                    crate::sensor::LowPass::First { .. } => {
+                        a[(z, z)] = -w;
+                        for col in 0..nm {
+                            a[(z, col)] += w * mech.sensor[(k, col)];
+                        }
+                    }
+                    crate::sensor::LowPass::Second { .. } => {
+                        let zr = z0 + m + k;
+                        a[(z, zr)] = 1.0;
+                        a[(zr, z)] = -w * w;
+                        a[(zr, zr)] = -SQRT_2 * w;
+                        for col in 0..nm {
+                            a[(zr, col)] += w * w * mech.sensor[(k, col)];
+                        }
+                    }
+                }
+            }
+            for name in &names {
+                states.push(Signal::new(format!("z_{name}"), "m", format!("sensor filter output, axis {name}")));
+            }
+            if filter_states == 2 {
+                for name in &names {
+                    states.push(Signal::new(
+                        format!("zdot_{name}"),
+                        "m/s",
+                        format!("sensor filter output's rate, axis {name}"),
+                    ));
+                }
+            }
+            parts.push(format!(
+                "sensor low-pass of order {filter_states}, corner {:.6} Hz; the range, noise, ADC and runout left out",
+                w / TAU
+            ));
+        }
+    }
+    let inputs = names
+        .iter()
+        .map(|a| {
+            Signal::new(
+                format!("i_ref_{a}"),
+                "A",
+                format!("current command of axis {a} (the amplifier's reference), about its bias"),
+            )
+        })
+        .collect();
+    let outputs = names
+        .iter()
+        .map(|a| Signal::new(format!("v_{a}"), "V", format!("sensor signal of axis {a}, about its levitated value")))
+        .collect();
+    Ok(LinearPlant {
+        scene: scene.name.clone(),
+        rotor_model: scene.rotor.model().name(),
+        speed_hz,
+        system: System { a, b, c, d: DMatrix::zeros(m, m) },
+        states,
+        inputs,
+        outputs,
+        parts,
+    })
+}
+
+/// The rotor's mechanics at spin speed `omega` (rad/s).
+fn mechanics(rotor: &Rotor, omega: f64) -> Mechanics {
+    match rotor {
+        Rotor::Planar(p) => {
+            let lc = &p.loop_constants;
+            let mass = DMatrix::from_diagonal_element(2, 2, p.rotor_mass);
+            let gyro = DMatrix::zeros(2, 2);
+            let ident = DMatrix::identity(2, 2);
+            let states = ["x", "y"]
+                .iter()
+                .map(|a| Signal::new(*a, "m", format!("rotor {a}, relative to the housing")))
+                .chain(["x", "y"].iter().map(|a| Signal::new(format!("v{a}"), "m/s", format!("rotor {a} velocity"))))
+                .collect();
+            rigid(&mass, &gyro, &ident, &ident, [lc.ks_n_per_m; 4], [lc.ki_n_per_a; 4], states)
+        }
+        Rotor::TwoPlane(p) => {
+            let r = &p.rotor;
+            let mass = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&[
+                r.mass,
+                r.mass,
+                r.transverse_inertia,
+                r.transverse_inertia,
+            ]));
+            let mut gyro = DMatrix::zeros(4, 4);
+            // I_t ä + I_p Ω ḃ = …,  I_t b̈ − I_p Ω ȧ = …
+            gyro[(2, 3)] = r.polar_inertia * omega;
+            gyro[(3, 2)] = -r.polar_inertia * omega;
+            let rows = |station: &dyn Fn(usize) -> f64| {
+                DMatrix::from_fn(4, 4, |k, col| {
+                    let dir = k % 2;
+                    if col == dir {
+                        1.0
+                    } else if col == 2 + dir {
+                        station(k / 2)
+                    } else {
+                        0.0
+                    }
+                })
+            };
+            let actuator = rows(&|i| p.planes[i].station);
+            let sensor = rows(&|i| p.planes[i].sensor);
+            let lc = |k: usize| p.planes[k / 2].params.loop_constants;
+            let ks = std::array::from_fn(|k| lc(k).ks_n_per_m);
+            let ki = std::array::from_fn(|k| lc(k).ki_n_per_a);
+            let q = [
+                ("x", "m", "rotor axis x at the centre of mass's station"),
+                ("y", "m", "rotor axis y at the centre of mass's station"),
+                ("a", "rad", "slope dx/dz of the rotor axis"),
+                ("b", "rad", "slope dy/dz of the rotor axis"),
+            ];
+            let states = q
+                .iter()
+                .map(|(n, u, d)| Signal::new(*n, u, *d))
+                .chain(
+                    q.iter().map(|(n, u, d)| Signal::new(format!("{n}dot"), &format!("{u}/s"), format!("rate of {d}"))),
+                )
+                .collect();
+            rigid(&mass, &gyro, &actuator, &sensor, ks, ki, states)
+        }
+        Rotor::Flexible(f) => {
+            let ss = plant_physics::flex::linear::OpenLoop::of(f).state_space(omega);
+            let r = ss.a.nrows() / 2;
+            let states = (1..=r)
+                .map(|k| {
+                    Signal::new(format!("eta_{k}"), "m*kg^0.5", format!("reduced coordinate {k} (mass-normalised)"))
+                })
+                .chain((1..=r).map(|k| {
+                    Signal::new(format!("etadot_{k}"), "m*kg^0.5/s", format!("rate of reduced coordinate {k}"))
+                }))
+                .collect();
+            Mechanics { a: ss.a, b: ss.b, sensor: ss.c, actuator: ss.actuator, states }
+        }
+    }
+}
+
+/// A rigid rotor's mechanics: `M q̈ + G q̇ = Φ_aᵀ (K_i i + K_s Φ_a q)`, sensors `Φ_s q`
+/// (`Φ_a`, `Φ_s` one row per axis; `ks`, `ki` per axis, the first `Φ_a.nrows()` used).
+fn rigid(
+    mass: &DMatrix<f64>,
+    gyro: &DMatrix<f64>,
+    actuator: &DMatrix<f64>,
+    sensor: &DMatrix<f64>,
+    ks: [f64; 4],
+    ki: [f64; 4],
+    states: Vec<Signal>,
+) -> Mechanics {
+    let (dof, axes) = (mass.nrows(), actuator.nrows());
+    let inv = DMatrix::from_diagonal(&mass.diagonal().map(|m| 1.0 / m));
+    let ks = DMatrix::from_diagonal(&nalgebra::DVector::from_fn(axes, |k, _| ks[k]));
+    let ki = DMatrix::from_diagonal(&nalgebra::DVector::from_fn(axes, |k, _| ki[k]));
+    let mut a = DMatrix::zeros(2 * dof, 2 * dof);
+    a.view_mut((0, dof), (dof, dof)).fill_with_identity();
+    a.view_mut((dof, 0), (dof, dof)).copy_from(&(&inv * actuator.transpose() * ks * actuator));
+    a.view_mut((dof, dof), (dof, dof)).copy_from(&(-(&inv * gyro)));
+    let mut b = DMatrix::zeros(2 * dof, axes);
+    b.view_mut((dof, 0), (dof, axes)).copy_from(&(&inv * actuator.transpose() * ki));
+    let pad = |rows: &DMatrix<f64>| {
+        let mut m = DMatrix::zeros(axes, 2 * dof);
+        m.view_mut((0, 0), (axes, dof)).copy_from(rows);
+        m
+    };
+    Mechanics { a, b, sensor: pad(sensor), actuator: pad(actuator), states }
+}
