@@ -93,6 +93,7 @@ pub mod pd_delay;
 pub mod pid;
 pub mod registry;
 pub mod relev;
+pub mod ross_pid;
 #[cfg(feature = "ipc")]
 pub mod serve;
 #[cfg(test)]
@@ -112,5 +113,6 @@ pub use pd::{PdGains, SampledPd};
 pub use pid::{PidDesign, PidGains, SampledPid};
 pub use registry::{all_law_names, build_law, build_rotor_law, find_law, law_names, ALL_LAWS, LAWS, ROTOR_LAWS};
 pub use relev::{Relev, RelevSpec};
+pub use ross_pid::{RossPid, RossPidGains};
 #[cfg(feature = "ipc")]
 pub use serve::{serve, ServeOptions};
