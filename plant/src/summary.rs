@@ -58,6 +58,10 @@ pub struct ModelInfo {
     /// (`added`, `ignored`, `parallel`; `rotor.ross_bearings`); not written when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ross_bearings: Vec<plant_physics::flex::ross::UsedBearing>,
+    /// A flexible rotor from a ROSS file: the file's `MagneticBearingElement`s made the planes'
+    /// AMBs and what each plane took from it (`rotor.ross_ambs`); not written when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ross_ambs: Vec<plant_physics::flex::ross_amb::UsedAmb>,
 }
 
 impl ModelInfo {
@@ -82,6 +86,10 @@ impl ModelInfo {
             delay_samples: c.delay_samples,
             ross_bearings: match &scene.rotor {
                 crate::config::Rotor::Flexible(f) => f.file_bearings.clone(),
+                _ => Vec::new(),
+            },
+            ross_ambs: match &scene.rotor {
+                crate::config::Rotor::Flexible(f) => f.file_ambs.clone(),
                 _ => Vec::new(),
             },
         }

@@ -138,6 +138,12 @@ pub struct RawRotor {
     /// `parallel` (kept as springs beside the AMBs); none: such a file is refused.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ross_bearings: Option<plant_physics::flex::ross::AtAmbs> = None,
+    /// Flexible, with `ross_file`: what to do with the file's `MagneticBearingElement`s:
+    /// `use` (each its plane's AMB, its PID the law `ross_pid`), `constants` (each its plane's
+    /// AMB, the scene's `[controller]` the law) or `refuse`; none: such a file is refused with the
+    /// constants each element stands for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ross_ambs: Option<plant_physics::flex::ross::RossAmbs> = None,
     /// Flexible: the node of AMB A (on the −z side of the centre of mass).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub amb_a_node: Option<usize> = None,

@@ -84,6 +84,8 @@ pub struct Params {
     /// A ROSS file's plain bearings and what became of each (added to the shaft, ignored for
     /// the AMB at their node, or kept beside it); empty for a shaft given as a table.
     pub file_bearings: Vec<super::ross::UsedBearing>,
+    /// A ROSS file's AMB elements made the planes' AMBs (`rotor.ross_ambs`); empty otherwise.
+    pub file_ambs: Vec<super::ross_amb::UsedAmb>,
 }
 
 /// What one plane does during an evaluation.

@@ -133,6 +133,9 @@ pub struct RossFile {
     pub rotor: Rotor,
     /// The file's plain bearings, in the file's order.
     pub bearings: Vec<FileBearing>,
+    /// The file's `MagneticBearingElement`s, checked, in the file's order (empty from
+    /// [`parse_file`], which refuses them; [`parse_file_with_ambs`] keeps them).
+    pub magnetics: Vec<super::ross_amb::MagneticBearing>,
 }
 
 /// What the scene does with the file's plain bearings at the AMB nodes (`rotor.ross_bearings`).
@@ -143,6 +146,20 @@ pub enum AtAmbs {
     Ignore,
     /// They are kept as springs in parallel with the scene's AMBs.
     Parallel,
+}
+
+/// What the scene does with the file's `MagneticBearingElement`s (`rotor.ross_ambs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RossAmbs {
+    /// Refused with the constants each stands for (the default, as when the key is absent).
+    Refuse,
+    /// Each becomes its plane's AMB: its constants, gains and sensor node, and its PID as the
+    /// plane's law (`ross_pid`).
+    Use,
+    /// Each becomes its plane's AMB (constants, gains, sensor node); the scene's `[controller]`
+    /// gives the law.
+    Constants,
 }
 
 /// What became of one of the file's bearings.
@@ -277,8 +294,20 @@ fn short(v: &Value) -> String {
 }
 
 /// Parses the text of a ROSS file (`file` names it in errors): the shaft and disks, and the
-/// plain bearings apart.
+/// plain bearings apart. A `MagneticBearingElement` is refused with the constants it stands for
+/// ([`super::ross_amb::MagneticBearing::refusal`]); [`parse_file_with_ambs`] keeps them.
 pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
+    let read = parse_file_with_ambs(text, file)?;
+    match read.magnetics.first() {
+        Some(m) => Err(FlexError::Ross { file: file.to_string(), message: m.refusal() }),
+        None => Ok(read),
+    }
+}
+
+/// [`parse_file`] with the file's `MagneticBearingElement`s read, checked (their nodes and
+/// sensor nodes on the shaft) and kept in [`RossFile::magnetics`], for the scene to make them
+/// its AMBs (`rotor.ross_ambs`).
+pub fn parse_file_with_ambs(text: &str, file: &str) -> Result<RossFile, FlexError> {
     let err = |message: String| FlexError::Ross { file: file.to_string(), message };
     let table: Table = text.parse().map_err(|e| err(format!("is not TOML: {e}")))?;
     let version = match table.get("ross_version") {
@@ -374,7 +403,7 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
             return Err(FlexError::NodeOutOfRange { what: format!("{file}: {at}"), node: n, nodes });
         }
     }
-    if let Some(m) = magnetics.first() {
+    for m in &magnetics {
         for (key, n) in [("n", m.node), ("sensor_node", m.sensor_node)] {
             if n >= nodes {
                 return Err(FlexError::NodeOutOfRange {
@@ -384,13 +413,12 @@ pub fn parse_file(text: &str, file: &str) -> Result<RossFile, FlexError> {
                 });
             }
         }
-        return Err(err(m.refusal()));
     }
     let rotor =
         Rotor { elements, disks: disks.into_iter().map(|(_, d)| d).collect(), bearings: Vec::new(), alpha, beta };
     rotor.validate().map_err(|e| err(e.to_string()))?;
     let bearings = bearings.into_iter().map(|(element, bearing)| FileBearing { element, bearing }).collect();
-    Ok(RossFile { version, rotor, bearings })
+    Ok(RossFile { version, rotor, bearings, magnetics })
 }
 
 pub(super) fn as_number(v: &Value) -> Option<f64> {

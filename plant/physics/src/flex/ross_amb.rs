@@ -1,8 +1,9 @@
 //! ROSS's `MagneticBearingElement` as a ROSS file saves it (a `BearingElement` table with its
 //! frequency-dependent equivalent coefficients and its parameters; MODEL.md §13.8): read, checked
-//! and turned into the constants it stands for by ROSS's own formulas. Not yet made the plane's
-//! AMB (issue 38 item 1): the reader refuses the element with those constants
-//! ([`MagneticBearing::refusal`]), for the engineer to give in the scene.
+//! and turned into the constants it stands for by ROSS's own formulas. A scene with
+//! `rotor.ross_ambs = "use"` or `"constants"` makes each element its plane's AMB
+//! ([`MagneticBearing::used`], what the run records); without it the reader refuses the element
+//! with those constants ([`MagneticBearing::refusal`]).
 //!
 //! Line numbers are those of `ross/bearing_seal_element.py` in ROSS 3.1.0 as PyPI ships it.
 
@@ -103,6 +104,74 @@ impl MagneticBearing {
             self.n_f,
             self.axis_rotation.to_degrees(),
         )
+    }
+}
+
+/// ROSS's PID of an element as the plane's law `ross_pid` takes it (its parameters).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct RossPid {
+    /// `kp_pid` (V/V on the sensor voltage).
+    pub kp: f64,
+    /// `ki_pid` (1/s).
+    pub ki_per_s: f64,
+    /// `kd_pid` (s).
+    pub kd_s: f64,
+    /// `n_f` (rad/s).
+    pub n_f_rad_s: f64,
+}
+
+/// A file's AMB element made a plane's AMB: what the run took from it (`summary.json`
+/// `model.ross_ambs`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct UsedAmb {
+    /// The element, as the file names its table.
+    pub element: String,
+    /// The plane it became (`"A"` or `"B"`).
+    pub plane: &'static str,
+    /// The actuator's node (`n`).
+    pub node: usize,
+    /// The sensor's node (`sensor_node`).
+    pub sensor_node: usize,
+    /// `k_i` (N/A), `amb.ki_n_per_a`.
+    pub ki_n_per_a: f64,
+    /// `k_s` (N/m, this testbed's sign), `amb.ks_n_per_m`.
+    pub ks_n_per_m: f64,
+    /// `k_amp` (A/V), `amb.amp_gain_a_per_v`.
+    pub amp_gain_a_per_v: f64,
+    /// `k_sense` (V/m), `amb.sensor_gain_v_per_m`.
+    pub sensor_gain_v_per_m: f64,
+    /// `g0` (mm), `amb.nominal_gap_mm` (the nonlinear law's magnet gap).
+    pub nominal_gap_mm: f64,
+    /// The PID made the plane's law (`rotor.ross_ambs = "use"`); none with `"constants"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pid: Option<RossPid>,
+    /// `sensors_axis_rotation` (degrees): not applied, the plant's axes are at 0° (issue 38
+    /// item 2).
+    pub axis_rotation_deg_not_applied: f64,
+}
+
+impl MagneticBearing {
+    /// Its PID as law `ross_pid`'s parameters.
+    pub fn ross_pid(&self) -> RossPid {
+        let [kp, ki, kd] = self.pid;
+        RossPid { kp, ki_per_s: ki, kd_s: kd, n_f_rad_s: self.n_f }
+    }
+
+    /// What plane `plane` takes from it, with its PID as the law or not.
+    pub fn used(&self, plane: &'static str, with_pid: bool) -> UsedAmb {
+        UsedAmb {
+            element: self.element.clone(),
+            plane,
+            node: self.node,
+            sensor_node: self.sensor_node,
+            ki_n_per_a: self.ki_n_per_a(),
+            ks_n_per_m: self.ks_n_per_m(),
+            amp_gain_a_per_v: self.k_amp,
+            sensor_gain_v_per_m: self.k_sense,
+            nominal_gap_mm: self.g0 * 1e3,
+            pid: with_pid.then(|| self.ross_pid()),
+            axis_rotation_deg_not_applied: self.axis_rotation.to_degrees(),
+        }
     }
 }
 

@@ -27,6 +27,9 @@ pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), Conf
     if let Some(b) = r.ross_bearings {
         return Err(range("rotor.ross_bearings", at_ambs_name(b), "", WHY));
     }
+    if let Some(b) = r.ross_ambs {
+        return Err(range("rotor.ross_ambs", super::ross_ambs::name(b), "", WHY));
+    }
     let nodes = [
         ("rotor.amb_a_node", r.amb_a_node),
         ("rotor.amb_b_node", r.amb_b_node),
@@ -84,6 +87,15 @@ pub(in crate::config) fn flexible_params(
                     "says what to do with a ROSS file's bearings, and this scene has no rotor.ross_file: remove it",
                 ));
             }
+            if let Some(b) = r.ross_ambs {
+                return Err(range(
+                    "rotor.ross_ambs",
+                    super::ross_ambs::name(b),
+                    "",
+                    "says what to do with a ROSS file's MagneticBearingElements, and this scene has no \
+                     rotor.ross_file: remove it",
+                ));
+            }
             (table.rotor().map_err(|e| flex_error("rotor.shaft", "the table", e))?, None)
         }
         (None, Some(file)) => {
@@ -92,7 +104,13 @@ pub(in crate::config) fn flexible_params(
                 .map_err(|e| range("rotor.ross_file", file, "", &format!("cannot read {}: {e}", path.display())))?;
             // The shaft and disks first: the AMB nodes are checked on them, then the file's
             // bearings are placed as the AMB nodes and rotor.ross_bearings say.
-            let read = flex::ross::parse_file(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?;
+            // With rotor.ross_ambs = "use" or "constants" the file's AMB elements are already the
+            // planes' AMBs (`super::ross_ambs::apply`); otherwise they are refused.
+            let parse = match r.ross_ambs {
+                Some(flex::ross::RossAmbs::Use | flex::ross::RossAmbs::Constants) => flex::ross::parse_file_with_ambs,
+                _ => flex::ross::parse_file,
+            };
+            let read = parse(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?;
             (read.rotor.clone(), Some((file, read)))
         }
     };
@@ -210,7 +228,15 @@ pub(in crate::config) fn flexible_params(
     // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
     // forms its terms at each evaluation, as before; the result is the same to the bit).
     let reduced = reduced.hold_speed(machine.rotor.speed);
-    Ok(machine::Params { machine, nodes, reduced: Arc::new(reduced), shaft: Arc::new(shaft), z, file_bearings })
+    Ok(machine::Params {
+        machine,
+        nodes,
+        reduced: Arc::new(reduced),
+        shaft: Arc::new(shaft),
+        z,
+        file_bearings,
+        file_ambs: Vec::new(),
+    })
 }
 
 /// `rotor.ross_bearings`'s value as the scene writes it.

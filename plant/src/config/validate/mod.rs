@@ -40,6 +40,7 @@ mod checks;
 mod controller_keys;
 pub(super) mod flexible_keys;
 mod hardware_keys;
+mod ross_ambs;
 pub(super) mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
@@ -110,6 +111,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     migrate_relev_aliases(&mut raw.controller, &mut warnings)?;
     resolve_command(&mut raw.controller, base_dir)?;
     let fmu = super::fmu::resolve(&mut raw.controller, base_dir)?;
+    // A ROSS file's AMB elements as the planes' AMBs (rotor.ross_ambs): written into the scene.
+    let file_ambs = ross_ambs::apply(&mut raw, base_dir)?;
     let (r, ctl, int) = (&raw.rotor, &raw.controller, &raw.integrator);
     let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
     let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;
@@ -132,12 +135,17 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let whole =
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
     // The rotor model, built from the scene by its own arm of `Rotor::from_raw`.
-    let rotor = Rotor::from_raw(&raw, &whole, base_dir)?;
-    // A ROSS file's bearings that act besides the AMBs: the run's first line says so.
-    if let Rotor::Flexible(f) = &rotor {
+    let mut rotor = Rotor::from_raw(&raw, &whole, base_dir)?;
+    // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
+    // AMBs: the run's first line says so.
+    if let Rotor::Flexible(f) = &mut rotor {
         if let Some(note) = flexible_keys::file_bearings_note(&raw, f) {
             warnings.insert(0, note);
         }
+        if let Some(note) = ross_ambs::note(&raw, &file_ambs) {
+            warnings.insert(0, note);
+        }
+        f.file_ambs = file_ambs;
     }
     // The sensor's and the controller's loop constants are the scene's (`[amb]`,
     // `[controller]`), the same on every plane.

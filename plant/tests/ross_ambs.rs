@@ -1,0 +1,176 @@
+//! Issue 38 item 1: a ROSS file's `MagneticBearingElement`s become the planes' AMBs
+//! (`rotor.ross_ambs`), checked against what ROSS itself wrote: the committed fixture
+//! `amb_element.toml` (ROSS 3.1 and 2.3 saved one element with its parameters and its
+//! frequency-dependent equivalent coefficients `kxx`, `cxx` at 50 frequencies). The imported
+//! plane's constants and law, put through ROSS's own equivalent (MODEL.md §13.8), give back
+//! ROSS's coefficients; and by hand, `k_i`, `k_s` are ROSS's formulas of the file's numbers.
+
+use plant::config::{load_scene, ConfigError, Rotor, Scene};
+use std::path::Path;
+
+const V23: &str = "v2.3/";
+
+fn fixture(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("physics/tests/fixtures/ross").join(name)
+}
+
+/// The fixture's element with a second one at node 3 (its table copied under another name: the
+/// same element, for a two-plane machine), as a scene's ROSS file: the shipped flexible scene's
+/// other keys, its shaft replaced by the file, `sets` on top.
+fn scene_of(dir: &str, sets: &[&str]) -> Result<Scene, ConfigError> {
+    scene_with(dir, sets, true)
+}
+
+/// [`scene_of`], with the second element (`two`) or with the fixture's one alone.
+fn scene_with(dir: &str, sets: &[&str], two: bool) -> Result<Scene, ConfigError> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(fixture(&format!("{dir}amb_element.toml"))).unwrap();
+    let table: toml::Table = text.parse().unwrap();
+    let mut second = table["BearingElement_AMB"].as_table().unwrap().clone();
+    second.insert("n".into(), 3.into());
+    if second.contains_key("sensor_node") {
+        second.insert("sensor_node".into(), 3.into());
+    }
+    second.insert("tag".into(), "AMB2".into());
+    let mut extra = toml::Table::new();
+    if two {
+        extra.insert("BearingElement_AMB2".into(), second.into());
+    }
+    // One folder per call: the tests run side by side.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let out = std::env::temp_dir().join(format!("ross-ambs-{}-{call}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("machine.toml"), text + "\n" + &toml::to_string(&extra).unwrap()).unwrap();
+    let mut scene: toml::Table =
+        std::fs::read_to_string(root.join("../config/flexible-10g.toml")).unwrap().parse().unwrap();
+    let rotor = scene["rotor"].as_table_mut().unwrap();
+    for key in ["shaft", "amb_a_node", "amb_b_node"] {
+        rotor.remove(key);
+    }
+    rotor.insert("ross_file".into(), "machine.toml".into());
+    rotor.insert("radius_mm".into(), 24.85.into());
+    std::fs::write(out.join("scene.toml"), toml::to_string(&scene).unwrap()).unwrap();
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let scene = load_scene(&out.join("scene.toml"), &sets);
+    std::fs::remove_dir_all(&out).unwrap();
+    scene
+}
+
+const USE: &[&str] = &["rotor.ross_ambs=\"use\"", "controller.mode=\"sampled\"", "controller.current_limit_a=20"];
+
+/// The file's numbers, by hand: ROSS's `ki`, `ks` (bearing_seal_element.py 3.1.0 lines
+/// 2603–2625) with μ₀ = 4π·10⁻⁷.
+fn by_hand(el: &toml::Table) -> (f64, f64) {
+    let f = |k: &str| el[k].as_float().or_else(|| el[k].as_integer().map(|i| i as f64)).unwrap();
+    let (g0, i0, ag, nw, alpha) = (f("g0"), f("i0"), f("ag"), f("nw"), f("alpha"));
+    let mu0 = 4e-7 * std::f64::consts::PI;
+    let ki = mu0 * nw * nw * ag * i0 * alpha.cos() / (g0 * g0);
+    (ki, ki * i0 / g0)
+}
+
+/// Both planes take the element's constants, nodes and PID; put through ROSS's equivalent
+/// `k_eq = −k_s + k_i A_a A_s Re C(jω)`, `c_eq = k_i A_a A_s Im C(jω) / ω` with `C` the law's
+/// own `ross_pid` gains, they give back the `kxx`, `cxx` ROSS 3.1 and 2.3 wrote, at each of the
+/// 50 frequencies, within 10⁻⁹ of the largest.
+#[test]
+fn the_planes_amb_and_law_are_rosss_element() {
+    for dir in ["", V23] {
+        let scene = scene_of(dir, USE).unwrap_or_else(|e| panic!("{dir}: {e}"));
+        let text = std::fs::read_to_string(fixture(&format!("{dir}amb_element.toml"))).unwrap();
+        let table: toml::Table = text.parse().unwrap();
+        let el = table["BearingElement_AMB"].as_table().unwrap();
+        let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+        assert_eq!(f.nodes.map(|n| (n.amb, n.sensor, n.touchdown)), [(1, 1, 1), (3, 3, 3)], "{dir}");
+        let (ki, ks) = by_hand(el);
+        for p in 0..2 {
+            let lc = scene.plane(p).loop_constants;
+            assert!((lc.ki_n_per_a - ki).abs() <= 1e-12 * ki, "{dir} plane {p}: {} against {ki}", lc.ki_n_per_a);
+            assert!((lc.ks_n_per_m - ks).abs() <= 1e-12 * ks, "{dir} plane {p}: {} against {ks}", lc.ks_n_per_m);
+            assert_eq!((lc.amp_gain_a_per_v, lc.sensor_gain_v_per_m), (1.5, 2000.0), "{dir}");
+        }
+        assert_eq!(scene.controller.law, "ross_pid");
+        let param = |k: &str| scene.controller.params.table()[k].as_float().unwrap();
+        let c = controller::RossPidGains {
+            kp: param("kp"),
+            ki: param("ki_per_s"),
+            kd: param("kd_s"),
+            n_f: param("n_f_rad_s"),
+        };
+        assert_eq!((c.kp, c.ki, c.kd, c.n_f), (2.0, 30.0, 0.003, 5000.0), "{dir}");
+        let list = |k: &str| -> Vec<f64> { el[k].as_array().unwrap().iter().map(|v| v.as_float().unwrap()).collect() };
+        let (freq, kxx, cxx) = (list("frequency"), list("kxx"), list("cxx"));
+        assert_eq!(freq.len(), 50);
+        let lc = scene.plane(0).loop_constants;
+        let gain = lc.ki_n_per_a * lc.amp_gain_a_per_v * lc.sensor_gain_v_per_m;
+        let k_max = kxx.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let c_max = cxx.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for ((w, k), cc) in freq.iter().zip(&kxx).zip(&cxx) {
+            let (re, im) = c.at(0.0, *w);
+            let (k_eq, c_eq) = (-lc.ks_n_per_m + gain * re, gain * im / w);
+            assert!((k_eq - k).abs() <= 1e-9 * k_max, "{dir} at {w} rad/s: k_eq {k_eq} against ROSS's {k}");
+            assert!((c_eq - cc).abs() <= 1e-9 * c_max, "{dir} at {w} rad/s: c_eq {c_eq} against ROSS's {cc}");
+        }
+        // Said first, and recorded.
+        assert!(
+            scene.warnings[0].contains("the file's MagneticBearingElements are the AMBs")
+                && scene.warnings[0].contains("plane A from \"BearingElement_AMB\" (node 1, sensor node 1")
+                && scene.warnings[0].contains("law ross_pid kp = 2, ki = 30 1/s, kd = 0.003 s, n_f = 5000 rad/s"),
+            "{dir}: {:?}",
+            scene.warnings
+        );
+        assert_eq!(f.file_ambs.len(), 2);
+        assert_eq!(f.file_ambs[1].element, "BearingElement_AMB2");
+        // The resolved scene states the file's values and reads back to the same machine.
+        let again: toml::Table = scene.to_toml().unwrap().parse().unwrap();
+        assert_eq!(again["controller"]["law"].as_str(), Some("ross_pid"));
+        assert_eq!(again["amb"]["a"]["ki_n_per_a"].as_float(), Some(scene.plane(0).loop_constants.ki_n_per_a));
+    }
+}
+
+/// `"constants"`: the constants and nodes, the scene's `[controller]` (its PD) the law.
+#[test]
+fn constants_keep_the_scenes_law() {
+    let scene = scene_of("", &["rotor.ross_ambs=\"constants\"", "controller.current_limit_a=20"]).unwrap();
+    assert_eq!(scene.controller.law, "pd");
+    assert!(scene.controller.params.is_empty());
+    let (ki, _) = by_hand(
+        std::fs::read_to_string(fixture("amb_element.toml")).unwrap().parse::<toml::Table>().unwrap()
+            ["BearingElement_AMB"]
+            .as_table()
+            .unwrap(),
+    );
+    assert!((scene.plane(1).loop_constants.ki_n_per_a - ki).abs() <= 1e-12 * ki);
+    let Rotor::Flexible(f) = &scene.rotor else { panic!("flexible") };
+    assert!(f.file_ambs.iter().all(|u| u.pid.is_none()));
+}
+
+/// Without the key the element is refused with its constants, as before; the choices that
+/// cannot hold are refused by key.
+#[test]
+fn refusals_name_the_key() {
+    let err = |sets: &[&str]| scene_of("", sets).err().unwrap_or_else(|| panic!("{sets:?} loaded")).to_string();
+    let e = err(&[]);
+    assert!(e.contains("is ROSS's MagneticBearingElement") && e.contains("k_i = 4.643925e0 N/A"), "{e}");
+    let e = err(&["rotor.ross_ambs=\"refuse\""]);
+    assert!(e.contains("is ROSS's MagneticBearingElement"), "{e}");
+    let e = err(&["rotor.ross_ambs=\"use\""]);
+    assert!(e.starts_with("controller.mode = \"continuous\"") && e.contains("rotor.ross_ambs = \"constants\""), "{e}");
+    let e = err(&[USE, &["controller.law=\"pid\""]].concat());
+    assert!(e.starts_with("controller.law = \"pid\""), "{e}");
+    let e = err(&[USE, &["controller.params.kp=3.0"]].concat());
+    assert!(e.starts_with("controller.params"), "{e}");
+    let e = err(&[USE, &["rotor.sensor_a_node=2"]].concat());
+    assert!(e.starts_with("rotor.sensor_a_node = 2") && e.contains("sensor at node 1 (sensor_node)"), "{e}");
+    // Only one plane's AMB in the file: "use" refused, "constants" takes it for plane A.
+    let one = |sets: &[&str]| scene_with("", sets, false);
+    let e = one(&[USE, &["rotor.amb_a_node=1", "rotor.amb_b_node=3"]].concat()).err().unwrap().to_string();
+    assert!(e.contains("plane B has no MagneticBearingElement"), "{e}");
+    let only_a = one(&["rotor.ross_ambs=\"constants\"", "rotor.amb_a_node=1", "rotor.amb_b_node=3"]).unwrap();
+    assert_eq!(only_a.plane(1).loop_constants.ki_n_per_a, 216.0, "plane B keeps the scene's [amb]");
+    assert!(only_a.warnings[0].contains("replace that plane's [amb] constants"), "{:?}", only_a.warnings);
+    let e = err(&["rotor.ross_ambs=\"constants\"", "rotor.amb_a_node=1", "rotor.amb_b_node=4"]);
+    assert!(e.contains("element \"BearingElement_AMB2\" (node 3) is at none of the AMB nodes"), "{e}");
+    let e = err(&["rotor.ross_ambs=\"some\""]);
+    assert!(e.contains("ross_ambs") && e.contains("some"), "{e}");
+}
