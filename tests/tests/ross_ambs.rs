@@ -1,0 +1,111 @@
+//! Issue 38 item 1 through the binary: the shipped machine's ROSS file with its two AMBs as
+//! ROSS's `MagneticBearingElement`s (`rotor.ross_ambs`) runs under the 10 G shock, its PID as
+//! the law `ross_pid` in sampled mode and in lockstep with the controller process (the same
+//! trace), and with the file's constants under the scene's continuous PD; the run's first line
+//! and `summary.json` say what came from the file. Bounded in time (`output_within`).
+
+mod common;
+
+use common::{assert_exit, output_within, plant_run, read_json, read_text, refused, scene, stderr, Csv, TempDir};
+use std::time::Duration;
+
+/// A short run in a debug build on a loaded machine.
+const RUN: Duration = Duration::from_secs(180);
+
+/// The shipped scene cut to 25 ms (the shock at 7 ms).
+const SHORT: &[&str] = &["scene.duration_s=0.025", "shock[0].start_s=0.007", "output.plots=false"];
+
+/// The elements' parameters (hand-chosen for the shipped machine: `k_i` ≈ 200 N/A, `k_s` ≈
+/// 4.0e5 N/m, a PID of about 1e6 N/m on each plane's 11 kg) as ROSS's keys.
+const AMB: &str = "g0 = 0.001\ni0 = 2.0\nag = 0.00215\nnw = 200\nalpha = 0.39269908\nk_amp = 1.0\nk_sense = 25000.0\n\
+                   kp_pid = 0.28\nki_pid = 2.8\nkd_pid = 0.000133\nn_f = 5000.0\nsensors_axis_rotation = 0.78539816\n";
+
+/// ROSS's `ki`, `ks` of [`AMB`] by hand (bearing_seal_element.py 3.1.0 lines 2603–2625).
+fn by_hand() -> (f64, f64) {
+    let mu0 = 4e-7 * std::f64::consts::PI;
+    let ki = mu0 * 200.0 * 200.0 * 0.00215 * 2.0 * 0.39269908f64.cos() / (0.001 * 0.001);
+    (ki, ki * 2.0 / 0.001)
+}
+
+/// The shipped flexible scene on the AMB machine's ROSS file (committed fixture), its plain
+/// bearings at nodes 2 and 14 (the engineer's 1e6 N/m springs) replaced by
+/// `MagneticBearingElement` tables of [`AMB`] (what ROSS 3.1 saves, without the equivalent
+/// coefficient lists, which the reader does not use).
+fn machine(dir: &TempDir) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut file: toml::Table =
+        read_text(&root.join("plant/physics/tests/fixtures/ross/amb_machine.toml")).parse().unwrap();
+    for (name, n) in [("BearingElement_AMB A", 2), ("BearingElement_AMB B", 14)] {
+        let mut el: toml::Table = AMB.parse().unwrap();
+        el.insert("n".into(), n.into());
+        el.insert("sensor_node".into(), n.into());
+        el.insert("tag".into(), name.trim_start_matches("BearingElement_").into());
+        file.insert(name.into(), el.into());
+    }
+    std::fs::write(dir.join("machine.toml"), toml::to_string(&file).unwrap()).unwrap();
+    let mut table: toml::Table = read_text(&scene("flexible-10g.toml")).parse().unwrap();
+    let rotor = table["rotor"].as_table_mut().unwrap();
+    rotor.remove("shaft");
+    rotor.insert("ross_file".into(), "machine.toml".into());
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn a_ross_machine_with_its_magnetic_bearings_runs_under_the_shock() {
+    let dir = TempDir::new("ross-ambs");
+    let file = machine(&dir);
+    // Without the choice: refused with the element's constants, nothing written.
+    refused("ross-ambs-none", &file, SHORT, &["is ROSS's MagneticBearingElement", "rotor.ross_file = machine.toml"]);
+    let (ki, ks) = by_hand();
+    let mut traces = Vec::new();
+    for (mode, choice) in [("sampled", "use"), ("lockstep", "use"), ("continuous", "constants")] {
+        let out = dir.join(mode);
+        let sets: Vec<String> = SHORT
+            .iter()
+            .map(|s| s.to_string())
+            .chain([format!("controller.mode=\"{mode}\""), format!("rotor.ross_ambs=\"{choice}\"")])
+            .collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let run = output_within(&mut plant_run(&file, &out, &sets), RUN);
+        assert_exit(&run, 0);
+        let first = stderr(&run).lines().next().unwrap_or_default().to_string();
+        assert!(
+            first.contains("rotor.ross_file = machine.toml: the file's MagneticBearingElements are the AMBs")
+                && first.contains("plane A from \"BearingElement_AMB A\" (node 2, sensor node 2")
+                && first.contains("plane B from \"BearingElement_AMB B\" (node 14, sensor node 14")
+                && first.contains("replace both planes' [amb] constants")
+                && first.contains("turned by 45.0°, 45.0° are not applied")
+                && (choice == "use") == first.contains("law ross_pid kp = 0.28, ki = 2.8 1/s, kd = 0.000133 s"),
+            "{mode}: first line: {first}"
+        );
+        let summary = read_json(&out.join("summary.json"));
+        assert_eq!(summary["status"], "completed", "{mode}: {summary:#}");
+        assert_eq!(summary["model"]["law"], if choice == "use" { "ross_pid" } else { "pd" }, "{mode}");
+        let ambs = summary["model"]["ross_ambs"].as_array().expect("model.ross_ambs");
+        assert_eq!(ambs.len(), 2);
+        for (amb, plane) in ambs.iter().zip(["A", "B"]) {
+            assert_eq!(amb["plane"], plane);
+            let got = amb["ki_n_per_a"].as_f64().unwrap();
+            assert!((got - ki).abs() <= 1e-12 * ki, "{mode}: k_i {got} against {ki}");
+            let got = amb["ks_n_per_m"].as_f64().unwrap();
+            assert!((got - ks).abs() <= 1e-12 * ks, "{mode}: k_s {got} against {ks}");
+            assert_eq!(amb["pid"].is_object(), choice == "use", "{mode}: {amb}");
+        }
+        for p in ["a", "b"] {
+            assert!(summary["planes"][p]["first_contact_s"].as_f64().is_some(), "{mode}: plane {p} never touched");
+        }
+        // Levitated before the shock: the rotor at each touchdown node within 5 µm of the centre
+        // (the scene's 2 µm unbalance whirls it by about that much; the touchdown gap is 150 µm).
+        let trace = Csv::read(&out.join("trace.csv"));
+        let col = |name: &str| trace.header.iter().position(|h| h == name).expect(name);
+        let (t, cols) = (col("t_s"), [col("dx_m"), col("dy_m"), col("b_dx_m"), col("b_dy_m")]);
+        let before = trace.rows.iter().filter(|r| r[t] < 0.007);
+        let largest = before.flat_map(|r| cols.map(|c| r[c].abs())).fold(0.0, f64::max);
+        eprintln!("{mode}: largest displacement before the shock {largest:e} m");
+        assert!(largest < 5e-6, "{mode}: {largest} m before the shock");
+        traces.push(trace);
+    }
+    assert_eq!(traces[0].rows, traces[1].rows, "lockstep (the controller process's ross_pid) differs from sampled");
+}
