@@ -120,7 +120,7 @@ impl ControlLaw for RossPid {
         let t = self.period_s;
         let a = 2.0 / t;
         let mut out = [0.0; 2];
-        for k in 0..2 {
+        for (k, o) in out.iter_mut().enumerate() {
             let u = s.sensor_v[k];
             let du = u - self.prev_u[k];
             self.derivative[k] = (kd * n_f * a * du - (n_f - a) * self.derivative[k]) / (a + n_f);
@@ -132,7 +132,7 @@ impl ControlLaw for RossPid {
             if !winds_up {
                 self.integral[k] = candidate;
             }
-            out[k] = current(self.integral[k]);
+            *o = current(self.integral[k]);
             self.prev_u[k] = u;
         }
         out

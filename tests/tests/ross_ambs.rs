@@ -20,7 +20,9 @@ const SHORT: &[&str] = &["scene.duration_s=0.025", "shock[0].start_s=0.007", "ou
 const AMB: &str = "g0 = 0.001\ni0 = 2.0\nag = 0.00215\nnw = 200\nalpha = 0.39269908\nk_amp = 1.0\nk_sense = 25000.0\n\
                    kp_pid = 0.28\nki_pid = 2.8\nkd_pid = 0.000133\nn_f = 5000.0\nsensors_axis_rotation = 0.78539816\n";
 
-/// ROSS's `ki`, `ks` of [`AMB`] by hand (bearing_seal_element.py 3.1.0 lines 2603–2625).
+/// ROSS's `ki`, `ks` of [`AMB`] by hand (bearing_seal_element.py 3.1.0 lines 2603–2625), with
+/// the file's alpha (ROSS's decimals, not π/8 exactly).
+#[allow(clippy::approx_constant)]
 fn by_hand() -> (f64, f64) {
     let mu0 = 4e-7 * std::f64::consts::PI;
     let ki = mu0 * 200.0 * 200.0 * 0.00215 * 2.0 * 0.39269908f64.cos() / (0.001 * 0.001);
