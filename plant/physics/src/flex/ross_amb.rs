@@ -88,12 +88,13 @@ impl MagneticBearing {
     pub fn refusal(&self) -> String {
         let [kp, ki, kd] = self.pid;
         format!(
-            "element \"{}\" (node {}) is ROSS's MagneticBearingElement, which this reader does not yet make the \
-             plane's AMB; by ROSS's formulas it stands for k_i = {:.6e} N/A and k_s = {:.6e} N/m (amb.ki_n_per_a, \
+            "element \"{}\" (node {}) is ROSS's MagneticBearingElement, which the scene must say what to do with; \
+             by ROSS's formulas it stands for k_i = {:.6e} N/A and k_s = {:.6e} N/m (amb.ki_n_per_a, \
              amb.ks_n_per_m), its sensor at node {} (rotor.sensor_*_node), amplifier gain {} A/V and sensor gain {} \
              V/m (amb.amp_gain_a_per_v, amb.sensor_gain_v_per_m), a PID kp = {kp}, ki = {ki} 1/s, kd = {kd} s with its \
-             derivative filtered at n_f = {} rad/s, axes turned by {:.1}°: give the AMB in the scene and remove the \
-             element from the rotor before saving",
+             derivative filtered at n_f = {} rad/s, axes turned by {:.1}°: rotor.ross_ambs = \"use\" makes it the \
+             plane's AMB with its PID as the law (ross_pid, sampled modes), \"constants\" the plane's AMB with the \
+             scene's [controller]",
             self.element,
             self.node,
             self.ki_n_per_a(),
