@@ -138,6 +138,23 @@ impl ControlLaw for RossPid {
         out
     }
 
+    /// Around levitation (no saturation) the law is linear: `i = bias − A_a C(z) u` with `C(z)`
+    /// its three Tustin terms over one denominator `(1 − z⁻¹)(1 − p z⁻¹)`, `p = (a − n_f)/(a +
+    /// n_f)`: a second-order filter of the sensor voltage behind the proportional gain 1 (what
+    /// `plant assess` and `plant linear` take the closed form of).
+    fn linear(&self) -> Option<crate::law::LinearLaw> {
+        let RossPidGains { kp, ki, kd, n_f } = self.gains;
+        let a = 2.0 / self.period_s;
+        let p = (a - n_f) / (a + n_f);
+        let h = 0.5 * ki * self.period_s;
+        let g = kd * n_f * a / (a + n_f);
+        let b = [kp + h + g, -kp * (1.0 + p) + h * (1.0 - p) - 2.0 * g, (kp - h) * p + g];
+        Some(crate::law::LinearLaw {
+            pd: crate::law::LinearPd { kp: 1.0, kd: 0.0 },
+            filter: Some((b, [-(1.0 + p), p])),
+        })
+    }
+
     fn reset(&mut self) {
         self.prev_u = [0.0; 2];
         self.integral = [0.0; 2];
@@ -200,6 +217,33 @@ mod tests {
             let scale = re.hypot(im);
             assert!((x[0] - re).abs() < 1e-6 * scale, "{f_hz} Hz: Re {} against {re}", x[0]);
             assert!((x[1] - im).abs() < 1e-6 * scale, "{f_hz} Hz: Im {} against {im}", x[1]);
+        }
+    }
+
+    /// Its linear form (a gain behind a second-order filter, as `plant assess` runs it) answers
+    /// as the law does on small motions, sample by sample, from rest.
+    #[test]
+    fn its_linear_form_is_the_law() {
+        let g = RossPidGains { kp: 0.28, ki: 2.8, kd: 1.33e-4, n_f: 5000.0 };
+        let (t, amp, bias) = (5e-5, 1.5, [0.0, 0.4]);
+        let mut law = RossPid::new(g, amp, bias, t, f64::INFINITY);
+        let linear = law.linear().unwrap();
+        let (b, a) = linear.filter.unwrap();
+        let (mut u1, mut u2, mut y1, mut y2) = ([0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
+        for k in 0..4000u64 {
+            let ph = k as f64 * 0.013;
+            let u = [1e-3 * ph.sin() + 2e-4, -2e-3 * (0.7 * ph).cos()];
+            let got = law.update(&Sample { seq: k, t_s: k as f64 * t, sensor_v: u, ..Default::default() });
+            for ax in 0..2 {
+                let y = b[0] * u[ax] + b[1] * u1[ax] + b[2] * u2[ax] - a[0] * y1[ax] - a[1] * y2[ax];
+                let want = bias[ax] - amp * (linear.pd.kp * y);
+                assert!(
+                    (got[ax] - want).abs() <= 1e-10 * (1.0 + want.abs()),
+                    "sample {k} axis {ax}: {} against {want}",
+                    got[ax]
+                );
+                (u2[ax], u1[ax], y2[ax], y1[ax]) = (u1[ax], u[ax], y1[ax], y);
+            }
         }
     }
 
