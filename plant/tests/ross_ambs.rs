@@ -171,6 +171,14 @@ fn refusals_name_the_key() {
     assert!(only_a.warnings[0].contains("replace that plane's [amb] constants"), "{:?}", only_a.warnings);
     let e = err(&["rotor.ross_ambs=\"constants\"", "rotor.amb_a_node=1", "rotor.amb_b_node=4"]);
     assert!(e.contains("element \"BearingElement_AMB2\" (node 3) is at none of the AMB nodes"), "{e}");
+    // The key where it has no file: a rigid scene, a shaft given as a table.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config");
+    for (scene, expect) in
+        [("paper-10g.toml", "this scene's rotor is rigid"), ("flexible-10g.toml", "no rotor.ross_file")]
+    {
+        let e = load_scene(&root.join(scene), &["rotor.ross_ambs=\"use\"".to_string()]).err().unwrap().to_string();
+        assert!(e.starts_with("rotor.ross_ambs = \"use\"") && e.contains(expect), "{scene}: {e}");
+    }
     let e = err(&["rotor.ross_ambs=\"some\""]);
     assert!(e.contains("ross_ambs") && e.contains("some"), "{e}");
 }
