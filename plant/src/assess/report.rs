@@ -619,6 +619,33 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             esc(c.sensitivity.why.as_deref().unwrap_or(""))
         ),
     });
+    row(
+        &mut h,
+        "gain and phase margins (computed: the law's linear form on the linear plant; measured: L = 1/S − 1)",
+        &|c| {
+            let all = c.sensitivity.result.as_ref().map(|s| s.margins.as_slice()).unwrap_or_default();
+            if all.is_empty() {
+                return "–".into();
+            }
+            let basis = if all.iter().all(|m| m.computed.is_none()) {
+                "<span class=\"note\">measured only: the law has no linear form here (a controller process, an FMU, \
+             or a law without one)</span><br>"
+            } else {
+                ""
+            };
+            basis.to_string()
+                + &all
+                    .iter()
+                    .map(|m| {
+                        let computed = m.computed.as_ref().map_or("no linear form".into(), super::margins::words);
+                        let measured =
+                            m.measured.as_ref().map_or("not measured (unstable)".into(), super::margins::words);
+                        format!("{} at {:.0} Hz: computed {computed}; measured {measured}", m.axis, m.speed_hz)
+                    })
+                    .collect::<Vec<_>>()
+                    .join("<br>")
+        },
+    );
     row(&mut h, "closed form (where the law has one; two-plane: plane A's load share alone)", &|c| match c
         .sensitivity
         .result
