@@ -124,6 +124,8 @@ pub fn words(m: &Margins) -> String {
         _ => "PM none in the band".into(),
     };
     let gm = match (m.gain_margin_db, m.gain_margin_hz) {
+        // The band's lower end: the open loop is real there (a PD's at DC).
+        (Some(g), Some(f)) if f <= crate::linear::MARGIN_BAND_HZ.0 => format!("GM {g:+.1} dB at DC"),
         (Some(g), Some(f)) => format!("GM {g:+.1} dB at {f:.2} Hz"),
         _ => "GM none in the band".into(),
     };

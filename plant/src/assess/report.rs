@@ -468,6 +468,17 @@ fn legend(r: &Report) -> String {
             .into(),
     );
     item(
+        "Gain and phase margins",
+        "The loop opened at the axis where the sensitivity is measured, every other axis closed: \
+         L = 1/S − 1. PM: the smallest phase margin, at a gain crossover (|L| = 1). GM: the gain margin \
+         nearest 0 dB, at a phase crossover (L real and negative); an AMB's open loop is unstable, so its \
+         first crossover is at DC with a negative margin (the gain may fall by that much before the rotor \
+         drops); a sampled loop adds one above the gain crossover where the gain may rise. <b>computed</b>: \
+         the law's linear form on the scene's linear model (<code>plant linear</code>); <b>measured</b>: from \
+         the measured S, between the measured frequencies only (DC is not measured)."
+            .into(),
+    );
+    item(
         "Vibration (ISO 14839-2), zones A–D",
         "The levitated rotor at its speed, no shock: the peak of the orbit at the sensor against \
          C<sub>min</sub>, the minimum radial clearance (the touchdown bearing's air gap): zone <b>A</b> below \
