@@ -302,7 +302,7 @@ fn check_digital(scene: &Scene, snapshot: &Snapshot) -> Result<(), SnapshotError
     let limits = scene.rotor_design().current_limits();
     for (k, c) in d.in_flight.iter().enumerate() {
         for (a, (&i, &limit)) in c.iter().zip(&limits).enumerate() {
-            if !(i.abs() <= limit) {
+            if i.is_nan() || i.abs() > limit {
                 return Err(SnapshotError::field(
                     format!("digital.in_flight[{k}][{a}]"),
                     format!("{i} A"),

@@ -743,14 +743,17 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
                 ));
             }
         } else {
-            if !(h >= settings.h_min && h <= settings.h_max && h > 0.0) {
+            // At most the macro step (a tick) and h_max: the integrator caps what it carries so.
+            // (Not bounded below by h_min: the step after one shortened to land on a tick's end
+            // may carry less.)
+            let most = settings.h_max.min(self.period * (1.0 + 1e-9));
+            if !(h > 0.0 && h <= most) {
                 return Err(SnapshotError::field(
                     "adaptive.h",
                     format!("{h} s"),
                     format!(
-                        "a step size within the integrator's bounds, {} s to {} s",
-                        settings.h_min.max(f64::MIN_POSITIVE),
-                        settings.h_max
+                        "a step size the integrator carries: positive, at most the controller period {} s and h_max = {} s",
+                        self.period, settings.h_max
                     ),
                 ));
             }
@@ -776,7 +779,7 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
             let (rotor, race) = self.model.radii(y, i);
             let (rotor_limit, race_limit) = (p.contact.gap + p.balls.clearance + depth, p.balls.clearance + depth);
             let plane = if M::PLANES == 1 { String::new() } else { format!(" at bearing {}", ["A", "B"][i]) };
-            if !(rotor <= rotor_limit) {
+            if rotor.is_nan() || rotor > rotor_limit {
                 return Err(SnapshotError::field(
                     format!("state: the rotor radius{plane}"),
                     format!("{rotor} m"),
@@ -786,7 +789,7 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
                     ),
                 ));
             }
-            if !(race <= race_limit) {
+            if race.is_nan() || race > race_limit {
                 return Err(SnapshotError::field(
                     format!("state: the race radius{plane}"),
                     format!("{race} m"),
