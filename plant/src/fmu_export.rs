@@ -99,7 +99,7 @@ pub struct Model {
     pub planes: usize,
     /// The variables, by value reference.
     pub variables: Vec<Variable>,
-    /// The GUID: a digest of the model description without it.
+    /// The GUID: a digest of the model description without it and of the whole resolved scene.
     pub guid: String,
 }
 
@@ -342,7 +342,10 @@ impl Model {
             variables,
             guid: String::new(),
         };
-        let digest = Sha256::digest(model.xml().as_bytes());
+        // The whole resolved scene, not only the description's variables: an edited
+        // resources/scene.toml (rotor.mass_kg, integrator.method: no FMU variable) made
+        // another plant under the same GUID (issue 40 item 4).
+        let digest = Sha256::digest(format!("{}\n{text}", model.xml()).as_bytes());
         let h: String = digest.iter().take(16).map(|b| format!("{b:02x}")).collect();
         model.guid = format!("{{{}-{}-{}-{}-{}}}", &h[0..8], &h[8..12], &h[12..16], &h[16..20], &h[20..32]);
         Ok(model)

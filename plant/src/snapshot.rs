@@ -99,6 +99,10 @@ pub struct Snapshot {
     /// The run's digital loop: the commands in flight.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub digital: Option<DigitalState>,
+    /// The seal ([`Snapshot::seal_for`]): SHA-256 of the scene's fingerprint and every other
+    /// field, hex. A saved state carries it; an in-memory one (an FMU's) has none (empty).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub seal: String,
 }
 
 /// The digital loop's part of a snapshot.
@@ -173,6 +177,26 @@ pub enum SnapshotError {
     /// Integrator settings out of range.
     #[error("the snapshot's integrator memory is out of range: {0}")]
     Integrator(String),
+    /// A field whose value this scene's plant could not have written.
+    #[error("the snapshot's {field} = {value}: {expected}")]
+    Field {
+        /// The field, as in the file.
+        field: String,
+        /// Its value, as read.
+        value: String,
+        /// What it must be, in words.
+        expected: String,
+    },
+    /// No seal, or one that is not that of this scene and the snapshot's fields.
+    #[error("{0}")]
+    Seal(String),
+}
+
+impl SnapshotError {
+    /// A [`SnapshotError::Field`].
+    pub fn field(field: impl Into<String>, value: impl std::fmt::Display, expected: impl Into<String>) -> Self {
+        Self::Field { field: field.into(), value: value.to_string(), expected: expected.into() }
+    }
 }
 
 impl Snapshot {
@@ -185,6 +209,45 @@ impl Snapshot {
             Some(why) => Err(SnapshotError::Scene(why)),
             None => Ok(()),
         }
+    }
+
+    /// The seal of this snapshot in a scene of `fingerprint`: SHA-256 (hex) of the snapshot as
+    /// JSON with `fingerprint` in place of its own and no seal. Computed from the scene, not read
+    /// from the file: a state whose fingerprint or any other field was edited, or that belongs to
+    /// another scene, has another seal. It catches edits and foreign states, not forgeries (an
+    /// editor may recompute it): the fields are also checked against the scene and the physics
+    /// ([`crate::run::check_start`]).
+    pub fn seal_for(&self, fingerprint: &Fingerprint) -> String {
+        use sha2::{Digest, Sha256};
+        let unsealed = Snapshot { fingerprint: fingerprint.clone(), seal: String::new(), ..self.clone() };
+        // Plain data (strings, numbers, booleans): serialising it cannot fail; an empty text
+        // would only make a seal no file carries.
+        let text = serde_json::to_string(&unsealed).unwrap_or_default();
+        format!("{:x}", Sha256::digest(text.as_bytes()))
+    }
+
+    /// Seals the snapshot for its own scene ([`Snapshot::seal_for`]): what a saved state carries.
+    pub fn seal(&mut self) {
+        self.seal = self.seal_for(&self.fingerprint);
+    }
+
+    /// Refuses a snapshot without a seal or whose seal is not that of `fingerprint` (the scene
+    /// it is to continue in) and its fields: a saved state edited, or of another scene.
+    pub fn check_seal(&self, fingerprint: &Fingerprint) -> Result<(), SnapshotError> {
+        if self.seal.is_empty() {
+            return Err(SnapshotError::Seal(
+                "the snapshot has no seal: written by hand or by an older plant; save the state again".into(),
+            ));
+        }
+        let expected = self.seal_for(fingerprint);
+        if self.seal != expected {
+            return Err(SnapshotError::Seal(format!(
+                "the snapshot's seal = {} is not {expected}, that of this scene and the snapshot's fields: \
+                 the file was edited (or belongs to another scene); a state is used as saved",
+                self.seal
+            )));
+        }
+        Ok(())
     }
 
     /// Writes the snapshot to `path`, whole or not at all.

@@ -50,6 +50,16 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
         assert!((measured - closed).abs() < 0.5, "measured {measured} dB, closed form {closed} dB");
         assert!(["A", "B", "C", "D"].contains(&axis["zone"].as_str().expect("zone")));
     }
+    // Its gain and phase margins: computed from the law's linear form on the linear plant and
+    // measured from S (L = 1/S − 1); the phase margins agree within the measurement's grid.
+    for m in s["margins"].as_array().expect("margins") {
+        let (computed, measured) = (&m["computed"], &m["measured"]);
+        let (pc, pm) = (num(computed, "phase_margin_deg"), num(measured, "phase_margin_deg"));
+        assert!(pc > 0.0 && (pc - pm).abs() < 3.0, "{m}");
+        let (fc, fm) = (num(computed, "phase_margin_hz"), num(measured, "phase_margin_hz"));
+        assert!((fc - fm).abs() < 0.05 * fc, "{m}");
+        assert!(num(computed, "gain_margin_db").is_finite(), "{m}");
+    }
     // The study's PD at 20 kHz: unstable, no peak, and its closed form agrees.
     let s = &c[1]["sensitivity"]["result"];
     for axis in s["axes"].as_array().expect("axes") {
@@ -92,6 +102,7 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
     }
     let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
     assert!(html.contains("<b>Warning:</b> ladder.members = 2 cannot reach"), "the page warns");
+    assert!(html.contains("gain and phase margins") && html.contains(": computed PM "), "the page gives the margins");
     assert!(html.contains("data:image/png;base64,") && html.contains("damped") && html.contains("study pd"));
     assert!(!html.contains("http://") && !html.contains("https://") && !html.contains("<script"), "self-contained");
     for png in ["sensitivity_1.png", "ladder_probability.png", "duty_friction.png"] {

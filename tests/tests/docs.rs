@@ -261,6 +261,21 @@ fn every_guide_results_and_developer_page_is_linked_from_the_readme() {
     assert!(orphans.is_empty(), "pages a newcomer cannot find from the README: {orphans:?}");
 }
 
+/// The README's crate table lists every workspace member (by its folder, as `` `plant/fmu/` ``).
+#[test]
+fn the_readmes_crate_table_lists_every_workspace_member() {
+    let root = common::workspace_root();
+    let manifest: toml::Table = fs::read_to_string(root.join("Cargo.toml")).unwrap().parse().unwrap();
+    let members = manifest["workspace"]["members"].as_array().expect("workspace.members");
+    let readme = fs::read_to_string(root.join("README.md")).unwrap();
+    let table: Vec<&str> = readme.lines().filter(|l| l.starts_with("| `")).collect();
+    assert!(!members.is_empty() && !table.is_empty());
+    for m in members {
+        let folder = format!("`{}/`", m.as_str().expect("a path"));
+        assert!(table.iter().any(|row| row.contains(&folder)), "README's crate table has no row for {folder}");
+    }
+}
+
 #[test]
 fn the_readme_is_a_short_front_door_starting_with_the_two_commands() {
     let readme = fs::read_to_string(common::workspace_root().join("README.md")).unwrap();

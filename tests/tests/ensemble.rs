@@ -395,21 +395,21 @@ fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
 #[test]
 fn a_run_says_how_robust_its_outcome_is() {
     let dir = TempDir::new("robustness");
-    let sets = ["scene.duration_s=0.06", "shock[0].start_s=0.005", "output.plots=false"];
+    let sets = ["scene.duration_s=0.03", "shock[0].start_s=0.005", "output.plots=false"];
     let plain = dir.join("plain");
     assert_exit(&output_within(&mut plant_run(&scene("paper-10g.toml"), &plain, &sets), LIMIT), 0);
     let out = dir.join("robust");
-    let o = output_within(plant_run(&scene("paper-10g.toml"), &out, &sets).args(["--robustness", "4"]), LIMIT);
+    let o = output_within(plant_run(&scene("paper-10g.toml"), &out, &sets).args(["--robustness", "2"]), LIMIT);
     assert_exit(&o, 0);
     assert_eq!(read_text(&plain.join("trace.csv")), read_text(&out.join("trace.csv")), "the run itself is unchanged");
     let s = read_json(&out.join("summary.json"));
     let r = &s["robustness"];
-    assert_eq!(r["members"], 4, "{r}");
+    assert_eq!(r["members"], 2, "{r}");
     let counted: u64 = r["modes"].as_object().expect("modes").values().map(|v| v.as_u64().expect("count")).sum();
-    assert_eq!(counted, 4, "{r}");
+    assert_eq!(counted, 2, "{r}");
     assert_eq!(r["run_mode"], s["post_shock_mode"], "{r}");
     let same = r["same_mode"].as_u64().expect("same_mode");
-    assert_eq!(r["verdict"], if same == 4 { "robust" } else { "fragile" }, "{r}");
+    assert_eq!(r["verdict"], if same == 2 { "robust" } else { "fragile" }, "{r}");
     for (key, figure) in [("max_contact_force_n", "max_contact_force_n"), ("max_radius_m", "max_radius_m")] {
         let own = num(&s, figure);
         let (lo, hi) = (num(&r[key], "min"), num(&r[key], "max"));
@@ -417,7 +417,7 @@ fn a_run_says_how_robust_its_outcome_is() {
     }
     let (lo, hi) = (num(&r["max_radius_m"], "min"), num(&r["max_radius_m"], "max"));
     assert!(hi > lo && (hi - lo) < 1e-6 * hi, "perturbed, and only in the last digits: [{lo}, {hi}]");
-    assert!(stderr(&o).contains(&format!("plant: robustness: {same} of 4 perturbed runs")), "{}", stderr(&o));
+    assert!(stderr(&o).contains(&format!("plant: robustness: {same} of 2 perturbed runs")), "{}", stderr(&o));
     // Bad input: nothing written.
     let bad = dir.join("bad");
     for (extra, says) in [

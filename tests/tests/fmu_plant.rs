@@ -547,6 +547,28 @@ fn a_fifo_as_the_fmus_scene_is_refused_at_once() {
     }
 }
 
+/// Issue 40 item 4: an FMU whose `resources/scene.toml` was edited in a key that is no FMU
+/// variable (the rotor's mass, the integrator) ran another plant under the same GUID; the GUID
+/// now covers the whole resolved scene, and `fmi2Instantiate` refuses with a line saying so.
+#[test]
+fn an_edited_scene_in_the_fmu_is_refused_at_instantiation() {
+    let dir = TempDir::new("fmu-scene-edited");
+    let fmu = write_fmu(&dir, "plant.fmu", &[]);
+    let (xml, unpacked) = unpack(&fmu, &dir, "plant");
+    let scene_file = unpacked.join("resources/scene.toml");
+    let original = std::fs::read_to_string(&scene_file).unwrap();
+    // The untouched FMU instantiates.
+    drop(Binary::load(&xml, &unpacked).instantiate());
+    for (from, to) in [("mass_kg = 11.5", "mass_kg = 12.0"), ("method = \"dp5\"", "method = \"rk4\"")] {
+        assert!(original.contains(from), "{from} not in the FMU's scene:\n{original}");
+        std::fs::write(&scene_file, original.replacen(from, to, 1)).unwrap();
+        let bin = Binary::load(&xml, &unpacked);
+        let log = bin.instantiate_as(1, &bin.guid).err().unwrap_or_else(|| panic!("{to}: instantiated"));
+        let line = &log.last().expect("a log line").1;
+        assert!(line.contains("fmuGUID = ") && line.contains("resources/scene.toml was edited"), "{to}: {line}");
+    }
+}
+
 /// Every bad call returns `fmi2Error` with a log line that says what was wrong, and the
 /// instance goes on where that is possible; a diverging plant returns `fmi2Error` with its time
 /// and state; the instantiation of another FMU's GUID or as model exchange is refused.

@@ -13,6 +13,8 @@
 //! `--resume` continues it to the uninterrupted soak's files.
 
 mod common;
+#[path = "common/edits.rs"]
+mod edits;
 
 use common::{
     assert_exit, controller_bin, num, output_within, plant_bin, read_json, stderr, workspace_root, Csv, Png, TempDir,
@@ -332,6 +334,9 @@ fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted
     for (says, edit) in edits {
         let mut c = saved.clone();
         edit(&mut c);
+        // Re-sealed (the plant's own seal, as an editor with the source would compute it), so
+        // that the refusal is the field's own check, not the seal's.
+        let c = reseal(&c).expect("a checkpoint");
         std::fs::write(cut.join("soak-state.json"), serde_json::to_string(&c).unwrap()).unwrap();
         let out = output_within(soak(&file, &cut, &[]).arg("--resume"), LIMIT);
         assert_exit(&out, 2);
@@ -342,6 +347,10 @@ fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted
     }
     let original = &before.iter().find(|(n, _)| n == "soak-state.json").unwrap().1;
     std::fs::write(cut.join("soak-state.json"), original).unwrap();
+
+    // Issue 40 item 4: every field of the checkpoint edited is refused before a file is
+    // touched, or resumes to the uninterrupted soak's files.
+    every_edited_field_is_refused_or_changes_nothing(&dir, &file, &cut, &whole, &saved);
 
     // The resume goes on from the checkpoint to the uninterrupted soak's files.
     let out = output_within(soak(&file, &cut, &[]).arg("--resume"), LIMIT);
@@ -359,4 +368,130 @@ fn a_soak_killed_with_sigkill_leaves_whole_rows_and_resumes_to_the_uninterrupted
     }
     assert!(!cut.join("soak-state.json").exists(), "a completed soak keeps no checkpoint");
     assert!(cut.join("controller.1.log").is_file(), "the killed soak's controller.log is kept");
+}
+
+/// The checkpoint `c` sealed as the plant seals it, if it still parses as one.
+fn reseal(c: &serde_json::Value) -> Option<serde_json::Value> {
+    let mut parsed: plant::soak::checkpoint::Checkpoint = serde_json::from_value(c.clone()).ok()?;
+    parsed.seal();
+    serde_json::to_value(&parsed).ok()
+}
+
+/// Each field of the checkpoint `saved` of the soak in `cut` (of programme `file`) edited (each
+/// number to 0, −1, ±1e300, 2^64 − 1 and a small change; each string and boolean changed; the
+/// programme's leaves one in 7, long arrays at three entries): `--resume` in a copy of `cut`
+/// refuses it (exit 2, the file named, the soak's files untouched) or writes `whole`'s
+/// `soak.csv` and `envelope.csv`. Twice: as edited (the seal no longer matches), and re-sealed
+/// for the checkpoint's own fields (the plant's are a saved state's, held by states.rs), but
+/// for the accumulators of the window and bin under way (any non-negative maxima and counts a
+/// soak could hold: only the seal tells them edited), which are re-sealed only at −1.
+fn every_edited_field_is_refused_or_changes_nothing(
+    dir: &TempDir,
+    file: &Path,
+    cut: &Path,
+    whole: &Path,
+    saved: &serde_json::Value,
+) {
+    let files: Vec<(String, Vec<u8>)> = std::fs::read_dir(cut)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
+        .collect();
+    let free = |path: &str| {
+        path.starts_with("tracker.acc.")
+            || matches!(
+                path,
+                "tracker.in_contact" | "tracker.clear_since" | "envelope.max_radius" | "envelope.max_force"
+            )
+    };
+    let mut programme_leaves = 0usize;
+    let mut last = String::new();
+    let mut cases: Vec<(String, String)> = Vec::new();
+    for e in edits::edits(saved, &[]) {
+        if e.path.starts_with("programme") {
+            if e.path != last {
+                programme_leaves += 1;
+            }
+            last = e.path.clone();
+            if programme_leaves % 7 != 1 {
+                continue;
+            }
+        }
+        cases.push((format!("{} = {}", e.path, e.value), serde_json::to_string(&e.doc).unwrap()));
+        let own = !e.path.starts_with("plant") && !e.path.starts_with("programme") && e.path != "seal";
+        if own && (!free(&e.path) || e.value == -1) {
+            if let Some(r) = reseal(&e.doc) {
+                cases.push((format!("{} = {} (re-sealed)", e.path, e.value), serde_json::to_string(&r).unwrap()));
+            }
+        }
+    }
+    assert!(cases.len() > 300, "{} cases", cases.len());
+    let soak_csv = std::fs::read(whole.join("soak.csv")).unwrap();
+    let envelope_csv = std::fs::read(whole.join("envelope.csv")).unwrap();
+    let numbered: Vec<(usize, &(String, String))> = cases.iter().enumerate().collect();
+    let results = edits::on_two_threads(&numbered, |(i, (what, body))| {
+        let run = dir.join(&format!("edited-{i}"));
+        std::fs::create_dir_all(&run).unwrap();
+        for (name, bytes) in &files {
+            std::fs::write(run.join(name), bytes).unwrap();
+        }
+        std::fs::write(run.join("soak-state.json"), body).unwrap();
+        let out = output_within(soak(file, &run, &[]).arg("--resume"), LIMIT);
+        let err = stderr(&out);
+        let touched = files
+            .iter()
+            .filter(|(n, _)| n != "soak-state.json")
+            .find(|(n, bytes)| std::fs::read(run.join(n)).ok().as_ref() != Some(bytes))
+            .map(|(n, _)| n.clone());
+        let verdict = match out.status.code() {
+            Some(2) if touched.is_some() => Err(format!("exit 2 but {touched:?} was touched")),
+            // The checkpoint named, or the soak's file it does not match.
+            Some(2) if !["soak-state.json", "soak.csv", "envelope.csv"].iter().any(|n| err.contains(n)) => {
+                Err(format!("no file named: {err}"))
+            }
+            Some(2) => Ok(Some(err)),
+            Some(0)
+                if std::fs::read(run.join("soak.csv")).unwrap() == soak_csv
+                    && std::fs::read(run.join("envelope.csv")).unwrap() == envelope_csv =>
+            {
+                Ok(None)
+            }
+            Some(0) => Err("exit 0 with other soak.csv or envelope.csv".to_owned()),
+            other => Err(format!("exit {other:?}: {err}")),
+        };
+        let _ = std::fs::remove_dir_all(&run);
+        (what.clone(), verdict)
+    });
+    let failures: Vec<String> =
+        results.iter().filter_map(|(what, v)| v.as_ref().err().map(|e| format!("{what}: {e}"))).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} edits neither refused nor harmless:\n{}",
+        failures.len(),
+        results.len(),
+        failures.join("\n")
+    );
+    // The known instances, refused for what they are.
+    let said = |what: &str| {
+        results
+            .iter()
+            .find(|(w, _)| w == what)
+            .and_then(|(_, v)| v.as_ref().ok().cloned().flatten())
+            .unwrap_or_default()
+    };
+    for (what, needles) in [
+        ("plant.adaptive.h = 0", &["seal"][..]),
+        ("plant.next_output = 0", &["seal"][..]),
+        ("rows = 0 (re-sealed)", &["rows = 0"][..]),
+        ("soak_csv_bytes = 0 (re-sealed)", &["soak_csv_bytes = 0"][..]),
+        ("envelope_csv_bytes = 0 (re-sealed)", &["envelope_csv_bytes = 0"][..]),
+        ("figures[0].max_contact_force_n = 0 (re-sealed)", &["soak_csv_bytes"][..]),
+        ("tracker.last_t = 0 (re-sealed)", &["tracker.last_t = 0"][..]),
+    ] {
+        let err = said(what);
+        for n in needles {
+            assert!(err.contains(n), "{what}: {n:?} not in {err:?}");
+        }
+    }
 }

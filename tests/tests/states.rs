@@ -4,6 +4,8 @@
 //! snapshots and bad times are refused naming the file or the flag, exit 2, nothing written.
 
 mod common;
+#[path = "common/edits.rs"]
+mod edits;
 
 use common::*;
 use std::path::Path;
@@ -156,5 +158,165 @@ fn bad_states_and_times_are_refused_before_anything_is_written() {
         assert_exit(&out, 2);
         assert!(stderr(&out).contains("--save-state-at") && stderr(&out).contains(needle), "{times}: {}", stderr(&out));
         assert!(!out_dir.exists());
+    }
+}
+
+/// Issue 40 item 4: every field of a real saved state, edited (each number to 0, −1, ±1e300,
+/// 2^64 − 1 and a small change; each string and boolean changed), is refused (exit 2, the
+/// file named, nothing written) or gives the rows of the untouched state. Twice: as edited (the
+/// seal no longer matches), and re-sealed as a careful editor would (the fields' own checks
+/// against the scene and the physics). The known instances are named by their fields.
+#[test]
+fn every_edited_field_of_a_saved_state_is_refused_or_changes_nothing() {
+    let tmp = TempDir::new("states-edited");
+    let sets = ["scene.duration_s=0.02", "shock[0].start_s=0.005", "output.plots=false", "controller.mode=\"sampled\""];
+    let scene = scene_path("cosim-10g.toml");
+    let good = tmp.join("good");
+    let mut cmd = plant_run(&scene, &good, &sets);
+    cmd.args(["--save-state-at", "0.01"]);
+    assert_exit(&output(&mut cmd), 0);
+    let state = good.join("state-0.01.json");
+    let text = read_text(&state);
+    let reference = {
+        let dir = tmp.join("untouched");
+        let mut cmd = plant_run(&scene, &dir, &sets);
+        cmd.arg("--from-state").arg(&state);
+        assert_exit(&output(&mut cmd), 0);
+        rows(&dir)
+    };
+    assert!(!reference.is_empty());
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // Re-sealed edits: every field but the state's numbers other than the rotor's position
+    // (x, y: the first two in every model) set 1 m or more from the centre, the sensor's noise generator and the samples'
+    // voltages, speeds and the commands in flight, which a plant may hold at values other
+    // than these (only the seal tells that they were edited); the seal itself is the one
+    // recomputed.
+    let free = |path: &str, value: &serde_json::Value| {
+        let far = value.as_f64().is_some_and(|v| v.abs() >= 1.0);
+        (path.starts_with("state[") && !(matches!(path, "state[0]" | "state[1]") && far))
+            || path == "sensor_rng"
+            || path == "seal"
+            || path.starts_with("digital.in_flight")
+            || path.ends_with(".sensor_v[0]")
+            || path.contains(".sensor_v[")
+            || path.ends_with(".speed_rad_s")
+    };
+    let mut cases = Vec::new();
+    for e in edits::edits(&doc, &["state"]) {
+        let resealed = if free(&e.path, &e.value) {
+            None
+        } else {
+            // The plant's own seal, as an editor with the source would compute it; an edit
+            // that no longer parses as a state is refused as such either way.
+            serde_json::from_value::<plant::snapshot::Snapshot>(e.doc.clone()).ok().map(|mut s| {
+                s.seal();
+                serde_json::to_string_pretty(&s).unwrap()
+            })
+        };
+        let plain = serde_json::to_string_pretty(&e.doc).unwrap();
+        cases.push((format!("{} = {}", e.path, e.value), plain));
+        if let Some(r) = resealed {
+            cases.push((format!("{} = {} (re-sealed)", e.path, e.value), r));
+        }
+    }
+    assert!(cases.len() > 200, "{} cases", cases.len());
+    let numbered: Vec<(usize, &(String, String))> = cases.iter().enumerate().collect();
+    let results = edits::on_two_threads(&numbered, |(i, (what, body))| {
+        let file = tmp.join(&format!("edited-{i}.json"));
+        std::fs::write(&file, body).unwrap();
+        let dir = tmp.join(&format!("run-{i}"));
+        let mut cmd = plant_run(&scene, &dir, &sets);
+        cmd.arg("--from-state").arg(&file);
+        let out = output_within(&mut cmd, std::time::Duration::from_secs(120));
+        let err = stderr(&out);
+        let verdict = match out.status.code() {
+            Some(2) if dir.exists() => Err("exit 2 but the output folder was created".to_owned()),
+            Some(2) if !err.contains(&format!("edited-{i}.json")) => Err(format!("the file is not named: {err}")),
+            Some(2) => Ok(Some(err)),
+            Some(0) if rows(&dir) == reference => Ok(None),
+            Some(0) => Err("exit 0 with other rows".to_owned()),
+            other => Err(format!("exit {other:?}: {err}")),
+        };
+        let _ = std::fs::remove_dir_all(&dir);
+        (what.clone(), verdict)
+    });
+    let failures: Vec<String> =
+        results.iter().filter_map(|(what, v)| v.as_ref().err().map(|e| format!("{what}: {e}"))).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} edits neither refused nor harmless:\n{}",
+        failures.len(),
+        results.len(),
+        failures.join("\n")
+    );
+    // The known instances, refused for what they are.
+    let said = |what: &str| {
+        results
+            .iter()
+            .find(|(w, _)| w == what)
+            .and_then(|(_, v)| v.as_ref().ok().cloned().flatten())
+            .unwrap_or_default()
+    };
+    let max = u64::MAX;
+    for (what, needles) in [
+        ("next_output = 0 (re-sealed)".to_owned(), &["next_output = 0", "the first output row after"][..]),
+        (
+            format!("next_output = {max} (re-sealed)"),
+            &["next_output = 18446744073709551615", "the first output row after"][..],
+        ),
+        ("next_output = 1e+300".to_owned(), &["not a whole snapshot"][..]),
+        (format!("steps = {max} (re-sealed)"), &["steps = 18446744073709551615", "at most 2^53"][..]),
+        (format!("rhs_evals = {max} (re-sealed)"), &["rhs_evals = 18446744073709551615"][..]),
+        ("adaptive.h = 0 (re-sealed)".to_owned(), &["adaptive"][..]),
+        ("state[0] = -1 (re-sealed)".to_owned(), &["state: the rotor radius = 1.0", "m: at most 0.0003"][..]),
+        ("next_output = 0".to_owned(), &["seal", "edited"][..]),
+        ("fingerprint[0][1] = \"0\"".to_owned(), &["rotor.model is 0 in the snapshot"][..]),
+    ] {
+        let err = said(&what);
+        for n in needles {
+            assert!(err.contains(n), "{what}: {n:?} not in {err:?}");
+        }
+    }
+}
+
+/// A rotor deeper in its race than any contact gets (0.3 mm beyond the 0.15 mm gap), refused
+/// by name though its seal is recomputed, and a fingerprint edited to another scene's.
+#[test]
+fn a_rotor_deep_in_its_race_and_an_edited_fingerprint_are_refused() {
+    let tmp = TempDir::new("states-deep");
+    let sets = ["scene.duration_s=0.02", "shock[0].start_s=0.005", "output.plots=false", "controller.mode=\"sampled\""];
+    let scene = scene_path("cosim-10g.toml");
+    let good = tmp.join("good");
+    let mut cmd = plant_run(&scene, &good, &sets);
+    cmd.args(["--save-state-at", "0.01"]);
+    assert_exit(&output(&mut cmd), 0);
+    let text = read_text(&good.join("state-0.01.json"));
+    let mut deep: plant::snapshot::Snapshot = serde_json::from_str(&text).unwrap();
+    // The planar rotor's x and y first: 0.45 mm from the centre, 0.3 mm beyond the gap.
+    deep.state[0] = 0.45e-3;
+    deep.state[1] = 0.0;
+    deep.seal();
+    let mut heavy: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for pair in heavy["fingerprint"].as_array_mut().unwrap() {
+        if pair[0] == "rotor.mass_kg" {
+            pair[1] = "12.0".into();
+        }
+    }
+    // Not re-sealed: whoever recomputes the seal for another scene forges a state of it.
+    for (name, snapshot, set, needle) in [
+        ("deep", serde_json::to_value(&deep).unwrap(), None, "state: the rotor radius = 0.00045 m: at most 0.0003"),
+        ("heavy", heavy, Some("rotor.mass_kg=12.0"), "the file was edited"),
+    ] {
+        let file = tmp.join(&format!("{name}.json"));
+        std::fs::write(&file, serde_json::to_string(&snapshot).unwrap()).unwrap();
+        let dir = tmp.join(name);
+        let mut all = sets.to_vec();
+        all.extend(set);
+        let mut cmd = plant_run(&scene, &dir, &all);
+        cmd.arg("--from-state").arg(&file);
+        let out = output(&mut cmd);
+        assert_exit(&out, 2);
+        assert!(stderr(&out).contains(needle) && stderr(&out).contains(&format!("{name}.json")), "{}", stderr(&out));
+        assert!(!dir.exists());
     }
 }

@@ -105,6 +105,13 @@ impl Spec {
                         let var = var.as_str().filter(|s| !s.is_empty()).ok_or_else(|| {
                             format!("controller.fmu.map.{signal} = {var}: must be an FMU variable's name (a string)")
                         })?;
+                        // Two signals on one variable: one of them would be lost silently.
+                        if let Some((other, _)) = spec.map.iter().find(|(_, v)| v.as_str() == var) {
+                            return Err(format!(
+                                "controller.fmu.map.{signal} = \"{var}\": controller.fmu.map.{other} maps that variable \
+                                 already; each FMU variable carries one signal"
+                            ));
+                        }
                         spec.map.insert(signal.clone(), var.to_string());
                     }
                 }
@@ -183,6 +190,16 @@ impl Spec {
                         .split_once('=')
                         .filter(|(a, b)| !a.is_empty() && !b.is_empty())
                         .ok_or_else(|| format!("--map {value}: must be SIGNAL=VARIABLE"))?;
+                    if let Some(before) = s.map.get(signal) {
+                        return Err(format!(
+                            "--map {value}: {signal} is mapped already (to {before}); map each signal once"
+                        ));
+                    }
+                    if let Some((other, _)) = s.map.iter().find(|(_, v)| v.as_str() == var) {
+                        return Err(format!(
+                            "--map {value}: {var} carries {other} already; each FMU variable carries one signal"
+                        ));
+                    }
                     s.map.insert(signal.to_string(), var.to_string());
                 }
                 "--solver" => {
@@ -241,5 +258,20 @@ mod tests {
         assert!(bad("path = \"a.fmu\"\nbogus = 1").contains("controller.fmu.bogus: unknown key"));
         assert!(bad("solver = \"rk4\"").contains("controller.fmu.path: missing"));
         assert!(Spec::take_args(vec!["--map".into(), "x".into()]).unwrap_err().contains("SIGNAL=VARIABLE"));
+        // A mapping that would lose a signal silently: two signals on one variable, one signal twice.
+        let e = bad("path = \"a.fmu\"\n[map]\ncurrent_x = \"u\"\ncurrent_y = \"u\"");
+        assert!(
+            e.contains("controller.fmu.map.current_y = \"u\": controller.fmu.map.current_x maps that variable"),
+            "{e}"
+        );
+        let args = |m: [&str; 2]| {
+            let mut a = vec!["x".to_string(), "--fmu".into(), "a.fmu".into()];
+            for v in m {
+                a.extend(["--map".to_string(), v.to_string()]);
+            }
+            Spec::take_args(a).unwrap_err()
+        };
+        assert!(args(["current_x=u", "current_x=v"]).contains("current_x is mapped already (to u)"));
+        assert!(args(["current_x=u", "current_y=u"]).contains("u carries current_x already"));
     }
 }

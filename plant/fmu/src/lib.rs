@@ -779,8 +779,9 @@ fn new_instance(
     if let Some(g) = token {
         if g != model.guid {
             return fail(format!(
-                "fmuGUID = {g}, but this binary with resources/scene.toml makes {}: the binary, the scene and \
-                 modelDescription.xml are not of one FMU (rewrite it with `plant fmu`)",
+                "fmuGUID = {g}, but this binary with resources/scene.toml makes {}: the GUID covers the whole \
+                 resolved scene, so resources/scene.toml was edited (any key: rotor.mass_kg, integrator.method, ...) \
+                 or the binary, the scene and modelDescription.xml are not of one FMU (rewrite it with `plant fmu`)",
                 model.guid
             ));
         }

@@ -376,6 +376,15 @@ fn bad_ross_files_are_refused_naming_the_element() {
             text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, 2000000.0,]", 1),
             "(node 0): kxx = [1000000.0, 2000000.0] N/m varies with frequency",
         ),
+        // A coefficient that is not a number: named as such, not as one that varies.
+        (
+            text.replacen("kxx = [ 1000000.0,]", "kxx = [ nan,]", 1),
+            "(node 0): kxx = [nan] N/m: NaN is not a finite coefficient",
+        ),
+        (
+            text.replacen("kxx = [ 1000000.0,]", "kxx = [ inf, inf,]", 1),
+            "kxx = [inf, inf] N/m: inf is not a finite coefficient",
+        ),
         (
             text.replacen("kxx = [ 1000000.0,]", "kxx = [ 1000000.0, 2000000.0,]\nfrequency = [ 0.0, 100.0,]", 1),
             "(node 0): frequency = [0.0, 100.0]: its coefficients vary with frequency",

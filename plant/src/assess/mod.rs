@@ -15,6 +15,7 @@ pub mod coupled;
 pub mod duty;
 pub mod hertz;
 pub mod ladder;
+pub mod margins;
 pub mod rainflow;
 pub mod report;
 pub mod sensitivity;
@@ -143,6 +144,9 @@ pub struct SensitivityPart {
     /// speed, the loops of all axes closed ([`coupled`]), with its difference from the
     /// measurement; empty for the rigid rotors.
     pub closed_form_axes: Vec<coupled::AxisClosedForm>,
+    /// Each measured axis' gain and phase margins, computed (the law's linear form on the
+    /// linear plant, where it has one) and measured (`L = 1/S − 1`) ([`margins`]).
+    pub margins: Vec<margins::AxisMargins>,
     /// Simulated time of all the measurement's runs (s).
     pub simulated_s: f64,
     /// The settings.
@@ -484,11 +488,13 @@ fn sensitivity_part(
         let diff = f.measured_difference_db.map_or(String::new(), |d| format!("; measured within {d:.2} dB"));
         log(&format!("  closed form {} at {:.0} Hz: zone {}{peak}{diff}", f.axis, f.speed_hz, f.zone));
     }
+    let margins = margins::of(scene, &axes);
     let part = SensitivityPart {
         axes,
         closed_form,
         closed_form_planes,
         closed_form_axes,
+        margins,
         simulated_s,
         settings: a.sensitivity.clone(),
     };

@@ -468,6 +468,17 @@ fn legend(r: &Report) -> String {
             .into(),
     );
     item(
+        "Gain and phase margins",
+        "The loop opened at the axis where the sensitivity is measured, every other axis closed: \
+         L = 1/S − 1. PM: the smallest phase margin, at a gain crossover (|L| = 1). GM: the gain margin \
+         nearest 0 dB, at a phase crossover (L real and negative); an AMB's open loop is unstable, so its \
+         first crossover is at DC with a negative margin (the gain may fall by that much before the rotor \
+         drops); a sampled loop adds one above the gain crossover where the gain may rise. <b>computed</b>: \
+         the law's linear form on the scene's linear model (<code>plant linear</code>); <b>measured</b>: from \
+         the measured S, between the measured frequencies only (DC is not measured)."
+            .into(),
+    );
+    item(
         "Vibration (ISO 14839-2), zones A–D",
         "The levitated rotor at its speed, no shock: the peak of the orbit at the sensor against \
          C<sub>min</sub>, the minimum radial clearance (the touchdown bearing's air gap): zone <b>A</b> below \
@@ -619,6 +630,33 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             esc(c.sensitivity.why.as_deref().unwrap_or(""))
         ),
     });
+    row(
+        &mut h,
+        "gain and phase margins (computed: the law's linear form on the linear plant; measured: L = 1/S − 1)",
+        &|c| {
+            let all = c.sensitivity.result.as_ref().map(|s| s.margins.as_slice()).unwrap_or_default();
+            if all.is_empty() {
+                return "–".into();
+            }
+            let basis = if all.iter().all(|m| m.computed.is_none()) {
+                "<span class=\"note\">measured only: the law has no linear form here (a controller process, an FMU, \
+             or a law without one)</span><br>"
+            } else {
+                ""
+            };
+            basis.to_string()
+                + &all
+                    .iter()
+                    .map(|m| {
+                        let computed = m.computed.as_ref().map_or("no linear form".into(), super::margins::words);
+                        let measured =
+                            m.measured.as_ref().map_or("not measured (unstable)".into(), super::margins::words);
+                        format!("{} at {:.0} Hz: computed {computed}; measured {measured}", m.axis, m.speed_hz)
+                    })
+                    .collect::<Vec<_>>()
+                    .join("<br>")
+        },
+    );
     row(&mut h, "closed form (where the law has one; two-plane: plane A's load share alone)", &|c| match c
         .sensitivity
         .result

@@ -592,6 +592,7 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
             parked_steps: self.parked_steps,
             sensor_rng: self.rng_at_tick,
             digital: None,
+            seal: String::new(),
         }
     }
 
@@ -616,6 +617,7 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
                 s.substeps, s.adaptive.h, s.adaptive.err_old
             )));
         }
+        self.check_fields(s)?;
         self.y = y;
         self.tick = s.tick;
         self.t = s.t_s;
@@ -635,6 +637,199 @@ impl<const N: usize, M: Machine<N>> Core for Stepper<N, M> {
         self.next_breakpoint = self.breakpoints.partition_point(|b| *b < s.t_s - tiny);
         Ok(())
     }
+}
+
+/// The largest counter a snapshot may carry: 2^53, the last integer an `f64` holds exactly
+/// (counters are summed and divided as `f64`), far beyond any run's (a year of 10 kHz ticks is
+/// 3e11) and far from a `u64`'s wrap (an edited counter at 2^64 − 1 wrapped).
+const MAX_COUNT: u64 = 1 << 53;
+
+impl<const N: usize, M: Machine<N>> Stepper<N, M> {
+    /// The fields of `s` against this plant's scene and physics, beyond their layout: each
+    /// refused naming the field, its value and what it must be (issue 40: an edited state was
+    /// believed). A state this plant wrote passes; the seal is checked before
+    /// ([`crate::run::check_start`]).
+    fn check_fields(&self, s: &Snapshot) -> Result<(), SnapshotError> {
+        // Times: within the run, on the tick grid (checked above), and the output rows' clock
+        // where this plant's would be at that time.
+        // (Whether the state is before the scene's end is the caller's question: `plant run`
+        // names scene.duration_s.)
+        if s.tick > MAX_COUNT {
+            return Err(SnapshotError::field("tick", s.tick, format!("at most 2^53 = {MAX_COUNT}")));
+        }
+        let expected_out = next_output_after(s.t_s, self.out_dt);
+        if s.next_output != expected_out {
+            return Err(SnapshotError::field(
+                "next_output",
+                s.next_output,
+                format!(
+                    "{expected_out}: the first output row after the state's time t_s = {} s on the output grid of {} s",
+                    s.t_s, self.out_dt
+                ),
+            ));
+        }
+        // Counters: below 2^53, and consistent with each other and with the ticks.
+        for (field, value) in [
+            ("steps", s.steps),
+            ("rejected", s.rejected),
+            ("rhs_evals", s.rhs_evals),
+            ("max_rhs_evals", s.max_rhs_evals),
+            ("parked_steps", s.parked_steps),
+        ] {
+            if value > MAX_COUNT {
+                return Err(SnapshotError::field(field, value, format!("at most 2^53 = {MAX_COUNT}")));
+            }
+        }
+        if s.steps > s.rhs_evals || s.rejected > s.rhs_evals {
+            return Err(SnapshotError::field(
+                "rhs_evals",
+                s.rhs_evals,
+                format!(
+                    "at least the steps ({}) and the rejected steps ({}): each takes an evaluation",
+                    s.steps, s.rejected
+                ),
+            ));
+        }
+        if s.max_rhs_evals > s.rhs_evals {
+            return Err(SnapshotError::field(
+                "max_rhs_evals",
+                s.max_rhs_evals,
+                format!("at most rhs_evals = {}", s.rhs_evals),
+            ));
+        }
+        if s.tick > 0 && (s.steps == 0 || s.max_rhs_evals == 0) {
+            return Err(SnapshotError::field(
+                if s.steps == 0 { "steps" } else { "max_rhs_evals" },
+                0,
+                format!("at least 1 after {} ticks", s.tick),
+            ));
+        }
+        let planes = M::PLANES as u64;
+        if s.parked_steps > s.tick.saturating_mul(planes) {
+            return Err(SnapshotError::field(
+                "parked_steps",
+                s.parked_steps,
+                format!("at most tick × planes = {} × {planes} (a macro step parks each race once at most)", s.tick),
+            ));
+        }
+        // The integrator: substeps of this scene, a step-size memory within the method's bounds.
+        let settings = self.integrator.settings();
+        if s.substeps != self.substeps && (self.contact_substeps == 0 || s.substeps != self.contact_substeps) {
+            return Err(SnapshotError::field(
+                "substeps",
+                s.substeps,
+                format!(
+                    "the scene's integrator.substeps = {} or integrator.contact_substeps = {}",
+                    self.substeps, self.contact_substeps
+                ),
+            ));
+        }
+        let (h, err_old) = (s.adaptive.h, s.adaptive.err_old);
+        let fresh = AdaptiveState::default();
+        if !settings.method.is_adaptive() || s.steps == 0 {
+            // A fixed-step method never changes the memory; an adaptive one before its first step
+            // has none.
+            if h != fresh.h || err_old != fresh.err_old {
+                return Err(SnapshotError::field(
+                    "adaptive",
+                    format!("h = {h} s, err_old = {err_old}"),
+                    format!(
+                        "h = {} s, err_old = {}: no memory {}",
+                        fresh.h,
+                        fresh.err_old,
+                        if s.steps == 0 { "before the first step" } else { "with a fixed-step method" }
+                    ),
+                ));
+            }
+        } else {
+            // At most the macro step (a tick) and h_max: the integrator caps what it carries so.
+            // (Not bounded below by h_min: the step after one shortened to land on a tick's end
+            // may carry less.)
+            let most = settings.h_max.min(self.period * (1.0 + 1e-9));
+            if !(h > 0.0 && h <= most) {
+                return Err(SnapshotError::field(
+                    "adaptive.h",
+                    format!("{h} s"),
+                    format!(
+                        "a step size the integrator carries: positive, at most the controller period {} s and h_max = {} s",
+                        self.period, settings.h_max
+                    ),
+                ));
+            }
+            if !(fresh.err_old..=1.0).contains(&err_old) {
+                return Err(SnapshotError::field(
+                    "adaptive.err_old",
+                    err_old,
+                    format!("the last accepted step's error norm, {} (its floor) to 1", fresh.err_old),
+                ));
+            }
+        }
+        // Positions: each body within its clearance and the deepest penetration the contact
+        // model is meant for (one gap, or the radius guard if smaller; real contacts are microns
+        // deep) — a rotor 0.3 mm deep in a 0.15 mm gap was taken.
+        let y: &[f64; N] = s.state.as_slice().try_into().map_err(|_| SnapshotError::Layout {
+            what: "state",
+            expected: N,
+            found: s.state.len(),
+        })?;
+        for (i, &(_, race_guard)) in self.guards.limits.iter().enumerate() {
+            let p = self.model.bearing(i);
+            let depth = p.contact.gap.min(race_guard - p.balls.clearance);
+            let (rotor, race) = self.model.radii(y, i);
+            let (rotor_limit, race_limit) = (p.contact.gap + p.balls.clearance + depth, p.balls.clearance + depth);
+            let plane = if M::PLANES == 1 { String::new() } else { format!(" at bearing {}", ["A", "B"][i]) };
+            if rotor.is_nan() || rotor > rotor_limit {
+                return Err(SnapshotError::field(
+                    format!("state: the rotor radius{plane}"),
+                    format!("{rotor} m"),
+                    format!(
+                        "at most {rotor_limit} m: the gap {} m, the race's clearance {} m and a contact {depth} m deep",
+                        p.contact.gap, p.balls.clearance
+                    ),
+                ));
+            }
+            if race.is_nan() || race > race_limit {
+                return Err(SnapshotError::field(
+                    format!("state: the race radius{plane}"),
+                    format!("{race} m"),
+                    format!(
+                        "at most {race_limit} m: the race's clearance {} m and a contact {depth} m deep",
+                        p.balls.clearance
+                    ),
+                ));
+            }
+            // A parked race: parking on in this scene, the race held (what parking leaves) and
+            // clear of the rotor (a touching race is released).
+            if s.parked[i] {
+                let mut held = *y;
+                self.model.park_race(&mut held, i);
+                let why = if !matches!(p.race_when_clear, RaceWhenClear::Parked(_)) {
+                    Some("false: the scene's races are never parked (rotor.race_when_clear)")
+                } else if held != *y {
+                    Some("false: the state's race moves, and a parked race is held")
+                } else if self.model.touching(y, i) {
+                    Some("false: the rotor touches the race, and a touching race is free")
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    return Err(SnapshotError::field(format!("parked[{i}]"), true, why));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The number of the first output row after time `t` on a grid of `dt`: where the output
+/// clock of a plant that has run to `t` stands (the rule of the tick loop: rows up to
+/// `t + 1e-9 dt` are written).
+fn next_output_after(t: f64, dt: f64) -> u64 {
+    let mut n = ((t / dt).floor() as u64).saturating_sub(1).max(1);
+    while (n as f64) * dt <= t + 1e-9 * dt {
+        n += 1;
+    }
+    n
 }
 
 /// The integrator's settings for `model` in `scene`: the scene's, with the model's absolute

@@ -49,6 +49,9 @@ pub struct Checkpoint {
     pub soak_csv_bytes: u64,
     /// Bytes of `envelope.csv` written.
     pub envelope_csv_bytes: u64,
+    /// The seal ([`Checkpoint::seal_for`]), hex.
+    #[serde(default)]
+    pub seal: String,
 }
 
 /// Why a soak cannot be resumed from its folder.
@@ -93,9 +96,30 @@ pub fn path(dir: &Path) -> PathBuf {
 }
 
 impl Checkpoint {
-    /// Writes the checkpoint into `dir`, whole or not at all.
+    /// The seal of this checkpoint under a programme of value `programme` ([`fingerprint`]):
+    /// SHA-256 (hex) of the checkpoint as JSON with `programme` in place of its own and no
+    /// seal. Recomputed from the programme on `--resume`, not read: a checkpoint with any field
+    /// edited has another seal. It catches edits, not forgeries (an editor may recompute it):
+    /// the fields are also checked against the programme, the plant and the files
+    /// ([`super::run`]'s resume).
+    pub fn seal_for(&self, programme: &serde_json::Value) -> String {
+        use sha2::{Digest, Sha256};
+        let unsealed = Checkpoint { programme: programme.clone(), seal: String::new(), ..self.clone() };
+        // Plain data: serialising it cannot fail; an empty text only makes a seal no file carries.
+        let text = serde_json::to_string(&unsealed).unwrap_or_default();
+        format!("{:x}", Sha256::digest(text.as_bytes()))
+    }
+
+    /// Seals the checkpoint for its own programme.
+    pub fn seal(&mut self) {
+        self.seal = self.seal_for(&self.programme);
+    }
+
+    /// Writes the checkpoint into `dir`, whole or not at all, sealed.
     pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
-        let text = serde_json::to_string(self)?;
+        let mut sealed = self.clone();
+        sealed.seal();
+        let text = serde_json::to_string(&sealed)?;
         crate::outfile::write(&path(dir), text.as_bytes())
     }
 
@@ -129,6 +153,14 @@ impl Checkpoint {
         let ours = fingerprint(prog).map_err(|e| fail(format!("the programme as a value: {e:#}")))?;
         if let Some(difference) = first_difference("", &checkpoint.programme, &ours) {
             return Err(ResumeError::Programme { path: shown, difference });
+        }
+        let expected = checkpoint.seal_for(&ours);
+        if checkpoint.seal != expected {
+            return Err(fail(format!(
+                "the checkpoint's seal = {:?} is not {expected}, that of this programme and the checkpoint's fields: \
+                 the file was edited; run without --resume to start afresh",
+                checkpoint.seal
+            )));
         }
         Ok(checkpoint)
     }

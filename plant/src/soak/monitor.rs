@@ -182,6 +182,60 @@ impl ShockTracker {
         }
     }
 
+    /// Why this tracker, read from a checkpoint (already [`ShockTracker::check_resumable`]),
+    /// cannot be the one that took `rows` output rows, the last at the plant's time `t_s`,
+    /// having closed `closed` windows: each field's value against those (issue 40 item 4).
+    pub fn check_at(&self, rows: u64, t_s: f64, closed: usize) -> Result<(), String> {
+        let tiny = 1e-9 * self.dt;
+        // The last row taken is at the plant's time, or within an output interval before it.
+        if !(self.last_t <= t_s + tiny && self.last_t > t_s - self.dt - tiny && rows > 0) {
+            return Err(format!(
+                "tracker.last_t = {} s: the last output row's time, at most the plant's t_s = {t_s} s and within \
+                 an output interval of {} s before it",
+                self.last_t, self.dt
+            ));
+        }
+        let current = self.starts.iter().rposition(|&s| s <= self.last_t);
+        if self.current != current {
+            return Err(format!(
+                "tracker.current = {:?}: the last shock started by t = {} s is {current:?}",
+                self.current, self.last_t
+            ));
+        }
+        if closed != current.unwrap_or(0) {
+            return Err(format!(
+                "{closed} closed shocks (figures): the shocks before the current one are {}",
+                current.unwrap_or(0)
+            ));
+        }
+        let a = &self.acc;
+        for (key, v) in [("max_force", a.max_force), ("max_radius", a.max_radius)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("tracker.acc.{key} = {v}: a maximum, finite and not negative"));
+            }
+        }
+        if a.contact_samples > rows {
+            return Err(format!("tracker.acc.contact_samples = {}: at most the {rows} rows taken", a.contact_samples));
+        }
+        if a.episodes > a.contact_samples {
+            return Err(format!(
+                "tracker.acc.episodes = {}: at most the contact samples, {} (an episode starts with one)",
+                a.episodes, a.contact_samples
+            ));
+        }
+        if let Some(c) = self.clear_since {
+            if !(0.0..=self.last_t).contains(&c) {
+                return Err(format!("tracker.clear_since = {c} s: a row's time, at most last_t = {} s", self.last_t));
+            }
+        }
+        Ok(())
+    }
+
+    /// The time of the last sample taken (s).
+    pub fn last_t(&self) -> f64 {
+        self.last_t
+    }
+
     /// Closes the window in progress at the end of the run (or where it stopped).
     pub fn finish(&mut self) -> Option<ShockFigures> {
         let j = self.current.take()?;
@@ -242,6 +296,34 @@ impl Envelope {
         } else {
             Err(format!("envelope.bin is {:?} s, the soak's is {:?} s", self.bin, fresh.bin))
         }
+    }
+
+    /// Why this envelope, read from a checkpoint, cannot be the one whose last sample was at
+    /// `last_t` (s): the bin under way is that of `last_t`, its maxima finite and not negative.
+    pub fn check_at(&self, last_t: f64) -> Result<(), String> {
+        let index = (last_t / self.bin).floor().max(0.0) as u64;
+        if self.index != index || !self.any {
+            return Err(format!(
+                "envelope.index = {}, any = {}: the bin under way at the last row's t = {last_t} s is {index}, with samples",
+                self.index, self.any
+            ));
+        }
+        for (key, v) in [("max_radius", self.max_radius), ("max_force", self.max_force)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("envelope.{key} = {v}: a maximum, finite and not negative"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The bin width (s).
+    pub fn bin(&self) -> f64 {
+        self.bin
+    }
+
+    /// The bin under way: bins `0..index` are closed.
+    pub fn index(&self) -> u64 {
+        self.index
     }
 
     /// One sample; returns the bin it completes, if any.

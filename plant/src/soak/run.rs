@@ -405,6 +405,25 @@ fn resumable(dir: &Path, prog: &Programme) -> Result<Checkpoint, SoakError> {
     c.tracker.check_resumable(&fresh).map_err(refuse)?;
     c.envelope.check_resumable(&monitor::Envelope::new(ENVELOPE_BIN_S)).map_err(refuse)?;
     crate::run::check_start(&prog.scene, &c.plant)?;
+    // The rest against the plant's state and the files (issue 40 item 4: an edited checkpoint
+    // wrote a wrong soak.csv with "all criteria met", or cut soak.csv to 0 bytes before it
+    // was refused).
+    if c.plant.t_s >= scene.duration {
+        return Err(refuse(format!(
+            "plant.t_s = {} s: before the soak's end, scene.duration_s = {} s",
+            c.plant.t_s, scene.duration
+        ))
+        .into());
+    }
+    if c.rows != c.plant.next_output {
+        return Err(refuse(format!(
+            "rows = {}: the rows before the plant's next output row, plant.next_output = {}",
+            c.rows, c.plant.next_output
+        ))
+        .into());
+    }
+    c.tracker.check_at(c.rows, c.plant.t_s, c.figures.len()).map_err(refuse)?;
+    c.envelope.check_at(c.tracker.last_t()).map_err(refuse)?;
     for (name, len) in [("soak.csv", c.soak_csv_bytes), ("envelope.csv", c.envelope_csv_bytes), ("rss.csv", 0)] {
         let path = dir.join(name);
         let fail = |message: String| ResumeError::File { path: path.display().to_string(), message };
@@ -419,6 +438,40 @@ fn resumable(dir: &Path, prog: &Programme) -> Result<Checkpoint, SoakError> {
                 .into())
             }
             Ok(_) => {}
+        }
+    }
+    let expected_soak: String = std::iter::once(SOAK_CSV_HEADER.to_owned())
+        .chain(c.figures.iter().map(|f| super::sink::shock_row(f, &prog.shocks[f.index]).join(",")))
+        .map(|line| line + "\n")
+        .collect();
+    let bin = c.envelope.bin();
+    for (name, len) in [("soak.csv", c.soak_csv_bytes), ("envelope.csv", c.envelope_csv_bytes)] {
+        let path = dir.join(name);
+        let fail = |message: String| ResumeError::File { path: path.display().to_string(), message };
+        let text = crate::input::read_text(&path, 1 << 30).map_err(|e| fail(format!("{e:#}")))?;
+        let Some(head) = text.as_bytes().get(..len as usize) else {
+            return Err(refuse(format!("{name}_bytes = {len}: more than the {} bytes of {name}", text.len())).into());
+        };
+        let head = String::from_utf8_lossy(head);
+        let expected = if name == "soak.csv" {
+            // The header and the closed shocks' rows, as the soak writes them from the figures.
+            format!("{} bytes: the header and the {} closed shocks' rows", expected_soak.len(), c.figures.len())
+        } else {
+            format!("the header and the {} closed envelope bins' rows", c.envelope.index())
+        };
+        let good = if name == "soak.csv" {
+            head == expected_soak
+        } else {
+            let mut lines = head.split_inclusive('\n');
+            lines.next() == Some(&format!("{ENVELOPE_CSV_HEADER}\n"))
+                && lines.enumerate().all(|(k, line)| {
+                    line.ends_with('\n') && line.split(',').next() == Some(&(k as f64 * bin).to_string())
+                })
+                && head.lines().count() as u64 == c.envelope.index() + 1
+        };
+        if !good {
+            let field = name.replace('.', "_");
+            return Err(refuse(format!("{field}_bytes = {len}: {name}'s first {len} bytes are not {expected}")).into());
         }
     }
     Ok(c)

@@ -58,23 +58,28 @@ impl Checkpoints {
     }
 }
 
+/// The fields of a shock's `soak.csv` row (`p` the shock as planned): what a resume compares
+/// the file's rows with.
+pub(crate) fn shock_row(f: &ShockFigures, p: &PlannedShock) -> [String; 12] {
+    [
+        f.index.to_string(),
+        f.start_s.to_string(),
+        p.peak_g.to_string(),
+        p.direction_deg.to_string(),
+        p.duration_s.to_string(),
+        u8::from(f.recovered).to_string(),
+        f.recovery_s.to_string(),
+        f.max_contact_force_n.to_string(),
+        f.contact_time_s.to_string(),
+        f.contact_episodes.to_string(),
+        f.max_radius_m.to_string(),
+        u8::from(f.complete).to_string(),
+    ]
+}
+
 impl SoakSink<'_> {
     fn write_shock(&mut self, f: ShockFigures) {
-        let p = &self.planned[f.index];
-        let row = [
-            f.index.to_string(),
-            f.start_s.to_string(),
-            p.peak_g.to_string(),
-            p.direction_deg.to_string(),
-            p.duration_s.to_string(),
-            u8::from(f.recovered).to_string(),
-            f.recovery_s.to_string(),
-            f.max_contact_force_n.to_string(),
-            f.contact_time_s.to_string(),
-            f.contact_episodes.to_string(),
-            f.max_radius_m.to_string(),
-            u8::from(f.complete).to_string(),
-        ];
+        let row = shock_row(&f, &self.planned[f.index]);
         let written =
             self.soak_csv.row(&row).and_then(|()| self.soak_csv.flush()).and_then(|()| self.envelope_csv.flush());
         self.keep_error(written);
@@ -106,6 +111,7 @@ impl SoakSink<'_> {
                 figures: self.figures.clone(),
                 soak_csv_bytes: self.soak_csv.written()?,
                 envelope_csv_bytes: self.envelope_csv.written()?,
+                seal: String::new(),
             };
             checkpoint.write(&self.checkpoints.dir)
         })();

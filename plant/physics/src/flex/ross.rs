@@ -572,9 +572,15 @@ fn bearing(t: &Table, at: &str, file: &str) -> Result<LinearBearing, FlexError> 
                 .collect::<Result<_, _>>()?,
             Some(v) => vec![as_number(v).ok_or_else(|| err(format!("{at}: {key} = {v} is not a number")))?],
         };
+        if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
+            return Err(err(format!(
+                "{at} (node {n}): {key} = {} {unit}: {bad} is not a finite coefficient",
+                short(&t[key])
+            )));
+        }
         match values.first() {
             None => Ok(0.0),
-            Some(&first) if values.iter().all(|&v| v == first) && first.is_finite() => Ok(first),
+            Some(&first) if values.iter().all(|&v| v == first) => Ok(first),
             Some(_) => Err(err(format!(
                 "{at} (node {n}): {key} = {} {unit} varies with frequency, which this model cannot represent (it takes \
                  constant coefficients; it does not evaluate them at one speed)",
