@@ -97,6 +97,7 @@ pub mod relev;
 pub mod serve;
 #[cfg(test)]
 mod test_plant;
+pub mod transfer_function;
 #[cfg(feature = "ipc")]
 pub mod wire;
 

@@ -188,6 +188,50 @@ impl ParamReader<'_> {
         }
     }
 
+    /// The array of numbers at `key` (integers taken as floats), if given: every element finite,
+    /// at least one. A refusal names the key, the whole array as given and the element at fault
+    /// (counted from 1).
+    pub fn optional_numbers(&mut self, key: &'static str, unit: &'static str) -> Result<Option<Vec<f64>>, LawError> {
+        self.read.push(key);
+        let Some(value) = self.table.get(key) else { return Ok(None) };
+        let toml::Value::Array(items) = value else {
+            return Err(self.error(
+                key,
+                value,
+                unit,
+                format!("expected an array of numbers ({})", unit_or_ratio(unit)),
+            ));
+        };
+        if items.is_empty() {
+            return Err(self.error(key, value, unit, "expected at least one coefficient"));
+        }
+        let mut out = Vec::with_capacity(items.len());
+        for (k, item) in items.iter().enumerate() {
+            let v = match item {
+                toml::Value::Float(f) => *f,
+                toml::Value::Integer(i) => *i as f64,
+                other => {
+                    return Err(self.error(key, value, unit, format!("element {} = {other} is not a number", k + 1)))
+                }
+            };
+            if !v.is_finite() {
+                return Err(self.error(key, value, unit, format!("element {} = {v} must be finite", k + 1)));
+            }
+            out.push(v);
+        }
+        Ok(Some(out))
+    }
+
+    /// The string at `key`, if given.
+    pub fn optional_text(&mut self, key: &'static str) -> Result<Option<String>, LawError> {
+        self.read.push(key);
+        match self.table.get(key) {
+            None => Ok(None),
+            Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+            Some(other) => Err(self.error(key, other, "", "expected a string")),
+        }
+    }
+
     /// The boolean at `key`, or `default` when absent.
     pub fn flag(&mut self, key: &'static str, default: bool) -> Result<bool, LawError> {
         self.read.push(key);

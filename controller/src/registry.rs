@@ -23,8 +23,14 @@ use crate::params::Params;
 
 /// Every per-plane law, in the order help texts list them: each runs the planar model and,
 /// one instance per plane, the two-plane rotor.
-pub const LAWS: &[LawEntry] =
-    &[crate::pd::LAW, crate::pid::LAW, crate::pd_delay::LAW, crate::relev::LAW, crate::notch::LAW];
+pub const LAWS: &[LawEntry] = &[
+    crate::pd::LAW,
+    crate::pid::LAW,
+    crate::pd_delay::LAW,
+    crate::relev::LAW,
+    crate::notch::LAW,
+    crate::transfer_function::LAW,
+];
 
 /// Every law of the whole rotor (they drive the two-plane rotor only).
 pub const ROTOR_LAWS: &[RotorLawEntry] = &[crate::modal::LAW];
@@ -36,6 +42,7 @@ pub const ALL_LAWS: &[AnyLaw] = &[
     AnyLaw::Plane(crate::pd_delay::LAW),
     AnyLaw::Plane(crate::relev::LAW),
     AnyLaw::Plane(crate::notch::LAW),
+    AnyLaw::Plane(crate::transfer_function::LAW),
     AnyLaw::Rotor(crate::modal::LAW),
 ];
 

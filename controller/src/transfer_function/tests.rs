@@ -1,0 +1,165 @@
+use super::*;
+use crate::pd::SampledPd;
+
+fn design() -> Design {
+    Design::study()
+}
+
+fn build_with(text: &str) -> Result<Box<dyn ControlLaw>, LawError> {
+    (LAW.build)(&design(), &Params::parse(text).unwrap())
+}
+
+fn close(a: &[f64], b: &[f64], rel: f64) -> bool {
+    let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= rel * scale)
+}
+
+/// Tustin of `g/(τ s + 1)` by hand: `(τK + 1) z + (1 − τK)` over `g (z + 1)`, with `K = 2/T`, or
+/// `ω/tan(ωT/2)` prewarped.
+#[test]
+fn tustin_of_a_first_order_lag_is_the_hand_result() {
+    let (g, tau, t): (f64, f64, f64) = (-3.0, 2e-4, 5e-5);
+    for k in [2.0 / t, 3000.0 / (3000.0 * t / 2.0).tan()] {
+        let prewarp = (k != 2.0 / t).then_some(3000.0);
+        let got = discretise(&[g], &[tau, 1.0], t, Method::Tustin { prewarp_rad_s: prewarp });
+        let (d0, d1) = (tau * k + 1.0, 1.0 - tau * k);
+        assert!(close(&got.b, &[g / d0, g / d0], 1e-15), "{got:?}");
+        assert!(close(&got.a, &[1.0, d1 / d0], 1e-15), "{got:?}");
+    }
+}
+
+/// Zero-order hold by hand: `g/(τ s + 1)` holds to `g (1 − e^{−T/τ}) / (z − e^{−T/τ})`; the double
+/// integrator `1/s²` to `T² (z + 1) / (2 (z − 1)²)`.
+#[test]
+fn zoh_of_a_lag_and_a_double_integrator_are_the_hand_results() {
+    let (g, tau, t): (f64, f64, f64) = (2.5, 3e-4, 5e-5);
+    let p = (-t / tau).exp();
+    let got = discretise(&[g], &[tau, 1.0], t, Method::Zoh);
+    assert!(close(&got.b, &[0.0, g * (1.0 - p)], 1e-13), "{got:?}");
+    assert!(close(&got.a, &[1.0, -p], 1e-15), "{got:?}");
+    let got = discretise(&[1.0], &[1.0, 0.0, 0.0], t, Method::Zoh);
+    assert!(close(&got.b, &[0.0, t * t / 2.0, t * t / 2.0], 1e-13), "{got:?}");
+    assert!(close(&got.a, &[1.0, -2.0, 1.0], 1e-15), "{got:?}");
+    // A static gain stays one.
+    assert_eq!(discretise(&[4.0], &[2.0], t, Method::Zoh), DiscreteTf { b: vec![2.0], a: vec![1.0] });
+}
+
+/// The study's PD written in z, from the closed forms (MODEL.md §3: `k_p = (k_e + k_s)/(k_i A_a
+/// A_s)`, `k_d = 2 ξ √(k_e m)/(k_i A_a A_s)`, computed here, not by the law): the same currents as
+/// `pd` sample by sample from rest, within round-off (the law sums `b₀ u_k + b₁ u_{k−1}` where
+/// `pd` sums `k_p u_k + k_d (u_k − u_{k−1})/T`: a few ulps of the largest term).
+#[test]
+fn the_studys_pd_in_z_answers_as_pd() {
+    let d = design();
+    let c = d.constants;
+    let loop_gain = c.ki_n_per_a * c.amp_gain_a_per_v * c.sensor_gain_v_per_m;
+    let kp = (d.stiffness_n_per_m + c.ks_n_per_m) / loop_gain;
+    let kd = 2.0 * d.damping_ratio * (d.stiffness_n_per_m * c.rotor_mass_kg).sqrt() / loop_gain;
+    let (a, t) = (c.amp_gain_a_per_v, d.period_s);
+    let text =
+        format!("num = [{:e}, {:e}]\nden = [1.0, 0.0]\ndomain = \"z\"\ndt_s = {t:e}", -a * (kp + kd / t), a * kd / t);
+    let mut tf = build_with(&text).unwrap();
+    let mut default = build_with("").unwrap();
+    let mut pd = SampledPd::new(PdGains::from_design(&d.pd(), &c).unwrap(), t);
+    for k in 0..500u64 {
+        let x = k as f64;
+        let u = if k == 0 { [0.0; 2] } else { [0.3 * (0.05 * x).sin(), 0.1 * (0.31 * x).cos() - 0.1] };
+        let s = Sample { seq: k, t_s: x * t, sensor_v: u, ..Default::default() };
+        let (i, j, r) = (tf.update(&s), default.update(&s), pd.update(&s));
+        for axis in 0..2 {
+            let scale = a * (kp + kd / t) * (u[axis].abs() + 0.4) + r[axis].abs();
+            assert!((i[axis] - r[axis]).abs() <= 1e-14 * scale, "sample {k}: {i:?} against pd's {r:?}");
+            assert!((j[axis] - r[axis]).abs() <= 1e-14 * scale, "sample {k}: default {j:?} against pd's {r:?}");
+        }
+    }
+}
+
+/// Transposed direct form II is the difference equation `Σ a_j y_{k−j} = Σ b_j u_{k−j}`, from
+/// rest, on a third-order transfer (checked against the equation written out), and `reset` goes
+/// back to rest.
+#[test]
+fn the_law_runs_the_difference_equation_from_rest() {
+    let b = [0.2, -0.1, 0.05, 0.01];
+    let a = [1.0, -0.5, 0.2, -0.1];
+    let mut law = TransferFunction::new(DiscreteTf { b: b.to_vec(), a: a.to_vec() }, [0.0, 0.5]);
+    let (mut us, mut ys) = (vec![0.0; 3], vec![0.0; 3]);
+    let mut first = None;
+    for k in 0..60 {
+        let u = ((k * 7 % 11) as f64 - 5.0) * 0.1;
+        let y = b[0] * u + b[1] * us[0] + b[2] * us[1] + b[3] * us[2] - a[1] * ys[0] - a[2] * ys[1] - a[3] * ys[2];
+        let i = law.update(&Sample { sensor_v: [u, u], ..Default::default() });
+        assert!((i[0] - y).abs() < 1e-14 && (i[1] - 0.5 - y).abs() < 1e-14, "{k}: {i:?} against {y}");
+        first.get_or_insert(i);
+        us.rotate_right(1);
+        ys.rotate_right(1);
+        (us[0], ys[0]) = (u, y);
+    }
+    law.reset();
+    assert_eq!(Some(law.update(&Sample { sensor_v: [-0.5, -0.5], ..Default::default() })), first);
+}
+
+/// Bad input, each refused naming the key, the value and what was expected.
+#[test]
+fn bad_input_is_refused_by_key_and_value() {
+    let t = design().period_s;
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "num = [1.0, 2.0, 3.0]\nden = [1.0, 1.0]",
+            &["controller.params.num", "[1.0, 2.0, 3.0]", "improper", "degree 2"],
+        ),
+        ("num = [1.0]\nden = [0.0, 1.0]", &["controller.params.den", "[0.0, 1.0]", "leading coefficient"]),
+        ("num = [1.0, nan]\nden = [1.0, 1.0]", &["controller.params.num", "element 2", "finite"]),
+        ("num = [1.0]\nden = [1.0, inf]", &["controller.params.den", "element 2 = inf", "finite"]),
+        ("num = [1.0]\nden = [1.0, \"x\"]", &["controller.params.den", "element 2", "not a number"]),
+        ("num = 1.0\nden = [1.0]", &["controller.params.num = 1.0", "array of numbers"]),
+        ("num = []\nden = [1.0]", &["controller.params.num", "at least one"]),
+        ("num = [1.0]", &["controller.params.den", "must be too"]),
+        (
+            "num = [1.0]\nden = [1.0, 0.5]\ndomain = \"z\"\ndt_s = 1e-4",
+            &["controller.params.dt_s = 0.0001 s", "controller period, 0.00005 s"],
+        ),
+        ("num = [1.0]\nden = [1.0, 0.5]\ndomain = \"z\"", &["controller.params.dt_s", "not set"]),
+        (
+            "num = [1.0]\nden = [1e-3, 1.0]\nprewarp_hz = 10000.0",
+            &["controller.params.prewarp_hz = 10000 Hz", "Nyquist", "10000 Hz"],
+        ),
+        (
+            "num = [1.0]\nden = [1e-3, 1.0]\nprewarp_hz = 1e3\ndiscretisation = \"zoh\"",
+            &["controller.params.prewarp_hz", "tustin"],
+        ),
+        (
+            "num = [1.0]\nden = [1e-3, 1.0]\ndiscretisation = \"euler\"",
+            &["controller.params.discretisation = \"euler\"", "\"zoh\""],
+        ),
+        ("num = [1.0]\nden = [1e-3, 1.0]\ndomain = \"w\"", &["controller.params.domain = \"w\"", "\"s\" or \"z\""]),
+        ("num = [1.0]\nden = [1e-3, 1.0]\ndt_s = 5e-5", &["controller.params.dt_s", "only for domain"]),
+        ("domain = \"z\"", &["controller.params.domain", "only with num and den"]),
+        (
+            "num = [1.0]\nden = [1e-300, 1.0]\ndiscretisation = \"tustin\"\nprewarp_hz = 1.0\nno = 1",
+            &["controller.params.no"],
+        ),
+    ];
+    let _ = t;
+    for (text, needles) in cases {
+        let e = build_with(text).err().unwrap_or_else(|| panic!("{text:?} was accepted")).to_string();
+        assert!(e.starts_with("law transfer_function"), "{e}");
+        for n in *needles {
+            assert!(e.contains(n), "{text:?}: no {n:?} in {e}");
+        }
+    }
+    // Too high an order.
+    let den = vec!["1.0"; MAX_ORDER + 2].join(", ");
+    let e = build_with(&format!("num = [1.0]\nden = [{den}]")).err().unwrap().to_string();
+    assert!(e.contains("controller.params.den") && e.contains(&format!("above {MAX_ORDER}")), "{e}");
+}
+
+/// An unstable controller is allowed, and leading zeros of the numerator lower its degree.
+#[test]
+fn an_unstable_law_builds_and_leading_zeros_are_harmless() {
+    let mut law = build_with("num = [0.0, 0.0, 1.0]\nden = [1.0, -1.0]\ndomain = \"z\"\ndt_s = 5e-5").unwrap();
+    let mut last = 0.0;
+    for k in 0..5 {
+        last = law.update(&Sample { seq: k, sensor_v: [1.0, 0.0], ..Default::default() })[0];
+    }
+    assert_eq!(last, 4.0); // an accumulator: 0, 1, 2, 3, 4 (one sample late)
+}
