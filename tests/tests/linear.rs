@@ -273,3 +273,202 @@ fn bad_input_is_refused_by_name_and_nothing_is_written() {
     assert!(stderr(&o).contains("symbolic link"), "{}", stderr(&o));
     assert_eq!(std::fs::read_dir(&target).unwrap().count(), 0);
 }
+
+// ---- Law `transfer_function` (issue 39 item 2) ----
+
+use controller::transfer_function::{discretise, Method};
+
+/// python-control's `sample_system` on the cases the Rust side discretised, coefficient by
+/// coefficient, relative 1e-12: the denominator to its largest coefficient, the numerator to the
+/// terms python-control subtracted to get it. python-control (scipy's `ss2tf`, for every
+/// method) takes the numerator as `poly(Φ − ΓC) + (D − 1) poly(Φ)`, a difference that cancels
+/// when the gain is small against 1 (8e-8 relative on 1/s² at 20 kHz, 1.5e-12 on an unstable
+/// first order prewarped), where the law's arithmetic is exact to round-off (the unit tests
+/// `zoh_of_a_lag_and_a_double_integrator_are_the_hand_results`,
+/// `tustin_of_a_first_order_lag_is_the_hand_result`).
+const TF_CHECK: &str = r#"
+import json, sys
+import numpy as np
+import control as ct
+from scipy.signal import tf2ss, cont2discrete
+cases = json.load(open(sys.argv[1]))
+worst = {}
+for c in cases:
+    sys_c = ct.tf(c["num"], c["den"])
+    kw = {}
+    if c["prewarp_rad_s"] is not None:
+        kw["prewarp_frequency"] = c["prewarp_rad_s"]
+    d = ct.sample_system(sys_c, c["period_s"], c["method"], **kw)
+    num, den = np.array(d.num[0][0], float), np.array(d.den[0][0], float)
+    num = np.concatenate([np.zeros(len(den) - len(num)), num])
+    b, a = np.array(c["b"]), np.array(c["a"])
+    assert len(b) == len(num) and len(a) == len(den), (c["name"], b, num, a, den)
+    scale_a = np.max(np.abs(den))
+    # What python-control does inside (scipy): tf2ss, cont2discrete (at the period shrunk for a
+    # prewarp), then ss2tf's difference poly(A - BC) + (D - 1) poly(A).
+    w = c["prewarp_rad_s"]
+    T = c["period_s"] if w is None else 2 * np.tan(w * c["period_s"] / 2) / w
+    A, B, C, D, _ = cont2discrete(tf2ss(c["num"], c["den"]), T, "bilinear" if c["method"] == "tustin" else "zoh")
+    scale_b = max(np.max(np.abs(np.poly(A - B @ C))), abs(D[0, 0] - 1) * np.max(np.abs(np.poly(A))),
+                  np.max(np.abs(num)))
+    eb, ea = np.max(np.abs(b - num)) / scale_b, np.max(np.abs(a - den)) / scale_a
+    worst[c["name"]] = (eb, ea)
+    assert eb <= 1e-12 and ea <= 1e-12, (c["name"], list(b), list(num), list(a), list(den), eb, ea)
+for k, (eb, ea) in worst.items():
+    print(f"{k}: numerator {eb:.2e}, denominator {ea:.2e}")
+"#;
+
+#[test]
+fn transfer_function_discretisation_is_python_controls_sample_system() {
+    use std::f64::consts::TAU;
+    let t = 1.0 / 20_000.0;
+    let mul = |a: &[f64], b: &[f64]| {
+        let mut out = vec![0.0; a.len() + b.len() - 1];
+        for (i, x) in a.iter().enumerate() {
+            for (j, y) in b.iter().enumerate() {
+                out[i + j] += x * y;
+            }
+        }
+        out
+    };
+    // A lead-lag (zero at 150 Hz, pole at 1.5 kHz), the same behind a notch at 900 Hz, a PID with
+    // a filtered derivative (a pole at 0), an unstable first order, and 1/s².
+    let (wz, wp, wn) = (TAU * 150.0, TAU * 1500.0, TAU * 900.0);
+    let lead = (vec![-1.2 / wz, -1.2], vec![1.0 / wp, 1.0]);
+    let notch = (mul(&lead.0, &[1.0, 2.0 * 0.01 * wn, wn * wn]), mul(&lead.1, &[1.0, 2.0 * 0.2 * wn, wn * wn]));
+    let pid = (vec![-2e-4, -0.9, -40.0], vec![1.0 / (TAU * 3000.0), 1.0, 0.0]);
+    let unstable = (vec![0.5], vec![1.0, -100.0]);
+    let double = (vec![1.0], vec![1.0, 0.0, 0.0]);
+    let mut cases = Vec::new();
+    for (name, (num, den)) in
+        [("lead-lag", lead), ("lead-lag-notch", notch), ("pid", pid), ("unstable", unstable), ("1/s2", double)]
+    {
+        for (method, m) in [
+            ("tustin", Method::Tustin { prewarp_rad_s: None }),
+            ("tustin", Method::Tustin { prewarp_rad_s: Some(wn) }),
+            ("zoh", Method::Zoh),
+        ] {
+            let d = discretise(&num, &den, t, m);
+            let prewarp = match m {
+                Method::Tustin { prewarp_rad_s } => prewarp_rad_s,
+                Method::Zoh => None,
+            };
+            let label = format!("{name} {method}{}", if prewarp.is_some() { " prewarped" } else { "" });
+            cases.push(serde_json::json!({
+                "name": label, "num": num, "den": den, "period_s": t, "method": method,
+                "prewarp_rad_s": prewarp, "b": d.b, "a": d.a,
+            }));
+        }
+    }
+    let dir = TempDir::new("tf-python");
+    let (file, script) = (dir.join("cases.json"), dir.join("check.py"));
+    std::fs::write(&file, serde_json::to_string(&cases).unwrap()).unwrap();
+    std::fs::write(&script, TF_CHECK).unwrap();
+    let o = output_within(Command::new(venv().join("bin/python")).arg(&script).arg(&file), Duration::from_secs(300));
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    assert_exit(&o, 0);
+}
+
+/// The scene's PD written as a transfer in z by hand, from the scene file's constants
+/// (MODEL.md §3: `k_p = (k_e + k_s)/(k_i A_a A_s)`, `k_d = 2 ξ √(k_e m)/(k_i A_a A_s)`, the rate
+/// the backward difference: `C(z) = −A_a ((k_p + k_d/T) − (k_d/T) z⁻¹)`), as `--set` overrides.
+fn pd_as_transfer(file: &Path, damping: f64) -> Vec<String> {
+    let t: toml::Table = std::fs::read_to_string(file).unwrap().parse().unwrap();
+    let f = |table: &str, key: &str| t[table][key].as_float().unwrap_or_else(|| panic!("{table}.{key}"));
+    let loop_gain = f("amb", "ki_n_per_a") * f("amb", "amp_gain_a_per_v") * f("amb", "sensor_gain_v_per_m");
+    let ke = f("controller", "stiffness_n_per_m");
+    let kp = (ke + f("amb", "ks_n_per_m")) / loop_gain;
+    let kd = 2.0 * damping * (ke * f("rotor", "mass_kg")).sqrt() / loop_gain;
+    let (a, period) = (f("amb", "amp_gain_a_per_v"), 1.0 / f("controller", "rate_hz"));
+    vec![
+        "controller.law=transfer_function".into(),
+        format!("controller.params.num=[{:e}, {:e}]", -a * (kp + kd / period), a * kd / period),
+        "controller.params.den=[1.0, 0.0]".into(),
+        "controller.params.domain=\"z\"".into(),
+        format!("controller.params.dt_s={period:e}"),
+    ]
+}
+
+/// A small shock (0.5 G, no contact) on the paper scene from rest, sampled, ξ = 0.2 (the naive PD's
+/// sampled loop at ξ = 0.01 grows, MODEL.md): the scene's PD written as a transfer in z gives
+/// `pd`'s trace within round-off (the law sums `b₀ u_k + b₁ u_{k−1}` where `pd` sums
+/// `k_p u_k + k_d (u_k − u_{k−1})/T`: each column within 1e-9 of its largest value); and the
+/// transfer run in lockstep by the `controller` process writes the sampled run's trace byte for
+/// byte (the same code in both processes).
+#[test]
+fn transfer_function_of_the_pd_runs_as_pd_sampled_and_lockstep() {
+    common::controller_bin();
+    let file = scene("paper-10g.toml");
+    let dir = TempDir::new("tf-pd");
+    let base = [
+        "scene.duration_s=0.05",
+        "shock[0].start_s=0.005",
+        "shock[0].peak_g=0.5",
+        "output.plots=false",
+        "controller.damping_ratio=0.2",
+        "controller.mode=sampled",
+        // From rest at the centre: the first sample reads 0 V, where `pd`'s first rate (zero) and
+        // the transfer's (from rest, u₋₁ = 0) agree.
+        "initial.unbalance_orbit=false",
+    ];
+    let run = |name: &str, extra: &[String]| {
+        let out = dir.join(name);
+        let sets: Vec<String> = base.iter().map(|s| s.to_string()).chain(extra.iter().cloned()).collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let o = output_within(&mut common::plant_run(&file, &out, &sets), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        out
+    };
+    let tf = pd_as_transfer(&file, 0.2);
+    let pd = common::Csv::read(&run("pd", &[]).join("trace.csv"));
+    let sampled = run("tf", &tf);
+    let ours = common::Csv::read(&sampled.join("trace.csv"));
+    assert_eq!(pd.header, ours.header);
+    let s = common::read_json(&sampled.join("summary.json"));
+    assert_eq!(common::num(&s, "max_contact_force_n"), 0.0, "the small shock touches: {s:#}");
+    let mut largest = 0.0f64;
+    for name in &pd.header {
+        let (a, b) = (pd.column(name), ours.column(name));
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-9 * scale, "{name}: {worst:e} against a largest value of {scale:e}");
+        largest = largest.max(worst / scale.max(f64::MIN_POSITIVE));
+    }
+    eprintln!("transfer_function against pd: largest difference {largest:.1e} of a column's largest value");
+    let mut lockstep = tf.clone();
+    lockstep.push("controller.mode=lockstep".into());
+    let lockstep = run("tf-lockstep", &lockstep);
+    assert!(
+        std::fs::read(sampled.join("trace.csv")).unwrap() == std::fs::read(lockstep.join("trace.csv")).unwrap(),
+        "the transfer in lockstep wrote another trace than in the plant's process"
+    );
+}
+
+/// Bad input to the law, through `plant run`: exit 2, the key, the value and what was expected
+/// named, nothing written.
+#[test]
+fn transfer_function_bad_input_is_refused_by_name_and_nothing_is_written() {
+    let file = scene("paper-10g.toml");
+    let law = ["controller.mode=sampled", "controller.law=transfer_function"];
+    let cases: [(&[&str], &[&str]); 7] = [
+        (&["controller.params.num=[1.0, 2.0]", "controller.params.den=[1.0]"], &["controller.params.num", "improper"]),
+        (&["controller.params.num=[1.0]", "controller.params.den=[0.0, 1.0]"], &["controller.params.den = [0.0, 1.0]", "leading"]),
+        (&["controller.params.num=[nan]", "controller.params.den=[1.0, 1.0]"], &["controller.params.num", "element 1 = NaN", "finite"]),
+        (
+            &["controller.params.num=[1.0]", "controller.params.den=[1.0, 0.5]", "controller.params.domain=\"z\"", "controller.params.dt_s=1e-4"],
+            &["controller.params.dt_s = 0.0001 s", "the scene's controller period, 0.00005 s"],
+        ),
+        (
+            &["controller.params.num=[1.0]", "controller.params.den=[1e-3, 1.0]", "controller.params.prewarp_hz=12000"],
+            &["controller.params.prewarp_hz = 12000 Hz", "below the Nyquist frequency", "10000 Hz"],
+        ),
+        (&["controller.params.num=[1.0]", "controller.params.den=[1.0, 1.0]", "controller.params.discretisation=\"foh\""], &["controller.params.discretisation = \"foh\"", "\"tustin\" or \"zoh\""]),
+        (&["controller.params.num=[1.0]"], &["controller.params.den", "must be too"]),
+    ];
+    for (i, (extra, needles)) in cases.iter().enumerate() {
+        let sets: Vec<&str> = SHORT_TF.iter().chain(&law).chain(extra.iter()).copied().collect();
+        common::refused(&format!("tf-bad-{i}"), &file, &sets, needles);
+    }
+}
+
+const SHORT_TF: [&str; 2] = ["scene.duration_s=0.01", "output.plots=false"];
