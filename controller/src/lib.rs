@@ -95,6 +95,7 @@ pub mod registry;
 pub mod relev;
 #[cfg(feature = "ipc")]
 pub mod serve;
+pub mod state_space;
 #[cfg(test)]
 mod test_plant;
 pub mod transfer_function;

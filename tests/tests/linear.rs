@@ -452,17 +452,35 @@ fn transfer_function_bad_input_is_refused_by_name_and_nothing_is_written() {
     let law = ["controller.mode=sampled", "controller.law=transfer_function"];
     let cases: [(&[&str], &[&str]); 7] = [
         (&["controller.params.num=[1.0, 2.0]", "controller.params.den=[1.0]"], &["controller.params.num", "improper"]),
-        (&["controller.params.num=[1.0]", "controller.params.den=[0.0, 1.0]"], &["controller.params.den = [0.0, 1.0]", "leading"]),
-        (&["controller.params.num=[nan]", "controller.params.den=[1.0, 1.0]"], &["controller.params.num", "element 1 = NaN", "finite"]),
         (
-            &["controller.params.num=[1.0]", "controller.params.den=[1.0, 0.5]", "controller.params.domain=\"z\"", "controller.params.dt_s=1e-4"],
+            &["controller.params.num=[1.0]", "controller.params.den=[0.0, 1.0]"],
+            &["controller.params.den = [0.0, 1.0]", "leading"],
+        ),
+        (
+            &["controller.params.num=[nan]", "controller.params.den=[1.0, 1.0]"],
+            &["controller.params.num", "element 1 = NaN", "finite"],
+        ),
+        (
+            &[
+                "controller.params.num=[1.0]",
+                "controller.params.den=[1.0, 0.5]",
+                "controller.params.domain=\"z\"",
+                "controller.params.dt_s=1e-4",
+            ],
             &["controller.params.dt_s = 0.0001 s", "the scene's controller period, 0.00005 s"],
         ),
         (
             &["controller.params.num=[1.0]", "controller.params.den=[1e-3, 1.0]", "controller.params.prewarp_hz=12000"],
             &["controller.params.prewarp_hz = 12000 Hz", "below the Nyquist frequency", "10000 Hz"],
         ),
-        (&["controller.params.num=[1.0]", "controller.params.den=[1.0, 1.0]", "controller.params.discretisation=\"foh\""], &["controller.params.discretisation = \"foh\"", "\"tustin\" or \"zoh\""]),
+        (
+            &[
+                "controller.params.num=[1.0]",
+                "controller.params.den=[1.0, 1.0]",
+                "controller.params.discretisation=\"foh\"",
+            ],
+            &["controller.params.discretisation = \"foh\"", "\"tustin\" or \"zoh\""],
+        ),
         (&["controller.params.num=[1.0]"], &["controller.params.den", "must be too"]),
     ];
     for (i, (extra, needles)) in cases.iter().enumerate() {
