@@ -39,7 +39,7 @@ use crate::error::LawError;
 use crate::law::{RotorLaw, RotorLawEntry, RotorSample};
 use crate::params::{Check, ParamReader, Params};
 use crate::pd::PdGains;
-use nalgebra::DMatrix;
+pub use nalgebra::DMatrix;
 
 /// The most states the law takes.
 pub const MAX_STATES: usize = 64;
