@@ -81,6 +81,7 @@ pub mod error;
 #[cfg(feature = "ipc")]
 pub mod file;
 pub mod law;
+pub mod law_file;
 #[cfg(feature = "ipc")]
 pub mod link;
 #[cfg(feature = "ipc")]

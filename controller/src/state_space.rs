@@ -17,6 +17,8 @@
 //! | `prewarp_hz` | Hz | none | Tustin's prewarp frequency (> 0, below Nyquist) |
 //! | `dt_s` | s | – | the discrete system's period; required with `domain = "z"`, must be the scene's controller period |
 //!
+//! | `file` | – | none | a JSON file `{"A": …, "B": …, "C": …, "D": …, "dt": 0}` (python-control's `StateSpace` fields; `dt` 0 or absent: continuous, else the controller's period) instead of `a` … `d`, `domain`, `dt_s` |
+//!
 //! `a`, `b`, `c` are given together or not at all; none of them: the design's PD per axis as
 //! `pd` samples it (one state per axis, the previous voltage), the sign convention written out.
 //! An unstable controller is allowed.
@@ -37,6 +39,7 @@
 use crate::design::{RotorDesign, ROTOR_AXES};
 use crate::error::LawError;
 use crate::law::{RotorLaw, RotorLawEntry, RotorSample};
+use crate::law_file::LawFile;
 use crate::params::{Check, ParamReader, Params};
 use crate::pd::PdGains;
 pub use nalgebra::DMatrix;
@@ -49,7 +52,7 @@ pub const LAW: RotorLawEntry = RotorLawEntry {
     name: "state_space",
     summary: "a state-space system (A, B, C, D) of every axis at once, sensor V to current A, continuous \
               (Tustin with optional prewarp, or zero-order hold, at the controller rate) or discrete \
-              (params a, b, c, d, domain, discretisation, prewarp_hz, dt_s)",
+              (params a, b, c, d, domain, discretisation, prewarp_hz, dt_s, file)",
     build,
 };
 
@@ -99,8 +102,37 @@ fn matrix(rows: &[Vec<f64>]) -> DMatrix<f64> {
 fn read(p: &mut ParamReader<'_>, design: &RotorDesign) -> Result<DiscreteSs, LawError> {
     let period_s = design.plane_a().period_s;
     let axes = design.axes() as usize;
-    let given = (p.optional_matrix("a", "")?, p.optional_matrix("b", "")?, p.optional_matrix("c", "A/V")?);
-    let d = p.optional_matrix("d", "A/V")?;
+    let file = p.optional_text("file")?;
+    let mut given = (p.optional_matrix("a", "")?, p.optional_matrix("b", "")?, p.optional_matrix("c", "A/V")?);
+    let mut d = p.optional_matrix("d", "A/V")?;
+    // From a file: A, B, C, D and the period (0 or absent: continuous), as python-control's
+    // StateSpace holds them.
+    let mut from_file: Option<(String, Option<f64>)> = None;
+    if let Some(path) = file {
+        if given.0.is_some() || given.1.is_some() || given.2.is_some() || d.is_some() {
+            return Err(p.error(
+                "file",
+                format!("{path:?}"),
+                "",
+                "a, b, c, d come from the file: not also in [controller.params]",
+            ));
+        }
+        let f = LawFile::read(p, &path, r#"{"A": [[...]], "B": [[...]], "C": [[...]], "D": [[...]], "dt": 0}"#)?;
+        given = (Some(f.matrix(p, "A")?), Some(f.matrix(p, "B")?), Some(f.matrix(p, "C")?));
+        d = if f.has("D") { Some(f.matrix(p, "D")?) } else { None };
+        let dt = f.number(p, "dt")?.filter(|dt| *dt != 0.0);
+        if let Some(dt) = dt {
+            if !(dt > 0.0 && (dt - period_s).abs() <= 1e-9 * period_s) {
+                return Err(p.error(
+                    "file",
+                    format!("{path:?}"),
+                    "",
+                    format!("its `dt` = {dt} s must be 0 (continuous) or the scene's controller period, {period_s} s"),
+                ));
+            }
+        }
+        from_file = Some((path, dt));
+    }
     let (a, b, c) = match given {
         (Some(a), Some(b), Some(c)) => (a, b, c),
         (None, None, None) => {
@@ -161,10 +193,23 @@ fn read(p: &mut ParamReader<'_>, design: &RotorDesign) -> Result<DiscreteSs, Law
         None => DMatrix::zeros(axes, axes),
     };
     let (a, b, c) = (matrix(&a), matrix(&b), matrix(&c));
-    let domain = p.optional_text("domain")?.unwrap_or_else(|| "s".into());
+    let domain = p.optional_text("domain")?;
     let method = p.optional_text("discretisation")?;
     let prewarp_hz = p.optional_number("prewarp_hz", "Hz", Check::Positive)?;
     let dt_s = p.optional_number("dt_s", "s", Check::Positive)?;
+    let (domain, dt_s) = match &from_file {
+        None => (domain.unwrap_or_else(|| "s".into()), dt_s),
+        Some((path, dt)) => {
+            let why = format!("the file {path:?} gives it (its `dt`)");
+            if let Some(v) = domain {
+                return Err(p.error("domain", format!("{v:?}"), "", why));
+            }
+            if let Some(v) = dt_s {
+                return Err(p.error("dt_s", v, "s", why));
+            }
+            (if dt.is_some() { "z" } else { "s" }.to_string(), *dt)
+        }
+    };
     let nyquist = 0.5 / period_s;
     let system = match domain.as_str() {
         "s" => {

@@ -13,11 +13,16 @@
 //! | `discretisation` | – | `"tustin"` | `"tustin"` (bilinear) or `"zoh"` (zero-order hold); `domain = "s"` only |
 //! | `prewarp_hz` | Hz | none | Tustin's prewarp frequency (> 0, below Nyquist); `"tustin"` only |
 //! | `dt_s` | s | – | the discrete law's sampling period; required with `domain = "z"`, must be the scene's controller period |
+//! | `file` | – | none | a JSON file holding `num`, `den`, `dt` instead |
 //!
 //! Neither `num` nor `den` given: the design's PD as `pd` samples it (`controller.stiffness_n_per_m`,
 //! `damping_ratio`), `C(z) = −A_a ((k_p + k_d/T) − (k_d/T) z⁻¹)`: a law that levitates, and the
 //! sign convention written out (a restoring law has a negative DC gain: `i = bias + C u`).
 //! Unlike `pd`, whose first rate is zero, the transfer starts from rest (`u₋₁ = 0`).
+//!
+//! `file`: the path of a JSON object `{"num": [...], "den": [...], "dt": 0}` (python-control's
+//! `TransferFunction` fields; `dt` 0 or absent: in `s`, else in `z` and the controller's period)
+//! instead of `num`, `den`, `domain` and `dt_s` ([`crate::law_file`]).
 //!
 //! The transfer must be proper (the numerator's degree at most the denominator's: a causal
 //! law), of order at most [`MAX_ORDER`], every coefficient finite. An unstable controller is
@@ -49,6 +54,7 @@
 //! ```
 
 use crate::law::{ControlLaw, Design, LawEntry, LawError, Sample};
+use crate::law_file::LawFile;
 use crate::params::{Check, ParamReader, Params};
 use crate::pd::PdGains;
 use nalgebra::DMatrix;
@@ -61,7 +67,7 @@ pub const LAW: LawEntry = LawEntry {
     name: "transfer_function",
     summary: "a transfer function on every axis, sensor V to current A, in s (Tustin with optional prewarp, or \
               zero-order hold, at the controller rate) or in z (params num, den, domain, discretisation, \
-              prewarp_hz, dt_s)",
+              prewarp_hz, dt_s, file)",
     build,
 };
 
@@ -101,7 +107,40 @@ fn coefficients(values: &[f64]) -> String {
 /// Reads and checks the law's parameters and discretises the transfer at `period_s`.
 fn read(p: &mut ParamReader<'_>, design: &Design) -> Result<DiscreteTf, LawError> {
     let period_s = design.period_s;
-    let (num, den) = match (p.optional_numbers("num", "A/V")?, p.optional_numbers("den", "")?) {
+    let file = p.optional_text("file")?;
+    let (given_num, given_den) = (p.optional_numbers("num", "A/V")?, p.optional_numbers("den", "")?);
+    // From a file: num, den and its period (0 or absent: continuous), as python-control's
+    // TransferFunction holds them.
+    let mut from_file: Option<(String, Option<f64>)> = None;
+    let (num, den) = match (given_num, given_den) {
+        (None, None) if file.is_some() => {
+            let path = file.clone().unwrap_or_default();
+            let f = LawFile::read(p, &path, r#"{"num": [...], "den": [...], "dt": 0}"#)?;
+            let (num, den) = (f.numbers(p, "num")?, f.numbers(p, "den")?);
+            let dt = f.number(p, "dt")?.filter(|dt| *dt != 0.0);
+            if let Some(dt) = dt {
+                if !(dt > 0.0 && (dt - period_s).abs() <= 1e-9 * period_s) {
+                    return Err(p.error(
+                        "file",
+                        format!("{path:?}"),
+                        "",
+                        format!(
+                            "its `dt` = {dt} s must be 0 (continuous) or the scene's controller period, {period_s} s"
+                        ),
+                    ));
+                }
+            }
+            from_file = Some((path, dt));
+            (num, den)
+        }
+        (Some(_), _) | (_, Some(_)) if file.is_some() => {
+            return Err(p.error(
+                "file",
+                format!("{:?}", file.unwrap_or_default()),
+                "",
+                "num and den come from the file: not also in [controller.params]",
+            ))
+        }
         (Some(num), Some(den)) => (num, den),
         (None, None) => {
             // Neither given: the design's PD as `pd` samples it (module doc), a law that levitates.
@@ -150,10 +189,23 @@ fn read(p: &mut ParamReader<'_>, design: &Design) -> Result<DiscreteTf, LawError
     if den.len() - 1 > MAX_ORDER {
         return Err(p.error("den", coefficients(&den), "", format!("order {} above {MAX_ORDER}", den.len() - 1)));
     }
-    let domain = p.optional_text("domain")?.unwrap_or_else(|| "s".into());
+    let domain = p.optional_text("domain")?;
     let method = p.optional_text("discretisation")?;
     let prewarp_hz = p.optional_number("prewarp_hz", "Hz", Check::Positive)?;
     let dt_s = p.optional_number("dt_s", "s", Check::Positive)?;
+    let (domain, dt_s) = match &from_file {
+        None => (domain.unwrap_or_else(|| "s".into()), dt_s),
+        Some((path, dt)) => {
+            let why = format!("the file {path:?} gives it (its `dt`)");
+            if let Some(v) = domain {
+                return Err(p.error("domain", format!("{v:?}"), "", why));
+            }
+            if let Some(v) = dt_s {
+                return Err(p.error("dt_s", v, "s", why));
+            }
+            (if dt.is_some() { "z" } else { "s" }.to_string(), *dt)
+        }
+    };
     let nyquist = 0.5 / period_s;
     let tf = match domain.as_str() {
         "s" => {

@@ -164,3 +164,24 @@ fn an_unstable_system_is_allowed() {
     }
     assert_eq!(last, 4.0);
 }
+
+/// From a JSON file (python-control's `StateSpace` fields, `D` optional): the law of the same
+/// parameters; sizes from the file checked against the axes.
+#[test]
+fn a_law_from_a_json_file_is_the_law_from_its_parameters() {
+    let path = std::env::temp_dir().join(format!("ss-{}-law.json", std::process::id()));
+    std::fs::write(&path, br#"{"A": [[-100.0]], "B": [[1.0, 0.5]], "C": [[-2.0], [0.3]], "dt": 0.0}"#).unwrap();
+    let file = format!("file = {:?}\ndiscretisation = \"zoh\"", path.display().to_string());
+    let inline = "a = [[-100.0]]\nb = [[1.0, 0.5]]\nc = [[-2.0], [0.3]]\ndiscretisation = \"zoh\"";
+    let (mut x, mut y) = (build_with(&planar(), &file).unwrap(), build_with(&planar(), inline).unwrap());
+    for k in 0..50u64 {
+        let s = RotorSample { seq: k, axes: 2, sensor_v: [0.01 * k as f64, -0.02, 0.0, 0.0], ..Default::default() };
+        assert_eq!(x.update(&s), y.update(&s));
+    }
+    let e = build_with(&RotorDesign::symmetric_study(), &file).err().unwrap().to_string();
+    assert!(e.contains("controller.params.b") && e.contains("expected 1 × 4"), "{e}");
+    std::fs::write(&path, br#"{"A": [[-100.0]], "B": [[1.0, 0.5]]}"#).unwrap();
+    let e = build_with(&planar(), &file).err().unwrap().to_string();
+    assert!(e.contains("controller.params.file") && e.contains("its `C` is missing"), "{e}");
+    let _ = std::fs::remove_file(&path);
+}

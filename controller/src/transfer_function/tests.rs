@@ -163,3 +163,82 @@ fn an_unstable_law_builds_and_leading_zeros_are_harmless() {
     }
     assert_eq!(last, 4.0); // an accumulator: 0, 1, 2, 3, 4 (one sample late)
 }
+
+/// A file in the temporary folder, removed when dropped.
+struct Temp(std::path::PathBuf);
+
+impl Temp {
+    fn new(name: &str, text: &[u8]) -> Self {
+        let path = std::env::temp_dir().join(format!("tf-{}-{name}", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        Temp(path)
+    }
+    fn param(&self) -> String {
+        format!("file = {:?}", self.0.display().to_string())
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// From a JSON file (python-control's fields): the same law as from the parameters, in s
+/// (with the discretisation keys beside the file) and in z; bad files refused naming `file`.
+#[test]
+fn a_law_from_a_json_file_is_the_law_from_its_parameters() {
+    let s = Temp::new("s.json", br#"{"num": [-1e-3, -1.2], "den": [1e-4, 1.0], "dt": 0}"#);
+    let z = Temp::new("z.json", br#"{"num": [[-5.0, 4.0]], "den": [[1.0, -0.3]], "dt": 5e-05}"#);
+    let pairs = [
+        (
+            format!("{}\nprewarp_hz = 150.0", s.param()),
+            "num = [-1e-3, -1.2]\nden = [1e-4, 1.0]\nprewarp_hz = 150.0".to_string(),
+        ),
+        (
+            format!("{}\ndiscretisation = \"zoh\"", s.param()),
+            "num = [-1e-3, -1.2]\nden = [1e-4, 1.0]\ndiscretisation = \"zoh\"".into(),
+        ),
+        (z.param(), "num = [-5.0, 4.0]\nden = [1.0, -0.3]\ndomain = \"z\"\ndt_s = 5e-5".into()),
+    ];
+    for (file, inline) in &pairs {
+        let (mut a, mut b) = (build_with(file).unwrap(), build_with(inline).unwrap());
+        for k in 0..50u64 {
+            let sample = Sample { seq: k, sensor_v: [0.01 * k as f64, -0.02], ..Default::default() };
+            assert_eq!(a.update(&sample), b.update(&sample), "{file}");
+        }
+    }
+    let npz = Temp::new("x.npz", b"PK\x03\x04binary");
+    let array = Temp::new("array.json", b"[1, 2]");
+    let no_den = Temp::new("no-den.json", br#"{"num": [1.0]}"#);
+    let bad_dt = Temp::new("dt.json", br#"{"num": [1.0], "den": [1.0, 0.5], "dt": 1e-4}"#);
+    let nan = Temp::new("nan.json", br#"{"num": ["x"], "den": [1.0]}"#);
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        (npz.param(), vec!["controller.params.file", "x.npz", "is not JSON", "a .npz or .mat file is not read"]),
+        (array.param(), vec!["controller.params.file", "holds a JSON array: expected an object"]),
+        (no_den.param(), vec!["controller.params.file", "its `den` is missing"]),
+        (bad_dt.param(), vec!["controller.params.file", "its `dt` = 0.0001 s", "controller period, 0.00005 s"]),
+        (nan.param(), vec!["controller.params.file", "its `num` element 1 = \"x\" is not a finite number"]),
+        (format!("{}\nnum = [1.0]", s.param()), vec!["controller.params.file", "not also in [controller.params]"]),
+        (format!("{}\ndomain = \"z\"", s.param()), vec!["controller.params.domain", "the file", "gives it"]),
+        (
+            "file = \"/no/such/law.json\"".into(),
+            vec!["controller.params.file = \"/no/such/law.json\"", "cannot be read"],
+        ),
+        ("file = \"/\"".into(), vec!["controller.params.file = \"/\"", "not a regular file"]),
+    ];
+    for (text, needles) in &cases {
+        let e = build_with(text).err().unwrap_or_else(|| panic!("{text:?} was accepted")).to_string();
+        for n in needles {
+            assert!(e.contains(n), "{text:?}: no {n:?} in {e}");
+        }
+    }
+    // A FIFO is refused at once, never waited on.
+    let fifo = std::env::temp_dir().join(format!("tf-{}-fifo.json", std::process::id()));
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().map(|s| s.success()).unwrap_or(false);
+    if made {
+        let e = build_with(&format!("file = {:?}", fifo.display().to_string())).err().unwrap().to_string();
+        let _ = std::fs::remove_file(&fifo);
+        assert!(e.contains("controller.params.file") && e.contains("not a regular file"), "{e}");
+    }
+}
