@@ -617,3 +617,83 @@ fn state_space_runs_as_pd_on_the_two_plane_rotor_and_refuses_sizes_of_another() 
         &["law state_space", "controller.params.b", "is 1 × 2: expected 1 × 4", "4 axes"],
     );
 }
+
+/// python-control writes a law as JSON, as docs/guide/controllers.md shows (`json.dump` of the
+/// `TransferFunction`'s and the `StateSpace`'s fields); `plant run` with `file = …` writes the
+/// trace byte for byte that the same law written into `[controller.params]` writes. A FIFO
+/// and a `.npz` are refused, exit 2, nothing written.
+const WRITE_LAWS: &str = r#"
+import json, sys
+import numpy as np
+import control as ct
+out = sys.argv[1]
+wz, wp = 2 * np.pi * 150, 2 * np.pi * 1500
+C = ct.tf([-1.2 / wz, -1.2], [1 / wp, 1])
+json.dump({"num": C.num[0][0].tolist(), "den": C.den[0][0].tolist(), "dt": C.dt}, open(f"{out}/tf.json", "w"))
+K = ct.ss(C)
+K = ct.ss(np.kron(np.eye(2), K.A), np.kron(np.eye(2), K.B), np.kron(np.eye(2), K.C), np.kron(np.eye(2), K.D))
+Kd = ct.sample_system(K, 5e-5, "zoh")
+json.dump({"A": Kd.A.tolist(), "B": Kd.B.tolist(), "C": Kd.C.tolist(), "D": Kd.D.tolist(), "dt": Kd.dt},
+          open(f"{out}/ss.json", "w"))
+print(f"num = {C.num[0][0].tolist()}\nden = {C.den[0][0].tolist()}")
+for k, m in zip("abcd", (Kd.A, Kd.B, Kd.C, Kd.D)):
+    print(f"{k} = {m.tolist()}")
+"#;
+
+#[test]
+fn a_law_python_control_wrote_runs_as_the_same_law_in_the_scene() {
+    let dir = TempDir::new("law-files");
+    std::fs::create_dir_all(dir.join("laws")).unwrap();
+    let script = dir.join("write.py");
+    std::fs::write(&script, WRITE_LAWS).unwrap();
+    let o = output_within(
+        Command::new(venv().join("bin/python")).arg(&script).arg(dir.join("laws")),
+        Duration::from_secs(120),
+    );
+    assert_exit(&o, 0);
+    let printed = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = |key: &str| {
+        let l = printed.lines().find(|l| l.starts_with(&format!("{key} = "))).unwrap();
+        format!("controller.params.{l}").replacen(" = ", "=", 1)
+    };
+    let file = scene("paper-10g.toml");
+    let base = ["scene.duration_s=0.02", "output.plots=false", "controller.mode=sampled"];
+    let run = |name: &str, extra: &[String]| {
+        let out = dir.join(name);
+        let sets: Vec<String> = base.iter().map(|s| s.to_string()).chain(extra.iter().cloned()).collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let o = output_within(&mut common::plant_run(&file, &out, &sets), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        std::fs::read(out.join("trace.csv")).unwrap()
+    };
+    let law = |name: &str| format!("controller.law={name}");
+    let path = |name: &str| format!("controller.params.file=\"{}\"", dir.join("laws").join(name).display());
+    let tf_file = run("tf-file", &[law("transfer_function"), path("tf.json")]);
+    let tf_inline = run("tf-inline", &[law("transfer_function"), line("num"), line("den")]);
+    assert!(tf_file == tf_inline, "transfer_function from python-control's JSON differs from the same in the scene");
+    let ss_file = run("ss-file", &[law("state_space"), path("ss.json")]);
+    let ss_inline = run(
+        "ss-inline",
+        &[
+            law("state_space"),
+            line("a"),
+            line("b"),
+            line("c"),
+            line("d"),
+            "controller.params.domain=\"z\"".into(),
+            "controller.params.dt_s=5e-5".into(),
+        ],
+    );
+    assert!(ss_file == ss_inline, "state_space from python-control's JSON differs from the same in the scene");
+    // Refused: a FIFO (never waited on) and a file of another format.
+    let fifo = dir.join("laws").join("fifo.json");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    std::fs::write(dir.join("laws").join("law.npz"), b"PK\x03\x04 not json").unwrap();
+    for (name, needles) in [
+        ("fifo.json", ["controller.params.file", "not a regular file"]),
+        ("law.npz", ["controller.params.file", "is not JSON"]),
+    ] {
+        let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.law=transfer_function", &path(name)];
+        common::refused(&format!("law-file-{name}"), &file, &sets, &needles);
+    }
+}
