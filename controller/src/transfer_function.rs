@@ -20,7 +20,8 @@
 //! sign convention written out (a restoring law has a negative DC gain: `i = bias + C u`).
 //! Unlike `pd`, whose first rate is zero, the transfer starts from rest (`u₋₁ = 0`).
 //!
-//! `file`: the path of a JSON object `{"num": [...], "den": [...], "dt": 0}` (python-control's
+//! `file`: the path of a JSON object `{"num": [...], "den": [...], "dt": 0}` or numpy's `.npz` of
+//! the same arrays (python-control's
 //! `TransferFunction` fields; `dt` 0 or absent: in `s`, else in `z` and the controller's period)
 //! instead of `num`, `den`, `domain` and `dt_s` ([`crate::law_file`]).
 //!

@@ -620,8 +620,9 @@ fn state_space_runs_as_pd_on_the_two_plane_rotor_and_refuses_sizes_of_another() 
 
 /// python-control writes a law as JSON, as docs/guide/controllers.md shows (`json.dump` of the
 /// `TransferFunction`'s and the `StateSpace`'s fields); `plant run` with `file = …` writes the
-/// trace byte for byte that the same law written into `[controller.params]` writes. A FIFO
-/// and a `.npz` are refused, exit 2, nothing written.
+/// trace byte for byte that the same law written into `[controller.params]` writes, and so does
+/// numpy's `.npz` of the same arrays (`savez`, and `savez_compressed` with A in Fortran order).
+/// A FIFO and a MATLAB `.mat` are refused, exit 2, nothing written.
 const WRITE_LAWS: &str = r#"
 import json, sys
 import numpy as np
@@ -635,6 +636,8 @@ K = ct.ss(np.kron(np.eye(2), K.A), np.kron(np.eye(2), K.B), np.kron(np.eye(2), K
 Kd = ct.sample_system(K, 5e-5, "zoh")
 json.dump({"A": Kd.A.tolist(), "B": Kd.B.tolist(), "C": Kd.C.tolist(), "D": Kd.D.tolist(), "dt": Kd.dt},
           open(f"{out}/ss.json", "w"))
+np.savez(f"{out}/tf.npz", num=C.num[0][0], den=C.den[0][0], dt=float(C.dt))
+np.savez_compressed(f"{out}/ss.npz", A=np.asfortranarray(Kd.A), B=Kd.B, C=Kd.C, D=Kd.D, dt=Kd.dt)
 print(f"num = {C.num[0][0].tolist()}\nden = {C.den[0][0].tolist()}")
 for k, m in zip("abcd", (Kd.A, Kd.B, Kd.C, Kd.D)):
     print(f"{k} = {m.tolist()}")
@@ -671,6 +674,8 @@ fn a_law_python_control_wrote_runs_as_the_same_law_in_the_scene() {
     let tf_file = run("tf-file", &[law("transfer_function"), path("tf.json")]);
     let tf_inline = run("tf-inline", &[law("transfer_function"), line("num"), line("den")]);
     assert!(tf_file == tf_inline, "transfer_function from python-control's JSON differs from the same in the scene");
+    let tf_npz = run("tf-npz", &[law("transfer_function"), path("tf.npz")]);
+    assert!(tf_npz == tf_inline, "transfer_function from numpy's .npz differs from the same in the scene");
     let ss_file = run("ss-file", &[law("state_space"), path("ss.json")]);
     let ss_inline = run(
         "ss-inline",
@@ -685,13 +690,15 @@ fn a_law_python_control_wrote_runs_as_the_same_law_in_the_scene() {
         ],
     );
     assert!(ss_file == ss_inline, "state_space from python-control's JSON differs from the same in the scene");
+    let ss_npz = run("ss-npz", &[law("state_space"), path("ss.npz")]);
+    assert!(ss_npz == ss_inline, "state_space from numpy's compressed .npz (A in Fortran order) differs");
     // Refused: a FIFO (never waited on) and a file of another format.
     let fifo = dir.join("laws").join("fifo.json");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
-    std::fs::write(dir.join("laws").join("law.npz"), b"PK\x03\x04 not json").unwrap();
+    std::fs::write(dir.join("laws").join("law.mat"), b"MATLAB 5.0 MAT-file, Platform: GLNXA64\x00\xff").unwrap();
     for (name, needles) in [
         ("fifo.json", ["controller.params.file", "not a regular file"]),
-        ("law.npz", ["controller.params.file", "is not JSON"]),
+        ("law.mat", ["controller.params.file", "is neither JSON nor numpy's .npz"]),
     ] {
         let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.law=transfer_function", &path(name)];
         common::refused(&format!("law-file-{name}"), &file, &sets, &needles);

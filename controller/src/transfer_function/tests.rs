@@ -209,12 +209,17 @@ fn a_law_from_a_json_file_is_the_law_from_its_parameters() {
         }
     }
     let npz = Temp::new("x.npz", b"PK\x03\x04binary");
+    let mat = Temp::new("x.mat", b"MATLAB 5.0 MAT-file, Platform: GLNXA64\x00\xff\xfe");
     let array = Temp::new("array.json", b"[1, 2]");
     let no_den = Temp::new("no-den.json", br#"{"num": [1.0]}"#);
     let bad_dt = Temp::new("dt.json", br#"{"num": [1.0], "den": [1.0, 0.5], "dt": 1e-4}"#);
     let nan = Temp::new("nan.json", br#"{"num": ["x"], "den": [1.0]}"#);
     let cases: Vec<(String, Vec<&str>)> = vec![
-        (npz.param(), vec!["controller.params.file", "x.npz", "is not JSON", "a .npz or .mat file is not read"]),
+        (npz.param(), vec!["controller.params.file", "x.npz", "is not a numpy .npz of float64 arrays"]),
+        (
+            mat.param(),
+            vec!["controller.params.file", "x.mat", "is neither JSON nor numpy's .npz", ".mat file is not read"],
+        ),
         (array.param(), vec!["controller.params.file", "holds a JSON array: expected an object"]),
         (no_den.param(), vec!["controller.params.file", "its `den` is missing"]),
         (bad_dt.param(), vec!["controller.params.file", "its `dt` = 0.0001 s", "controller period, 0.00005 s"]),
