@@ -17,7 +17,7 @@
 //! | `prewarp_hz` | Hz | none | Tustin's prewarp frequency (> 0, below Nyquist) |
 //! | `dt_s` | s | – | the discrete system's period; required with `domain = "z"`, must be the scene's controller period |
 //!
-//! | `file` | – | none | a JSON file `{"A": …, "B": …, "C": …, "D": …, "dt": 0}` (python-control's `StateSpace` fields; `dt` 0 or absent: continuous, else the controller's period) instead of `a` … `d`, `domain`, `dt_s` |
+//! | `file` | – | none | a JSON file `{"A": …, "B": …, "C": …, "D": …, "dt": 0}` or numpy's `.npz` of the same (python-control's `StateSpace` fields; `dt` 0 or absent: continuous, else the controller's period) instead of `a` … `d`, `domain`, `dt_s` |
 //!
 //! `a`, `b`, `c` are given together or not at all; none of them: the design's PD per axis as
 //! `pd` samples it (one state per axis, the previous voltage), the sign convention written out.
