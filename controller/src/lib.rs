@@ -81,6 +81,7 @@ pub mod error;
 #[cfg(feature = "ipc")]
 pub mod file;
 pub mod law;
+pub mod law_file;
 #[cfg(feature = "ipc")]
 pub mod link;
 #[cfg(feature = "ipc")]
@@ -96,8 +97,10 @@ pub mod relev;
 pub mod ross_pid;
 #[cfg(feature = "ipc")]
 pub mod serve;
+pub mod state_space;
 #[cfg(test)]
 mod test_plant;
+pub mod transfer_function;
 #[cfg(feature = "ipc")]
 pub mod wire;
 

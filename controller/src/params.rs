@@ -188,6 +188,104 @@ impl ParamReader<'_> {
         }
     }
 
+    /// The array of numbers at `key` (integers taken as floats), if given: every element finite,
+    /// at least one. A refusal names the key, the whole array as given and the element at fault
+    /// (counted from 1).
+    pub fn optional_numbers(&mut self, key: &'static str, unit: &'static str) -> Result<Option<Vec<f64>>, LawError> {
+        self.read.push(key);
+        let Some(value) = self.table.get(key) else { return Ok(None) };
+        let toml::Value::Array(items) = value else {
+            return Err(self.error(
+                key,
+                value,
+                unit,
+                format!("expected an array of numbers ({})", unit_or_ratio(unit)),
+            ));
+        };
+        if items.is_empty() {
+            return Err(self.error(key, value, unit, "expected at least one coefficient"));
+        }
+        let mut out = Vec::with_capacity(items.len());
+        for (k, item) in items.iter().enumerate() {
+            let v = match item {
+                toml::Value::Float(f) => *f,
+                toml::Value::Integer(i) => *i as f64,
+                other => {
+                    return Err(self.error(key, value, unit, format!("element {} = {other} is not a number", k + 1)))
+                }
+            };
+            if !v.is_finite() {
+                return Err(self.error(key, value, unit, format!("element {} = {v} must be finite", k + 1)));
+            }
+            out.push(v);
+        }
+        Ok(Some(out))
+    }
+
+    /// The matrix at `key` (an array of rows, each an array of numbers, every row as long as the
+    /// first, every element finite), if given. A refusal names the key, the row and the column
+    /// at fault (counted from 1).
+    pub fn optional_matrix(
+        &mut self,
+        key: &'static str,
+        unit: &'static str,
+    ) -> Result<Option<Vec<Vec<f64>>>, LawError> {
+        self.read.push(key);
+        let Some(value) = self.table.get(key) else { return Ok(None) };
+        let shape = || format!("expected an array of rows, each an array of numbers ({})", unit_or_ratio(unit));
+        let toml::Value::Array(rows) = value else { return Err(self.error(key, value, unit, shape())) };
+        let mut out = Vec::with_capacity(rows.len());
+        for (r, row) in rows.iter().enumerate() {
+            let toml::Value::Array(items) = row else { return Err(self.error(key, value, unit, shape())) };
+            let mut line = Vec::with_capacity(items.len());
+            for (c, item) in items.iter().enumerate() {
+                let v = match item {
+                    toml::Value::Float(f) => *f,
+                    toml::Value::Integer(i) => *i as f64,
+                    other => {
+                        return Err(self.error(
+                            key,
+                            value,
+                            unit,
+                            format!("row {} column {} = {other} is not a number", r + 1, c + 1),
+                        ))
+                    }
+                };
+                if !v.is_finite() {
+                    return Err(self.error(
+                        key,
+                        value,
+                        unit,
+                        format!("row {} column {} = {v} must be finite", r + 1, c + 1),
+                    ));
+                }
+                line.push(v);
+            }
+            if let Some(first) = out.first().map(Vec::len) {
+                if line.len() != first {
+                    return Err(self.error(
+                        key,
+                        value,
+                        unit,
+                        format!("row {} has {} columns, row 1 has {first}", r + 1, line.len()),
+                    ));
+                }
+            }
+            out.push(line);
+        }
+        Ok(Some(out))
+    }
+
+    /// The string at `key`, if given.
+    pub fn optional_text(&mut self, key: &'static str) -> Result<Option<String>, LawError> {
+        self.read.push(key);
+        match self.table.get(key) {
+            None => Ok(None),
+            Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+            Some(other) => Err(self.error(key, other, "", "expected a string")),
+        }
+    }
+
     /// The boolean at `key`, or `default` when absent.
     pub fn flag(&mut self, key: &'static str, default: bool) -> Result<bool, LawError> {
         self.read.push(key);

@@ -30,10 +30,11 @@ pub const LAWS: &[LawEntry] = &[
     crate::relev::LAW,
     crate::notch::LAW,
     crate::ross_pid::LAW,
+    crate::transfer_function::LAW,
 ];
 
-/// Every law of the whole rotor (they drive the two-plane rotor only).
-pub const ROTOR_LAWS: &[RotorLawEntry] = &[crate::modal::LAW];
+/// Every law of the whole rotor (`modal` drives the two-plane rotor only, `state_space` both).
+pub const ROTOR_LAWS: &[RotorLawEntry] = &[crate::modal::LAW, crate::state_space::LAW];
 
 /// Every law of either kind: what the `controller` binary serves.
 pub const ALL_LAWS: &[AnyLaw] = &[
@@ -43,7 +44,9 @@ pub const ALL_LAWS: &[AnyLaw] = &[
     AnyLaw::Plane(crate::relev::LAW),
     AnyLaw::Plane(crate::notch::LAW),
     AnyLaw::Plane(crate::ross_pid::LAW),
+    AnyLaw::Plane(crate::transfer_function::LAW),
     AnyLaw::Rotor(crate::modal::LAW),
+    AnyLaw::Rotor(crate::state_space::LAW),
 ];
 
 /// The entry of a per-plane law, by name.

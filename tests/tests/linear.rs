@@ -273,3 +273,506 @@ fn bad_input_is_refused_by_name_and_nothing_is_written() {
     assert!(stderr(&o).contains("symbolic link"), "{}", stderr(&o));
     assert_eq!(std::fs::read_dir(&target).unwrap().count(), 0);
 }
+
+// ---- Law `transfer_function` (issue 39 item 2) ----
+
+use controller::transfer_function::{discretise, Method};
+
+/// python-control's `sample_system` on the cases the Rust side discretised, coefficient by
+/// coefficient, relative 1e-12: the denominator to its largest coefficient, the numerator to the
+/// terms python-control subtracted to get it. python-control (scipy's `ss2tf`, for every
+/// method) takes the numerator as `poly(Φ − ΓC) + (D − 1) poly(Φ)`, a difference that cancels
+/// when the gain is small against 1 (8e-8 relative on 1/s² at 20 kHz, 1.5e-12 on an unstable
+/// first order prewarped), where the law's arithmetic is exact to round-off (the unit tests
+/// `zoh_of_a_lag_and_a_double_integrator_are_the_hand_results`,
+/// `tustin_of_a_first_order_lag_is_the_hand_result`).
+const TF_CHECK: &str = r#"
+import json, sys
+import numpy as np
+import control as ct
+from scipy.signal import tf2ss, cont2discrete
+cases = json.load(open(sys.argv[1]))
+worst = {}
+for c in cases:
+    sys_c = ct.tf(c["num"], c["den"])
+    kw = {}
+    if c["prewarp_rad_s"] is not None:
+        kw["prewarp_frequency"] = c["prewarp_rad_s"]
+    d = ct.sample_system(sys_c, c["period_s"], c["method"], **kw)
+    num, den = np.array(d.num[0][0], float), np.array(d.den[0][0], float)
+    num = np.concatenate([np.zeros(len(den) - len(num)), num])
+    b, a = np.array(c["b"]), np.array(c["a"])
+    assert len(b) == len(num) and len(a) == len(den), (c["name"], b, num, a, den)
+    scale_a = np.max(np.abs(den))
+    # What python-control does inside (scipy): tf2ss, cont2discrete (at the period shrunk for a
+    # prewarp), then ss2tf's difference poly(A - BC) + (D - 1) poly(A).
+    w = c["prewarp_rad_s"]
+    T = c["period_s"] if w is None else 2 * np.tan(w * c["period_s"] / 2) / w
+    A, B, C, D, _ = cont2discrete(tf2ss(c["num"], c["den"]), T, "bilinear" if c["method"] == "tustin" else "zoh")
+    scale_b = max(np.max(np.abs(np.poly(A - B @ C))), abs(D[0, 0] - 1) * np.max(np.abs(np.poly(A))),
+                  np.max(np.abs(num)))
+    eb, ea = np.max(np.abs(b - num)) / scale_b, np.max(np.abs(a - den)) / scale_a
+    worst[c["name"]] = (eb, ea)
+    assert eb <= 1e-12 and ea <= 1e-12, (c["name"], list(b), list(num), list(a), list(den), eb, ea)
+for k, (eb, ea) in worst.items():
+    print(f"{k}: numerator {eb:.2e}, denominator {ea:.2e}")
+"#;
+
+#[test]
+fn transfer_function_discretisation_is_python_controls_sample_system() {
+    use std::f64::consts::TAU;
+    let t = 1.0 / 20_000.0;
+    let mul = |a: &[f64], b: &[f64]| {
+        let mut out = vec![0.0; a.len() + b.len() - 1];
+        for (i, x) in a.iter().enumerate() {
+            for (j, y) in b.iter().enumerate() {
+                out[i + j] += x * y;
+            }
+        }
+        out
+    };
+    // A lead-lag (zero at 150 Hz, pole at 1.5 kHz), the same behind a notch at 900 Hz, a PID with
+    // a filtered derivative (a pole at 0), an unstable first order, and 1/s².
+    let (wz, wp, wn) = (TAU * 150.0, TAU * 1500.0, TAU * 900.0);
+    let lead = (vec![-1.2 / wz, -1.2], vec![1.0 / wp, 1.0]);
+    let notch = (mul(&lead.0, &[1.0, 2.0 * 0.01 * wn, wn * wn]), mul(&lead.1, &[1.0, 2.0 * 0.2 * wn, wn * wn]));
+    let pid = (vec![-2e-4, -0.9, -40.0], vec![1.0 / (TAU * 3000.0), 1.0, 0.0]);
+    let unstable = (vec![0.5], vec![1.0, -100.0]);
+    let double = (vec![1.0], vec![1.0, 0.0, 0.0]);
+    let mut cases = Vec::new();
+    for (name, (num, den)) in
+        [("lead-lag", lead), ("lead-lag-notch", notch), ("pid", pid), ("unstable", unstable), ("1/s2", double)]
+    {
+        for (method, m) in [
+            ("tustin", Method::Tustin { prewarp_rad_s: None }),
+            ("tustin", Method::Tustin { prewarp_rad_s: Some(wn) }),
+            ("zoh", Method::Zoh),
+        ] {
+            let d = discretise(&num, &den, t, m);
+            let prewarp = match m {
+                Method::Tustin { prewarp_rad_s } => prewarp_rad_s,
+                Method::Zoh => None,
+            };
+            let label = format!("{name} {method}{}", if prewarp.is_some() { " prewarped" } else { "" });
+            cases.push(serde_json::json!({
+                "name": label, "num": num, "den": den, "period_s": t, "method": method,
+                "prewarp_rad_s": prewarp, "b": d.b, "a": d.a,
+            }));
+        }
+    }
+    let dir = TempDir::new("tf-python");
+    let (file, script) = (dir.join("cases.json"), dir.join("check.py"));
+    std::fs::write(&file, serde_json::to_string(&cases).unwrap()).unwrap();
+    std::fs::write(&script, TF_CHECK).unwrap();
+    let o = output_within(Command::new(venv().join("bin/python")).arg(&script).arg(&file), Duration::from_secs(300));
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    assert_exit(&o, 0);
+}
+
+/// The scene's PD written as a transfer in z by hand, from the scene file's constants
+/// (MODEL.md §3: `k_p = (k_e + k_s)/(k_i A_a A_s)`, `k_d = 2 ξ √(k_e m)/(k_i A_a A_s)`, the rate
+/// the backward difference: `C(z) = −A_a ((k_p + k_d/T) − (k_d/T) z⁻¹)`), as `--set` overrides.
+fn pd_as_transfer(file: &Path, damping: f64) -> Vec<String> {
+    let t: toml::Table = std::fs::read_to_string(file).unwrap().parse().unwrap();
+    let f = |table: &str, key: &str| t[table][key].as_float().unwrap_or_else(|| panic!("{table}.{key}"));
+    let loop_gain = f("amb", "ki_n_per_a") * f("amb", "amp_gain_a_per_v") * f("amb", "sensor_gain_v_per_m");
+    let ke = f("controller", "stiffness_n_per_m");
+    let kp = (ke + f("amb", "ks_n_per_m")) / loop_gain;
+    let kd = 2.0 * damping * (ke * f("rotor", "mass_kg")).sqrt() / loop_gain;
+    let (a, period) = (f("amb", "amp_gain_a_per_v"), 1.0 / f("controller", "rate_hz"));
+    vec![
+        "controller.law=transfer_function".into(),
+        format!("controller.params.num=[{:e}, {:e}]", -a * (kp + kd / period), a * kd / period),
+        "controller.params.den=[1.0, 0.0]".into(),
+        "controller.params.domain=\"z\"".into(),
+        format!("controller.params.dt_s={period:e}"),
+    ]
+}
+
+/// A small shock (0.5 G, no contact) on the paper scene from rest, sampled, ξ = 0.2 (the naive PD's
+/// sampled loop at ξ = 0.01 grows, MODEL.md): the scene's PD written as a transfer in z gives
+/// `pd`'s trace within round-off (the law sums `b₀ u_k + b₁ u_{k−1}` where `pd` sums
+/// `k_p u_k + k_d (u_k − u_{k−1})/T`: each column within 1e-12 of its largest value); and the
+/// transfer run in lockstep by the `controller` process writes the sampled run's trace byte for
+/// byte (the same code in both processes).
+#[test]
+fn transfer_function_of_the_pd_runs_as_pd_sampled_and_lockstep() {
+    common::controller_bin();
+    let file = scene("paper-10g.toml");
+    let dir = TempDir::new("tf-pd");
+    let base = [
+        "scene.duration_s=0.05",
+        "shock[0].start_s=0.005",
+        "shock[0].peak_g=0.5",
+        "output.plots=false",
+        "controller.damping_ratio=0.2",
+        "controller.mode=sampled",
+        // From rest at the centre: the first sample reads 0 V, where `pd`'s first rate (zero) and
+        // the transfer's (from rest, u₋₁ = 0) agree.
+        "initial.unbalance_orbit=false",
+    ];
+    let run = |name: &str, extra: &[String]| {
+        let out = dir.join(name);
+        let sets: Vec<String> = base.iter().map(|s| s.to_string()).chain(extra.iter().cloned()).collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let o = output_within(&mut common::plant_run(&file, &out, &sets), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        out
+    };
+    let tf = pd_as_transfer(&file, 0.2);
+    let pd = common::Csv::read(&run("pd", &[]).join("trace.csv"));
+    let sampled = run("tf", &tf);
+    let ours = common::Csv::read(&sampled.join("trace.csv"));
+    assert_eq!(pd.header, ours.header);
+    let s = common::read_json(&sampled.join("summary.json"));
+    assert_eq!(common::num(&s, "max_contact_force_n"), 0.0, "the small shock touches: {s:#}");
+    let mut largest = 0.0f64;
+    for name in &pd.header {
+        let (a, b) = (pd.column(name), ours.column(name));
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-12 * scale, "{name}: {worst:e} against a largest value of {scale:e}");
+        largest = largest.max(worst / scale.max(f64::MIN_POSITIVE));
+    }
+    eprintln!("transfer_function against pd: largest difference {largest:.1e} of a column's largest value");
+    let mut lockstep = tf.clone();
+    lockstep.push("controller.mode=lockstep".into());
+    let lockstep = run("tf-lockstep", &lockstep);
+    assert!(
+        std::fs::read(sampled.join("trace.csv")).unwrap() == std::fs::read(lockstep.join("trace.csv")).unwrap(),
+        "the transfer in lockstep wrote another trace than in the plant's process"
+    );
+}
+
+/// Bad input to the law, through `plant run`: exit 2, the key, the value and what was expected
+/// named, nothing written.
+#[test]
+fn transfer_function_bad_input_is_refused_by_name_and_nothing_is_written() {
+    let file = scene("paper-10g.toml");
+    let law = ["controller.mode=sampled", "controller.law=transfer_function"];
+    let cases: [(&[&str], &[&str]); 7] = [
+        (&["controller.params.num=[1.0, 2.0]", "controller.params.den=[1.0]"], &["controller.params.num", "improper"]),
+        (
+            &["controller.params.num=[1.0]", "controller.params.den=[0.0, 1.0]"],
+            &["controller.params.den = [0.0, 1.0]", "leading"],
+        ),
+        (
+            &["controller.params.num=[nan]", "controller.params.den=[1.0, 1.0]"],
+            &["controller.params.num", "element 1 = NaN", "finite"],
+        ),
+        (
+            &[
+                "controller.params.num=[1.0]",
+                "controller.params.den=[1.0, 0.5]",
+                "controller.params.domain=\"z\"",
+                "controller.params.dt_s=1e-4",
+            ],
+            &["controller.params.dt_s = 0.0001 s", "the scene's controller period, 0.00005 s"],
+        ),
+        (
+            &["controller.params.num=[1.0]", "controller.params.den=[1e-3, 1.0]", "controller.params.prewarp_hz=12000"],
+            &["controller.params.prewarp_hz = 12000 Hz", "below the Nyquist frequency", "10000 Hz"],
+        ),
+        (
+            &[
+                "controller.params.num=[1.0]",
+                "controller.params.den=[1.0, 1.0]",
+                "controller.params.discretisation=\"foh\"",
+            ],
+            &["controller.params.discretisation = \"foh\"", "\"tustin\" or \"zoh\""],
+        ),
+        (&["controller.params.num=[1.0]"], &["controller.params.den", "must be too"]),
+    ];
+    for (i, (extra, needles)) in cases.iter().enumerate() {
+        let sets: Vec<&str> = SHORT_TF.iter().chain(&law).chain(extra.iter()).copied().collect();
+        common::refused(&format!("tf-bad-{i}"), &file, &sets, needles);
+    }
+}
+
+const SHORT_TF: [&str; 2] = ["scene.duration_s=0.01", "output.plots=false"];
+
+/// python-control's `sample_system` on state-space systems (python-control keeps the
+/// realisation: `(A_d, B_d, C_d, D_d)` from scipy's `cont2discrete`), against the law's, matrix
+/// by matrix, relative 1e-12 of each matrix's largest entry.
+const SS_CHECK: &str = r#"
+import json, sys
+import numpy as np
+import control as ct
+for c in json.load(open(sys.argv[1])):
+    kw = {} if c["prewarp_rad_s"] is None else {"prewarp_frequency": c["prewarp_rad_s"]}
+    d = ct.sample_system(ct.ss(c["A"], c["B"], c["C"], c["D"]), c["period_s"], c["method"], **kw)
+    worst = 0.0
+    for ours, theirs in zip([c["a"], c["b"], c["c"], c["d"]], [d.A, d.B, d.C, d.D]):
+        ours = np.array(ours)
+        e = np.max(np.abs(ours - theirs)) / np.max(np.abs(theirs))
+        worst = max(worst, e)
+        assert e <= 1e-12, (c["name"], ours, theirs, e)
+    print(f"{c['name']}: {worst:.2e}")
+"#;
+
+#[test]
+fn state_space_discretisation_is_python_controls_sample_system() {
+    use controller::state_space::{discretise, DMatrix, Method};
+    use std::f64::consts::TAU;
+    let t = 1.0 / 20_000.0;
+    // Six states on four axes, coupled, with fast (3 kHz) and slow (30 Hz) modes, one unstable.
+    let a = DMatrix::from_row_slice(
+        6,
+        6,
+        &[
+            -2e4, 3e3, 0.0, 0.0, 10.0, 0.0, //
+            -3e3, -2e4, 0.0, 0.0, 0.0, 0.0, //
+            1.0, 0.0, -200.0, 50.0, 0.0, 0.0, //
+            0.0, 0.0, -50.0, -200.0, 0.0, 0.0, //
+            0.0, 0.0, 0.0, 0.0, 30.0, 0.0, //
+            0.0, 5.0, 0.0, 0.0, 0.0, -1e3,
+        ],
+    );
+    let b = DMatrix::from_fn(6, 4, |i, j| ((i + 2 * j) % 5) as f64 - 2.0);
+    let c = DMatrix::from_fn(4, 6, |i, j| -0.3 * ((3 * i + j) % 4) as f64 + 0.1);
+    let d = DMatrix::from_fn(4, 4, |i, j| if i == j { -0.8 } else { 0.05 });
+    let json = |m: &DMatrix<f64>| (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect::<Vec<Vec<f64>>>();
+    let mut cases = Vec::new();
+    for (name, method, m, prewarp) in [
+        ("tustin", "tustin", Method::Tustin { prewarp_rad_s: None }, None),
+        (
+            "tustin prewarped at 2 kHz",
+            "tustin",
+            Method::Tustin { prewarp_rad_s: Some(TAU * 2000.0) },
+            Some(TAU * 2000.0),
+        ),
+        ("zoh", "zoh", Method::Zoh, None),
+    ] {
+        let s = discretise(&a, &b, &c, &d, t, m).unwrap();
+        cases.push(serde_json::json!({
+            "name": name, "method": method, "prewarp_rad_s": prewarp, "period_s": t,
+            "A": json(&a), "B": json(&b), "C": json(&c), "D": json(&d),
+            "a": json(&s.a), "b": json(&s.b), "c": json(&s.c), "d": json(&s.d),
+        }));
+    }
+    let dir = TempDir::new("ss-python");
+    let (file, script) = (dir.join("cases.json"), dir.join("check.py"));
+    std::fs::write(&file, serde_json::to_string(&cases).unwrap()).unwrap();
+    std::fs::write(&script, SS_CHECK).unwrap();
+    let o = output_within(Command::new(venv().join("bin/python")).arg(&script).arg(&file), Duration::from_secs(300));
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    assert_exit(&o, 0);
+}
+
+/// `state_space` without matrices is the design's PD on every axis: on the two-plane rotor
+/// (planes of different designs), sampled, from rest, a small shock, its trace is
+/// decentralised `pd`'s within round-off (1e-12 of each column's largest value), and in lockstep
+/// the sampled run's byte for byte. Matrices sized for the planar model are refused on it,
+/// naming the key and the 4 axes, exit 2, nothing written.
+#[test]
+fn state_space_runs_as_pd_on_the_two_plane_rotor_and_refuses_sizes_of_another() {
+    common::controller_bin();
+    let file = scene("two-plane-asymmetric-10g.toml");
+    let dir = TempDir::new("ss-pd");
+    let base = [
+        "scene.duration_s=0.03",
+        "shock[0].start_s=0.005",
+        "shock[0].peak_g=0.5",
+        "output.plots=false",
+        "controller.damping_ratio=0.2",
+        "controller.mode=sampled",
+        "initial.unbalance_orbit=false",
+    ];
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let sets: Vec<&str> = base.iter().chain(extra).copied().collect();
+        let o = output_within(&mut common::plant_run(&file, &out, &sets), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        out
+    };
+    let pd = common::Csv::read(&run("pd", &["controller.law=pd"]).join("trace.csv"));
+    let sampled = run("ss", &["controller.law=state_space"]);
+    let ours = common::Csv::read(&sampled.join("trace.csv"));
+    assert_eq!(pd.header, ours.header);
+    let mut largest = 0.0f64;
+    for name in &pd.header {
+        let (a, b) = (pd.column(name), ours.column(name));
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-12 * scale, "{name}: {worst:e} against a largest value of {scale:e}");
+        largest = largest.max(worst / scale.max(f64::MIN_POSITIVE));
+    }
+    eprintln!("state_space against pd: largest difference {largest:.1e} of a column's largest value");
+    let lockstep = run("ss-lockstep", &["controller.law=state_space", "controller.mode=lockstep"]);
+    assert!(
+        std::fs::read(sampled.join("trace.csv")).unwrap() == std::fs::read(lockstep.join("trace.csv")).unwrap(),
+        "state_space in lockstep wrote another trace than in the plant's process"
+    );
+    common::refused(
+        "ss-bad-axes",
+        &file,
+        &[
+            "scene.duration_s=0.01",
+            "output.plots=false",
+            "controller.law=state_space",
+            "controller.params.a=[[-1.0]]",
+            "controller.params.b=[[1.0, 0.0]]",
+            "controller.params.c=[[1.0], [0.0]]",
+        ],
+        &["law state_space", "controller.params.b", "is 1 × 2: expected 1 × 4", "4 axes"],
+    );
+}
+
+/// python-control writes a law as JSON, as docs/guide/controllers.md shows (`json.dump` of the
+/// `TransferFunction`'s and the `StateSpace`'s fields); `plant run` with `file = …` writes the
+/// trace byte for byte that the same law written into `[controller.params]` writes, and so does
+/// numpy's `.npz` of the same arrays (`savez`, and `savez_compressed` with A in Fortran order).
+/// A FIFO and a MATLAB `.mat` are refused, exit 2, nothing written.
+const WRITE_LAWS: &str = r#"
+import json, sys
+import numpy as np
+import control as ct
+out = sys.argv[1]
+wz, wp = 2 * np.pi * 150, 2 * np.pi * 1500
+C = ct.tf([-1.2 / wz, -1.2], [1 / wp, 1])
+json.dump({"num": C.num[0][0].tolist(), "den": C.den[0][0].tolist(), "dt": C.dt}, open(f"{out}/tf.json", "w"))
+K = ct.ss(C)
+K = ct.ss(np.kron(np.eye(2), K.A), np.kron(np.eye(2), K.B), np.kron(np.eye(2), K.C), np.kron(np.eye(2), K.D))
+Kd = ct.sample_system(K, 5e-5, "zoh")
+json.dump({"A": Kd.A.tolist(), "B": Kd.B.tolist(), "C": Kd.C.tolist(), "D": Kd.D.tolist(), "dt": Kd.dt},
+          open(f"{out}/ss.json", "w"))
+np.savez(f"{out}/tf.npz", num=C.num[0][0], den=C.den[0][0], dt=float(C.dt))
+np.savez_compressed(f"{out}/ss.npz", A=np.asfortranarray(Kd.A), B=Kd.B, C=Kd.C, D=Kd.D, dt=Kd.dt)
+print(f"num = {C.num[0][0].tolist()}\nden = {C.den[0][0].tolist()}")
+for k, m in zip("abcd", (Kd.A, Kd.B, Kd.C, Kd.D)):
+    print(f"{k} = {m.tolist()}")
+"#;
+
+#[test]
+fn a_law_python_control_wrote_runs_as_the_same_law_in_the_scene() {
+    let dir = TempDir::new("law-files");
+    std::fs::create_dir_all(dir.join("laws")).unwrap();
+    let script = dir.join("write.py");
+    std::fs::write(&script, WRITE_LAWS).unwrap();
+    let o = output_within(
+        Command::new(venv().join("bin/python")).arg(&script).arg(dir.join("laws")),
+        Duration::from_secs(120),
+    );
+    assert_exit(&o, 0);
+    let printed = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = |key: &str| {
+        let l = printed.lines().find(|l| l.starts_with(&format!("{key} = "))).unwrap();
+        format!("controller.params.{l}").replacen(" = ", "=", 1)
+    };
+    let file = scene("paper-10g.toml");
+    let base = ["scene.duration_s=0.02", "output.plots=false", "controller.mode=sampled"];
+    let run = |name: &str, extra: &[String]| {
+        let out = dir.join(name);
+        let sets: Vec<String> = base.iter().map(|s| s.to_string()).chain(extra.iter().cloned()).collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let o = output_within(&mut common::plant_run(&file, &out, &sets), Duration::from_secs(300));
+        assert_exit(&o, 0);
+        std::fs::read(out.join("trace.csv")).unwrap()
+    };
+    let law = |name: &str| format!("controller.law={name}");
+    let path = |name: &str| format!("controller.params.file=\"{}\"", dir.join("laws").join(name).display());
+    let tf_file = run("tf-file", &[law("transfer_function"), path("tf.json")]);
+    let tf_inline = run("tf-inline", &[law("transfer_function"), line("num"), line("den")]);
+    assert!(tf_file == tf_inline, "transfer_function from python-control's JSON differs from the same in the scene");
+    let tf_npz = run("tf-npz", &[law("transfer_function"), path("tf.npz")]);
+    assert!(tf_npz == tf_inline, "transfer_function from numpy's .npz differs from the same in the scene");
+    let ss_file = run("ss-file", &[law("state_space"), path("ss.json")]);
+    let ss_inline = run(
+        "ss-inline",
+        &[
+            law("state_space"),
+            line("a"),
+            line("b"),
+            line("c"),
+            line("d"),
+            "controller.params.domain=\"z\"".into(),
+            "controller.params.dt_s=5e-5".into(),
+        ],
+    );
+    assert!(ss_file == ss_inline, "state_space from python-control's JSON differs from the same in the scene");
+    let ss_npz = run("ss-npz", &[law("state_space"), path("ss.npz")]);
+    assert!(ss_npz == ss_inline, "state_space from numpy's compressed .npz (A in Fortran order) differs");
+    // Refused: a FIFO (never waited on) and a file of another format.
+    let fifo = dir.join("laws").join("fifo.json");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    std::fs::write(dir.join("laws").join("law.mat"), b"MATLAB 5.0 MAT-file, Platform: GLNXA64\x00\xff").unwrap();
+    for (name, needles) in [
+        ("fifo.json", ["controller.params.file", "not a regular file"]),
+        ("law.mat", ["controller.params.file", "is neither JSON nor numpy's .npz"]),
+    ] {
+        let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.law=transfer_function", &path(name)];
+        common::refused(&format!("law-file-{name}"), &file, &sets, &needles);
+    }
+}
+
+/// The closed loop in the linear regime against python-control: the paper scene, sampled, from
+/// rest at (1, 0.5) µm (no unbalance, no shock, no contact, the linear force law, integrator
+/// tolerance 1e-12), under a `transfer_function` PD with a derivative filter at 2 kHz (in `s`,
+/// Tustin). python-control closes the exported discrete plant (`plant linear`, its hold and
+/// delay states in) with its own `sample_system` of the same transfer
+/// (`feedback(P, K, sign=+1)`, `forced_response` from the same start); the run's rotor state
+/// (position and velocity, every sample) is its to 1e-9 of the largest value (measured 2.8e-14).
+const KICK: &str = r#"
+import sys, numpy as np, control as ct
+num, den = [float(v) for v in sys.argv[3].split(",")], [float(v) for v in sys.argv[4].split(",")]
+z = np.load(sys.argv[1] + "/linear.npz")
+dt = float(z["dt"])
+P = ct.ss(z["Ad"], z["Bd"], z["Cd"], z["Dd"], dt)
+assert list(z["states_d"][:4]) == ["x", "y", "vx", "vy"], z["states_d"]
+K = ct.ss(ct.sample_system(ct.tf(num, den), dt, "tustin"))
+cl = ct.feedback(P, ct.append(K, K), sign=1)
+tr = np.genfromtxt(sys.argv[2] + "/trace.csv", delimiter=",", names=True)
+n = len(tr["t_s"])
+x0 = np.zeros(cl.nstates); x0[0], x0[1] = 1e-6, 5e-7
+r = ct.forced_response(cl, np.arange(n) * dt, np.zeros((2, n)), X0=x0, return_x=True)
+for k, col in enumerate(["dx_m", "dy_m", "vx_m_s", "vy_m_s"]):
+    e = np.max(np.abs(tr[col] - r.states[k])) / np.max(np.abs(r.states[k]))
+    print(f"{col}: {e:.1e} of its largest value")
+    assert e <= 1e-9, (col, e)
+"#;
+
+#[test]
+fn a_transfer_function_loop_is_python_controls_forced_response_on_the_exported_plant() {
+    let dir = TempDir::new("tf-kick");
+    let file = scene("paper-10g.toml");
+    let sets = ["controller.mode=sampled"];
+    let lin = dir.join("lin");
+    let mut cmd = plant_linear(&file, &lin, &[]);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    assert_exit(&output_within(&mut cmd, Duration::from_secs(60)), 0);
+    // The PD of the scene (k_e = 1e6 N/m, here ξ = 0.2) with its derivative filtered at 2 kHz:
+    // C(s) = −(k_p + k_d s/(τ s + 1)), k_p = (k_e + k_s)/(k_i A_s), k_d = 2 ξ √(k_e m)/(k_i A_s).
+    let (kp, kd, tau) =
+        ((1e6 + 4.32e5) / 5.4e6, 2.0 * 0.2 * (1e6f64 * 11.5).sqrt() / 5.4e6, 1.0 / (std::f64::consts::TAU * 2000.0));
+    let (num, den) = ([-(kp * tau + kd), -kp], [tau, 1.0]);
+    let list = |v: &[f64]| v.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(",");
+    let run = dir.join("run");
+    let all = [
+        "scene.duration_s=0.02".to_string(),
+        "output.plots=false".into(),
+        "controller.law=transfer_function".into(),
+        format!("controller.params.num=[{}]", list(&num)),
+        format!("controller.params.den=[{}]", list(&den)),
+        "rotor.eccentricity_um=0".into(),
+        "initial.unbalance_orbit=false".into(),
+        "initial.rotor_x_um=1.0".into(),
+        "initial.rotor_y_um=0.5".into(),
+        "shock[0].start_s=10".into(),
+        "integrator.rtol=1e-12".into(),
+        "integrator.atol=1e-18".into(),
+        sets[0].into(),
+    ];
+    let all: Vec<&str> = all.iter().map(String::as_str).collect();
+    let o = output_within(&mut common::plant_run(&file, &run, &all), Duration::from_secs(300));
+    assert_exit(&o, 0);
+    let script = dir.join("kick.py");
+    std::fs::write(&script, KICK).unwrap();
+    let o = output_within(
+        Command::new(venv().join("bin/python")).arg(&script).arg(&lin).arg(&run).arg(list(&num)).arg(list(&den)),
+        Duration::from_secs(120),
+    );
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    assert_exit(&o, 0);
+}
