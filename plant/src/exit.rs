@@ -274,10 +274,7 @@ impl HasExitCode for Interrupted {
     }
 }
 
-/// An argument of a command that cannot be used (bad input: exit 2).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct BadArgument(pub String);
+pub use crate::argument::BadArgument;
 
 /// A command stopped by SIGINT/SIGTERM (exit 130): what it had finished was written, as the
 /// text says.

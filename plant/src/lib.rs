@@ -18,6 +18,7 @@ pub use run::stepper::Plant;
 pub use run::{digital, stepper};
 
 pub mod analysis;
+pub mod argument;
 pub mod assess;
 pub mod atomic;
 pub mod bench;

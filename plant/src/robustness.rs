@@ -21,8 +21,8 @@ use crate::ensemble::stats::quantile;
 use crate::grid::Mode;
 use crate::hooks::Cancel;
 use crate::run::{run, Outcome};
+pub use crate::summary::{Robustness, Spread};
 use rayon::prelude::*;
-use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -71,67 +71,12 @@ pub fn perturbation(scene: &Scene, k: usize) -> Result<Vec<String>, ConfigError>
     Ok(vec![format!("rotor.unbalance_phase_deg={phase:?}"), format!("initial.rotor_x_um={x:?}")])
 }
 
-/// Least, median and largest of a figure over the run and its members.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Spread {
-    /// Least.
-    pub min: Option<f64>,
-    /// Median.
-    pub median: Option<f64>,
-    /// Largest.
-    pub max: Option<f64>,
-}
-
 fn spread(values: &[f64]) -> Spread {
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     Spread {
         min: finite.iter().copied().reduce(f64::min),
         median: quantile(&finite, 0.5),
         max: finite.iter().copied().reduce(f64::max),
-    }
-}
-
-/// `summary.json`'s `robustness`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Robustness {
-    /// Perturbed runs beside the run.
-    pub members: usize,
-    /// What was perturbed, in words.
-    pub perturbation: String,
-    /// `robust` (every member in the run's mode) or `fragile`.
-    pub verdict: &'static str,
-    /// The run's own motion mode.
-    pub run_mode: &'static str,
-    /// Members that ended in it.
-    pub same_mode: usize,
-    /// Members per motion mode (`recovered`, `dry_whirl`, `rebound`, `diverged`).
-    pub modes: BTreeMap<&'static str, usize>,
-    /// Peak contact force over the run and its members (N).
-    pub max_contact_force_n: Spread,
-    /// Largest radius over the run and its members (m).
-    pub max_radius_m: Spread,
-    /// Recovery time over the run and the members that recovered from contact (s).
-    pub recovery_s: Spread,
-    /// Members (and the run) still touching at the end: no recovery time.
-    pub still_touching: usize,
-}
-
-impl Robustness {
-    /// The words for the run's last line.
-    pub fn headline(&self) -> String {
-        let range = |s: &Spread, scale: f64, digits: usize, unit: &str| match (s.min, s.max) {
-            (Some(a), Some(b)) => format!("{:.*}–{:.*} {unit}", digits, a * scale, digits, b * scale),
-            _ => "none".into(),
-        };
-        format!(
-            "robustness: {} of {} perturbed runs {} as this one ({}); peak contact force {}, max radius {}",
-            self.same_mode,
-            self.members,
-            self.run_mode,
-            self.verdict.to_uppercase(),
-            range(&self.max_contact_force_n, 1.0, 0, "N"),
-            range(&self.max_radius_m, 1e6, 1, "µm"),
-        )
     }
 }
 

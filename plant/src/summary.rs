@@ -194,7 +194,7 @@ pub struct Summary {
     /// How robust the outcome is: the run repeated with perturbations (`plant run --robustness
     /// N`, `[robustness] members`); absent unless asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub robustness: Option<crate::robustness::Robustness>,
+    pub robustness: Option<Robustness>,
     /// Co-simulation figures (`lockstep`, `realtime` modes only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cosim: Option<crate::cosim::CosimReport>,
@@ -431,5 +431,60 @@ mod tests {
         lengths.sort_unstable();
         lengths.dedup();
         assert!(lengths.len() >= 5, "the cases cover the layouts: {lengths:?}");
+    }
+}
+
+/// Least, median and largest of a figure over the run and its members.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spread {
+    /// Least.
+    pub min: Option<f64>,
+    /// Median.
+    pub median: Option<f64>,
+    /// Largest.
+    pub max: Option<f64>,
+}
+
+/// `summary.json`'s `robustness`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Robustness {
+    /// Perturbed runs beside the run.
+    pub members: usize,
+    /// What was perturbed, in words.
+    pub perturbation: String,
+    /// `robust` (every member in the run's mode) or `fragile`.
+    pub verdict: &'static str,
+    /// The run's own motion mode.
+    pub run_mode: &'static str,
+    /// Members that ended in it.
+    pub same_mode: usize,
+    /// Members per motion mode (`recovered`, `dry_whirl`, `rebound`, `diverged`).
+    pub modes: std::collections::BTreeMap<&'static str, usize>,
+    /// Peak contact force over the run and its members (N).
+    pub max_contact_force_n: Spread,
+    /// Largest radius over the run and its members (m).
+    pub max_radius_m: Spread,
+    /// Recovery time over the run and the members that recovered from contact (s).
+    pub recovery_s: Spread,
+    /// Members (and the run) still touching at the end: no recovery time.
+    pub still_touching: usize,
+}
+
+impl Robustness {
+    /// The words for the run's last line.
+    pub fn headline(&self) -> String {
+        let range = |s: &Spread, scale: f64, digits: usize, unit: &str| match (s.min, s.max) {
+            (Some(a), Some(b)) => format!("{:.*}–{:.*} {unit}", digits, a * scale, digits, b * scale),
+            _ => "none".into(),
+        };
+        format!(
+            "robustness: {} of {} perturbed runs {} as this one ({}); peak contact force {}, max radius {}",
+            self.same_mode,
+            self.members,
+            self.run_mode,
+            self.verdict.to_uppercase(),
+            range(&self.max_contact_force_n, 1.0, 0, "N"),
+            range(&self.max_radius_m, 1e6, 1, "µm"),
+        )
     }
 }

@@ -282,11 +282,13 @@ fn realtime_cosimulation_of_the_flexible_rotor_runs_its_four_axes() {
     assert_eq!(trace.header[37..], ["mid_dx_m", "mid_dy_m"]);
     assert_eq!(trace.rows.len(), 101);
     // Each axis commanded: its current leaves the bias (the unbalance on x, the shock on y).
+    // The rotor starts at rest on its AMBs (issue 38 item 5), so the x axes move by the
+    // unbalance's orbit only in these 5 ms (about 0.013 A); a frozen axis would not move at all.
     for axis in ["ix_a", "iy_a", "b_ix_a", "b_iy_a"] {
         let i = trace.column(axis);
         assert!(i.iter().all(|v| v.abs() <= 2.0), "{axis} past the 2 A limit: {i:?}");
         let (lo, hi) = i.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
-        assert!(hi - lo > 0.02, "{axis} barely moves: {lo} to {hi} A");
+        assert!(hi - lo > 0.005, "{axis} barely moves: {lo} to {hi} A");
     }
 
     let cmp = dir.join("compare");

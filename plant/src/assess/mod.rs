@@ -15,6 +15,8 @@ pub mod coupled;
 pub mod duty;
 pub mod hertz;
 pub mod ladder;
+#[cfg(test)]
+mod linear_check;
 pub mod margins;
 pub mod rainflow;
 pub mod report;

@@ -159,36 +159,4 @@ mod tests {
             );
         }
     }
-
-    /// The sampled PD with its delay: the crossings are where `plant assess`'s planar closed
-    /// form (`assess::closed_form::loop_gain`, its own arithmetic: `G_o = −L`) is real and
-    /// negative, or of modulus 1; the margins its values there.
-    #[test]
-    fn the_sampled_pd_margins_are_the_closed_forms_crossings() {
-        let scene = shipped("cosim-10g.toml", &[]);
-        let b = super::super::build(&scene, 0.0).expect("model");
-        let law = law::of(&scene).expect("law");
-        let (pd, axis) = crate::assess::closed_form_of_plane(&scene, 0).expect("closed form");
-        let go = |f: f64| -crate::assess::closed_form::loop_gain(&axis, &pd, f);
-        let m = &margins(&law, &b.plant.system, &b.discrete.0, 0.01, 1e5)[0];
-        assert!(m.phase_crossovers.len() >= 2, "DC and the delay's: {m:?}");
-        for c in &m.phase_crossovers[1..] {
-            let v = go(c.f_hz);
-            assert!(v.re < 0.0 && v.im.abs() < 1e-8 * v.norm(), "{c:?}: {v}");
-            assert!((c.margin * v.norm() - 1.0).abs() < 1e-9, "{c:?}: {v}");
-        }
-        for c in &m.gain_crossovers {
-            let v = go(c.f_hz);
-            assert!((v.norm() - 1.0).abs() < 1e-9, "{c:?}: {v}");
-            assert!(
-                (c.margin - (180.0 + v.im.atan2(v.re).to_degrees() - if v.im > 0.0 { 360.0 } else { 0.0 })).abs()
-                    < 1e-7
-            );
-        }
-        let (gm, _) = m.gain_margin_db.expect("gain margin");
-        let (pm, _) = m.phase_margin_deg.expect("phase margin");
-        eprintln!("cosim-10g axis x: {m:?}");
-        assert!(pm > 0.0 && pm < 90.0, "{pm}");
-        assert!(gm.abs() < 20.0, "{gm}");
-    }
 }

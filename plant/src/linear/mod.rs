@@ -13,8 +13,8 @@ pub mod law;
 pub mod margins;
 pub mod model;
 
+use crate::argument::BadArgument;
 use crate::config::load_scene;
-use crate::exit::BadArgument;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
@@ -133,4 +133,4 @@ pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
