@@ -77,6 +77,7 @@
 
 pub mod design;
 pub mod discrete_pd;
+pub mod discretisation;
 pub mod error;
 #[cfg(feature = "ipc")]
 pub mod file;

@@ -37,6 +37,7 @@
 //! in buffers allocated once when the law is built.
 
 use crate::design::{RotorDesign, ROTOR_AXES};
+use crate::discretisation::{self, Domain};
 use crate::error::LawError;
 use crate::law::{RotorLaw, RotorLawEntry, RotorSample};
 use crate::law_file::LawFile;
@@ -82,17 +83,7 @@ pub struct DiscreteSs {
     pub d: DMatrix<f64>,
 }
 
-/// How a continuous system becomes discrete.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Method {
-    /// Bilinear, with an optional prewarp frequency (rad/s).
-    Tustin {
-        /// ω_w (rad/s), if any.
-        prewarp_rad_s: Option<f64>,
-    },
-    /// Zero-order hold.
-    Zoh,
-}
+pub use crate::discretisation::Method;
 
 fn matrix(rows: &[Vec<f64>]) -> DMatrix<f64> {
     let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
@@ -193,52 +184,9 @@ fn read(p: &mut ParamReader<'_>, design: &RotorDesign) -> Result<DiscreteSs, Law
         None => DMatrix::zeros(axes, axes),
     };
     let (a, b, c) = (matrix(&a), matrix(&b), matrix(&c));
-    let domain = p.optional_text("domain")?;
-    let method = p.optional_text("discretisation")?;
-    let prewarp_hz = p.optional_number("prewarp_hz", "Hz", Check::Positive)?;
-    let dt_s = p.optional_number("dt_s", "s", Check::Positive)?;
-    let (domain, dt_s) = match &from_file {
-        None => (domain.unwrap_or_else(|| "s".into()), dt_s),
-        Some((path, dt)) => {
-            let why = format!("the file {path:?} gives it (its `dt`)");
-            if let Some(v) = domain {
-                return Err(p.error("domain", format!("{v:?}"), "", why));
-            }
-            if let Some(v) = dt_s {
-                return Err(p.error("dt_s", v, "s", why));
-            }
-            (if dt.is_some() { "z" } else { "s" }.to_string(), *dt)
-        }
-    };
-    let nyquist = 0.5 / period_s;
-    let system = match domain.as_str() {
-        "s" => {
-            if let Some(dt) = dt_s {
-                return Err(p.error("dt_s", dt, "s", "only for domain = \"z\" (a continuous system has no period)"));
-            }
-            let method = match method.as_deref().unwrap_or("tustin") {
-                "tustin" => {
-                    if let Some(f) = prewarp_hz.filter(|f| *f >= nyquist) {
-                        return Err(p.error(
-                            "prewarp_hz",
-                            f,
-                            "Hz",
-                            format!("must be below the Nyquist frequency of the controller's rate, {nyquist} Hz"),
-                        ));
-                    }
-                    Method::Tustin { prewarp_rad_s: prewarp_hz.map(|f| std::f64::consts::TAU * f) }
-                }
-                "zoh" => {
-                    if let Some(f) = prewarp_hz {
-                        return Err(p.error("prewarp_hz", f, "Hz", "only with discretisation = \"tustin\""));
-                    }
-                    Method::Zoh
-                }
-                other => {
-                    return Err(p.error("discretisation", format!("{other:?}"), "", "expected \"tustin\" or \"zoh\""))
-                }
-            };
-            match discretise(&a, &b, &c, &d, period_s, method) {
+    let system =
+        match discretisation::read(p, from_file.as_ref(), period_s, "a continuous system", "a discrete system")? {
+            Domain::Continuous(method) => match discretise(&a, &b, &c, &d, period_s, method) {
                 Some(s) => s,
                 None => {
                     return Err(p.error(
@@ -248,35 +196,9 @@ fn read(p: &mut ParamReader<'_>, design: &RotorDesign) -> Result<DiscreteSs, Law
                         "I − A T/2 is singular: A has an eigenvalue at 2/T, where Tustin has no image",
                     ))
                 }
-            }
-        }
-        "z" => {
-            if let Some(m) = method {
-                return Err(p.error("discretisation", format!("{m:?}"), "", "only for domain = \"s\""));
-            }
-            if let Some(f) = prewarp_hz {
-                return Err(p.error("prewarp_hz", f, "Hz", "only for domain = \"s\" with discretisation = \"tustin\""));
-            }
-            let Some(dt) = dt_s else {
-                return Err(p.error(
-                    "dt_s",
-                    "(not set)",
-                    "s",
-                    format!("a discrete system needs its sampling period: the controller's, {period_s} s"),
-                ));
-            };
-            if (dt - period_s).abs() > 1e-9 * period_s {
-                return Err(p.error(
-                    "dt_s",
-                    dt,
-                    "s",
-                    format!("must be the scene's controller period, {period_s} s (1 / controller.rate_hz)"),
-                ));
-            }
-            DiscreteSs { a, b, c, d }
-        }
-        other => return Err(p.error("domain", format!("{other:?}"), "", "expected \"s\" or \"z\"")),
-    };
+            },
+            Domain::Discrete => DiscreteSs { a, b, c, d },
+        };
     let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
     if !(finite(&system.a) && finite(&system.b) && finite(&system.c) && finite(&system.d)) {
         return Err(p.error("a", "(as given)", "", format!("discretised at {period_s} s, the matrices overflow")));

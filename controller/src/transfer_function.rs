@@ -54,6 +54,7 @@
 //! y_k = b₀ u_k + s₁        s_j ← b_j u_k − a_j y_k + s_{j+1}  (s_{n+1} = 0)        i_k = bias + y_k
 //! ```
 
+use crate::discretisation::{self, Domain};
 use crate::law::{ControlLaw, Design, LawEntry, LawError, Sample};
 use crate::law_file::LawFile;
 use crate::params::{Check, ParamReader, Params};
@@ -80,17 +81,7 @@ fn build(design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawErr
     Ok(Box::new(TransferFunction::new(tf, bias)))
 }
 
-/// How a transfer in `s` becomes one in `z`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Method {
-    /// Bilinear, with an optional prewarp frequency (rad/s).
-    Tustin {
-        /// ω_w (rad/s), if any.
-        prewarp_rad_s: Option<f64>,
-    },
-    /// Zero-order hold.
-    Zoh,
-}
+pub use crate::discretisation::Method;
 
 /// A discrete transfer `b(z)/a(z)`, descending powers of `z`, `a₀ = 1`, `b` as long as `a`.
 #[derive(Clone, Debug, PartialEq)]
@@ -190,81 +181,9 @@ fn read(p: &mut ParamReader<'_>, design: &Design) -> Result<DiscreteTf, LawError
     if den.len() - 1 > MAX_ORDER {
         return Err(p.error("den", coefficients(&den), "", format!("order {} above {MAX_ORDER}", den.len() - 1)));
     }
-    let domain = p.optional_text("domain")?;
-    let method = p.optional_text("discretisation")?;
-    let prewarp_hz = p.optional_number("prewarp_hz", "Hz", Check::Positive)?;
-    let dt_s = p.optional_number("dt_s", "s", Check::Positive)?;
-    let (domain, dt_s) = match &from_file {
-        None => (domain.unwrap_or_else(|| "s".into()), dt_s),
-        Some((path, dt)) => {
-            let why = format!("the file {path:?} gives it (its `dt`)");
-            if let Some(v) = domain {
-                return Err(p.error("domain", format!("{v:?}"), "", why));
-            }
-            if let Some(v) = dt_s {
-                return Err(p.error("dt_s", v, "s", why));
-            }
-            (if dt.is_some() { "z" } else { "s" }.to_string(), *dt)
-        }
-    };
-    let nyquist = 0.5 / period_s;
-    let tf = match domain.as_str() {
-        "s" => {
-            if let Some(dt) = dt_s {
-                return Err(p.error("dt_s", dt, "s", "only for domain = \"z\" (a transfer in s has no period)"));
-            }
-            let method = match method.as_deref().unwrap_or("tustin") {
-                "tustin" => {
-                    if let Some(f) = prewarp_hz {
-                        if f >= nyquist {
-                            return Err(p.error(
-                                "prewarp_hz",
-                                f,
-                                "Hz",
-                                format!("must be below the Nyquist frequency of the controller's rate, {nyquist} Hz"),
-                            ));
-                        }
-                    }
-                    Method::Tustin { prewarp_rad_s: prewarp_hz.map(|f| std::f64::consts::TAU * f) }
-                }
-                "zoh" => {
-                    if let Some(f) = prewarp_hz {
-                        return Err(p.error("prewarp_hz", f, "Hz", "only with discretisation = \"tustin\""));
-                    }
-                    Method::Zoh
-                }
-                other => {
-                    return Err(p.error("discretisation", format!("{other:?}"), "", "expected \"tustin\" or \"zoh\""))
-                }
-            };
-            discretise(&num, &den, period_s, method)
-        }
-        "z" => {
-            if let Some(m) = method {
-                return Err(p.error("discretisation", format!("{m:?}"), "", "only for domain = \"s\""));
-            }
-            if let Some(f) = prewarp_hz {
-                return Err(p.error("prewarp_hz", f, "Hz", "only for domain = \"s\" with discretisation = \"tustin\""));
-            }
-            let Some(dt) = dt_s else {
-                return Err(p.error(
-                    "dt_s",
-                    "(not set)",
-                    "s",
-                    format!("a law in z needs its sampling period: the controller's, {period_s} s"),
-                ));
-            };
-            if (dt - period_s).abs() > 1e-9 * period_s {
-                return Err(p.error(
-                    "dt_s",
-                    dt,
-                    "s",
-                    format!("must be the scene's controller period, {period_s} s (1 / controller.rate_hz)"),
-                ));
-            }
-            normalise(&num, &den)
-        }
-        other => return Err(p.error("domain", format!("{other:?}"), "", "expected \"s\" or \"z\"")),
+    let tf = match discretisation::read(p, from_file.as_ref(), period_s, "a transfer in s", "a law in z")? {
+        Domain::Continuous(method) => discretise(&num, &den, period_s, method),
+        Domain::Discrete => normalise(&num, &den),
     };
     if !tf.b.iter().chain(&tf.a).all(|v| v.is_finite()) {
         return Err(p.error(
