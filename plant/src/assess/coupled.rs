@@ -9,7 +9,8 @@
 //! golden-section search: the largest, and each local peak (a bending mode's among them).
 
 use super::sensitivity::{self, Settings};
-use crate::config::{ControlMode, Scene};
+use crate::config::Scene;
+use crate::linear::law::LinearLaw;
 use plant_physics::flex::linear::{AxisLaw, OpenLoop, PlanePd, Response, SampledLoop};
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -50,40 +51,19 @@ enum Law {
 }
 
 /// The scene's law as a linear loop: the continuous PD, or the registry's law where it is a PD
-/// behind an optional filter (a command is a black box: `None`).
+/// behind an optional filter (a command is a black box: `None`), as [`crate::linear::law::of`]
+/// reads it (one entry per axis, x then y of each plane), for the two-plane loop.
 fn law_of(scene: &Scene) -> Option<Law> {
-    let c = &scene.controller;
-    let designs = scene.plane_designs();
-    if designs.len() != 2 {
+    if scene.plane_designs().len() != 2 {
         return None;
     }
-    if c.mode == ControlMode::Continuous {
-        let gains = crate::run::plane_gains(scene).ok()?;
-        return Some(Law::Continuous([0, 1].map(|i| PlanePd {
-            kp: gains[i].kp,
-            kd: gains[i].kd,
-            amp_gain: gains[i].amp_gain_a_per_v,
-            sensor_gain: designs[i].constants.sensor_gain_v_per_m,
-        })));
+    match crate::linear::law::of(scene)? {
+        LinearLaw::Continuous(pds) => Some(Law::Continuous([*pds.first()?, *pds.get(2)?])),
+        LinearLaw::Sampled { laws, period } => {
+            let laws: [AxisLaw; 4] = laws.try_into().ok()?;
+            Some(Law::Sampled(SampledLoop { laws, period, delay: scene.controller.delay_samples }))
+        }
     }
-    if !(c.mode == ControlMode::Sampled || c.cosim.command.is_none()) {
-        return None;
-    }
-    let mut laws = Vec::with_capacity(4);
-    for d in &designs {
-        let linear = controller::build_law(&c.law, d, &c.params).ok()?.linear()?;
-        let pd = PlanePd {
-            kp: linear.pd.kp,
-            kd: linear.pd.kd,
-            amp_gain: d.constants.amp_gain_a_per_v,
-            sensor_gain: d.constants.sensor_gain_v_per_m,
-        };
-        let law = AxisLaw::pd(&pd, c.period, linear.filter);
-        laws.push(law.clone());
-        laws.push(law);
-    }
-    let laws: [AxisLaw; 4] = laws.try_into().ok()?;
-    Some(Law::Sampled(SampledLoop { laws, period: c.period, delay: c.delay_samples }))
 }
 
 /// The closed form of every axis at each speed in `speeds_hz`, for a scene whose rotor gives
