@@ -717,16 +717,7 @@ mod fmi2 {
 /// its `[rotor.shaft]` table, cut to 5 ms; `extra` is TOML added to the file's text: another
 /// bearing table, say. Writes the scene and the file into `dir` and returns the scene's path.
 fn ross_scene(dir: &TempDir, extra: &str) -> std::path::PathBuf {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let ross = read_text(&root.join("plant/physics/tests/fixtures/ross/amb_machine.toml")) + extra;
-    std::fs::write(dir.join("machine.toml"), ross).unwrap();
-    let mut table: toml::Table = read_text(&scene("flexible-10g.toml")).parse().unwrap();
-    let rotor = table["rotor"].as_table_mut().unwrap();
-    rotor.remove("shaft");
-    rotor.insert("ross_file".into(), "machine.toml".into());
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
-    path
+    common::flexible_scene_on_ross_file(dir, &(common::ross_amb_machine() + extra))
 }
 
 /// Issue 38 item 4: the file's plain bearings at the AMB nodes (the AMB machine models each AMB

@@ -6,9 +6,7 @@
 
 mod common;
 
-use common::{
-    assert_exit, output_within, plant_bin, plant_run, read_json, read_text, refused, scene, stderr, Csv, TempDir,
-};
+use common::{assert_exit, output_within, plant_bin, plant_run, read_json, refused, stderr, Csv, TempDir};
 use std::process::Command;
 use std::time::Duration;
 
@@ -37,9 +35,7 @@ fn by_hand() -> (f64, f64) {
 /// `MagneticBearingElement` tables of [`AMB`] (what ROSS 3.1 saves, without the equivalent
 /// coefficient lists, which the reader does not use).
 fn machine(dir: &TempDir) -> std::path::PathBuf {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut file: toml::Table =
-        read_text(&root.join("plant/physics/tests/fixtures/ross/amb_machine.toml")).parse().unwrap();
+    let mut file: toml::Table = common::ross_amb_machine().parse().unwrap();
     for (name, n) in [("BearingElement_AMB A", 2), ("BearingElement_AMB B", 14)] {
         let mut el: toml::Table = AMB.parse().unwrap();
         el.insert("n".into(), n.into());
@@ -47,14 +43,7 @@ fn machine(dir: &TempDir) -> std::path::PathBuf {
         el.insert("tag".into(), name.trim_start_matches("BearingElement_").into());
         file.insert(name.into(), el.into());
     }
-    std::fs::write(dir.join("machine.toml"), toml::to_string(&file).unwrap()).unwrap();
-    let mut table: toml::Table = read_text(&scene("flexible-10g.toml")).parse().unwrap();
-    let rotor = table["rotor"].as_table_mut().unwrap();
-    rotor.remove("shaft");
-    rotor.insert("ross_file".into(), "machine.toml".into());
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
-    path
+    common::flexible_scene_on_ross_file(dir, &toml::to_string(&file).unwrap())
 }
 
 #[test]

@@ -240,23 +240,9 @@ fn every_edited_field_of_a_saved_state_is_refused_or_changes_nothing() {
         let _ = std::fs::remove_dir_all(&dir);
         (what.clone(), verdict)
     });
-    let failures: Vec<String> =
-        results.iter().filter_map(|(what, v)| v.as_ref().err().map(|e| format!("{what}: {e}"))).collect();
-    assert!(
-        failures.is_empty(),
-        "{} of {} edits neither refused nor harmless:\n{}",
-        failures.len(),
-        results.len(),
-        failures.join("\n")
-    );
+    edits::assert_refused_or_harmless(&results);
     // The known instances, refused for what they are.
-    let said = |what: &str| {
-        results
-            .iter()
-            .find(|(w, _)| w == what)
-            .and_then(|(_, v)| v.as_ref().ok().cloned().flatten())
-            .unwrap_or_default()
-    };
+    let said = |what: &str| edits::refusal(&results, what);
     let max = u64::MAX;
     for (what, needles) in [
         ("next_output = 0 (re-sealed)".to_owned(), &["next_output = 0", "the first output row after"][..]),

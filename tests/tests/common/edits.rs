@@ -93,3 +93,25 @@ pub fn on_two_threads<T: Sync, R: Send>(items: &[T], job: impl Fn(&T) -> R + Syn
     });
     results.into_inner().unwrap().into_iter().map(|r| r.expect("every item ran")).collect()
 }
+
+/// One edit's verdict: `Ok(Some(message))` refused with that message, `Ok(None)` harmless (the
+/// untouched file's outputs), `Err(why)` neither.
+pub type Verdict = Result<Option<String>, String>;
+
+/// Fails naming every edit (`(what, verdict)`) that was neither refused nor harmless.
+pub fn assert_refused_or_harmless(results: &[(String, Verdict)]) {
+    let failures: Vec<String> =
+        results.iter().filter_map(|(what, v)| v.as_ref().err().map(|e| format!("{what}: {e}"))).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} edits neither refused nor harmless:\n{}",
+        failures.len(),
+        results.len(),
+        failures.join("\n")
+    );
+}
+
+/// What the edit `what` was refused with (empty: it was harmless, or not made).
+pub fn refusal(results: &[(String, Verdict)], what: &str) -> String {
+    results.iter().find(|(w, _)| w == what).and_then(|(_, v)| v.as_ref().ok().cloned().flatten()).unwrap_or_default()
+}

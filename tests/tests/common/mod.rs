@@ -19,6 +19,25 @@ pub fn scene(name: &str) -> PathBuf {
     workspace_root().join("config").join(name)
 }
 
+/// The committed ROSS file of the AMB machine (saved by ROSS 3.1), as text.
+pub fn ross_amb_machine() -> String {
+    read_text(&workspace_root().join("plant/physics/tests/fixtures/ross/amb_machine.toml"))
+}
+
+/// The shipped flexible scene with its shaft from a ROSS file (`rotor.ross_file`) of text
+/// `machine` instead of its `[rotor.shaft]` table: writes `machine.toml` and `scene.toml` into
+/// `dir` and returns the scene's path.
+pub fn flexible_scene_on_ross_file(dir: &TempDir, machine: &str) -> PathBuf {
+    std::fs::write(dir.join("machine.toml"), machine).unwrap();
+    let mut table: toml::Table = read_text(&scene("flexible-10g.toml")).parse().unwrap();
+    let rotor = table["rotor"].as_table_mut().unwrap();
+    rotor.remove("shaft");
+    rotor.insert("ross_file".into(), "machine.toml".into());
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+    path
+}
+
 /// Writes `assess.toml` into `dir`: a small assessment of the study's scene (0.3 s runs in
 /// process, a damped `pd_delay`, the vibration and a ladder of one 3 G rung with two members),
 /// and returns its path.
