@@ -9,7 +9,7 @@ mod common;
 
 use common::{
     assert_exit, controller_bin, num, output_within, plant_run, read_json, rogue_bin, scene, stderr, workspace_root,
-    Csv, TempDir, SHORT,
+    write_script, Csv, TempDir, SHORT,
 };
 use std::path::PathBuf;
 use std::process::Command;
@@ -117,21 +117,18 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
 #[cfg(unix)]
 #[test]
 fn a_command_gets_the_run_id_and_is_respawned_after_a_crash() {
-    use std::os::unix::fs::PermissionsExt;
     let dir = TempDir::new("command-contract");
     let scene_file = dir.join("scene.toml");
     std::fs::copy(scene("paper-10g.toml"), &scene_file).unwrap();
     let wrapper = dir.join("wrap.sh");
     let log = dir.join("calls.txt");
-    std::fs::write(
+    write_script(
         &wrapper,
-        format!(
+        &format!(
             "#!/bin/sh\nprintf 'args %s | env %s %s\\n' \"$*\" \"$AMB_TESTBED_RUN_ID\" \"$AMB_TESTBED_CONNECT_TIMEOUT_S\" >> {log:?}\nexec {:?} \"$@\"\n",
             controller_bin().display().to_string()
         ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    );
     let out = dir.join("run");
     let id = format!("t{}-contract", std::process::id());
     let extra = sets(&[
@@ -372,23 +369,18 @@ fn the_c_header_has_every_constant_and_layout_of_wire_rs() {
 #[cfg(unix)]
 #[test]
 fn the_controllers_output_goes_to_controller_log_and_never_blocks_it() {
-    use std::os::unix::fs::PermissionsExt;
     let dir = TempDir::new("controller-log");
     let chatty = dir.join("chatty.sh");
     // 3 MiB on stdout (a pipe holds 64 KiB), a line on stderr, then the real controller.
-    std::fs::write(
+    write_script(
         &chatty,
-        format!(
+        &format!(
             "#!/bin/sh\nhead -c 3145728 /dev/zero | tr '\\0' x\necho 'chatty: starting' >&2\nexec {:?} \"$@\"\n",
             controller_bin().display().to_string()
         ),
-    )
-    .unwrap();
+    );
     let failing = dir.join("failing.sh");
-    std::fs::write(&failing, "#!/bin/sh\necho 'failing: cannot open my gains file' >&2\nexit 3\n").unwrap();
-    for script in [&chatty, &failing] {
-        std::fs::set_permissions(script, std::fs::Permissions::from_mode(0o755)).unwrap();
-    }
+    write_script(&failing, "#!/bin/sh\necho 'failing: cannot open my gains file' >&2\nexit 3\n");
 
     let out = dir.join("run");
     let extra = sets(&["controller.mode=lockstep".into(), command_set(&[&chatty.display().to_string()])]);

@@ -20,8 +20,8 @@ mod common;
 mod v3;
 
 use common::{
-    assert_exit, controller_bin, num, output_within, plant_bin, plant_run, read_json, scene, stderr, Csv, Proc,
-    TempDir, SHORT,
+    assert_exit, controller_bin, install_executable, num, output_within, plant_bin, plant_run, read_json, scene,
+    stderr, Csv, Proc, TempDir, SHORT,
 };
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -439,9 +439,7 @@ fn controller_without_a_plant_gives_up_with_exit_4() {
 fn missing_controller_executable_is_a_clear_error() {
     let dir = TempDir::new("cosim-no-controller");
     let lone = dir.join("plant");
-    if std::fs::hard_link(plant_bin(), &lone).is_err() {
-        std::fs::copy(plant_bin(), &lone).unwrap();
-    }
+    install_executable(plant_bin(), &lone);
     let out = dir.join("run");
     let mut cmd = Command::new(&lone);
     cmd.arg("run").arg(scene("paper-10g.toml")).arg("--out").arg(&out);

@@ -18,7 +18,9 @@
 
 mod common;
 
-use common::{assert_exit, fmpy_venv, output_within, plant_bin, scene, stderr, workspace_root, Csv, TempDir};
+use common::{
+    assert_exit, fmpy_venv, install_executable, output_within, plant_bin, scene, stderr, workspace_root, Csv, TempDir,
+};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -790,7 +792,7 @@ fn plant_fmu_refuses_a_bad_scene_and_names_a_missing_binary() {
     assert!(!dir.join("x.fmu").exists());
     // A `plant` with no binary beside it says how to build one.
     let lonely = dir.join("plant");
-    std::fs::copy(plant_bin(), &lonely).expect("a copy of plant");
+    install_executable(plant_bin(), &lonely);
     let out = output_within(
         Command::new(&lonely).arg("fmu").arg(scene("cosim-10g.toml")).arg("--out").arg(dir.join("x.fmu")),
         LIMIT,

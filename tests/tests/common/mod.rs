@@ -637,3 +637,27 @@ impl Table {
         self.text(row, name).parse().unwrap_or_else(|e| panic!("{name} of row {row}: {e}"))
     }
 }
+
+/// Puts an executable at `to`, a copy of `from` with mode 755, written by a child process
+/// (`install`), never through a file descriptor of this test process. A test binary runs
+/// its tests on threads, and a sibling test's fork inherits every descriptor open at that
+/// moment: an executable this process held open for writing would then fail to start with
+/// "Text file busy" (ETXTBSY) until that child execs, as `plant fmu`'s test did in CI.
+pub fn install_executable(from: &Path, to: &Path) {
+    let status = Command::new("install")
+        .args(["-m", "755"])
+        .arg(from)
+        .arg(to)
+        .status()
+        .unwrap_or_else(|e| panic!("install {} {}: {e}", from.display(), to.display()));
+    assert!(status.success(), "install {} {}: {status}", from.display(), to.display());
+}
+
+/// Writes a script `text` as the executable `to` (mode 755), by way of
+/// [`install_executable`]: the text goes to a plain file first, which is never executed.
+pub fn write_script(to: &Path, text: &str) {
+    let draft = to.with_extension("draft");
+    std::fs::write(&draft, text).unwrap_or_else(|e| panic!("{}: {e}", draft.display()));
+    install_executable(&draft, to);
+    std::fs::remove_file(&draft).unwrap_or_else(|e| panic!("{}: {e}", draft.display()));
+}
