@@ -10,10 +10,18 @@
 //! that changes among them is a branch of the contact sequence that integration round-off
 //! could have picked as well, not a property of the machine or the controller.
 //!
-//! **The verdict.** `robust`: every member ends in the run's motion mode; `fragile`: at least
-//! one does not (the run's outcome is one branch of several). The figures' spread (least,
-//! median, largest over the run and its members) says how far a single-run figure can be
-//! trusted either way.
+//! **Integration error.** With `[robustness] integration` (on unless set to `false`), one more
+//! run repeats the scene unperturbed with its integrator refined: an adaptive method (DP5,
+//! DOP853) at a tenth of its tolerances, a fixed-step one with four times its substeps (and
+//! contact substeps). A contact sequence whose branch the integrator's own error picks (the
+//! flexible scene under coarse RK4 did) shows there, where the perturbed members, all run with
+//! the same integrator, may agree among themselves.
+//!
+//! **The verdict.** `robust`: every member, and the refined run, ends in the run's motion
+//! mode; `fragile`: at least one does not (the run's outcome is one branch of several). The
+//! figures' spread (least, median, largest over the run and its perturbed members) says how
+//! far a single-run figure can be trusted either way; the refined run's figures stand beside
+//! them.
 
 use crate::config::{load_scene, ConfigError, ControlMode, Scene};
 use crate::ensemble::member::{figures, Figures};
@@ -21,7 +29,7 @@ use crate::ensemble::stats::quantile;
 use crate::grid::Mode;
 use crate::hooks::Cancel;
 use crate::run::{run, Outcome};
-pub use crate::summary::{Robustness, Spread};
+pub use crate::summary::{IntegrationCheck, Robustness, Spread};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -71,6 +79,33 @@ pub fn perturbation(scene: &Scene, k: usize) -> Result<Vec<String>, ConfigError>
     Ok(vec![format!("rotor.unbalance_phase_deg={phase:?}"), format!("initial.rotor_x_um={x:?}")])
 }
 
+/// The integration-error run's overrides and their description: an adaptive method at a tenth of
+/// its tolerances, a fixed-step method with four times its substeps (at most the 100 000 the
+/// scene allows).
+pub fn refinement(scene: &Scene) -> Result<(Vec<String>, String), ConfigError> {
+    let i = scene.resolved()?.integrator;
+    let method = serde_json::to_value(i.method).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default();
+    if i.method.is_adaptive() {
+        let mut sets =
+            vec![format!("integrator.rtol={:?}", i.rtol / 10.0), format!("integrator.atol={:?}", i.atol / 10.0)];
+        let overrides = [
+            ("atol_position_m", i.atol_position_m),
+            ("atol_velocity_m_s", i.atol_velocity_m_s),
+            ("atol_angle_rad", i.atol_angle_rad),
+            ("atol_angular_speed_rad_s", i.atol_angular_speed_rad_s),
+        ];
+        sets.extend(overrides.iter().filter_map(|(k, v)| v.map(|v| format!("integrator.{k}={:?}", v / 10.0))));
+        Ok((sets, format!("{method} at rtol {:e}, atol {:e}", i.rtol / 10.0, i.atol / 10.0)))
+    } else {
+        let four = |n: u32| n.saturating_mul(4).min(100_000);
+        let sets = vec![
+            format!("integrator.substeps={}", four(i.substeps)),
+            format!("integrator.contact_substeps={}", four(i.contact_substeps)),
+        ];
+        Ok((sets, format!("{method} with {} substeps", four(i.substeps))))
+    }
+}
+
 fn spread(values: &[f64]) -> Spread {
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     Spread {
@@ -91,12 +126,22 @@ pub fn assess(
     n: usize,
     stop: &AtomicBool,
 ) -> anyhow::Result<Option<Robustness>> {
-    let mut scenes = Vec::with_capacity(n);
+    let mut scenes = Vec::with_capacity(n + 1);
     for k in 1..=n {
         let mut sets = set.to_vec();
         sets.extend(perturbation(scene, k)?);
         scenes.push(load_scene(path, &sets)?);
     }
+    let refined = match scene.resolved()?.robustness.is_some_and(|r| r.integration) {
+        true => {
+            let (extra, setting) = refinement(scene)?;
+            let mut sets = set.to_vec();
+            sets.extend(extra);
+            scenes.push(load_scene(path, &sets)?);
+            Some(setting)
+        }
+        false => None,
+    };
     let results: Vec<anyhow::Result<Option<Figures>>> = crate::assess::jobs_for(scene, || {
         scenes
             .par_iter()
@@ -109,18 +154,20 @@ pub fn assess(
             })
             .collect()
     });
-    let mut members = Vec::with_capacity(n);
+    let mut members = Vec::with_capacity(n + 1);
     for r in results {
         match r? {
             Some(f) => members.push(f),
             None => return Ok(None),
         }
     }
-    Ok(Some(judge(own, &members)))
+    let refined = refined.map(|setting| (members.pop().expect("the refined run is the last"), setting));
+    Ok(Some(judge(own, &members, refined)))
 }
 
-/// The verdict and spreads of the run `own` among its `members` (pure).
-pub fn judge(own: &Figures, members: &[Figures]) -> Robustness {
+/// The verdict and spreads of the run `own` among its perturbed `members`, and beside the run
+/// `refined` with its integrator refined (and that setting, in words) (pure).
+pub fn judge(own: &Figures, members: &[Figures], refined: Option<(Figures, String)>) -> Robustness {
     let mut modes: BTreeMap<&'static str, usize> = Mode::ALL.iter().map(|m| (m.name(), 0)).collect();
     for m in members {
         *modes.entry(m.mode.name()).or_default() += 1;
@@ -128,6 +175,15 @@ pub fn judge(own: &Figures, members: &[Figures]) -> Robustness {
     let same_mode = members.iter().filter(|m| m.mode == own.mode).count();
     let all: Vec<&Figures> = std::iter::once(own).chain(members).collect();
     let recoveries: Vec<f64> = all.iter().filter_map(|f| f.recovery_s).collect();
+    let integration = refined.map(|(f, setting)| IntegrationCheck {
+        setting,
+        mode: f.mode.name(),
+        same_mode: f.mode == own.mode,
+        max_contact_force_n: f.max_contact_force_n,
+        max_radius_m: f.max_radius_m,
+        recovery_s: f.recovery_s,
+    });
+    let agrees = same_mode == members.len() && integration.as_ref().is_none_or(|i| i.same_mode);
     Robustness {
         members: members.len(),
         perturbation: format!(
@@ -135,7 +191,7 @@ pub fn judge(own: &Figures, members: &[Figures]) -> Robustness {
              k = 1 … {}",
             members.len().div_ceil(2)
         ),
-        verdict: if same_mode == members.len() { "robust" } else { "fragile" },
+        verdict: if agrees { "robust" } else { "fragile" },
         run_mode: own.mode.name(),
         same_mode,
         modes,
@@ -143,6 +199,7 @@ pub fn judge(own: &Figures, members: &[Figures]) -> Robustness {
         max_radius_m: spread(&all.iter().map(|f| f.max_radius_m).collect::<Vec<_>>()),
         recovery_s: spread(&recoveries),
         still_touching: all.len() - recoveries.len(),
+        integration,
     }
 }
 
@@ -174,15 +231,37 @@ mod tests {
     fn a_run_is_fragile_when_a_member_ends_otherwise() {
         let own = run(Mode::Recovered, 5000.0, Some(0.2));
         let same = [run(Mode::Recovered, 5100.0, Some(0.25)), run(Mode::Recovered, 4900.0, Some(0.1))];
-        let r = judge(&own, &same);
+        let r = judge(&own, &same, None);
         assert_eq!((r.verdict, r.same_mode, r.members, r.still_touching), ("robust", 2, 2, 0));
         assert_eq!(r.max_contact_force_n, Spread { min: Some(4900.0), median: Some(5000.0), max: Some(5100.0) });
         assert_eq!((r.recovery_s.min, r.recovery_s.max), (Some(0.1), Some(0.25)));
         let mixed = [run(Mode::Recovered, 5100.0, Some(0.25)), run(Mode::Rebound, 6600.0, None)];
-        let r = judge(&own, &mixed);
+        let r = judge(&own, &mixed, None);
         assert_eq!((r.verdict, r.same_mode, r.still_touching), ("fragile", 1, 1));
         assert_eq!((r.modes["recovered"], r.modes["rebound"], r.modes["dry_whirl"]), (1, 1, 0));
         assert!(r.headline().contains("1 of 2 perturbed runs recovered as this one (FRAGILE)"), "{}", r.headline());
         assert!(r.headline().contains("peak contact force 5000–6600 N"), "{}", r.headline());
+    }
+
+    /// A refined integrator that ends in another mode makes the run fragile though every
+    /// perturbed member agrees; the headline says which setting and what it gave.
+    #[test]
+    fn a_run_is_fragile_when_the_refined_integrator_ends_otherwise() {
+        let own = run(Mode::Recovered, 5000.0, Some(0.2));
+        let same = [run(Mode::Recovered, 5100.0, Some(0.25)), run(Mode::Recovered, 4900.0, Some(0.1))];
+        let agreeing = judge(&own, &same, Some((run(Mode::Recovered, 5050.0, Some(0.2)), "dp5 at rtol 1e-7".into())));
+        assert_eq!(agreeing.verdict, "robust");
+        assert!(agreeing.headline().contains("integrator refined (dp5 at rtol 1e-7): recovered as this one"));
+        let r = judge(&own, &same, Some((run(Mode::Rebound, 6636.0, None), "rk4 with 64 substeps".into())));
+        assert_eq!((r.verdict, r.same_mode), ("fragile", 2));
+        let i = r.integration.as_ref().expect("the refined run");
+        assert_eq!((i.mode, i.same_mode, i.max_contact_force_n, i.recovery_s), ("rebound", false, 6636.0, None));
+        // The spreads stay those of the perturbed members and the run.
+        assert_eq!(r.max_contact_force_n.max, Some(5100.0));
+        assert!(
+            r.headline().contains("rk4 with 64 substeps): rebound (another mode), peak contact force 6636 N"),
+            "{}",
+            r.headline()
+        );
     }
 }

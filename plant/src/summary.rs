@@ -468,6 +468,27 @@ pub struct Robustness {
     pub recovery_s: Spread,
     /// Members (and the run) still touching at the end: no recovery time.
     pub still_touching: usize,
+    /// The run repeated with the integrator refined (`[robustness] integration`); absent when
+    /// not asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integration: Option<IntegrationCheck>,
+}
+
+/// `summary.json`'s `robustness.integration`: the run with its integrator refined.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct IntegrationCheck {
+    /// The refined setting, in words.
+    pub setting: String,
+    /// Its motion mode.
+    pub mode: &'static str,
+    /// Whether it ends in the run's motion mode.
+    pub same_mode: bool,
+    /// Its peak contact force (N).
+    pub max_contact_force_n: f64,
+    /// Its largest radius (m).
+    pub max_radius_m: f64,
+    /// Its recovery time (s); none while still touching.
+    pub recovery_s: Option<f64>,
 }
 
 impl Robustness {
@@ -477,8 +498,17 @@ impl Robustness {
             (Some(a), Some(b)) => format!("{:.*}–{:.*} {unit}", digits, a * scale, digits, b * scale),
             _ => "none".into(),
         };
+        let integration = match &self.integration {
+            Some(i) => format!(
+                "; integrator refined ({}): {}, peak contact force {:.0} N",
+                i.setting,
+                if i.same_mode { format!("{} as this one", i.mode) } else { format!("{} (another mode)", i.mode) },
+                i.max_contact_force_n
+            ),
+            None => String::new(),
+        };
         format!(
-            "robustness: {} of {} perturbed runs {} as this one ({}); peak contact force {}, max radius {}",
+            "robustness: {} of {} perturbed runs {} as this one ({}); peak contact force {}, max radius {}{integration}",
             self.same_mode,
             self.members,
             self.run_mode,

@@ -418,6 +418,27 @@ fn a_run_says_how_robust_its_outcome_is() {
     let (lo, hi) = (num(&r["max_radius_m"], "min"), num(&r["max_radius_m"], "max"));
     assert!(hi > lo && (hi - lo) < 1e-6 * hi, "perturbed, and only in the last digits: [{lo}, {hi}]");
     assert!(stderr(&o).contains(&format!("plant: robustness: {same} of 2 perturbed runs")), "{}", stderr(&o));
+    // The run repeated with its integrator refined (paper-10g: DP5 at rtol 1e-6, atol 1e-9):
+    // a tenth of both tolerances, its figures beside the spreads, close to the run's own.
+    let i = &r["integration"];
+    assert_eq!(i["setting"], "dp5 at rtol 1e-7, atol 1e-10", "{r}");
+    assert_eq!(i["same_mode"], i["mode"] == s["post_shock_mode"], "{r}");
+    let (own, refined) = (num(&s, "max_contact_force_n"), num(i, "max_contact_force_n"));
+    assert!((refined - own).abs() < 0.01 * own, "refined {refined} N against the run's {own} N");
+    assert!(stderr(&o).contains("integrator refined (dp5 at rtol 1e-7, atol 1e-10)"), "{}", stderr(&o));
+    let off = dir.join("no-integration");
+    let o = output_within(
+        plant_run(&scene("paper-10g.toml"), &off, &sets).args([
+            "--robustness",
+            "1",
+            "--set",
+            "robustness.integration=false",
+        ]),
+        LIMIT,
+    );
+    assert_exit(&o, 0);
+    let r = &read_json(&off.join("summary.json"))["robustness"];
+    assert!(r.get("integration").is_none() && r["members"] == 1, "{r}");
     // Bad input: nothing written.
     let bad = dir.join("bad");
     for (extra, says) in [

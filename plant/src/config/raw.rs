@@ -745,6 +745,9 @@ scene_table! {
 pub struct RawRobustness {
     /// Perturbed runs beside the run (0: none; at most 256).
     pub members: i64 = 0,
+    /// With `members` > 0, one more run with the integrator refined (a tenth of the adaptive
+    /// tolerances, or four times the fixed-step substeps): an outcome integration error picks.
+    pub integration: bool = true,
 }
 }
 
