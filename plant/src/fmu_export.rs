@@ -345,7 +345,7 @@ impl Model {
         // The whole resolved scene, not only the description's variables: an edited
         // resources/scene.toml (rotor.mass_kg, integrator.method: no FMU variable) made
         // another plant under the same GUID (issue 40 item 4).
-        let digest = Sha256::digest(format!("{}\n{text}", model.xml()).as_bytes());
+        let digest = Sha256::digest(format!("{}\n{}", model.xml(), portable(&table)?).as_bytes());
         let h: String = digest.iter().take(16).map(|b| format!("{b:02x}")).collect();
         model.guid = format!("{{{}-{}-{}-{}-{}}}", &h[0..8], &h[8..12], &h[12..16], &h[16..20], &h[20..32]);
         Ok(model)
@@ -608,25 +608,78 @@ pub fn find_library(library: Option<&Path>) -> Result<PathBuf, String> {
     }
 }
 
+/// The files a resolved scene reads: each one's place in the table (a recorded shock's `file`,
+/// `rotor.ross_file`), as a path of keys, and the path written there.
+fn files_read(table: &toml::Table) -> Vec<(Vec<String>, String)> {
+    let mut files = Vec::new();
+    let shocks = table.get("shock").and_then(|s| s.as_array()).map(Vec::as_slice).unwrap_or_default();
+    for (i, shock) in shocks.iter().enumerate() {
+        if let Some(file) = shock.get("file").and_then(|f| f.as_str()) {
+            files.push((vec!["shock".into(), i.to_string(), "file".into()], file.to_owned()));
+        }
+    }
+    if let Some(file) = table.get("rotor").and_then(|r| r.get("ross_file")).and_then(|f| f.as_str()) {
+        files.push((vec!["rotor".into(), "ross_file".into()], file.to_owned()));
+    }
+    files
+}
+
+/// Sets the string at `keys` (a table key, or an array index) in `table`.
+fn set_at(table: &mut toml::Table, keys: &[String], value: String) {
+    let Some((last, walk)) = keys.split_last() else { return };
+    let mut at: &mut toml::Value = match table.get_mut(&walk[0]) {
+        Some(v) => v,
+        None => return,
+    };
+    for k in &walk[1..] {
+        let next = match at {
+            toml::Value::Array(a) => k.parse::<usize>().ok().and_then(|i| a.get_mut(i)),
+            toml::Value::Table(t) => t.get_mut(k),
+            _ => None,
+        };
+        match next {
+            Some(v) => at = v,
+            None => return,
+        }
+    }
+    if let toml::Value::Table(t) = at {
+        t.insert(last.clone(), toml::Value::String(value));
+    }
+}
+
+/// The resolved scene with each file it reads named by the SHA-256 of its bytes instead of its
+/// path: what the GUID covers. The paths differ between where `plant fmu` stages the FMU and
+/// where an importer unpacks it (a GUID over them refused every FMU with a recorded shock at
+/// `fmi2Instantiate`); the bytes do not, and an edited file in `resources/` changes the GUID.
+fn portable(table: &toml::Table) -> Result<String, String> {
+    let mut t = table.clone();
+    for (keys, file) in files_read(table) {
+        let bytes = crate::input::read_bytes(Path::new(&file), crate::input::MAX_TABLE_BYTES)
+            .map_err(|e| format!("{} = {file}: {e}", keys.join(".")))?;
+        let hex: String = Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect();
+        set_at(&mut t, &keys, format!("sha256:{hex}"));
+    }
+    toml::to_string(&t).map_err(|e| e.to_string())
+}
+
 /// Writes the FMU of `scene` to `out` (FMI `fmi`): `modelDescription.xml`, `binaries/<platform>/<id>.so`
-/// (`library`), `resources/scene.toml` (the scene as resolved; a recorded shock's file beside
-/// it). Returns the model it describes.
+/// (`library`), `resources/scene.toml` (the scene as resolved; each file it reads, a recorded
+/// shock's or `rotor.ross_file`, beside it). Returns the model it describes.
 pub fn package(scene: &Scene, library: &Path, out: &Path, fmi: Fmi) -> anyhow::Result<Model> {
     use anyhow::Context;
     let mut raw: toml::Table = toml::from_str(&scene.to_toml()?).context("the resolved scene")?;
-    // A recorded shock's file goes into resources/ and the scene names it there.
+    // Each file the scene reads (a recorded shock's, the ROSS machine) goes into resources/ and
+    // the scene names it there.
     let mut extra = Vec::new();
-    if let Some(shocks) = raw.get_mut("shock").and_then(|s| s.as_array_mut()) {
-        for (i, shock) in shocks.iter_mut().enumerate() {
-            let Some(t) = shock.as_table_mut() else { continue };
-            if let Some(file) = t.get("file").and_then(|f| f.as_str()).map(PathBuf::from) {
-                let bytes = crate::input::read_bytes(&file, crate::input::MAX_TABLE_BYTES)
-                    .with_context(|| format!("shock[{i}].file {}", file.display()))?;
-                let name = format!("shock-{i}.csv");
-                t.insert("file".into(), toml::Value::String(name.clone()));
-                extra.push((name, bytes));
-            }
-        }
+    for (keys, file) in files_read(&raw) {
+        let bytes = crate::input::read_bytes(Path::new(&file), crate::input::MAX_TABLE_BYTES)
+            .with_context(|| format!("{} {file}", keys.join(".")))?;
+        let name = match keys[0].as_str() {
+            "shock" => format!("shock-{}.csv", keys[1]),
+            _ => "rotor-ross.toml".to_string(),
+        };
+        set_at(&mut raw, &keys, name.clone());
+        extra.push((name, bytes));
     }
     let text = toml::to_string(&raw).context("writing the scene")?;
     // The model as the binary will see it: from the scene read back from the text written.
@@ -712,5 +765,72 @@ mod tests {
         let other = Model::of(&crate::config::shipped("cosim-10g.toml", &["shock[0].peak_g=12.0"])).unwrap();
         assert_ne!(other.guid, planar.guid);
         assert_eq!(planar.guid, Model::of(&crate::config::shipped("cosim-10g.toml", &[])).unwrap().guid);
+    }
+
+    /// An FMU whose scene reads files (a recorded shock, a ROSS machine) carries them in
+    /// `resources/`, and the scene unpacked anywhere makes the GUID written into it (it once
+    /// held the staging folder's paths, and every such FMU was refused at instantiation); an
+    /// edited file in `resources/` makes another GUID.
+    #[test]
+    fn an_fmu_with_files_is_the_same_model_wherever_it_is_unpacked() {
+        let dir = std::env::temp_dir().join(format!("plant-fmu-files-test-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv: String = std::iter::once("t_s,accel_m_s2\n".to_string())
+            .chain((0..50).map(|i| format!("{},{}\n", i as f64 * 1e-4, (i as f64 * 0.1).sin() * 50.0)))
+            .collect();
+        std::fs::write(dir.join("rec.csv"), &csv).unwrap();
+        let mut table: toml::Table =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/cosim-10g.toml"))
+                .unwrap()
+                .parse()
+                .unwrap();
+        let mut shock = toml::Table::new();
+        shock.insert("kind".into(), "recorded".into());
+        shock.insert("file".into(), "rec.csv".into());
+        table.insert("shock".into(), toml::Value::Array(vec![toml::Value::Table(shock)]));
+        std::fs::write(dir.join("scene.toml"), toml::to_string(&table).unwrap()).unwrap();
+        let scene = load_scene(&dir.join("scene.toml"), &[]).unwrap();
+        let library = dir.join("lib.so");
+        std::fs::write(&library, b"not a library: package only copies it").unwrap();
+        let model = package(&scene, &library, &dir.join("x.fmu"), Fmi::V2).unwrap();
+        let unpacked = dir.join("unpacked");
+        std::fs::create_dir_all(&unpacked).unwrap();
+        let mut zip = zip::ZipArchive::new(std::fs::File::open(dir.join("x.fmu")).unwrap()).unwrap();
+        for name in ["resources/scene.toml", "resources/shock-0.csv"] {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut zip.by_name(name).unwrap(), &mut bytes).unwrap();
+            std::fs::write(unpacked.join(name.trim_start_matches("resources/")), bytes).unwrap();
+        }
+        let back = Model::of(&load_fmu_scene(&unpacked, &[]).unwrap()).unwrap();
+        assert_eq!(back.guid, model.guid);
+        std::fs::write(unpacked.join("shock-0.csv"), csv.replace(",0\n", ",1\n")).unwrap();
+        let edited = Model::of(&load_fmu_scene(&unpacked, &[]).unwrap()).unwrap();
+        assert_ne!(edited.guid, model.guid);
+
+        // The flexible scene on a ROSS file: the machine goes in as resources/rotor-ross.toml.
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        std::fs::copy(root.join("plant/physics/tests/fixtures/ross/amb_machine.toml"), dir.join("m.toml")).unwrap();
+        let mut table: toml::Table =
+            std::fs::read_to_string(root.join("config/flexible-10g.toml")).unwrap().parse().unwrap();
+        let rotor = table["rotor"].as_table_mut().unwrap();
+        rotor.remove("shaft");
+        rotor.insert("ross_file".into(), "m.toml".into());
+        rotor.insert("ross_bearings".into(), "ignore".into());
+        std::fs::write(dir.join("flex.toml"), toml::to_string(&table).unwrap()).unwrap();
+        let model =
+            package(&load_scene(&dir.join("flex.toml"), &[]).unwrap(), &library, &dir.join("f.fmu"), Fmi::V2).unwrap();
+        let flex = dir.join("flex");
+        std::fs::create_dir_all(&flex).unwrap();
+        let mut zip = zip::ZipArchive::new(std::fs::File::open(dir.join("f.fmu")).unwrap()).unwrap();
+        for name in ["resources/scene.toml", "resources/rotor-ross.toml"] {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut zip.by_name(name).unwrap(), &mut bytes).unwrap();
+            std::fs::write(flex.join(name.trim_start_matches("resources/")), bytes).unwrap();
+        }
+        std::fs::remove_file(dir.join("m.toml")).unwrap();
+        let back = Model::of(&load_fmu_scene(&flex, &[]).unwrap()).unwrap();
+        assert_eq!(back.guid, model.guid);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -773,6 +773,19 @@ fn a_ross_files_bearings_at_the_amb_nodes_need_a_choice() {
     assert_eq!(of("BearingElement_seal")["node"], 8);
     assert_eq!(of("BearingElement_seal")["stiffness_n_per_m"][0][0], 2e5);
     assert_eq!(summary["status"], "completed", "{summary:#}");
+    // The run folder's scene.toml names the machine by its absolute path: it reruns from
+    // anywhere, to the same trace (it named it relative to the scene's folder, and the rerun
+    // found no file).
+    let recorded = read_text(&out.join("scene.toml"));
+    let machine = std::path::absolute(dir.join("machine.toml")).unwrap().display().to_string();
+    assert!(recorded.contains(&format!("ross_file = {machine:?}")), "{recorded}");
+    let rerun = dir.join("rerun");
+    let again = output_within(
+        Command::new(plant_bin()).arg("run").arg(out.join("scene.toml")).arg("--out").arg(&rerun).arg("--quiet"),
+        RUN,
+    );
+    assert_exit(&again, 0);
+    assert_eq!(read_text(&out.join("trace.csv")), read_text(&rerun.join("trace.csv")));
     // ROSS's MagneticBearingElement: with a zero gap refused naming it; whole, refused with the
     // constants it stands for (not yet the plane's AMB).
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");

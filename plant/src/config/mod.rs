@@ -361,15 +361,22 @@ impl Scene {
     /// The scene as resolved (every key, overrides applied), as a scene file: `scene.toml` of
     /// a run folder, which reproduces the run.
     ///
-    /// A recorded shock's `file` is written as an absolute path, so that the run folder's
-    /// `scene.toml` finds it wherever the folder is (`plant analyze`, a rerun).
+    /// Every file the scene reads (a recorded shock's `file`, `rotor.ross_file`) is written as
+    /// an absolute path, so that the run folder's `scene.toml` finds it wherever the folder is
+    /// (`plant analyze`, a rerun).
     pub fn to_toml(&self) -> Result<String, ConfigError> {
         let mut raw = self.source.raw.clone();
+        let absolute = |file: &Path| {
+            let joined = self.source.base_dir.join(file);
+            std::path::absolute(&joined).unwrap_or(joined)
+        };
         for shock in &mut raw.shock {
             if let ShockSpec::Recorded { file, .. } = shock {
-                let joined = self.source.base_dir.join(&*file);
-                *file = std::path::absolute(&joined).unwrap_or(joined);
+                *file = absolute(file);
             }
+        }
+        if let Some(file) = &mut raw.rotor.ross_file {
+            *file = absolute(Path::new(file)).display().to_string();
         }
         toml::to_string(&raw)
             .map_err(|e| ConfigError::Parse { path: "the resolved scene".into(), message: e.to_string() })
