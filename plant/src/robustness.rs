@@ -18,7 +18,10 @@
 //! the same integrator, may agree among themselves.
 //!
 //! **The verdict.** `robust`: every member, and the refined run, ends in the run's motion
-//! mode; `fragile`: at least one does not (the run's outcome is one branch of several). The
+//! mode, and the refined run's peak contact force and largest radius are the run's within
+//! [`CONVERGED`]; `fragile`: at least one ends in another mode (the run's outcome is one branch
+//! of several); `unconverged`: all end in the run's mode, but the refined run's figures are not
+//! the run's (the integrator's setting is too coarse for them). The
 //! figures' spread (least, median, largest over the run and its perturbed members) says how
 //! far a single-run figure can be trusted either way; the refined run's figures stand beside
 //! them.
@@ -37,6 +40,10 @@ use std::sync::atomic::AtomicBool;
 
 /// The most perturbed members a run may ask for.
 pub const MAX_MEMBERS: usize = 256;
+
+/// How far (relative) the refined run's peak contact force and largest radius may be from the
+/// run's for its figures to count as converged in the integrator.
+pub const CONVERGED: f64 = 0.01;
 
 /// The unbalance angle's step (rad).
 pub const ANGLE_STEP_RAD: f64 = 1e-9;
@@ -179,11 +186,15 @@ pub fn judge(own: &Figures, members: &[Figures], refined: Option<(Figures, Strin
         setting,
         mode: f.mode.name(),
         same_mode: f.mode == own.mode,
+        converged: [(f.max_contact_force_n, own.max_contact_force_n), (f.max_radius_m, own.max_radius_m)]
+            .iter()
+            .all(|&(a, b)| (a - b).abs() <= CONVERGED * a.abs().max(b.abs())),
         max_contact_force_n: f.max_contact_force_n,
         max_radius_m: f.max_radius_m,
         recovery_s: f.recovery_s,
     });
     let agrees = same_mode == members.len() && integration.as_ref().is_none_or(|i| i.same_mode);
+    let converged = integration.as_ref().is_none_or(|i| i.converged);
     Robustness {
         members: members.len(),
         perturbation: format!(
@@ -191,7 +202,11 @@ pub fn judge(own: &Figures, members: &[Figures], refined: Option<(Figures, Strin
              k = 1 … {}",
             members.len().div_ceil(2)
         ),
-        verdict: if agrees { "robust" } else { "fragile" },
+        verdict: match (agrees, converged) {
+            (false, _) => "fragile",
+            (true, false) => "unconverged",
+            (true, true) => "robust",
+        },
         run_mode: own.mode.name(),
         same_mode,
         modes,
@@ -263,5 +278,15 @@ mod tests {
             "{}",
             r.headline()
         );
+        // The same mode with another peak (the flexible scene at RK4 with 2 substeps: 35 343 N,
+        // refined 5 102 N): the run's figures are not converged in the integrator.
+        let own = run(Mode::Rebound, 35_343.0, None);
+        let r =
+            judge(&own, &[run(Mode::Rebound, 35_343.0, None)], Some((run(Mode::Rebound, 5102.0, None), "rk4".into())));
+        assert_eq!(r.verdict, "unconverged");
+        assert!(r.headline().contains("rebound as this one but with other figures"), "{}", r.headline());
+        // Within 1 %: converged.
+        let r = judge(&own, &[], Some((run(Mode::Rebound, 35_343.0 * 1.009, None), "rk4".into())));
+        assert_eq!(r.verdict, "robust");
     }
 }

@@ -452,7 +452,9 @@ pub struct Robustness {
     pub members: usize,
     /// What was perturbed, in words.
     pub perturbation: String,
-    /// `robust` (every member in the run's mode) or `fragile`.
+    /// `robust` (every member and the refined run in the run's mode, the refined run's figures
+    /// the run's), `fragile` (a member or the refined run in another mode) or `unconverged`
+    /// (all in the run's mode, but the refined run's figures are not the run's).
     pub verdict: &'static str,
     /// The run's own motion mode.
     pub run_mode: &'static str,
@@ -483,6 +485,9 @@ pub struct IntegrationCheck {
     pub mode: &'static str,
     /// Whether it ends in the run's motion mode.
     pub same_mode: bool,
+    /// Whether its peak contact force and largest radius are the run's within
+    /// `robustness::CONVERGED` (relative): the run's figures are converged in the integrator.
+    pub converged: bool,
     /// Its peak contact force (N).
     pub max_contact_force_n: f64,
     /// Its largest radius (m).
@@ -502,7 +507,11 @@ impl Robustness {
             Some(i) => format!(
                 "; integrator refined ({}): {}, peak contact force {:.0} N",
                 i.setting,
-                if i.same_mode { format!("{} as this one", i.mode) } else { format!("{} (another mode)", i.mode) },
+                match (i.same_mode, i.converged) {
+                    (true, true) => format!("{} as this one", i.mode),
+                    (true, false) => format!("{} as this one but with other figures", i.mode),
+                    (false, _) => format!("{} (another mode)", i.mode),
+                },
                 i.max_contact_force_n
             ),
             None => String::new(),

@@ -409,7 +409,8 @@ fn a_run_says_how_robust_its_outcome_is() {
     assert_eq!(counted, 2, "{r}");
     assert_eq!(r["run_mode"], s["post_shock_mode"], "{r}");
     let same = r["same_mode"].as_u64().expect("same_mode");
-    assert_eq!(r["verdict"], if same == 2 { "robust" } else { "fragile" }, "{r}");
+    let refined_same = r["integration"]["same_mode"] == true;
+    assert_eq!(r["verdict"], if same == 2 && refined_same { "robust" } else { "fragile" }, "{r}");
     for (key, figure) in [("max_contact_force_n", "max_contact_force_n"), ("max_radius_m", "max_radius_m")] {
         let own = num(&s, figure);
         let (lo, hi) = (num(&r[key], "min"), num(&r[key], "max"));
@@ -425,6 +426,9 @@ fn a_run_says_how_robust_its_outcome_is() {
     assert_eq!(i["same_mode"], i["mode"] == s["post_shock_mode"], "{r}");
     let (own, refined) = (num(&s, "max_contact_force_n"), num(i, "max_contact_force_n"));
     assert!((refined - own).abs() < 0.01 * own, "refined {refined} N against the run's {own} N");
+    let radius = (num(&s, "max_radius_m"), num(i, "max_radius_m"));
+    assert!((radius.1 - radius.0).abs() < 0.01 * radius.0, "radius {radius:?}");
+    assert_eq!(i["converged"], true, "{r}");
     assert!(stderr(&o).contains("integrator refined (dp5 at rtol 1e-7, atol 1e-10)"), "{}", stderr(&o));
     let off = dir.join("no-integration");
     let o = output_within(
