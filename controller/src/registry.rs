@@ -72,7 +72,12 @@ pub fn build_law(name: &str, design: &Design, params: &Params) -> Result<Box<dyn
         return (entry.build)(design, params);
     }
     match ROTOR_LAWS.iter().find(|e| e.name == name) {
-        Some(e) => Err(LawError::Axes { law: e.name, axes: 2, drives: "a two-plane rotor (4 axes) only" }),
+        // Not "two-plane only": state_space drives a planar rotor too, as a law of the rotor.
+        Some(e) => Err(LawError::Axes {
+            law: e.name,
+            axes: 2,
+            drives: "the whole rotor at once, not one plane (build it with build_rotor_law)",
+        }),
         None => Err(LawError::Unknown { name: name.to_string(), known: all_law_names() }),
     }
 }
@@ -173,6 +178,9 @@ mod tests {
         }
         let e = build_law("modal", &design(), &Params::default()).err().unwrap();
         assert!(matches!(e, LawError::Axes { law: "modal", axes: 2, .. }), "{e:?}");
+        // state_space drives a planar rotor too: the refusal says why it is not a plane's law.
+        let e = build_law("state_space", &design(), &Params::default()).err().unwrap().to_string();
+        assert!(e.contains("the whole rotor at once") && !e.contains("two-plane"), "{e}");
     }
 
     /// A per-plane law on the two-plane rotor is that law once per plane, each built from its
