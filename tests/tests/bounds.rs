@@ -229,8 +229,8 @@ fn keys_of_a_choice_not_made_and_absurd_stiffness_are_refused_at_load() {
 
 /// Issue 40 item 7: a regular file of `/proc` waits in its read (`/proc/kmsg`) or reads bytes
 /// though its size is 0 (`/proc/self/status`), and a FIFO waits in its opening. At each entry
-/// that reads a user's file (the scene, `--from-state`, a soak programme, an assessment, the
-/// controller's `--config`), a FIFO and `/proc/self/status` are refused at once, exit 2, named
+/// that reads a user's file (the scene, `--from-state`, `rotor.ross_file`, a recorded shock's
+/// `file`, a soak programme, an assessment, the controller's `--config`), a FIFO and `/proc/self/status` are refused at once, exit 2, named
 /// (the bounded reader opens with `O_NONBLOCK` and wants a regular file with a size).
 #[cfg(target_os = "linux")]
 #[test]
@@ -241,6 +241,16 @@ fn every_entry_refuses_a_fifo_and_a_size_0_file_of_proc_at_once() {
     let status = Path::new("/proc/self/status");
     let paper = scene("paper-10g.toml");
     let controller = common::controller_bin();
+    // A flexible scene on a ROSS file, and a scene with a recorded shock: their files are set
+    // to the input below.
+    let flexible = common::flexible_scene_on_ross_file(&dir, &common::ross_amb_machine());
+    let mut recorded: toml::Table = common::read_text(&paper).parse().unwrap();
+    let mut shock = toml::Table::new();
+    shock.insert("kind".into(), "recorded".into());
+    shock.insert("file".into(), "shock.csv".into());
+    recorded.insert("shock".into(), toml::Value::Array(vec![toml::Value::Table(shock)]));
+    let recorded_scene = dir.join("recorded.toml");
+    std::fs::write(&recorded_scene, toml::to_string(&recorded).unwrap()).unwrap();
     for input in [fifo.as_path(), status] {
         let shown = input.display().to_string();
         let out = dir.join("out");
@@ -263,6 +273,18 @@ fn every_entry_refuses_a_fifo_and_a_size_0_file_of_proc_at_once() {
             ("assess", {
                 let mut c = Command::new(plant_bin());
                 c.arg("assess").arg(input).arg("--out").arg(&out);
+                c
+            }),
+            ("rotor.ross_file", {
+                let mut c = Command::new(plant_bin());
+                c.arg("run").arg(&flexible).arg("--out").arg(&out);
+                c.args(["--set", "rotor.ross_bearings=\"ignore\"", "--set", &format!("rotor.ross_file={shown:?}")]);
+                c
+            }),
+            ("a recorded shock's file", {
+                let mut c = Command::new(plant_bin());
+                c.arg("run").arg(&recorded_scene).arg("--out").arg(&out);
+                c.args(["--set", &format!("shock[0].file={shown:?}")]);
                 c
             }),
             ("controller --config", {
