@@ -58,9 +58,9 @@ const GRID: usize = 2000;
 /// `discrete` for a sampled law) over `[f_min, f_max]` (Hz; a sampled law's band is cut at
 /// 0.499 of its rate).
 pub fn margins(law: &LinearLaw, continuous: &System, discrete: &System, f_min: f64, f_max: f64) -> Vec<AxisMargins> {
-    let f_max = match law {
-        LinearLaw::Sampled { period, .. } => f_max.min(0.499 / period),
-        LinearLaw::Continuous(_) => f_max,
+    let f_max = match law.period() {
+        Some(period) => f_max.min(0.499 / period),
+        None => f_max,
     };
     let axes = continuous.b.ncols();
     let g = |f: f64| -> Vec<C64> {

@@ -201,3 +201,42 @@ fn a_unipolar_drive_is_the_bipolar_one_with_half_the_back_emf() {
     let other = model("realistic-10g.toml", &[common[0], "amb.back_emf_v_s_per_m=432"], 500.0);
     assert_ne!(other.plant.system, bipolar.plant.system, "k_b is in the model");
 }
+
+/// The linear forms of `transfer_function` and `state_space` (their margins computed, not only
+/// measured): without `num`/`den` (`a` … `c`) each law is the design's PD as `pd` samples it
+/// (controller/src/transfer_function.rs, state_space.rs), a second reading of the same law by
+/// another path (`DiscreteTf`'s coefficients, the state-space system's response), so its
+/// sensitivity on the linear plant is `pd`'s: on the planar rotor and on the two-plane one at
+/// speed (the state-space law as the full matrix `C(z)` of every axis at once).
+#[test]
+fn transfer_function_and_state_space_laws_have_the_pds_linear_form() {
+    for (file, speed_hz) in [("paper-10g.toml", 0.0), ("two-plane-asymmetric-10g.toml", 300.0)] {
+        let scene_of = |law: &str| {
+            let l = format!("controller.law=\"{law}\"");
+            shipped(file, &["controller.mode=\"sampled\"", &l])
+        };
+        let pd = scene_of("pd");
+        let b = build(&pd, speed_hz).expect("model");
+        let reference = law::of(&pd).expect("pd's linear form");
+        for name in ["transfer_function", "state_space"] {
+            let scene = scene_of(name);
+            let form = law::of(&scene).unwrap_or_else(|| panic!("{file}: {name} has no linear form"));
+            assert_eq!(form.period(), reference.period());
+            let mut worst: f64 = 0.0;
+            for f in freqs().into_iter().filter(|f| *f < 9e3) {
+                let want = law::sensitivity(&reference, &b.plant.system, &b.discrete.0, f);
+                let got = law::sensitivity(&form, &b.plant.system, &b.discrete.0, f);
+                for k in 0..want.nrows() {
+                    worst = worst.max(rel(got[(k, k)], want[(k, k)]));
+                }
+                if matches!(form, LinearLaw::StateSpace { .. }) {
+                    // The PD per axis: no coupling between the axes' laws.
+                    let c = form.matrix_at(f);
+                    assert!((0..c.nrows()).all(|i| (0..c.ncols()).all(|j| i == j || c[(i, j)].norm() == 0.0)));
+                }
+            }
+            eprintln!("{file} {name}: |ΔS|/|S| up to {worst:.1e} against pd");
+            assert!(worst < 1e-9, "{file} {name}: |ΔS|/|S| up to {worst:e} against pd");
+        }
+    }
+}
