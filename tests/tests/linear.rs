@@ -819,6 +819,13 @@ fn the_worked_loop_designs_in_python_control_and_the_report_card_agrees() {
         // A design, not a stub: stable, zone A (|S| below 9.5 dB), a phase margin above 30°.
         assert!(s < 9.5 && pm > 30.0, "{axis}: {r}");
     }
+    // The report card's open-loop Bode and Nyquist charts (item 3): the section and the chart,
+    // the last axis' colour (y_B, the palette's fourth, 0xd6 0x27 0x28) drawn on it.
+    let html = common::read_text(&out.join("assess/report.html"));
+    assert!(html.contains("Open loop: Bode and Nyquist") && html.contains("open_loop_1.png"), "no open-loop section");
+    let chart = common::Png::read(&out.join("assess/open_loop_1.png"));
+    assert_eq!((chart.width, chart.height), (1800, 800));
+    assert!(chart.count_in_plot([0xd6, 0x27, 0x28]) > 2000, "y_B's curve is not on the open-loop chart");
     let summary = common::read_json(&out.join("shock/summary.json"));
     assert_eq!(summary["status"], "completed", "{summary}");
     assert_eq!(summary["model"]["law"], "state_space", "{summary}");

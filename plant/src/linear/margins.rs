@@ -106,6 +106,20 @@ pub fn margins(law: &LinearLaw, continuous: &System, discrete: &System, f_min: f
         .collect()
 }
 
+/// Each axis' open loop `G_o = 1 / S_kk − 1` (the margins' loop, every other axis closed) at
+/// each of `freqs` (Hz): `[axis][frequency]`, for the report card's Bode and Nyquist charts.
+pub fn open_loops(law: &LinearLaw, continuous: &System, discrete: &System, freqs: &[f64]) -> Vec<Vec<C64>> {
+    let axes = continuous.b.ncols();
+    let mut out = vec![Vec::with_capacity(freqs.len()); axes];
+    for &f in freqs {
+        let s = law::sensitivity(law, continuous, discrete, f);
+        for (k, row) in out.iter_mut().enumerate() {
+            row.push(C64::new(1.0, 0.0) / s[(k, k)] - 1.0);
+        }
+    }
+    out
+}
+
 /// The root of `h` in `[lo, hi]` where it changes sign (`h(lo)` has the sign of `at_lo`), by
 /// bisection to the last bits of `f`.
 fn bisect(mut lo: f64, mut hi: f64, h: &dyn Fn(f64) -> f64, at_lo: f64) -> f64 {
