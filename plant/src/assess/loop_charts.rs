@@ -259,21 +259,37 @@ fn chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
 /// embedding them (empty where nothing was measured).
 pub fn section(dir: &Path, r: &Report) -> anyhow::Result<String> {
     let mut h = String::new();
+    let head = |h: &mut String| {
+        if h.is_empty() {
+            let _ = writeln!(
+                h,
+                "<h2>Open loop: Bode and Nyquist</h2><p class=\"note\">Each measured axis' open loop \
+                 G<sub>o</sub>, every other axis closed (S = 1/(1 + G<sub>o</sub>)): lines, the closed \
+                 form (the law's linear form on the linear plant; none for a law without one); dots, the \
+                 measured points (G<sub>o</sub> = 1/S − 1). The gain margin is read where the phase \
+                 crosses −180°, the phase margin where |G<sub>o</sub>| crosses 0 dB; on the Nyquist plot, \
+                 the distance to −1 (the cross), with the unit circle. An AMB's open loop is unstable: its \
+                 Nyquist plot starts on the negative real axis left of −1.</p>"
+            );
+        }
+    };
     for (i, c) in r.controllers.iter().enumerate() {
+        // Said whether or not the loop was measured stable.
+        let unstable =
+            c.sensitivity.result.as_ref().and_then(|s| s.margins.first()).map_or(0, |m| m.law_unstable_poles);
+        if unstable > 0 {
+            head(&mut h);
+            let _ = writeln!(
+                h,
+                "<p class=\"note\"><b>{}: an unstable controller</b>: its linear form has {unstable} pole(s) \
+                 outside the unit circle (allowed: some designs are; the loop's stability is the sensitivity's \
+                 and the Nyquist plot's).</p>",
+                c.label.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+            );
+        }
         let name = format!("open_loop_{}.png", i + 1);
         if chart(&dir.join(&name), c)? {
-            if h.is_empty() {
-                let _ = writeln!(
-                    h,
-                    "<h2>Open loop: Bode and Nyquist</h2><p class=\"note\">Each measured axis' open loop \
-                     G<sub>o</sub>, every other axis closed (S = 1/(1 + G<sub>o</sub>)): lines, the closed \
-                     form (the law's linear form on the linear plant; none for a law without one); dots, the \
-                     measured points (G<sub>o</sub> = 1/S − 1). The gain margin is read where the phase \
-                     crosses −180°, the phase margin where |G<sub>o</sub>| crosses 0 dB; on the Nyquist plot, \
-                     the distance to −1 (the cross), with the unit circle. An AMB's open loop is unstable: its \
-                     Nyquist plot starts on the negative real axis left of −1.</p>"
-                );
-            }
+            head(&mut h);
             h.push_str(&image(dir, &name, &format!("{}: open loop, Bode and Nyquist", c.label))?);
         }
     }

@@ -48,6 +48,10 @@ pub struct AxisMargins {
     /// law has no linear form. Not in `report.json`.
     #[serde(skip)]
     pub open_loop: Vec<(f64, C64)>,
+    /// The law's own poles outside the unit circle (its linear form's; 0 without one): an
+    /// unstable controller, which the report says. Not in `report.json`.
+    #[serde(skip)]
+    pub law_unstable_poles: usize,
 }
 
 /// Points of the computed open loop drawn on the charts.
@@ -68,6 +72,7 @@ pub fn of(scene: &Scene, measured: &[AxisResult]) -> Vec<AxisMargins> {
     let freqs: Vec<f64> =
         (0..OPEN_LOOP_POINTS).map(|i| lo * (hi / lo).powf(i as f64 / (OPEN_LOOP_POINTS - 1) as f64)).collect();
     let mut open_loop = Vec::new();
+    let unstable = law.as_ref().map_or(0, |l| l.unstable_poles());
     measured
         .iter()
         .map(|x| {
@@ -96,7 +101,14 @@ pub fn of(scene: &Scene, measured: &[AxisResult]) -> Vec<AxisMargins> {
             let points: Vec<(f64, C64)> =
                 x.points.iter().map(|p| (p.f_hz, C64::new(p.s[0], p.s[1]))).filter(|(_, s)| s.norm() > 0.0).collect();
             let measured = (x.stable && points.len() >= 2).then(|| measured_margins(&points));
-            AxisMargins { axis: x.axis.clone(), speed_hz: x.speed_hz, computed, measured, open_loop: open_loop.clone() }
+            AxisMargins {
+                axis: x.axis.clone(),
+                speed_hz: x.speed_hz,
+                computed,
+                measured,
+                open_loop: open_loop.clone(),
+                law_unstable_poles: unstable,
+            }
         })
         .collect()
 }

@@ -40,6 +40,8 @@ struct JsonLaw<'a> {
     /// A state-space law's discrete system (its `axes` empty).
     #[serde(skip_serializing_if = "Option::is_none")]
     system: Option<JsonLawSystem>,
+    /// The law's own poles outside the unit circle (summed over the axes of a per-axis law).
+    unstable_poles: usize,
 }
 
 #[derive(Serialize)]
@@ -150,6 +152,7 @@ pub fn json(e: &Export<'_>) -> Vec<u8> {
                 }
                 _ => None,
             },
+            unstable_poles: law.unstable_poles(),
         }),
         margins: e
             .margins

@@ -73,6 +73,31 @@ impl LinearLaw {
         }
     }
 
+    /// The law's own poles outside the stability region (`|z| > 1`; a continuous PD has none):
+    /// an unstable controller is allowed (some designs are), and the report says so.
+    pub fn unstable_poles(&self) -> usize {
+        let outside = |m: DMatrix<f64>| m.complex_eigenvalues().iter().filter(|p| p.norm() > 1.0 + 1e-12).count();
+        match self {
+            LinearLaw::Continuous(_) => 0,
+            // Each axis' denominator `1 + d₁ z⁻¹ + …`: the eigenvalues of its companion matrix.
+            LinearLaw::Sampled { laws, .. } => laws
+                .iter()
+                .map(|l| {
+                    let n = l.den.len();
+                    if n == 0 {
+                        return 0;
+                    }
+                    outside(DMatrix::from_fn(n, n, |i, j| match i {
+                        0 => -l.den[j],
+                        _ if j + 1 == i => 1.0,
+                        _ => 0.0,
+                    }))
+                })
+                .sum(),
+            LinearLaw::StateSpace { system, .. } => outside(system.a.clone()),
+        }
+    }
+
     /// The sampling period (s) of a sampled law, `None` for a continuous one.
     pub fn period(&self) -> Option<f64> {
         match self {

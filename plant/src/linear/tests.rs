@@ -240,3 +240,37 @@ fn transfer_function_and_state_space_laws_have_the_pds_linear_form() {
         }
     }
 }
+
+/// An unstable controller is allowed and said: a `transfer_function` law `1/(1 − 1.5 z⁻¹)`
+/// (its pole at z = 1.5) has one unstable pole per axis; the design's PD none; a `state_space`
+/// law with `A_d = diag(1.5, 0.5)`, one.
+#[test]
+fn a_laws_unstable_poles_are_counted() {
+    let tf = shipped(
+        "paper-10g.toml",
+        &[
+            "controller.mode=\"sampled\"",
+            "controller.law=\"transfer_function\"",
+            "controller.params.num=[1.0, 0.0]",
+            "controller.params.den=[1.0, -1.5]",
+            "controller.params.domain=\"z\"",
+            "controller.params.dt_s=5e-5",
+        ],
+    );
+    assert_eq!(law::of(&tf).expect("linear form").unstable_poles(), 2, "one per axis, x and y");
+    let pd = shipped("paper-10g.toml", &["controller.mode=\"sampled\"", "controller.law=\"transfer_function\""]);
+    assert_eq!(law::of(&pd).expect("linear form").unstable_poles(), 0);
+    let ss = shipped(
+        "paper-10g.toml",
+        &[
+            "controller.mode=\"sampled\"",
+            "controller.law=\"state_space\"",
+            "controller.params.a=[[1.5, 0.0], [0.0, 0.5]]",
+            "controller.params.b=[[1.0, 0.0], [0.0, 1.0]]",
+            "controller.params.c=[[-1.0, 0.0], [0.0, -1.0]]",
+            "controller.params.domain=\"z\"",
+            "controller.params.dt_s=5e-5",
+        ],
+    );
+    assert_eq!(law::of(&ss).expect("linear form").unstable_poles(), 1);
+}
