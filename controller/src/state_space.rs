@@ -58,16 +58,23 @@ pub const LAW: RotorLawEntry = RotorLawEntry {
 };
 
 fn build(design: &RotorDesign, params: &Params) -> Result<Box<dyn RotorLaw>, LawError> {
-    design.check()?;
-    let mut p = params.reader(LAW.name);
-    let system = read(&mut p, design)?;
-    p.finish()?;
+    let system = discrete(design, params)?;
     let mut bias = [0.0; ROTOR_AXES];
     for (k, plane) in design.planes().iter().enumerate() {
         let b = PdGains::from_design(&plane.pd(), &plane.constants)?.bias_a;
         bias[2 * k..2 * k + 2].copy_from_slice(&b);
     }
     Ok(Box::new(StateSpace::new(system, bias)))
+}
+
+/// The discrete system the law runs on `design` with `params` (read, checked and discretised as
+/// [`LAW`] builds it): the law's linear form, which the plant's margins are computed from.
+pub fn discrete(design: &RotorDesign, params: &Params) -> Result<DiscreteSs, LawError> {
+    design.check()?;
+    let mut p = params.reader(LAW.name);
+    let system = read(&mut p, design)?;
+    p.finish()?;
+    Ok(system)
 }
 
 /// A discrete state-space system `(A_d, B_d, C_d, D_d)`.

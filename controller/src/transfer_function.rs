@@ -74,11 +74,18 @@ pub const LAW: LawEntry = LawEntry {
 };
 
 fn build(design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawError> {
+    let tf = discrete(design, params)?;
+    let bias = PdGains::from_design(&design.pd(), &design.constants)?.bias_a;
+    Ok(Box::new(TransferFunction::new(tf, bias)))
+}
+
+/// The discrete transfer the law runs on `design` with `params` (read, checked and discretised
+/// as [`LAW`] builds it): the law's linear form, which the plant's margins are computed from.
+pub fn discrete(design: &Design, params: &Params) -> Result<DiscreteTf, LawError> {
     let mut p = params.reader(LAW.name);
     let tf = read(&mut p, design)?;
     p.finish()?;
-    let bias = PdGains::from_design(&design.pd(), &design.constants)?.bias_a;
-    Ok(Box::new(TransferFunction::new(tf, bias)))
+    Ok(tf)
 }
 
 pub use crate::discretisation::Method;

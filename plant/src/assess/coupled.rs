@@ -63,6 +63,7 @@ fn law_of(scene: &Scene) -> Option<Law> {
             let laws: [AxisLaw; 4] = laws.try_into().ok()?;
             Some(Law::Sampled(SampledLoop { laws, period, delay: scene.controller.delay_samples }))
         }
+        LinearLaw::StateSpace { .. } => None,
     }
 }
 

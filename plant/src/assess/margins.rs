@@ -43,26 +43,54 @@ pub struct AxisMargins {
     pub computed: Option<Margins>,
     /// From the measured sensitivity (`None`: an unstable loop, not measured).
     pub measured: Option<Margins>,
+    /// The computed open loop `G_o` on [`OPEN_LOOP_POINTS`] log-spaced frequencies, `(f (Hz),
+    /// G_o)`, for the report's Bode and Nyquist charts (`super::loop_charts`); empty where the
+    /// law has no linear form. Not in `report.json`.
+    #[serde(skip)]
+    pub open_loop: Vec<(f64, C64)>,
+    /// The law's own poles outside the unit circle (its linear form's; 0 without one): an
+    /// unstable controller, which the report says. Not in `report.json`.
+    #[serde(skip)]
+    pub law_unstable_poles: usize,
 }
+
+/// Points of the computed open loop drawn on the charts.
+pub const OPEN_LOOP_POINTS: usize = 600;
 
 /// The margins of every measured axis of `scene`'s loop.
 pub fn of(scene: &Scene, measured: &[AxisResult]) -> Vec<AxisMargins> {
     let law = linear::law::of(scene);
     let names = super::axis_names(scene);
-    let mut computed_at: Vec<(f64, Vec<Computed>)> = Vec::new();
+    type AtSpeed = (f64, Vec<Computed>, Vec<Vec<(f64, C64)>>);
+    let mut computed_at: Vec<AtSpeed> = Vec::new();
+    // The charts' band: the measured one, widened a decade each way (cut at a sampled law's
+    // Nyquist frequency).
+    let lo = measured.iter().flat_map(|x| x.points.first()).map(|p| p.f_hz).fold(f64::INFINITY, f64::min);
+    let hi = measured.iter().flat_map(|x| x.points.last()).map(|p| p.f_hz).fold(0.0, f64::max);
+    let (lo, hi) = if lo.is_finite() && hi > lo { (lo / 10.0, hi * 10.0) } else { (1.0, 1e4) };
+    let hi = law.as_ref().and_then(|l| l.period()).map_or(hi, |t| hi.min(0.499 / t));
+    let freqs: Vec<f64> =
+        (0..OPEN_LOOP_POINTS).map(|i| lo * (hi / lo).powf(i as f64 / (OPEN_LOOP_POINTS - 1) as f64)).collect();
+    let mut open_loop = Vec::new();
+    let unstable = law.as_ref().map_or(0, |l| l.unstable_poles());
     measured
         .iter()
         .map(|x| {
+            open_loop = Vec::new();
             let computed = law.as_ref().and_then(|law| {
-                if !computed_at.iter().any(|(s, _)| *s == x.speed_hz) {
+                if !computed_at.iter().any(|(s, _, _)| *s == x.speed_hz) {
                     let m = linear::build(scene, x.speed_hz).ok().map(|b| {
                         let (lo, hi) = linear::MARGIN_BAND_HZ;
-                        linear::margins::margins(law, &b.plant.system, &b.discrete.0, lo, hi)
+                        let curves = linear::margins::open_loops(law, &b.plant.system, &b.discrete.0, &freqs);
+                        let curves = curves.into_iter().map(|c| freqs.iter().copied().zip(c).collect()).collect();
+                        (linear::margins::margins(law, &b.plant.system, &b.discrete.0, lo, hi), curves)
                     });
-                    computed_at.push((x.speed_hz, m.unwrap_or_default()));
+                    let (m, curves) = m.unwrap_or_default();
+                    computed_at.push((x.speed_hz, m, curves));
                 }
-                let (_, all) = computed_at.iter().find(|(s, _)| *s == x.speed_hz)?;
+                let (_, all, curves) = computed_at.iter().find(|(s, _, _)| *s == x.speed_hz)?;
                 let k = names.iter().position(|n| *n == x.axis)?;
+                open_loop = curves.get(k).cloned().unwrap_or_default();
                 all.get(k).map(|m| Margins {
                     gain_margin_db: m.gain_margin_db.map(|g| g.0),
                     gain_margin_hz: m.gain_margin_db.map(|g| g.1),
@@ -73,7 +101,14 @@ pub fn of(scene: &Scene, measured: &[AxisResult]) -> Vec<AxisMargins> {
             let points: Vec<(f64, C64)> =
                 x.points.iter().map(|p| (p.f_hz, C64::new(p.s[0], p.s[1]))).filter(|(_, s)| s.norm() > 0.0).collect();
             let measured = (x.stable && points.len() >= 2).then(|| measured_margins(&points));
-            AxisMargins { axis: x.axis.clone(), speed_hz: x.speed_hz, computed, measured }
+            AxisMargins {
+                axis: x.axis.clone(),
+                speed_hz: x.speed_hz,
+                computed,
+                measured,
+                open_loop: open_loop.clone(),
+                law_unstable_poles: unstable,
+            }
         })
         .collect()
 }

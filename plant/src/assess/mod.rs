@@ -17,6 +17,7 @@ pub mod hertz;
 pub mod ladder;
 #[cfg(test)]
 mod linear_check;
+pub mod loop_charts;
 pub mod margins;
 pub mod rainflow;
 pub mod report;

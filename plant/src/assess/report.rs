@@ -836,6 +836,7 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
             h.push_str(&image(dir, name, &format!("{}: |S| and |T|", r.controllers[*i].label))?);
         }
     }
+    h.push_str(&super::loop_charts::section(dir, r)?);
     if let Some(b) = &r.bearing {
         let _ = writeln!(h, "<h2>Basis of the duty figures</h2><p class=\"note\">Taken at the output samples of each member's run. Rotor–race pressure: Hertz line contact of the shaft in the bore over the race width ({:.1} mm), steel E = {:.0} GPa, ν = {}; with a very conformal contact the half-width is not small against the radius, so it is Hertz's estimate outside its strict validity. Ball pressure: Hertz point contact of the most loaded ball on the inner raceway (ball {:.2} mm, pitch diameter {:.1} mm, groove conformity {}). Static capacity of one ball Q₀ = {:.0} N (the load giving {:.0} MPa, ISO 76's basis; C₀ = Z Q₀/5). Ball-load cycles: rainflow count of each ball's load, cycles with a range ≥ {:.0} % of Q₀, summed over the balls. Friction energy: ∫ |μ N v_slip| dt at the rotor–race contact. None of these figures is a life.</p>",
             b.width_m * 1e3, b.materials.youngs_modulus_pa * 1e-9, b.materials.poisson, b.ball_diameter_m * 1e3, b.pitch_diameter_m * 1e3, b.materials.groove_conformity, b.ball_static_load_n, b.materials.static_pressure_pa * 1e-6, b.capacity_fraction * 100.0);

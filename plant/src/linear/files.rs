@@ -37,6 +37,23 @@ struct JsonLaw<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     dt: Option<f64>,
     axes: Vec<super::law::Transfer>,
+    /// A state-space law's discrete system (its `axes` empty).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    system: Option<JsonLawSystem>,
+    /// The law's own poles outside the unit circle (summed over the axes of a per-axis law).
+    unstable_poles: usize,
+}
+
+#[derive(Serialize)]
+struct JsonLawSystem {
+    #[serde(rename = "A")]
+    a: Vec<Vec<f64>>,
+    #[serde(rename = "B")]
+    b: Vec<Vec<f64>>,
+    #[serde(rename = "C")]
+    c: Vec<Vec<f64>>,
+    #[serde(rename = "D")]
+    d: Vec<Vec<f64>>,
 }
 
 #[derive(Serialize)]
@@ -127,8 +144,15 @@ pub fn json(e: &Export<'_>) -> Vec<u8> {
         law: e.law.map(|(name, law)| JsonLaw {
             name,
             form: law.form(),
-            dt: matches!(law, super::law::LinearLaw::Sampled { .. }).then_some(e.period),
+            dt: law.period().map(|_| e.period),
             axes: law.transfers(),
+            system: match law {
+                super::law::LinearLaw::StateSpace { system: l, .. } => {
+                    Some(JsonLawSystem { a: rows(&l.a), b: rows(&l.b), c: rows(&l.c), d: rows(&l.d) })
+                }
+                _ => None,
+            },
+            unstable_poles: law.unstable_poles(),
         }),
         margins: e
             .margins

@@ -7,8 +7,11 @@
 //! The law: the continuous PD `C(s) = −A_a (k_p + k_d s)` of `controller.mode = "continuous"`,
 //! or a registry law that is linear around levitation ([`controller::ControlLaw::linear`]: a
 //! PD with a backward difference behind an optional second-order filter) sampled at the
-//! controller's rate, `C(z)` (its delay is the discrete plant's: [`super::discrete`]). A
-//! co-simulated command is a black box: no linear form.
+//! controller's rate, `C(z)` (its delay is the discrete plant's: [`super::discrete`]); or a
+//! law given as a linear system: `transfer_function`'s discrete transfer on every axis, and
+//! `state_space`'s discrete system of every axis at once (a full matrix `C(z)`: a law may
+//! couple the axes), as the law runs them (`controller::transfer_function::discrete`,
+//! `controller::state_space::discrete`). A co-simulated command is a black box: no linear form.
 
 use super::model::System;
 use crate::config::{ControlMode, Scene};
@@ -29,6 +32,14 @@ pub enum LinearLaw {
         /// Period T (s).
         period: f64,
     },
+    /// A discrete state-space law of every axis at once (`state_space`), sensor volts of every
+    /// axis in, their current commands out, at `period`.
+    StateSpace {
+        /// `(A_d, B_d, C_d, D_d)`.
+        system: System,
+        /// Period T (s).
+        period: f64,
+    },
 }
 
 impl LinearLaw {
@@ -44,6 +55,54 @@ impl LinearLaw {
                 let z = C64::new(0.0, w * period).exp();
                 laws.iter().map(|l| l.at(z)).collect()
             }
+            LinearLaw::StateSpace { .. } => {
+                let c = self.matrix_at(f_hz);
+                (0..c.nrows()).map(|k| c[(k, k)]).collect()
+            }
+        }
+    }
+
+    /// The law's transfer matrix `C` (A/V, axes × axes) at `f_hz` (Hz): diagonal but for a
+    /// state-space law.
+    pub fn matrix_at(&self, f_hz: f64) -> DMatrix<C64> {
+        match self {
+            LinearLaw::StateSpace { system, period } => {
+                response(system, C64::new(0.0, std::f64::consts::TAU * f_hz * period).exp())
+            }
+            _ => DMatrix::from_diagonal(&nalgebra::DVector::from_vec(self.at(f_hz))),
+        }
+    }
+
+    /// The law's own poles outside the stability region (`|z| > 1`; a continuous PD has none):
+    /// an unstable controller is allowed (some designs are), and the report says so.
+    pub fn unstable_poles(&self) -> usize {
+        let outside = |m: DMatrix<f64>| m.complex_eigenvalues().iter().filter(|p| p.norm() > 1.0 + 1e-12).count();
+        match self {
+            LinearLaw::Continuous(_) => 0,
+            // Each axis' denominator `1 + d₁ z⁻¹ + …`: the eigenvalues of its companion matrix.
+            LinearLaw::Sampled { laws, .. } => laws
+                .iter()
+                .map(|l| {
+                    let n = l.den.len();
+                    if n == 0 {
+                        return 0;
+                    }
+                    outside(DMatrix::from_fn(n, n, |i, j| match i {
+                        0 => -l.den[j],
+                        _ if j + 1 == i => 1.0,
+                        _ => 0.0,
+                    }))
+                })
+                .sum(),
+            LinearLaw::StateSpace { system, .. } => outside(system.a.clone()),
+        }
+    }
+
+    /// The sampling period (s) of a sampled law, `None` for a continuous one.
+    pub fn period(&self) -> Option<f64> {
+        match self {
+            LinearLaw::Continuous(_) => None,
+            LinearLaw::Sampled { period, .. } | LinearLaw::StateSpace { period, .. } => Some(*period),
         }
     }
 }
@@ -80,6 +139,8 @@ impl LinearLaw {
                     Transfer { num, den }
                 })
                 .collect(),
+            // Not one transfer per axis: the system itself ([`LinearLaw::StateSpace`]).
+            LinearLaw::StateSpace { .. } => Vec::new(),
         }
     }
 
@@ -87,7 +148,7 @@ impl LinearLaw {
     pub fn form(&self) -> &'static str {
         match self {
             LinearLaw::Continuous(_) => "continuous",
-            LinearLaw::Sampled { .. } => "sampled",
+            LinearLaw::Sampled { .. } | LinearLaw::StateSpace { .. } => "sampled",
         }
     }
 }
@@ -111,8 +172,22 @@ pub fn of(scene: &Scene) -> Option<LinearLaw> {
     if !(c.mode == ControlMode::Sampled || c.cosim.command.is_none()) {
         return None;
     }
+    if c.law == controller::state_space::LAW.name {
+        let ss = controller::state_space::discrete(&scene.rotor_design(), &c.params).ok()?;
+        let system = System { a: ss.a, b: ss.b, c: ss.c, d: ss.d };
+        return Some(LinearLaw::StateSpace { system, period: c.period });
+    }
     let mut laws = Vec::with_capacity(2 * designs.len());
     for d in &designs {
+        if c.law == controller::transfer_function::LAW.name {
+            // `b(z)/a(z)` in descending powers of `z`, `a₀ = 1`, `b` as long as `a`: in `z⁻¹`,
+            // `(b₀ + b₁ z⁻¹ + …) / (1 + a₁ z⁻¹ + …)`, the form `AxisLaw` holds.
+            let tf = controller::transfer_function::discrete(d, &c.params).ok()?;
+            let law = AxisLaw { num: tf.b, den: tf.a[1..].to_vec(), sensor_gain: d.constants.sensor_gain_v_per_m };
+            laws.push(law.clone());
+            laws.push(law);
+            continue;
+        }
         let linear = controller::build_law(&c.law, d, &c.params).ok()?.linear()?;
         let pd = PlanePd {
             kp: linear.pd.kp,
@@ -150,19 +225,26 @@ pub fn response(sys: &System, w: C64) -> DMatrix<C64> {
 /// for a continuous law, the discrete one (its delay states in) on `z = e^{jωT}` for a sampled.
 pub fn plant_at(law: &LinearLaw, continuous: &System, discrete: &System, f_hz: f64) -> DMatrix<C64> {
     let w = std::f64::consts::TAU * f_hz;
-    match law {
-        LinearLaw::Continuous(_) => response(continuous, C64::new(0.0, w)),
-        LinearLaw::Sampled { period, .. } => response(discrete, C64::new(0.0, w * period).exp()),
+    match law.period() {
+        None => response(continuous, C64::new(0.0, w)),
+        Some(period) => response(discrete, C64::new(0.0, w * period).exp()),
     }
 }
 
-/// `S = (I − P C)⁻¹` at `f_hz` (Hz): `P` the plant's response (V/A), `C = diag` of the law's
-/// (A/V). Each axis' sensitivity is its diagonal entry.
+/// `S = (I − P C)⁻¹` at `f_hz` (Hz): `P` the plant's response (V/A), `C` the law's (A/V,
+/// [`LinearLaw::matrix_at`]). Each axis' sensitivity is its diagonal entry.
 pub fn sensitivity(law: &LinearLaw, continuous: &System, discrete: &System, f_hz: f64) -> DMatrix<C64> {
     let p = plant_at(law, continuous, discrete, f_hz);
-    let c = law.at(f_hz);
     let m = p.nrows();
-    let l = DMatrix::from_fn(m, m, |i, j| p[(i, j)] * c[j]);
+    let l = match law {
+        LinearLaw::StateSpace { .. } => &p * law.matrix_at(f_hz),
+        _ => {
+            // Diagonal: each column scaled, as the product would but without its zero terms
+            // (the same figures as before a law could couple the axes).
+            let c = law.at(f_hz);
+            DMatrix::from_fn(m, m, |i, j| p[(i, j)] * c[j])
+        }
+    };
     let i_minus_l = DMatrix::<C64>::identity(m, m) - l;
     i_minus_l.try_inverse().unwrap_or_else(|| DMatrix::from_element(m, m, C64::new(f64::NAN, 0.0)))
 }

@@ -58,9 +58,9 @@ const GRID: usize = 2000;
 /// `discrete` for a sampled law) over `[f_min, f_max]` (Hz; a sampled law's band is cut at
 /// 0.499 of its rate).
 pub fn margins(law: &LinearLaw, continuous: &System, discrete: &System, f_min: f64, f_max: f64) -> Vec<AxisMargins> {
-    let f_max = match law {
-        LinearLaw::Sampled { period, .. } => f_max.min(0.499 / period),
-        LinearLaw::Continuous(_) => f_max,
+    let f_max = match law.period() {
+        Some(period) => f_max.min(0.499 / period),
+        None => f_max,
     };
     let axes = continuous.b.ncols();
     let g = |f: f64| -> Vec<C64> {
@@ -104,6 +104,20 @@ pub fn margins(law: &LinearLaw, continuous: &System, discrete: &System, f_min: f
             AxisMargins { axis: k, phase_crossovers: phase, gain_crossovers: gain, gain_margin_db, phase_margin_deg }
         })
         .collect()
+}
+
+/// Each axis' open loop `G_o = 1 / S_kk − 1` (the margins' loop, every other axis closed) at
+/// each of `freqs` (Hz): `[axis][frequency]`, for the report card's Bode and Nyquist charts.
+pub fn open_loops(law: &LinearLaw, continuous: &System, discrete: &System, freqs: &[f64]) -> Vec<Vec<C64>> {
+    let axes = continuous.b.ncols();
+    let mut out = vec![Vec::with_capacity(freqs.len()); axes];
+    for &f in freqs {
+        let s = law::sensitivity(law, continuous, discrete, f);
+        for (k, row) in out.iter_mut().enumerate() {
+            row.push(C64::new(1.0, 0.0) / s[(k, k)] - 1.0);
+        }
+    }
+    out
 }
 
 /// The root of `h` in `[lo, hi]` where it changes sign (`h(lo)` has the sign of `at_lo`), by

@@ -116,7 +116,7 @@ pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
         // `controller.law` names.
         law: law.as_ref().map(|l| match l {
             law::LinearLaw::Continuous(_) => ("continuous_pd", l),
-            law::LinearLaw::Sampled { .. } => (scene.controller.law.as_str(), l),
+            law::LinearLaw::Sampled { .. } | law::LinearLaw::StateSpace { .. } => (scene.controller.law.as_str(), l),
         }),
         margins: &margins,
     };

@@ -201,3 +201,76 @@ fn a_unipolar_drive_is_the_bipolar_one_with_half_the_back_emf() {
     let other = model("realistic-10g.toml", &[common[0], "amb.back_emf_v_s_per_m=432"], 500.0);
     assert_ne!(other.plant.system, bipolar.plant.system, "k_b is in the model");
 }
+
+/// The linear forms of `transfer_function` and `state_space` (their margins computed, not only
+/// measured): without `num`/`den` (`a` … `c`) each law is the design's PD as `pd` samples it
+/// (controller/src/transfer_function.rs, state_space.rs), a second reading of the same law by
+/// another path (`DiscreteTf`'s coefficients, the state-space system's response), so its
+/// sensitivity on the linear plant is `pd`'s: on the planar rotor and on the two-plane one at
+/// speed (the state-space law as the full matrix `C(z)` of every axis at once).
+#[test]
+fn transfer_function_and_state_space_laws_have_the_pds_linear_form() {
+    for (file, speed_hz) in [("paper-10g.toml", 0.0), ("two-plane-asymmetric-10g.toml", 300.0)] {
+        let scene_of = |law: &str| {
+            let l = format!("controller.law=\"{law}\"");
+            shipped(file, &["controller.mode=\"sampled\"", &l])
+        };
+        let pd = scene_of("pd");
+        let b = build(&pd, speed_hz).expect("model");
+        let reference = law::of(&pd).expect("pd's linear form");
+        for name in ["transfer_function", "state_space"] {
+            let scene = scene_of(name);
+            let form = law::of(&scene).unwrap_or_else(|| panic!("{file}: {name} has no linear form"));
+            assert_eq!(form.period(), reference.period());
+            let mut worst: f64 = 0.0;
+            for f in freqs().into_iter().filter(|f| *f < 9e3) {
+                let want = law::sensitivity(&reference, &b.plant.system, &b.discrete.0, f);
+                let got = law::sensitivity(&form, &b.plant.system, &b.discrete.0, f);
+                for k in 0..want.nrows() {
+                    worst = worst.max(rel(got[(k, k)], want[(k, k)]));
+                }
+                if matches!(form, LinearLaw::StateSpace { .. }) {
+                    // The PD per axis: no coupling between the axes' laws.
+                    let c = form.matrix_at(f);
+                    assert!((0..c.nrows()).all(|i| (0..c.ncols()).all(|j| i == j || c[(i, j)].norm() == 0.0)));
+                }
+            }
+            eprintln!("{file} {name}: |ΔS|/|S| up to {worst:.1e} against pd");
+            assert!(worst < 1e-9, "{file} {name}: |ΔS|/|S| up to {worst:e} against pd");
+        }
+    }
+}
+
+/// An unstable controller is allowed and said: a `transfer_function` law `1/(1 − 1.5 z⁻¹)`
+/// (its pole at z = 1.5) has one unstable pole per axis; the design's PD none; a `state_space`
+/// law with `A_d = diag(1.5, 0.5)`, one.
+#[test]
+fn a_laws_unstable_poles_are_counted() {
+    let tf = shipped(
+        "paper-10g.toml",
+        &[
+            "controller.mode=\"sampled\"",
+            "controller.law=\"transfer_function\"",
+            "controller.params.num=[1.0, 0.0]",
+            "controller.params.den=[1.0, -1.5]",
+            "controller.params.domain=\"z\"",
+            "controller.params.dt_s=5e-5",
+        ],
+    );
+    assert_eq!(law::of(&tf).expect("linear form").unstable_poles(), 2, "one per axis, x and y");
+    let pd = shipped("paper-10g.toml", &["controller.mode=\"sampled\"", "controller.law=\"transfer_function\""]);
+    assert_eq!(law::of(&pd).expect("linear form").unstable_poles(), 0);
+    let ss = shipped(
+        "paper-10g.toml",
+        &[
+            "controller.mode=\"sampled\"",
+            "controller.law=\"state_space\"",
+            "controller.params.a=[[1.5, 0.0], [0.0, 0.5]]",
+            "controller.params.b=[[1.0, 0.0], [0.0, 1.0]]",
+            "controller.params.c=[[-1.0, 0.0], [0.0, -1.0]]",
+            "controller.params.domain=\"z\"",
+            "controller.params.dt_s=5e-5",
+        ],
+    );
+    assert_eq!(law::of(&ss).expect("linear form").unstable_poles(), 1);
+}
