@@ -1,11 +1,11 @@
 //! End-to-end tests of `run.mcap` (issue 42 item 1): `plant run --mcap` records the run's rows
-//! as JSON messages per topic, its events as `foxglove.Log` and the scene as metadata.
+//! as CDR messages per topic (ROS 2 message definitions as schemas), its events as `foxglove.Log` and the scene as metadata.
 //!
 //! What is pinned: the file, read back by the `mcap` Python reader (an outside implementation
 //! of the format, in a venv under `target/`, `mcap_venv`), holds one message per row on each
 //! topic, every field bit for bit the `trace.csv` column it names (planar, two-plane and
 //! flexible scenes; the radius as the hypot of the row's x and y, within 1 ulp, computed here),
-//! the schemas are JSON schemas with each field's unit, the scene's metadata is `scene.toml`,
+//! the schemas give each field's unit and column, the scene's metadata is `scene.toml`,
 //! and the events hold the shock's start and the run's status; a run without the flag writes
 //! no recording and the same `scene.toml` as before; a link at `run.mcap` is replaced, not
 //! followed; a bad value of the key exits 2 naming it.
@@ -55,29 +55,36 @@ fn mcap_venv() -> &'static Path {
 }
 
 /// Reads a recording with the `mcap` Python package and prints it as JSON: per topic its
-/// schema (name, encoding, text) and its messages' fields as the doubles' bit patterns (a
-/// signed 64-bit integer, `null` for a JSON null); the metadata; the events' messages.
+/// schema (name, encoding, text) and its messages' fields as the doubles' bit patterns (signed
+/// 64-bit integers), decoded here from the schema's `float64` lines and CDR's layout (a 4-byte
+/// little-endian header, then the 8-byte doubles); the metadata; the events' messages.
 const READER: &str = r#"
 import json, struct, sys
 from mcap.reader import make_reader
-bits = lambda v: None if v is None else struct.unpack("<q", struct.pack("<d", float(v)))[0]
-out = {"topics": {}, "metadata": {}, "events": [], "log_times_ok": True}
+out = {"topics": {}, "metadata": {}, "events": [], "log_times_ok": True, "headers_ok": True}
 with open(sys.argv[1], "rb") as f:
     reader = make_reader(f)
     for m in reader.iter_metadata():
         out["metadata"][m.name] = dict(m.metadata)
     for schema, channel, message in reader.iter_messages(log_time_order=False):
-        data = json.loads(message.data)
         if channel.topic == "/events":
+            data = json.loads(message.data)
             out["events"].append([message.log_time, data["level"], data["message"]])
             continue
+        text = schema.data.decode()
+        names = [l.split()[1] for l in text.splitlines() if l.startswith("float64 ")]
         t = out["topics"].setdefault(channel.topic, {
             "schema": schema.name, "encoding": schema.encoding, "message_encoding": channel.message_encoding,
-            "schema_text": schema.data.decode(), "fields": {}})
-        if message.log_time != round(data["t_s"] * 1e9):
+            "schema_text": text, "fields": {n: [] for n in names}})
+        data = bytes(message.data)
+        if data[:4] != b"\x00\x01\x00\x00" or len(data) != 4 + 8 * len(names):
+            out["headers_ok"] = False
+            continue
+        values = struct.unpack("<%dq" % len(names), data[4:])
+        if message.log_time != round(struct.unpack("<d", data[4:12])[0] * 1e9):
             out["log_times_ok"] = False
-        for k, v in data.items():
-            t["fields"].setdefault(k, []).append(bits(v))
+        for n, v in zip(names, values):
+            t["fields"][n].append(v)
 print(json.dumps(out))
 "#;
 
@@ -108,16 +115,19 @@ fn assert_holds_trace(run: &Path, rec: &serde_json::Value) -> Vec<String> {
     let topics = rec["topics"].as_object().expect("topics");
     let mut carried = Vec::new();
     for (name, t) in topics {
-        assert_eq!(t["encoding"], "jsonschema", "{name}");
-        assert_eq!(t["message_encoding"], "json", "{name}");
-        let schema: serde_json::Value = serde_json::from_str(t["schema_text"].as_str().unwrap()).expect("schema JSON");
+        assert_eq!(t["encoding"], "ros2msg", "{name}");
+        assert_eq!(t["message_encoding"], "cdr", "{name}");
+        let schema = t["schema_text"].as_str().unwrap();
         let fields = t["fields"].as_object().unwrap();
         let plane_b = name.starts_with("/plane_b/");
         for (field, values) in fields {
-            let values: Vec<Option<i64>> = serde_json::from_value(values.clone()).unwrap();
+            let values: Vec<i64> = serde_json::from_value(values.clone()).unwrap();
             assert_eq!(values.len(), rows, "{name}.{field}: one message per row");
-            let description =
-                schema["properties"][field]["description"].as_str().unwrap_or_else(|| panic!("{name}.{field}"));
+            // The field's line of the schema, with its unit and column in the comment.
+            let description = schema
+                .lines()
+                .find(|l| l.starts_with(&format!("float64 {field} ")))
+                .unwrap_or_else(|| panic!("{name}.{field} in {schema}"));
             if field == "radius_m" {
                 assert!(description.contains("(m)"), "{description}");
                 assert_radius(name, &trace, &values);
@@ -130,14 +140,17 @@ fn assert_holds_trace(run: &Path, rec: &serde_json::Value) -> Vec<String> {
             assert!(description.contains(&format!("({})", unit_of(&column))), "{name}.{field}: {description}");
             let expected = trace.column(&column);
             for (i, (got, want)) in values.iter().zip(&expected).enumerate() {
-                match got {
-                    Some(bits) => assert_eq!(*bits, want.to_bits() as i64, "{name}.{field} row {i}: {want}"),
-                    None => assert!(!want.is_finite(), "{name}.{field} row {i}: null for {want}"),
+                // trace.csv writes every NaN as `NaN`: a NaN's payload is not in the trace.
+                if want.is_nan() {
+                    assert!(f64::from_bits(*got as u64).is_nan(), "{name}.{field} row {i}: NaN");
+                } else {
+                    assert_eq!(*got, want.to_bits() as i64, "{name}.{field} row {i}: {want}");
                 }
             }
         }
     }
     assert_eq!(rec["log_times_ok"], true, "each message's log time is its t_s in ns");
+    assert_eq!(rec["headers_ok"], true, "each message is the CDR header and one double per schema field");
     // Every column but the time is carried once, and `t_s` by every topic.
     carried.retain(|c| c != "t_s");
     carried.sort();
@@ -171,7 +184,7 @@ fn unit_of(column: &str) -> &'static str {
 
 /// The radius field: hypot of the row's x and y (the topic's), within one ulp (Python's hypot
 /// and libm's may round differently), computed here from the trace.
-fn assert_radius(topic: &str, trace: &Csv, values: &[Option<i64>]) {
+fn assert_radius(topic: &str, trace: &Csv, values: &[i64]) {
     let (x, y) = match topic {
         "/plane_a/rotor" => ("dx_m", "dy_m"),
         "/plane_b/rotor" => ("b_dx_m", "b_dy_m"),
@@ -180,7 +193,7 @@ fn assert_radius(topic: &str, trace: &Csv, values: &[Option<i64>]) {
     };
     for (i, ((v, x), y)) in values.iter().zip(trace.column(x)).zip(trace.column(y)).enumerate() {
         let want = (x * x + y * y).sqrt();
-        let got = f64::from_bits(v.expect("a finite radius") as u64);
+        let got = f64::from_bits(*v as u64);
         assert!((got - want).abs() <= 2.0 * f64::EPSILON * want, "{topic} radius row {i}: {got} vs {want}");
     }
 }

@@ -1,6 +1,6 @@
-//! `run.mcap`: a run's rows as messages on the topics of [`super::topics`] (JSON, with JSON
-//! schemas), its events as `foxglove.Log` on `/events` ([`super::events`]) and the scene as
-//! metadata, lz4-compressed chunks, for Foxglove, Lichtblick, PlotJuggler and the `mcap`
+//! `run.mcap`: a run's rows as messages on the topics of [`super::topics`] (CDR, with ROS 2
+//! message definitions as schemas), its events as `foxglove.Log` on `/events`
+//! ([`super::events`]) and the scene as metadata, lz4-compressed chunks, for Foxglove, Lichtblick, PlotJuggler and the `mcap`
 //! readers. A [`crate::run::Sink`], fed the same rows as `trace.csv`.
 //!
 //! The file is created new in the run's folder ([`crate::outfile::create`]: an entry at the
@@ -38,7 +38,7 @@ pub struct McapSink {
     events: Events,
     pending: Vec<Event>,
     values: Vec<f64>,
-    text: String,
+    bytes: Vec<u8>,
     sequence: u32,
     error: Option<anyhow::Error>,
 }
@@ -69,8 +69,8 @@ impl McapSink {
         let none = BTreeMap::new();
         let mut channels = Vec::new();
         for topic in topics(&columns) {
-            let schema = writer.add_schema(topic.schema, "jsonschema", topic.schema_json().as_bytes())?;
-            let channel = writer.add_channel(schema, &topic.name, "json", &none)?;
+            let schema = writer.add_schema(&ros2_name(topic.schema), "ros2msg", topic.schema_text().as_bytes())?;
+            let channel = writer.add_channel(schema, &topic.name, "cdr", &none)?;
             channels.push((topic, channel));
         }
         let log = writer.add_schema("foxglove.Log", "jsonschema", LOG_SCHEMA.as_bytes())?;
@@ -87,7 +87,7 @@ impl McapSink {
             events: Events::new(scene),
             pending: Vec::new(),
             values: Vec::new(),
-            text: String::with_capacity(512),
+            bytes: Vec::with_capacity(512),
             sequence: 0,
             error: None,
         })
@@ -104,8 +104,8 @@ impl McapSink {
         let Some(writer) = self.writer.as_mut() else { return };
         let mut written = Ok(());
         for (topic, channel) in &self.topics {
-            topic.message(&self.values, &mut self.text);
-            written = write(writer, *channel, &mut self.sequence, ns, self.text.as_bytes());
+            topic.message(&self.values, &mut self.bytes);
+            written = write(writer, *channel, &mut self.sequence, ns, &self.bytes);
             if written.is_err() {
                 break;
             }
@@ -140,8 +140,17 @@ impl McapSink {
         writer.finish()?;
         let mut file = writer.into_inner();
         std::io::Write::flush(&mut file)?;
-        file.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        // Not synced to disk: a streamed output, as `trace.csv` is.
+        file.into_inner().map_err(|e| e.into_error())?;
         Ok(())
+    }
+}
+
+/// A ROS 2 type name for a schema: `plant.Rotor` → `plant_msgs/msg/Rotor`.
+fn ros2_name(schema: &str) -> String {
+    match schema.split_once('.') {
+        Some((package, name)) => format!("{package}_msgs/msg/{name}"),
+        None => schema.to_string(),
     }
 }
 

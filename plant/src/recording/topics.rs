@@ -1,14 +1,15 @@
 //! The one mapping from a run's rows to the recording's topics (issue 42): which trace column
-//! goes to which topic and field, each topic's JSON schema (units in its descriptions), and a
-//! row's message on each topic. `run.mcap` ([`super::mcap_file`]) and any live view take their
+//! goes to which topic and field, each topic's schema (a ROS 2 message definition, units in its
+//! comments), and a row's message on each topic. `run.mcap` ([`super::mcap_file`]) and any live view take their
 //! topics from here, so that a change of the rows (typed rows, new columns) changes this file
 //! only.
 //!
-//! Each topic's message is a JSON object: `t_s` (the row's time, s) and the topic's fields,
-//! named like their `trace.csv` columns (plane B's without the `b_` prefix), with the same
-//! numbers: shortest round-trip scientific notation (`{:e}`, as `trace.csv`), so a reader gets
-//! the trace's doubles bit for bit; a non-finite value (a failed run's last row) is `null`,
-//! which JSON has in place of NaN and infinities.
+//! Each topic's message is a ROS 2 message (`ros2msg` schema, CDR encoding, which Foxglove,
+//! Lichtblick and PlotJuggler all read) of `float64` fields: `t_s` (the row's time, s) and the
+//! topic's fields, named like their `trace.csv` columns (plane B's without the `b_` prefix),
+//! each the row's double itself, so a reader gets the trace's numbers bit for bit (NaN
+//! included). A binary encoding rather than JSON: formatting each number as text (a first
+//! version did) cost 45 % more CPU time than the run without a recording.
 
 use crate::config::Scene;
 use crate::trace::{
@@ -157,67 +158,44 @@ pub fn unit(column: &str) -> &'static str {
 }
 
 impl Topic {
-    /// The topic's JSON schema (draft 07): `t_s` and each field a number (`null` when not
-    /// finite), each described with its `trace.csv` column and unit.
-    pub fn schema_json(&self) -> String {
-        let mut properties = serde_json::Map::new();
-        properties.insert(
-            "t_s".into(),
-            serde_json::json!({"type": "number", "description": "Simulated time (s): trace.csv column t_s."}),
+    /// The topic's schema, a ROS 2 message definition (`ros2msg`): `t_s` and each field a
+    /// `float64`, each commented with its unit and `trace.csv` column.
+    pub fn schema_text(&self) -> String {
+        let mut text = format!(
+            "# {}: one row of trace.csv (issue 42); each field's unit and column in its comment.\n",
+            self.schema
         );
+        text.push_str("float64 t_s  # t_s (s): simulated time, trace.csv column t_s\n");
         for f in &self.fields {
-            let description =
-                format!("{} ({}): trace.csv column {}; null when not finite.", f.name, unit(f.column), f.column);
-            properties
-                .insert(f.name.clone(), serde_json::json!({"type": ["number", "null"], "description": description}));
+            let _ =
+                writeln!(text, "float64 {}  # {} ({}): trace.csv column {}", f.name, f.name, unit(f.column), f.column);
         }
-        let mut required = vec!["t_s".to_string()];
-        required.extend(self.fields.iter().map(|f| f.name.clone()));
         if self.radius.is_some() {
-            let description = "radius_m (m): the rotor's radius, hypot of the x and y fields; null when not finite.";
-            properties
-                .insert("radius_m".into(), serde_json::json!({"type": ["number", "null"], "description": description}));
-            required.push("radius_m".into());
+            text.push_str("float64 radius_m  # radius_m (m): the rotor's radius, hypot of the x and y fields\n");
         }
-        serde_json::json!({
-            "$schema": "http://json-schema.org/draft-07/schema#",
-            "title": self.schema,
-            "type": "object",
-            "properties": properties,
-            "required": required,
-        })
-        .to_string()
+        text
     }
 
     /// The topic's message of one row (`values` as [`Columns::values`] gives them), into `out`
-    /// (cleared first). Written here rather than through serde_json so that each number is
-    /// `trace.csv`'s own `{:e}` text, without a map built per row.
-    pub fn message(&self, values: &[f64], out: &mut String) {
+    /// (cleared first): CDR, little-endian (the encapsulation header `00 01 00 00`, then each
+    /// `float64` as its 8 bytes, which are 8-aligned after the header). Written by hand rather
+    /// than through a CDR crate: a row of doubles is the whole of it, and the doubles go out as
+    /// their bits, the trace's numbers exactly (NaN included), with nothing formatted per row.
+    pub fn message(&self, values: &[f64], out: &mut Vec<u8>) {
         out.clear();
-        out.push_str("{\"t_s\":");
-        number(values[0], out);
+        out.extend_from_slice(&CDR_LE);
+        out.extend_from_slice(&values[0].to_le_bytes());
         for f in &self.fields {
-            out.push_str(",\"");
-            out.push_str(&f.name);
-            out.push_str("\":");
-            number(values[f.index], out);
+            out.extend_from_slice(&values[f.index].to_le_bytes());
         }
         if let Some((x, y)) = self.radius {
-            out.push_str(",\"radius_m\":");
-            number(values[x].hypot(values[y]), out);
+            out.extend_from_slice(&values[x].hypot(values[y]).to_le_bytes());
         }
-        out.push('}');
     }
 }
 
-/// A JSON number as `trace.csv` writes it (`{:e}`, valid JSON: `-4.3e-4`, `0e0`), or `null`.
-fn number(v: f64, out: &mut String) {
-    if v.is_finite() {
-        let _ = write!(out, "{v:e}");
-    } else {
-        out.push_str("null");
-    }
-}
+/// The CDR encapsulation header of a little-endian message (`CDR_LE`).
+pub const CDR_LE: [u8; 4] = [0, 1, 0, 0];
 
 #[cfg(test)]
 mod tests {
@@ -258,21 +236,27 @@ mod tests {
     }
 
     #[test]
-    fn a_message_is_json_with_the_trace_numbers() {
+    fn a_message_is_the_rows_doubles_after_the_cdr_header() {
         let topic = Topic {
             name: "/x".into(),
             schema: "plant.X",
             fields: vec![
                 Field { name: "a".into(), column: "a_m", index: 1 },
-                Field { name: "b".into(), column: "b_m", index: 2 },
+                Field { name: "b".into(), column: "b_n", index: 2 },
             ],
-            radius: None,
+            radius: Some((1, 2)),
         };
-        let mut out = String::new();
-        let values = [1.5e-4, 0.1 + 0.2, f64::NAN];
+        let mut out = Vec::new();
+        let values = [1.5e-4, 3.0, -4.0];
         topic.message(&values, &mut out);
-        assert_eq!(out, "{\"t_s\":1.5e-4,\"a\":3.0000000000000004e-1,\"b\":null}");
-        let parsed: serde_json::Value = serde_json::from_str(&out).unwrap();
-        assert_eq!(parsed["a"].as_f64().unwrap().to_bits(), (0.1f64 + 0.2).to_bits());
+        let mut want = vec![0u8, 1, 0, 0];
+        for v in [1.5e-4f64, 3.0, -4.0, 5.0] {
+            want.extend_from_slice(&v.to_le_bytes());
+        }
+        assert_eq!(out, want);
+        let text = topic.schema_text();
+        assert!(text.contains("float64 a  # a (m): trace.csv column a_m\n"), "{text}");
+        assert!(text.contains("float64 b  # b (N): trace.csv column b_n\n"), "{text}");
+        assert!(text.ends_with("float64 radius_m  # radius_m (m): the rotor's radius, hypot of the x and y fields\n"));
     }
 }
