@@ -230,8 +230,31 @@ fn two_plane_and_flexible_recordings_hold_their_planes_and_mid_span() {
     }
     let dir = TempDir::new("mcap-flexible");
     let run = record(&dir, &scene("flexible-10g.toml"), &["scene.duration_s=0.01", "output.plots=false"]);
-    let topics = assert_holds_trace(&run, &read_back(&run));
+    let rec = read_back(&run);
+    let topics = assert_holds_trace(&run, &rec);
     assert!(topics.iter().any(|x| x == "/mid_span"), "{topics:?}");
+    // Every series of the shipped layout names a topic and field of this recording (the
+    // flexible rotor's has both planes and the mid-span).
+    let layout: serde_json::Value =
+        serde_json::from_str(&read_text(&common::workspace_root().join("docs/layouts/plant-study.json")))
+            .expect("the layout's JSON");
+    let mut paths = Vec::new();
+    for panel in layout["configById"].as_object().unwrap().values() {
+        for p in panel["paths"].as_array().into_iter().flatten() {
+            paths.push(p["value"].as_str().unwrap().to_string());
+        }
+        if let Some(x) = panel["xAxisPath"]["value"].as_str() {
+            paths.push(x.to_string());
+        }
+        if let Some(t) = panel["topicToRender"].as_str() {
+            assert_eq!(t, "/events");
+        }
+    }
+    assert!(paths.len() >= 10, "{paths:?}");
+    for path in paths {
+        let (topic, field) = path.split_once('.').unwrap_or_else(|| panic!("{path}"));
+        assert!(rec["topics"][topic]["fields"].get(field).is_some(), "the layout's {path} is not in the recording");
+    }
 }
 
 #[test]
