@@ -54,6 +54,10 @@ pub enum Command {
         /// same as `--set robustness.members=N`).
         #[arg(long, value_name = "N")]
         robustness: Option<u32>,
+        /// Also record the run as run.mcap in the output folder, for Foxglove, Lichtblick and
+        /// PlotJuggler (the same as `--set output.mcap=true`).
+        #[arg(long)]
+        mcap: bool,
     },
     /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
     /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.

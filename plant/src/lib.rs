@@ -47,6 +47,7 @@ pub mod outfile;
 pub mod output;
 pub mod plot;
 pub mod record;
+pub mod recording;
 pub mod rng;
 pub mod robustness;
 pub mod row_file;

@@ -84,7 +84,21 @@ fn warn(message: &str) {
 /// Runs one command.
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, out, mut set, quiet, controller, run_id, save_state_at, from_state, robustness } => {
+        Command::Run {
+            scene,
+            out,
+            mut set,
+            quiet,
+            controller,
+            run_id,
+            save_state_at,
+            from_state,
+            robustness,
+            mcap,
+        } => {
+            if mcap {
+                set.push("output.mcap=true".into());
+            }
             let states = States { save_at: save_state_at, from: from_state };
             if let Some(n) = robustness {
                 set.push(format!("robustness.members={n}"));

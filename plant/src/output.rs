@@ -17,6 +17,7 @@ use crate::hooks::Hooks;
 use crate::offload::{run_into_offloaded, When};
 use crate::plot::{self, Scale, Series};
 use crate::record::{ChartData, PlaneRecorded, Recorder};
+use crate::recording::mcap_file::McapSink;
 use crate::run::{Outcome, RunResult, SetupError, Sink, SinkRun};
 use crate::summary::Summary;
 use crate::trace::{Record, TraceError, TraceWriter};
@@ -53,6 +54,7 @@ pub const RUN_FILES: &[&str] = &[
     "poincare_b.png",
     "controller.log",
     "tet.png",
+    crate::recording::mcap_file::FILE,
 ];
 
 /// Why `plant run` stopped before it wrote its results.
@@ -142,6 +144,7 @@ pub struct RunFolder {
     trace: TraceWriter,
     recorder: Recorder,
     error: Option<std::io::Error>,
+    mcap: Option<McapSink>,
 }
 
 impl RunFolder {
@@ -156,7 +159,8 @@ impl RunFolder {
             scene.rotor.bends(),
         )
         .with_context(|| format!("creating {}", path.display()))?;
-        Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None })
+        let mcap = scene.mcap.then(|| McapSink::create(dir, scene)).transpose()?;
+        Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None, mcap })
     }
 
     /// One sample (also for a trace already in memory).
@@ -167,6 +171,9 @@ impl RunFolder {
             }
         }
         self.recorder.push(r);
+        if let Some(m) = &mut self.mcap {
+            m.push(r);
+        }
     }
 
     /// Flushes `trace.csv`, writes `summary.json`, then the charts. A run that completed but
@@ -218,6 +225,8 @@ impl RunFolder {
             summary.error = run.outcome.error();
             write_json(&dir.join("summary.json"), &summary)?;
         }
+        // The recording closes last: its failure (a full disk) loses none of the other outputs.
+        self.mcap.take().map(|m| m.finish(&summary)).transpose()?;
         Ok(Written { summary, run, skipped_charts: skipped })
     }
 }

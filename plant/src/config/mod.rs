@@ -215,6 +215,8 @@ pub struct Scene {
     pub output_interval: f64,
     /// Write plots.
     pub plots: bool,
+    /// Record the run as `run.mcap` (`[output] mcap`, `plant run --mcap`).
+    pub mcap: bool,
     /// Notes for the user: deprecated keys, a run with few controller ticks. The CLI prints
     /// them as `plant: warning: …`.
     pub warnings: Vec<String>,

@@ -736,6 +736,9 @@ pub struct RawOutput {
     pub rate_hz: f64 = 20000.0,
     /// Write PNG plots.
     pub plots: bool = true,
+    /// Also record the run as `run.mcap` (issue 42); written into `scene.toml` only when set.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mcap: Option<bool> = None,
 }
 }
 

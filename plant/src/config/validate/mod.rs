@@ -301,6 +301,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         hardware,
         output_interval: 1.0 / output_rate,
         plots: raw.output.plots,
+        mcap: raw.output.mcap.unwrap_or(false),
         warnings,
         source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
     };

@@ -1,0 +1,301 @@
+//! End-to-end tests of `run.mcap` (issue 42 item 1): `plant run --mcap` records the run's rows
+//! as CDR messages per topic (ROS 2 message definitions as schemas), its events as `foxglove.Log` and the scene as metadata.
+//!
+//! What is pinned: the file, read back by the `mcap` Python reader (an outside implementation
+//! of the format, in a venv under `target/`, `mcap_venv`), holds one message per row on each
+//! topic, every field bit for bit the `trace.csv` column it names (planar, two-plane and
+//! flexible scenes; the radius as the hypot of the row's x and y, within 1 ulp, computed here),
+//! the schemas give each field's unit and column, the scene's metadata is `scene.toml`,
+//! and the events hold the shock's start and the run's status; a run without the flag writes
+//! no recording and the same `scene.toml` as before; a link at `run.mcap` is replaced, not
+//! followed; a bad value of the key exits 2 naming it.
+
+mod common;
+
+use common::{assert_exit, output_within, read_text, scene, stderr, Csv, TempDir, SHORT};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+use std::time::Duration;
+
+/// One short run in a debug build on a loaded machine: a hang fails.
+const LIMIT: Duration = Duration::from_secs(300);
+
+/// The `mcap` Python reader's release the test installs (and the lz4 it reads chunks with).
+const MCAP_PY: &str = "1.6.0";
+const LZ4_PY: &str = "4.4.5";
+
+/// `target/mcap-venv` with the `mcap` reader: made if absent or stale, under a file lock.
+fn mcap_venv() -> &'static Path {
+    static VENV: OnceLock<PathBuf> = OnceLock::new();
+    VENV.get_or_init(|| {
+        let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().expect("CARGO_TARGET_TMPDIR is target/tmp");
+        let dir = target.join("mcap-venv");
+        let stamp = format!("mcap {MCAP_PY}\nlz4 {LZ4_PY}\n");
+        let lock = std::fs::File::create(target.join("mcap-venv.lock")).expect("venv lock file");
+        lock.lock().expect("locking the venv");
+        let stamp_file = dir.join("mcap.stamp");
+        if dir.join("bin/python").exists() && std::fs::read_to_string(&stamp_file).ok().as_deref() == Some(&stamp) {
+            return dir;
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+        let venv = output_within(Command::new("python3").arg("-m").arg("venv").arg(&dir), Duration::from_secs(120));
+        assert_exit(&venv, 0);
+        let install = output_within(
+            Command::new(dir.join("bin/python"))
+                .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+                .arg(format!("mcap=={MCAP_PY}"))
+                .arg(format!("lz4=={LZ4_PY}")),
+            Duration::from_secs(600),
+        );
+        assert_exit(&install, 0);
+        std::fs::write(&stamp_file, stamp).expect("venv stamp");
+        dir
+    })
+}
+
+/// Reads a recording with the `mcap` Python package and prints it as JSON: per topic its
+/// schema (name, encoding, text) and its messages' fields as the doubles' bit patterns (signed
+/// 64-bit integers), decoded here from the schema's `float64` lines and CDR's layout (a 4-byte
+/// little-endian header, then the 8-byte doubles); the metadata; the events' messages.
+const READER: &str = r#"
+import json, struct, sys
+from mcap.reader import make_reader
+out = {"topics": {}, "metadata": {}, "events": [], "log_times_ok": True, "headers_ok": True}
+with open(sys.argv[1], "rb") as f:
+    reader = make_reader(f)
+    for m in reader.iter_metadata():
+        out["metadata"][m.name] = dict(m.metadata)
+    for schema, channel, message in reader.iter_messages(log_time_order=False):
+        if channel.topic == "/events":
+            data = json.loads(message.data)
+            out["events"].append([message.log_time, data["level"], data["message"]])
+            continue
+        text = schema.data.decode()
+        names = [l.split()[1] for l in text.splitlines() if l.startswith("float64 ")]
+        t = out["topics"].setdefault(channel.topic, {
+            "schema": schema.name, "encoding": schema.encoding, "message_encoding": channel.message_encoding,
+            "schema_text": text, "fields": {n: [] for n in names}})
+        data = bytes(message.data)
+        if data[:4] != b"\x00\x01\x00\x00" or len(data) != 4 + 8 * len(names):
+            out["headers_ok"] = False
+            continue
+        values = struct.unpack("<%dq" % len(names), data[4:])
+        if message.log_time != round(struct.unpack("<d", data[4:12])[0] * 1e9):
+            out["log_times_ok"] = False
+        for n, v in zip(names, values):
+            t["fields"][n].append(v)
+print(json.dumps(out))
+"#;
+
+/// The recording of `dir/run.mcap` as the Python reader sees it.
+fn read_back(dir: &Path) -> serde_json::Value {
+    let python = mcap_venv().join("bin/python");
+    let out =
+        output_within(Command::new(python).arg("-c").arg(READER).arg(dir.join("run.mcap")), Duration::from_secs(300));
+    assert_exit(&out, 0);
+    serde_json::from_slice(&out.stdout).expect("the reader's JSON")
+}
+
+/// Runs `scene_file` with `sets` and `--mcap` into `dir/run`; returns the folder.
+fn record(dir: &TempDir, scene_file: &Path, sets: &[&str]) -> PathBuf {
+    let out = dir.join("run");
+    let mut cmd = common::plant_run(scene_file, &out, sets);
+    let done = output_within(cmd.arg("--mcap").arg("--quiet"), LIMIT);
+    assert_exit(&done, 0);
+    out
+}
+
+/// Every topic's every field equals its `trace.csv` column bit for bit, one message per row;
+/// returns the topics seen.
+fn assert_holds_trace(run: &Path, rec: &serde_json::Value) -> Vec<String> {
+    let trace = Csv::read(&run.join("trace.csv"));
+    let rows = trace.rows.len();
+    assert!(rows > 100, "{rows} rows");
+    let topics = rec["topics"].as_object().expect("topics");
+    let mut carried = Vec::new();
+    for (name, t) in topics {
+        assert_eq!(t["encoding"], "ros2msg", "{name}");
+        assert_eq!(t["message_encoding"], "cdr", "{name}");
+        let schema = t["schema_text"].as_str().unwrap();
+        let fields = t["fields"].as_object().unwrap();
+        let plane_b = name.starts_with("/plane_b/");
+        for (field, values) in fields {
+            let values: Vec<i64> = serde_json::from_value(values.clone()).unwrap();
+            assert_eq!(values.len(), rows, "{name}.{field}: one message per row");
+            // The field's line of the schema, with its unit and column in the comment.
+            let description = schema
+                .lines()
+                .find(|l| l.starts_with(&format!("float64 {field} ")))
+                .unwrap_or_else(|| panic!("{name}.{field} in {schema}"));
+            if field == "radius_m" {
+                assert!(description.contains("(m)"), "{description}");
+                assert_radius(name, &trace, &values);
+                continue;
+            }
+            let column = if plane_b && field != "t_s" { format!("b_{field}") } else { field.clone() };
+            carried.push(column.clone());
+            // The unit is the column name's suffix: `_m` → (m), `_a` → (A), …
+            assert!(description.contains(&column), "{name}.{field}: {description}");
+            assert!(description.contains(&format!("({})", unit_of(&column))), "{name}.{field}: {description}");
+            let expected = trace.column(&column);
+            for (i, (got, want)) in values.iter().zip(&expected).enumerate() {
+                // trace.csv writes every NaN as `NaN`: a NaN's payload is not in the trace.
+                if want.is_nan() {
+                    assert!(f64::from_bits(*got as u64).is_nan(), "{name}.{field} row {i}: NaN");
+                } else {
+                    assert_eq!(*got, want.to_bits() as i64, "{name}.{field} row {i}: {want}");
+                }
+            }
+        }
+    }
+    assert_eq!(rec["log_times_ok"], true, "each message's log time is its t_s in ns");
+    assert_eq!(rec["headers_ok"], true, "each message is the CDR header and one double per schema field");
+    // Every column but the time is carried once, and `t_s` by every topic.
+    carried.retain(|c| c != "t_s");
+    carried.sort();
+    let mut columns: Vec<String> = trace.header.iter().filter(|c| *c != "t_s").cloned().collect();
+    columns.sort();
+    assert_eq!(carried, columns);
+    topics.keys().cloned().collect()
+}
+
+/// A column's unit, from its name (the trace's naming rule, written out again here).
+fn unit_of(column: &str) -> &'static str {
+    let ends = |s: &str| column.ends_with(s);
+    if ends("_m_s") {
+        "m/s"
+    } else if ends("_rad_s") {
+        "rad/s"
+    } else if ends("_rad") {
+        "rad"
+    } else if ends("_m") {
+        "m"
+    } else if ends("_n") {
+        "N"
+    } else if ends("_a") {
+        "A"
+    } else if ends("_v") {
+        "V"
+    } else {
+        "s"
+    }
+}
+
+/// The radius field: hypot of the row's x and y (the topic's), within one ulp (Python's hypot
+/// and libm's may round differently), computed here from the trace.
+fn assert_radius(topic: &str, trace: &Csv, values: &[i64]) {
+    let (x, y) = match topic {
+        "/plane_a/rotor" => ("dx_m", "dy_m"),
+        "/plane_b/rotor" => ("b_dx_m", "b_dy_m"),
+        "/mid_span" => ("mid_dx_m", "mid_dy_m"),
+        other => panic!("radius on {other}"),
+    };
+    for (i, ((v, x), y)) in values.iter().zip(trace.column(x)).zip(trace.column(y)).enumerate() {
+        let want = (x * x + y * y).sqrt();
+        let got = f64::from_bits(*v as u64);
+        assert!((got - want).abs() <= 2.0 * f64::EPSILON * want, "{topic} radius row {i}: {got} vs {want}");
+    }
+}
+
+#[test]
+fn a_recording_holds_the_trace_bit_for_bit() {
+    let dir = TempDir::new("mcap-planar");
+    let run = record(&dir, &scene("paper-10g.toml"), SHORT);
+    let rec = read_back(&run);
+    let topics = assert_holds_trace(&run, &rec);
+    let want = ["/housing", "/plane_a/coils", "/plane_a/contact", "/plane_a/race", "/plane_a/rotor", "/rotor/spin"];
+    assert_eq!(topics, want);
+    // The scene as metadata: the run's own scene.toml.
+    assert_eq!(rec["metadata"]["scene"]["scene.toml"].as_str().unwrap(), read_text(&run.join("scene.toml")));
+    // The events: the shock's start at its row (10 ms), contact onsets, the status at the end.
+    let events: Vec<(u64, u64, String)> = serde_json::from_value(rec["events"].clone()).unwrap();
+    assert!(
+        events.iter().any(|(t, level, m)| *t == 10_000_000 && *level == 2 && m == "shock 1 of 1 starts (t = 0.01 s)"),
+        "{events:?}"
+    );
+    assert!(events.iter().any(|(_, _, m)| m == "contact onset 1"), "{events:?}");
+    let last_ns = 50_000_000;
+    assert!(events.iter().any(|(t, _, m)| *t == last_ns && m == "run completed"), "{events:?}");
+    assert!(events.iter().any(|(_, _, m)| m.starts_with("motion after the shock: ")), "{events:?}");
+}
+
+#[test]
+fn two_plane_and_flexible_recordings_hold_their_planes_and_mid_span() {
+    let dir = TempDir::new("mcap-two-plane");
+    let run = record(&dir, &scene("two-plane-asymmetric-10g.toml"), &["scene.duration_s=0.02", "output.plots=false"]);
+    let topics = assert_holds_trace(&run, &read_back(&run));
+    for t in ["/plane_b/rotor", "/plane_b/race", "/plane_b/contact", "/plane_b/coils", "/tilt"] {
+        assert!(topics.iter().any(|x| x == t), "{t} in {topics:?}");
+    }
+    let dir = TempDir::new("mcap-flexible");
+    let run = record(&dir, &scene("flexible-10g.toml"), &["scene.duration_s=0.01", "output.plots=false"]);
+    let rec = read_back(&run);
+    let topics = assert_holds_trace(&run, &rec);
+    assert!(topics.iter().any(|x| x == "/mid_span"), "{topics:?}");
+    // Every series of the shipped layout names a topic and field of this recording (the
+    // flexible rotor's has both planes and the mid-span).
+    let layout: serde_json::Value =
+        serde_json::from_str(&read_text(&common::workspace_root().join("docs/layouts/plant-study.json")))
+            .expect("the layout's JSON");
+    let mut paths = Vec::new();
+    for panel in layout["configById"].as_object().unwrap().values() {
+        for p in panel["paths"].as_array().into_iter().flatten() {
+            paths.push(p["value"].as_str().unwrap().to_string());
+        }
+        if let Some(x) = panel["xAxisPath"]["value"].as_str() {
+            paths.push(x.to_string());
+        }
+        if let Some(t) = panel["topicToRender"].as_str() {
+            assert_eq!(t, "/events");
+        }
+    }
+    assert!(paths.len() >= 10, "{paths:?}");
+    for path in paths {
+        let (topic, field) = path.split_once('.').unwrap_or_else(|| panic!("{path}"));
+        assert!(rec["topics"][topic]["fields"].get(field).is_some(), "the layout's {path} is not in the recording");
+    }
+}
+
+#[test]
+fn without_the_flag_nothing_is_recorded_and_scene_toml_is_unchanged() {
+    let dir = TempDir::new("mcap-off");
+    let out = dir.join("run");
+    let done = output_within(common::plant_run(&scene("paper-10g.toml"), &out, SHORT).arg("--quiet"), LIMIT);
+    assert_exit(&done, 0);
+    assert!(!out.join("run.mcap").exists());
+    // The key is written into the resolved scene only when set (earlier runs' scene.toml stay
+    // byte-identical).
+    assert!(!read_text(&out.join("scene.toml")).contains("mcap"));
+    let on = record(&dir, &scene("paper-10g.toml"), SHORT);
+    assert!(read_text(&on.join("scene.toml")).contains("mcap = true"));
+    // A reused folder loses an earlier recording when the next run does not record.
+    let done = output_within(common::plant_run(&scene("paper-10g.toml"), &on, SHORT).arg("--quiet"), LIMIT);
+    assert_exit(&done, 0);
+    assert!(!on.join("run.mcap").exists(), "a stale run.mcap stayed");
+}
+
+#[test]
+fn a_link_at_run_mcap_is_replaced_not_followed() {
+    let dir = TempDir::new("mcap-link");
+    let out = dir.join("run");
+    std::fs::create_dir_all(&out).unwrap();
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, "untouched").unwrap();
+    std::os::unix::fs::symlink(&victim, out.join("run.mcap")).unwrap();
+    record(&dir, &scene("paper-10g.toml"), SHORT);
+    assert_eq!(read_text(&victim), "untouched");
+    let meta = std::fs::symlink_metadata(out.join("run.mcap")).unwrap();
+    assert!(meta.file_type().is_file(), "run.mcap is a regular file");
+}
+
+#[test]
+fn a_bad_value_of_the_key_exits_2_naming_it() {
+    let dir = TempDir::new("mcap-bad");
+    let out = dir.join("run");
+    let mut cmd = common::plant_run(&scene("paper-10g.toml"), &out, &["output.mcap=3"]);
+    let done = output_within(&mut cmd, LIMIT);
+    assert_exit(&done, 2);
+    assert!(stderr(&done).contains("mcap"), "{}", stderr(&done));
+    assert!(!out.join("run.mcap").exists() && !out.join("trace.csv").exists());
+}
