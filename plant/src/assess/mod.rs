@@ -649,55 +649,78 @@ fn assess_controller(
         };
     }
     if a.parts.contains(&Part::Ladder) && !interrupted() {
-        if !levitated {
-            let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
-            report.ladder = PartOutcome::failed(Failure::NotGradable, why, 0.0);
-        } else {
-            log(&format!("{}: shock ladder", c.label));
-            let t = Instant::now();
-            let b = bearing(&scene, a)?;
-            // A member may end once decided only where the probe measured the loop stable.
-            let stable = decay_at_speed.is_some_and(|s| s > 0.0);
-            let kind = |e: &anyhow::Error| {
-                if interrupted() {
-                    Failure::Interrupted
-                } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
-                    Failure::InvalidCommands
-                } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
-                    Failure::PeerLost
-                } else {
-                    Failure::Other
-                }
-            };
-            report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
-                Ok((l, Some(e))) => {
-                    let kind = kind(&e);
-                    PartOutcome {
-                        status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
-                        why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
-                        failure: Some(kind),
-                        result: Some(l),
-                        wall_s: t.elapsed().as_secs_f64(),
-                    }
-                }
-                Ok((l, None)) if l.interrupted => PartOutcome {
-                    status: "interrupted",
-                    why: Some("interrupted: the rungs marked incomplete were not decided".into()),
-                    failure: Some(Failure::Interrupted),
-                    result: Some(l),
-                    wall_s: t.elapsed().as_secs_f64(),
-                },
-                Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
-                Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
-            };
-        }
+        report.ladder = ladder_part(a, c, &scene, levitated, decay_at_speed, stop, log)?;
     }
+    if interrupted() {
+        mark_not_measured(&mut report, &a.parts);
+    }
+    report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
+    report.wall_s = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// The shock ladder of one controller: none where the rotor was not levitated before the
+/// shock; a member may end once decided only where the probe measured the loop stable.
+fn ladder_part(
+    a: &Assessment,
+    c: &ControllerSpec,
+    scene: &Scene,
+    levitated: bool,
+    decay_at_speed: Option<f64>,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> anyhow::Result<PartOutcome<ladder::LadderResult>> {
+    let interrupted = || stop.load(Ordering::Relaxed);
+    if !levitated {
+        let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
+        return Ok(PartOutcome::failed(Failure::NotGradable, why, 0.0));
+    }
+    log(&format!("{}: shock ladder", c.label));
+    let t = Instant::now();
+    let b = bearing(scene, a)?;
+    let stable = decay_at_speed.is_some_and(|s| s > 0.0);
+    let kind = |e: &anyhow::Error| {
+        if interrupted() {
+            Failure::Interrupted
+        } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
+            Failure::InvalidCommands
+        } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
+            Failure::PeerLost
+        } else {
+            Failure::Other
+        }
+    };
+    Ok(match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
+        Ok((l, Some(e))) => {
+            let kind = kind(&e);
+            PartOutcome {
+                status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
+                why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
+                failure: Some(kind),
+                result: Some(l),
+                wall_s: t.elapsed().as_secs_f64(),
+            }
+        }
+        Ok((l, None)) if l.interrupted => PartOutcome {
+            status: "interrupted",
+            why: Some("interrupted: the rungs marked incomplete were not decided".into()),
+            failure: Some(Failure::Interrupted),
+            result: Some(l),
+            wall_s: t.elapsed().as_secs_f64(),
+        },
+        Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
+        Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
+    })
+}
+
+/// An interrupted assessment: each part asked for and not reached says so.
+fn mark_not_measured(report: &mut ControllerReport, parts: &[Part]) {
     for (status, part) in [
         (report.sensitivity.status, "sensitivity"),
         (report.vibration.status, "vibration"),
         (report.ladder.status, "ladder"),
     ] {
-        if status == "skipped" && interrupted() && a.parts.iter().any(|p| p.name() == part) {
+        if status == "skipped" && parts.iter().any(|p| p.name() == part) {
             match part {
                 "sensitivity" => {
                     report.sensitivity =
@@ -711,9 +734,6 @@ fn assess_controller(
             }
         }
     }
-    report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
-    report.wall_s = started.elapsed().as_secs_f64();
-    Ok(report)
 }
 
 /// The whole report.
@@ -763,7 +783,63 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
             c.sets.insert(0, LOCKSTEP_WAIT.into());
         }
     }
-    // Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2).
+    let first = check_scenes(&a, stop)?;
+    let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
+    let _claim = crate::claim::claim(&dir, true)?;
+    let quiet = args.quiet;
+    let log = move |l: &str| {
+        if !quiet {
+            eprintln!("plant assess: {l}");
+        }
+    };
+    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
+    // Paths as seen from where the command ran: the report names no folder of this machine.
+    let cwd = std::env::current_dir().unwrap_or_default();
+    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, &cwd) };
+    let roots = roots(&cwd, &a.scene, &dir);
+    let mut report = Report {
+        program: format!("plant {}", env!("CARGO_PKG_VERSION")),
+        file: shown_here(&args.file),
+        scene: shown_here(&a.scene),
+        out: shown_here(&dir),
+        parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
+        bearing,
+        ladder_settings: a.ladder.clone(),
+        warnings: a.warnings.clone(),
+        controllers: Vec::new(),
+        interrupted: false,
+        wall_s: 0.0,
+        roots,
+    };
+    for c in &a.controllers {
+        let r = assess_controller(&a, c, stop, &log)?;
+        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
+        report.controllers.push(r);
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+    }
+    for c in a.controllers.iter().skip(report.controllers.len()) {
+        report.controllers.push(not_assessed(c));
+    }
+    report.interrupted = stop.load(Ordering::Relaxed);
+    report.wall_s = started.elapsed().as_secs_f64();
+    report::write(&dir, &report)?;
+    log(&format!("wrote {}", dir.join("report.html").display()));
+    failed(&report, &dir)?;
+    // A signal while the report was written: every part was measured and the report is whole,
+    // but the command was asked to stop (exit 130, as `run` and `soak` do).
+    if stop.load(Ordering::Relaxed) {
+        let message = "interrupted while the report was written (every part was measured)".to_string();
+        return Err(AssessError { kind: Failure::Interrupted, message, dir: dir.display().to_string() }.into());
+    }
+    Ok(dir)
+}
+
+/// Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2), and
+/// its controller starts; the first controller's scene.
+fn check_scenes(a: &Assessment, stop: &AtomicBool) -> anyhow::Result<Option<Scene>> {
     let mut first = None;
     for c in &a.controllers {
         let scene = load_scene(&a.scene, &c.sets)?;
@@ -796,72 +872,47 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         }
         first.get_or_insert(scene);
     }
-    let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
-    let _claim = crate::claim::claim(&dir, true)?;
-    let quiet = args.quiet;
-    let log = move |l: &str| {
-        if !quiet {
-            eprintln!("plant assess: {l}");
-        }
-    };
-    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
-    // Paths as seen from where the command ran: the report names no folder of this machine.
-    let cwd = std::env::current_dir().unwrap_or_default();
-    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, &cwd) };
+    Ok(first)
+}
+
+/// The absolute folders the report names (the scene's, the report's, the working folder) and
+/// how it shows them, relative to `cwd`; the longest first.
+fn roots(cwd: &Path, scene: &Path, dir: &Path) -> Vec<(String, String)> {
+    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, cwd) };
     let mut roots = Vec::new();
     if !cwd.as_os_str().is_empty() {
-        let scene_dir = a.scene.parent().unwrap_or(Path::new("."));
+        let scene_dir = scene.parent().unwrap_or(Path::new("."));
         let absolute = |p: &Path| shown(&cwd.join(p));
         roots.push((absolute(scene_dir), shown_here(scene_dir)));
-        roots.push((absolute(&dir), shown_here(&dir)));
-        roots.push((shown(&cwd), ".".to_string()));
+        roots.push((absolute(dir), shown_here(dir)));
+        roots.push((shown(cwd), ".".to_string()));
         // The longest first: a folder inside another is replaced as itself.
         roots.sort_by_key(|(abs, _)| std::cmp::Reverse(abs.len()));
         roots.retain(|(abs, _)| abs != "/");
     }
-    let mut report = Report {
-        program: format!("plant {}", env!("CARGO_PKG_VERSION")),
-        file: shown_here(&args.file),
-        scene: shown_here(&a.scene),
-        out: shown_here(&dir),
-        parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
-        bearing,
-        ladder_settings: a.ladder.clone(),
-        warnings: a.warnings.clone(),
-        controllers: Vec::new(),
-        interrupted: false,
+    roots
+}
+
+/// A controller the interrupted assessment did not reach.
+fn not_assessed(c: &ControllerSpec) -> ControllerReport {
+    let mut r = ControllerReport {
+        label: c.label.clone(),
+        set: c.own.clone(),
+        law: String::new(),
+        mode: String::new(),
+        rate_hz: 0.0,
+        sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        verdict: String::new(),
         wall_s: 0.0,
-        roots,
     };
-    for c in &a.controllers {
-        let r = assess_controller(&a, c, stop, &log)?;
-        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
-        report.controllers.push(r);
-        if stop.load(Ordering::Relaxed) {
-            break;
-        }
-    }
-    for c in a.controllers.iter().skip(report.controllers.len()) {
-        let mut r = ControllerReport {
-            label: c.label.clone(),
-            set: c.own.clone(),
-            law: String::new(),
-            mode: String::new(),
-            rate_hz: 0.0,
-            sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            verdict: String::new(),
-            wall_s: 0.0,
-        };
-        r.verdict = "not assessed: interrupted".into();
-        report.controllers.push(r);
-    }
-    report.interrupted = stop.load(Ordering::Relaxed);
-    report.wall_s = started.elapsed().as_secs_f64();
-    report::write(&dir, &report)?;
-    log(&format!("wrote {}", dir.join("report.html").display()));
+    r.verdict = "not assessed: interrupted".into();
+    r
+}
+
+/// The worst failure of any part of any controller, as the command's error.
+fn failed(report: &Report, dir: &Path) -> anyhow::Result<()> {
     let failures: Vec<(Failure, String)> = report
         .controllers
         .iter()
@@ -885,13 +936,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         };
         return Err(AssessError { kind: worst, message, dir: dir.display().to_string() }.into());
     }
-    // A signal while the report was written: every part was measured and the report is whole,
-    // but the command was asked to stop (exit 130, as `run` and `soak` do).
-    if stop.load(Ordering::Relaxed) {
-        let message = "interrupted while the report was written (every part was measured)".to_string();
-        return Err(AssessError { kind: Failure::Interrupted, message, dir: dir.display().to_string() }.into());
-    }
-    Ok(dir)
+    Ok(())
 }
 
 /// `path` relative to `cwd` (both taken lexically, `path` joined to `cwd` when relative), with
