@@ -91,7 +91,7 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
     } else if r.vibration.status != "skipped" {
         parts.push(format!("vibration {}", r.vibration.status));
     }
-    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.members > 0)) {
+    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.tally.members > 0)) {
         // An interrupted or failed ladder: its figures are those of the rungs decided so far.
         let so_far = match r.ladder.status {
             "measured" => String::new(),
@@ -103,9 +103,9 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
             parts.push(format!(
                 "at {duty_g} G{}: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
                 if rung.complete { "" } else { " (incomplete)" },
-                rung.p_recovered,
-                rung.p_lo,
-                rung.p_hi,
+                rung.tally.p_recovered,
+                rung.tally.p_lo,
+                rung.tally.p_hi,
                 d.contact_time_s.median.unwrap_or(f64::NAN),
                 d.friction_energy_j.median.unwrap_or(f64::NAN),
                 d.peak_ball_pressure_mpa.median.unwrap_or(f64::NAN)
@@ -120,7 +120,9 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
 /// The highest safe shock in words, with the interval that decides it: the safe rung's
 /// [lower, upper], or where none is safe the first rung's (the one that failed), and the counts.
 fn safe_words(l: &LadderResult, min_p: f64) -> String {
-    let interval = |x: &Rung| format!("{}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi);
+    let interval = |x: &Rung| {
+        format!("{}/{} recovered, [{:.2}, {:.2}]", x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi)
+    };
     match l.safe_up_to_g {
         Some(g) => {
             let at = l.rungs.iter().find(|x| x.peak_g == g).map(|x| format!(" ({} at {g} G)", interval(x)));
@@ -128,7 +130,7 @@ fn safe_words(l: &LadderResult, min_p: f64) -> String {
         }
         None => {
             let first =
-                l.rungs.iter().find(|x| x.members > 0).map(|x| format!(" (at {} G: {})", x.peak_g, interval(x)));
+                l.rungs.iter().find(|x| x.tally.members > 0).map(|x| format!(" (at {} G: {})", x.peak_g, interval(x)));
             format!("P(recovered) ≥ {min_p} at no rung{}", first.unwrap_or_default())
         }
     }
@@ -346,7 +348,12 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
         with.iter()
             .map(|(i, c, l)| Line {
                 label: format!("{}{suffix}", c.label),
-                points: l.rungs.iter().filter(|x| x.members > 0).filter_map(|x| f(x).map(|v| (x.peak_g, v))).collect(),
+                points: l
+                    .rungs
+                    .iter()
+                    .filter(|x| x.tally.members > 0)
+                    .filter_map(|x| f(x).map(|v| (x.peak_g, v)))
+                    .collect(),
                 colour: colour(*i),
                 dashed,
                 width: 2,
@@ -356,11 +363,18 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
     let bars: Vec<ErrorBars> = with
         .iter()
         .map(|(i, _, l)| {
-            (colour(*i), l.rungs.iter().filter(|x| x.members > 0).map(|x| (x.peak_g, x.p_lo, x.p_hi)).collect())
+            (
+                colour(*i),
+                l.rungs
+                    .iter()
+                    .filter(|x| x.tally.members > 0)
+                    .map(|x| (x.peak_g, x.tally.p_lo, x.tally.p_hi))
+                    .collect(),
+            )
         })
         .collect();
     // A ladder interrupted or stopped before any member was counted has nothing to draw.
-    let lines = series(&|x| Some(x.p_recovered), false, "");
+    let lines = series(&|x| Some(x.tally.p_recovered), false, "");
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_probability.png");
         let min_p = format!("{}", r.ladder_settings.min_p);
@@ -375,8 +389,8 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
         )?;
         out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
     }
-    let mut lines = series(&|x| x.recovery_median_s.map(|v| v * 1e3), false, " median");
-    lines.extend(series(&|x| x.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
+    let mut lines = series(&|x| x.tally.recovery_median_s.map(|v| v * 1e3), false, " median");
+    lines.extend(series(&|x| x.tally.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_recovery.png");
         chart(

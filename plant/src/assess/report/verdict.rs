@@ -181,7 +181,10 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 // Coloured by its value: green only from the duty rung (the design shock) up.
                 let class = safe_class(g, r.ladder_settings.duty_g);
                 let at = l.rungs.iter().find(|x| x.peak_g == g).map_or(String::new(), |x| {
-                    format!("; at {g} G {}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi)
+                    format!(
+                        "; at {g} G {}/{} recovered, [{:.2}, {:.2}]",
+                        x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
+                    )
                 });
                 format!(
                     "<b class=\"{class}\">{g} G</b> (every rung up to it: lower bound ≥ {}{at})",
@@ -189,10 +192,10 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 )
             }
             None => {
-                let first = l.rungs.iter().find(|x| x.members > 0).map_or(String::new(), |x| {
+                let first = l.rungs.iter().find(|x| x.tally.members > 0).map_or(String::new(), |x| {
                     format!(
                         ": at {} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.peak_g, x.recovered, x.members, x.p_lo, x.p_hi
+                        x.peak_g, x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
                     )
                 });
                 format!(
