@@ -328,6 +328,71 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
     }
     check_criteria(&raw.criteria)?;
 
+    let (specs, shocks, list_key) = planned_shocks(&raw, dir, hold)?;
+    let last = shocks.last().map_or(0.0, |s| s.start_s + s.duration_s);
+
+    // The scene: its file, the programme's overrides, the command line's, then the programme's
+    // mode, shocks and duration.
+    let scene_path = dir.join(&raw.scene);
+    let mut set = raw.set.clone();
+    set.extend(cli_set.iter().cloned());
+    let base = crate::config::load_scene(&scene_path, &set)?;
+    let plots = base.plots;
+    let programme_set = [
+        format!("controller.mode={}", toml::Value::String(crate::summary::snake_name(&mode))),
+        format!("scene.duration_s={:?}", tidy(last + settle)),
+        format!("scene.name={}", toml::Value::String(raw.name.clone())),
+        // The soak draws its own plots; `scene.toml` would reproduce the run with the full trace.
+        "output.plots=false".to_string(),
+    ];
+    // Shock files (recorded pulses) are relative to the programme file, like its other paths.
+    let scene = base
+        .with_shocks(&specs, dir, &programme_set)
+        .map_err(|e| blame_duration(e, settle, last, list_key, &shocks))?;
+    // One RSS sample per tick at most, and a bounded number of them (each is a row of rss.csv
+    // and a few numbers in memory).
+    let period = scene.controller.period;
+    if rss_every < period || scene.duration / rss_every > MAX_RSS_SAMPLES {
+        return Err(range(
+            "rss_every_s",
+            rss_every,
+            "s",
+            &format!(
+                "must be at least the controller period ({period} s) and give at most {MAX_RSS_SAMPLES:e} samples over the soak's {} s",
+                scene.duration
+            ),
+        ));
+    }
+    if hold < 10.0 * scene.output_interval {
+        return Err(range(
+            "recovery.hold_s",
+            hold,
+            "s",
+            &format!("must be at least 10 output samples ({} s at output.rate_hz)", 10.0 * scene.output_interval),
+        ));
+    }
+    let clear_radius = (0..scene.planes()).map(|i| fraction * scene.plane(i).contact.gap).collect();
+    Ok(Programme {
+        name: raw.name.clone(),
+        scene,
+        shocks,
+        hold,
+        clear_radius,
+        rss_every,
+        plots,
+        criteria: raw.criteria.clone(),
+        raw,
+    })
+}
+
+/// The programme's shocks (exactly one of `[random]` and `[[shock]]`), in time order and each
+/// far enough from the one before for its pulse and `hold` (s); the key that names their
+/// spacing (`shock` or `random.spacing_s`).
+fn planned_shocks(
+    raw: &RawProgramme,
+    dir: &Path,
+    hold: f64,
+) -> Result<(Vec<ShockSpec>, Vec<PlannedShock>, &'static str), ConfigError> {
     // Shocks: exactly one of [random] and [[shock]].
     let (specs, list_key) = match (&raw.random, raw.shock.is_empty()) {
         (Some(r), true) => (random_shocks(r)?, "random.spacing_s"),
@@ -371,27 +436,16 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
             ));
         }
     }
-    let last = shocks.last().map_or(0.0, |s| s.start_s + s.duration_s);
+    Ok((specs, shocks, list_key))
+}
 
-    // The scene: its file, the programme's overrides, the command line's, then the programme's
-    // mode, shocks and duration.
-    let scene_path = dir.join(&raw.scene);
-    let mut set = raw.set.clone();
-    set.extend(cli_set.iter().cloned());
-    let base = crate::config::load_scene(&scene_path, &set)?;
-    let plots = base.plots;
-    let programme_set = [
-        format!("controller.mode={}", toml::Value::String(crate::summary::snake_name(&mode))),
-        format!("scene.duration_s={:?}", tidy(last + settle)),
-        format!("scene.name={}", toml::Value::String(raw.name.clone())),
-        // The soak draws its own plots; `scene.toml` would reproduce the run with the full trace.
-        "output.plots=false".to_string(),
-    ];
-    // Shock files (recorded pulses) are relative to the programme file, like its other paths.
-    // A bound of the scene's duration is the programme's to blame: its last shock's end plus
-    // `settle_s` (the scene would name `scene.duration_s`, which the programme sets).
-    let scene = base.with_shocks(&specs, dir, &programme_set).map_err(|e| match e {
-        ConfigError::Range { key, value, unit, why } if key == "scene.duration_s" || why.contains("scene.duration_s") => {
+/// A bound of the scene's duration is the programme's to blame: its last shock's end (`last`,
+/// s) plus `settle` (s); the scene would name `scene.duration_s`, which the programme sets.
+fn blame_duration(e: ConfigError, settle: f64, last: f64, list_key: &str, shocks: &[PlannedShock]) -> ConfigError {
+    match e {
+        ConfigError::Range { key, value, unit, why }
+            if key == "scene.duration_s" || why.contains("scene.duration_s") =>
+        {
             let (blame, shown) = if settle >= last || list_key != "shock" {
                 ("settle_s".to_string(), settle.to_string())
             } else {
@@ -404,41 +458,7 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
             range(&blame, shown, "s", &why)
         }
         e => e,
-    })?;
-    // One RSS sample per tick at most, and a bounded number of them (each is a row of rss.csv
-    // and a few numbers in memory).
-    let period = scene.controller.period;
-    if rss_every < period || scene.duration / rss_every > MAX_RSS_SAMPLES {
-        return Err(range(
-            "rss_every_s",
-            rss_every,
-            "s",
-            &format!(
-                "must be at least the controller period ({period} s) and give at most {MAX_RSS_SAMPLES:e} samples over the soak's {} s",
-                scene.duration
-            ),
-        ));
     }
-    if hold < 10.0 * scene.output_interval {
-        return Err(range(
-            "recovery.hold_s",
-            hold,
-            "s",
-            &format!("must be at least 10 output samples ({} s at output.rate_hz)", 10.0 * scene.output_interval),
-        ));
-    }
-    let clear_radius = (0..scene.planes()).map(|i| fraction * scene.plane(i).contact.gap).collect();
-    Ok(Programme {
-        name: raw.name.clone(),
-        scene,
-        shocks,
-        hold,
-        clear_radius,
-        rss_every,
-        plots,
-        criteria: raw.criteria.clone(),
-        raw,
-    })
 }
 
 fn check_criteria(c: &Criteria) -> Result<(), ConfigError> {
