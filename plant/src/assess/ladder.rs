@@ -25,9 +25,7 @@
 
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
-use crate::ensemble::member::{
-    close_to_decision, figures, member_overrides, shock_size, verify_overrides, MemberResult,
-};
+use crate::ensemble::member::{close_to_decision, figures, member_overrides, verify_overrides, MemberResult};
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
 use crate::ensemble::tally::{tally, Tally};
@@ -381,7 +379,7 @@ impl Hooks for MemberHooks<'_> {
 /// The overrides that give rung peak `g` (G) to the scene's programme.
 pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
     let raw = scene.resolved()?;
-    let first = raw.shock.first().and_then(shock_size).map(|(_, v)| v);
+    let first = raw.shock.first().and_then(shock_table::ShockSpec::size).map(|(_, v)| v);
     let Some(first) = first.filter(|v| *v > 0.0) else {
         anyhow::bail!("the shock ladder needs a scene whose first [[shock]] has a size (peak_g, amplitude_g or scale)");
     };
@@ -390,7 +388,7 @@ pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
         .shock
         .iter()
         .enumerate()
-        .filter_map(|(k, s)| shock_size(s).map(|(field, v)| format!("shock[{k}].{field}={:?}", v * factor)))
+        .filter_map(|(k, s)| s.size().map(|(field, v)| format!("shock[{k}].{field}={:?}", v * factor)))
         .collect())
 }
 

@@ -283,16 +283,6 @@ fn random_shocks(r: &RawRandom) -> Result<Vec<ShockSpec>, ConfigError> {
     Ok(shocks)
 }
 
-fn peak_of(spec: &ShockSpec) -> f64 {
-    match spec {
-        ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => *p,
-        ShockSpec::DoubleHalfSine { design_accel_g: Some(a0), .. } => a0 / 2.0,
-        ShockSpec::HalfSine { peak_g, .. } => *peak_g,
-        ShockSpec::Sine { amplitude_g, .. } => *amplitude_g,
-        _ => f64::NAN,
-    }
-}
-
 /// Most RSS samples over a soak (rows of `rss.csv`).
 pub const MAX_RSS_SAMPLES: f64 = 1e6;
 
@@ -407,7 +397,7 @@ fn planned_shocks(
     for (spec, shock) in specs.iter().zip(&programme.shocks) {
         shocks.push(PlannedShock {
             start_s: shock.start,
-            peak_g: peak_of(spec),
+            peak_g: spec.peak_g(),
             direction_deg: shock.direction().to_degrees(),
             duration_s: shock.pulse.duration(),
         });
