@@ -18,11 +18,17 @@ pub mod ladder;
 #[cfg(test)]
 mod linear_check;
 pub mod margins;
+mod outcome;
+mod paths;
 pub mod rainflow;
 pub mod report;
 pub mod sensitivity;
 pub mod spec;
 pub mod vibration;
+
+pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
+use paths::roots;
+pub use paths::{relative_text, relative_to, shown, shown_relative};
 
 use crate::config::{load_scene, ConfigError, ControlMode, Scene};
 use crate::cosim::Launch;
@@ -31,7 +37,6 @@ use crate::ensemble::spec::MemberSetting;
 use crate::run::{run_into, Outcome};
 use anyhow::Context;
 use rayon::prelude::*;
-use serde::Serialize;
 use spec::{Assessment, ControllerSpec, Part};
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
@@ -57,144 +62,6 @@ pub struct AssessArgs {
     /// No progress lines.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// How a part of an assessment failed; each has its exit code.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Failure {
-    /// The rotor is not levitated before the shock, or the excitation drove it into the
-    /// touchdown bearing: nothing to grade (exit 9).
-    NotGradable,
-    /// The controller process was lost (exit 4).
-    PeerLost,
-    /// The controller's commands were non-finite past the scene's budget (exit 8).
-    InvalidCommands,
-    /// A run diverged (exit 3).
-    Diverged,
-    /// Interrupted by SIGINT/SIGTERM (exit 130).
-    Interrupted,
-    /// Anything else (exit 1).
-    Other,
-}
-
-impl Failure {
-    fn rank(self) -> u8 {
-        match self {
-            Failure::Interrupted => 6,
-            Failure::PeerLost => 5,
-            Failure::InvalidCommands => 4,
-            Failure::Diverged => 3,
-            Failure::NotGradable => 2,
-            Failure::Other => 1,
-        }
-    }
-}
-
-/// An assessment that wrote its report but could not measure everything.
-#[derive(Debug, thiserror::Error)]
-#[error("{message}; the report in {dir} holds what was measured and says what was not")]
-pub struct AssessError {
-    /// The gravest failure.
-    pub kind: Failure,
-    /// What failed, for each part.
-    pub message: String,
-    /// The report's folder.
-    pub dir: String,
-}
-
-/// A part's outcome.
-#[derive(Clone, Debug, Serialize)]
-pub struct PartOutcome<T> {
-    /// `measured`, `skipped`, `failed`, or `interrupted`.
-    pub status: &'static str,
-    /// Why it was not measured.
-    pub why: Option<String>,
-    /// How it failed.
-    pub failure: Option<Failure>,
-    /// The result.
-    pub result: Option<T>,
-    /// Wall time (s).
-    pub wall_s: f64,
-}
-
-impl<T> PartOutcome<T> {
-    fn measured(result: T, wall_s: f64) -> Self {
-        Self { status: "measured", why: None, failure: None, result: Some(result), wall_s }
-    }
-    fn skipped(why: &str) -> Self {
-        Self { status: "skipped", why: Some(why.to_string()), failure: None, result: None, wall_s: 0.0 }
-    }
-    fn failed(kind: Failure, why: String, wall_s: f64) -> Self {
-        let status = if kind == Failure::Interrupted { "interrupted" } else { "failed" };
-        Self { status, why: Some(why), failure: Some(kind), result: None, wall_s }
-    }
-}
-
-/// The sensitivity part: one result per axis and speed.
-#[derive(Clone, Debug, Serialize)]
-pub struct SensitivityPart {
-    /// Per axis and speed.
-    pub axes: Vec<sensitivity::AxisResult>,
-    /// The closed form of the law, where it has one (`pd`, `pd_delay` and the continuous PD on
-    /// the linear bearing): per speed-independent axis, its peak and zone.
-    pub closed_form: Option<ClosedFormPeak>,
-    /// The two-plane rotor: each plane's closed form (its load share as a planar rotor with the
-    /// plane's design, [`closed_form_of_plane`]), planes A then B; empty for the planar model.
-    pub closed_form_planes: Vec<ClosedFormPeak>,
-    /// A rotor whose axes couple through it (the flexible rotor): each axis' closed form at each
-    /// speed, the loops of all axes closed ([`coupled`]), with its difference from the
-    /// measurement; empty for the rigid rotors.
-    pub closed_form_axes: Vec<coupled::AxisClosedForm>,
-    /// Each measured axis' gain and phase margins, computed (the law's linear form on the
-    /// linear plant, where it has one) and measured (`L = 1/S − 1`) ([`margins`]).
-    pub margins: Vec<margins::AxisMargins>,
-    /// Simulated time of all the measurement's runs (s).
-    pub simulated_s: f64,
-    /// The settings.
-    pub settings: sensitivity::Settings,
-}
-
-/// The closed form's peak for comparison.
-#[derive(Clone, Debug, Serialize)]
-pub struct ClosedFormPeak {
-    /// The closed loop is stable.
-    pub stable: bool,
-    /// Peak frequency (Hz).
-    pub f_hz: Option<f64>,
-    /// Peak `|S|`.
-    pub s_abs: Option<f64>,
-    /// In dB.
-    pub s_db: Option<f64>,
-    /// Zone.
-    pub zone: String,
-    /// `|S|` in dB at each measured frequency of the first axis, for the chart.
-    pub curve: Vec<(f64, f64)>,
-}
-
-/// One controller's assessment.
-#[derive(Clone, Debug, Serialize)]
-pub struct ControllerReport {
-    /// Label.
-    pub label: String,
-    /// Its overrides of the scene.
-    pub set: Vec<String>,
-    /// Law, mode, rate.
-    pub law: String,
-    /// Controller mode.
-    pub mode: String,
-    /// Rate (Hz).
-    pub rate_hz: f64,
-    /// Stability margin.
-    pub sensitivity: PartOutcome<SensitivityPart>,
-    /// Vibration.
-    pub vibration: PartOutcome<vibration::Vibration>,
-    /// Shock ladder with the duty.
-    pub ladder: PartOutcome<ladder::LadderResult>,
-    /// The verdict line.
-    pub verdict: String,
-    /// Wall time of the whole (s).
-    pub wall_s: f64,
 }
 
 /// The axes a scene's loop has, by name: x then y (the planar model), x_A, y_A, x_B, y_B (the
@@ -736,39 +603,6 @@ fn mark_not_measured(report: &mut ControllerReport, parts: &[Part]) {
     }
 }
 
-/// The whole report.
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    /// Program and version.
-    pub program: String,
-    /// The assessment file or scene.
-    pub file: String,
-    /// The scene every controller runs.
-    pub scene: String,
-    /// The report's folder.
-    pub out: String,
-    /// The parts asked for.
-    pub parts: Vec<String>,
-    /// The bearing's basis (materials, static capacity, cycle threshold).
-    pub bearing: Option<duty::Bearing>,
-    /// The ladder's settings.
-    pub ladder_settings: ladder::Settings,
-    /// What the settings cannot answer (a ladder whose members cannot reach `min_p`), said at
-    /// load time on the terminal too.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-    /// One per controller.
-    pub controllers: Vec<ControllerReport>,
-    /// True when interrupted: the parts not measured say so.
-    pub interrupted: bool,
-    /// Wall time (s).
-    pub wall_s: f64,
-    /// Absolute folders and how the report shows them (relative to where the command ran): every
-    /// text of the report is written with them replaced ([`report::write`]).
-    #[serde(skip)]
-    pub roots: Vec<(String, String)>,
-}
-
 /// `plant assess`: loads everything first (bad input: exit 2 before anything runs), assesses
 /// each controller, writes the report (also when a part failed or the run was interrupted).
 pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> {
@@ -875,24 +709,6 @@ fn check_scenes(a: &Assessment, stop: &AtomicBool) -> anyhow::Result<Option<Scen
     Ok(first)
 }
 
-/// The absolute folders the report names (the scene's, the report's, the working folder) and
-/// how it shows them, relative to `cwd`; the longest first.
-fn roots(cwd: &Path, scene: &Path, dir: &Path) -> Vec<(String, String)> {
-    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, cwd) };
-    let mut roots = Vec::new();
-    if !cwd.as_os_str().is_empty() {
-        let scene_dir = scene.parent().unwrap_or(Path::new("."));
-        let absolute = |p: &Path| shown(&cwd.join(p));
-        roots.push((absolute(scene_dir), shown_here(scene_dir)));
-        roots.push((absolute(dir), shown_here(dir)));
-        roots.push((shown(cwd), ".".to_string()));
-        // The longest first: a folder inside another is replaced as itself.
-        roots.sort_by_key(|(abs, _)| std::cmp::Reverse(abs.len()));
-        roots.retain(|(abs, _)| abs != "/");
-    }
-    roots
-}
-
 /// A controller the interrupted assessment did not reach.
 fn not_assessed(c: &ControllerSpec) -> ControllerReport {
     let mut r = ControllerReport {
@@ -937,66 +753,6 @@ fn failed(report: &Report, dir: &Path) -> anyhow::Result<()> {
         return Err(AssessError { kind: worst, message, dir: dir.display().to_string() }.into());
     }
     Ok(())
-}
-
-/// `path` relative to `cwd` (both taken lexically, `path` joined to `cwd` when relative), with
-/// `..` where it lies outside `cwd`: `/work/t/config/a.toml` from `/work/t` is `config/a.toml`,
-/// from `/work/u` `../t/config/a.toml`.
-pub fn shown_relative(path: &Path, cwd: &Path) -> String {
-    let abs = PathBuf::from(shown(&cwd.join(path)));
-    let base = PathBuf::from(shown(cwd));
-    let a: Vec<_> = abs.components().collect();
-    let b: Vec<_> = base.components().collect();
-    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
-    let mut out = PathBuf::new();
-    for _ in common..b.len() {
-        out.push("..");
-    }
-    for c in &a[common..] {
-        out.push(c);
-    }
-    if out.as_os_str().is_empty() {
-        ".".into()
-    } else {
-        out.display().to_string()
-    }
-}
-
-/// `text` with each absolute folder of `roots` (followed by `/`) replaced by how the report
-/// shows it (`.` drops out: `/work/t/runs/x` with `("/work/t", ".")` is `runs/x`).
-pub fn relative_text(text: &str, roots: &[(String, String)]) -> String {
-    let mut out = text.to_string();
-    for (abs, rel) in roots {
-        let to = if rel == "." { String::new() } else { format!("{rel}/") };
-        out = out.replace(&format!("{abs}/"), &to);
-    }
-    out
-}
-
-/// Where a relative path of an assessment file points.
-pub fn relative_to(file: &Path, path: &str) -> PathBuf {
-    file.parent().unwrap_or(Path::new(".")).join(path)
-}
-
-/// A path as the report shows it: `.` and each `dir/..` pair dropped, lexically
-/// (`config/assess/../paper-10g.toml` is shown `config/paper-10g.toml`); the scene is still
-/// loaded by the path as written, which a symbolic link could make differ.
-pub fn shown(path: &Path) -> String {
-    use std::path::Component;
-    let mut kept: Vec<Component> = Vec::new();
-    for c in path.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir if matches!(kept.last(), Some(Component::Normal(_))) => {
-                kept.pop();
-            }
-            c => kept.push(c),
-        }
-    }
-    if kept.is_empty() {
-        return ".".into();
-    }
-    kept.iter().collect::<PathBuf>().display().to_string()
 }
 
 #[cfg(test)]
