@@ -17,8 +17,8 @@
 
 use std::ffi::c_int;
 
-/// The exit code when an FMU ends the process: a lost controller's ([`plant::exit::Code`]).
-const FMU_ENDED: c_int = plant::exit::Code::PeerLost as c_int;
+/// The exit code when an FMU ends the process: a lost controller's ([`crate::exit_code::Code`]).
+const FMU_ENDED: c_int = crate::exit_code::Code::PeerLost as c_int;
 
 /// Ends the process at once (what the C library's `_exit` does).
 fn exit_group(code: c_int) -> ! {

@@ -1,19 +1,21 @@
 //! `plant`: runs scenes of the AMB/touchdown-bearing testbed.
 //!
-//! `main` → [`run`] → [`plant::exit::code`], on ripgrep's model: every command
+//! `main` → [`run`] → [`exit_code::code`], on ripgrep's model: every command
 //! returns its errors to `main`, which prints them once ([`report`]) and maps
-//! them to the exit code by their type, never by their text ([`plant::exit`]
+//! them to the exit code by their type, never by their text ([`exit_code`]
 //! holds the codes and the one map; `docs/guide/running.md` the table).
 
 mod cli;
+mod exit_code;
 mod fmu_exit;
 
 use anyhow::Context;
 use clap::{CommandFactory, FromArgMatches};
 use cli::{BenchCommand, Cli, Command, ControllerArg};
+use exit_code::Code;
 use plant::config::{load_scene, Scene};
 use plant::cosim::Launch;
-use plant::exit::{self, Code, Ending, StopKind};
+use plant::exit::{Ending, StopKind};
 use plant::run::{Hooks, Outcome};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -45,7 +47,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             report(&err);
-            ExitCode::from(u8::from(exit::code(&err)))
+            ExitCode::from(u8::from(exit_code::code(&err)))
         }
     }
 }
@@ -53,7 +55,7 @@ fn main() -> ExitCode {
 /// Prints an error once: `plant: error: …` (an interruption is not an error: `plant: …`).
 fn report(err: &anyhow::Error) {
     let text = chain_text(err);
-    if exit::code(err) == Code::Interrupted {
+    if exit_code::code(err) == Code::Interrupted {
         eprintln!("plant: {text}");
     } else {
         eprintln!("plant: error: {text}");

@@ -148,6 +148,43 @@ pub struct ProgrammeSpec {
 }
 
 impl ShockSpec {
+    /// The field that sets the shock's size and its value (`peak_g`, `design_accel_g`,
+    /// `amplitude_g` or a recorded pulse's `scale`); `None` for a double half-sine given
+    /// neither.
+    pub fn size(&self) -> Option<(&'static str, f64)> {
+        match self {
+            ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => Some(("peak_g", *p)),
+            ShockSpec::DoubleHalfSine { design_accel_g: Some(a), .. } => Some(("design_accel_g", *a)),
+            ShockSpec::DoubleHalfSine { .. } => None,
+            ShockSpec::HalfSine { peak_g, .. } => Some(("peak_g", *peak_g)),
+            ShockSpec::Sine { amplitude_g, .. } => Some(("amplitude_g", *amplitude_g)),
+            ShockSpec::Recorded { scale, .. } => Some(("scale", *scale)),
+        }
+    }
+
+    /// The peak acceleration (G): a double half-sine's `a_1` (`A_0 / 2` when given as its
+    /// design acceleration), a half-sine's peak, a sine's amplitude; NaN for a recorded pulse
+    /// (its peak is in its file).
+    pub fn peak_g(&self) -> f64 {
+        match self {
+            ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => *p,
+            ShockSpec::DoubleHalfSine { design_accel_g: Some(a0), .. } => a0 / 2.0,
+            ShockSpec::HalfSine { peak_g, .. } => *peak_g,
+            ShockSpec::Sine { amplitude_g, .. } => *amplitude_g,
+            _ => f64::NAN,
+        }
+    }
+
+    /// The direction from +x (degrees).
+    pub fn direction_deg(&self) -> f64 {
+        match self {
+            ShockSpec::DoubleHalfSine { direction_deg, .. }
+            | ShockSpec::HalfSine { direction_deg, .. }
+            | ShockSpec::Sine { direction_deg, .. }
+            | ShockSpec::Recorded { direction_deg, .. } => *direction_deg,
+        }
+    }
+
     /// Validate this spec into a [`Shock`]; a recorded shock's file is
     /// resolved against `base_dir`. Error keys are unprefixed (`f2_hz`);
     /// [`programme_from_specs`] adds `shock[i].`.
@@ -250,6 +287,33 @@ pub fn load_programme(path: &Path) -> Result<Programme, ShockError> {
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    /// A double half-sine given by its design acceleration A₀ peaks at a₁ = A₀/2 (BV043/85),
+    /// is sized by that field, and keeps its direction; a recorded pulse's peak is in its file.
+    #[test]
+    fn a_shock_names_its_size_peak_and_direction() {
+        let design = ShockSpec::DoubleHalfSine {
+            peak_g: None,
+            design_accel_g: Some(24.0),
+            f1_hz: 10.0,
+            f2_hz: 80.0,
+            start_s: 0.0,
+            direction_deg: 30.0,
+        };
+        assert_eq!(design.size(), Some(("design_accel_g", 24.0)));
+        assert_eq!(design.peak_g(), 12.0);
+        assert_eq!(design.direction_deg(), 30.0);
+        let neither = ShockSpec::DoubleHalfSine {
+            peak_g: None,
+            design_accel_g: None,
+            f1_hz: 10.0,
+            f2_hz: 80.0,
+            start_s: 0.0,
+            direction_deg: 90.0,
+        };
+        assert_eq!(neither.size(), None);
+        assert!(neither.peak_g().is_nan());
+    }
 
     const EXAMPLE: &str = r#"
 [[shock]]

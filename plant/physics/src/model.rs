@@ -220,6 +220,46 @@ pub enum Control {
     },
 }
 
+impl Control {
+    /// The coil current (A, x then y) and the AMB's force (N) of a bearing `p` whose rotor sits
+    /// at `delta` (m) in the magnets' gap, at time `t`; the continuous laws read `sensor()`, the
+    /// sensor's position and rate (m, m/s), only when they need it. One match for every rotor
+    /// model (planar, two-plane, flexible).
+    #[inline]
+    pub(crate) fn amb(
+        self,
+        t: f64,
+        p: &Params,
+        delta: Vector2<f64>,
+        sensor: impl FnOnce() -> (Vector2<f64>, Vector2<f64>),
+    ) -> ([f64; 2], Vector2<f64>) {
+        let current = match self {
+            Control::Continuous(gains) => {
+                let a_s = p.loop_constants.sensor_gain_v_per_m;
+                let (x, v) = sensor();
+                saturate(gains.current((x * a_s).into(), (v * a_s).into()), p.current_limit)
+            }
+            Control::ContinuousExcited(gains, sine) => {
+                // The excitation is added at the sensor, before the PD (its rate to the rate).
+                let a_s = p.loop_constants.sensor_gain_v_per_m;
+                let (x, v) = sensor();
+                let (e, e_dot) = sine.at(t);
+                let u = x * a_s + Vector2::from(e);
+                let u_dot = v * a_s + Vector2::from(e_dot);
+                saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
+            }
+            Control::Held(i) => i,
+            Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
+        };
+        let force = match self {
+            // Unipolar amplifiers: each magnet's own current.
+            Control::Magnets { plus, minus } => p.amb.magnet_force(delta, plus.into(), minus.into()),
+            _ => p.amb.force(delta, current.into()),
+        };
+        (current, force)
+    }
+}
+
 /// A sine added to the sensor signal the controller reads, per axis (V):
 /// `E(t) = a_k sin(ω t + φ)`, with its rate `Ė(t) = a_k ω cos(ω t + φ)`.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -391,28 +431,7 @@ impl Model {
         let p = &self.params;
         let a_h = Vector2::from(self.base.accel(t));
         let delta = pair(y, XR);
-        let current = match self.control {
-            Control::Continuous(gains) => {
-                let a_s = p.loop_constants.sensor_gain_v_per_m;
-                let u = delta * a_s;
-                let u_dot = pair(y, VXR) * a_s;
-                saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
-            }
-            Control::ContinuousExcited(gains, sine) => {
-                let a_s = p.loop_constants.sensor_gain_v_per_m;
-                let (e, e_dot) = sine.at(t);
-                let u = delta * a_s + Vector2::from(e);
-                let u_dot = pair(y, VXR) * a_s + Vector2::from(e_dot);
-                saturate(gains.current(u.into(), u_dot.into()), p.current_limit)
-            }
-            Control::Held(i) => i,
-            Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
-        };
-        let amb_force = match self.control {
-            // Unipolar amplifiers: each magnet's own current.
-            Control::Magnets { plus, minus } => p.amb.magnet_force(delta, plus.into(), minus.into()),
-            _ => p.amb.force(delta, current.into()),
-        };
+        let (current, amb_force) = self.control.amb(t, p, delta, || (delta, pair(y, VXR)));
         if self.race_parked {
             return self.evaluate_parked(t, y, a_h, current, amb_force);
         }

@@ -25,11 +25,10 @@
 
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
-use crate::ensemble::member::{
-    close_to_decision, figures, member_overrides, shock_size, verify_overrides, MemberResult,
-};
+use crate::ensemble::member::{close_to_decision, figures, member_overrides, verify_overrides, MemberResult};
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
+use crate::ensemble::tally::{tally, Tally};
 use crate::grid::Point;
 use crate::hooks::Hooks;
 use crate::run::{run_into, Outcome, RunResult, Sink};
@@ -190,26 +189,9 @@ fn rung_duty(d: &[&Duty]) -> RungDuty {
 pub struct Rung {
     /// Peak of the first shock (G).
     pub peak_g: f64,
-    /// Members counted.
-    pub members: usize,
-    /// Members recovered.
-    pub recovered: usize,
-    /// Members in dry whirl.
-    pub dry_whirl: usize,
-    /// Members rebounding.
-    pub rebound: usize,
-    /// Diverged (also at the reference setting).
-    pub diverged: usize,
-    /// Recovered share and its Wilson 95 % interval.
-    pub p_recovered: f64,
-    /// Lower end.
-    pub p_lo: f64,
-    /// Upper end.
-    pub p_hi: f64,
-    /// Median recovery time of the recovered members (s).
-    pub recovery_median_s: Option<f64>,
-    /// Their 90th percentile (s).
-    pub recovery_p90_s: Option<f64>,
+    /// The counted members' modes and recovery statistics.
+    #[serde(flatten)]
+    pub tally: Tally,
     /// Members re-run at the reference setting, and of those, members whose mode changed.
     pub verified: usize,
     /// Numerically sensitive members.
@@ -397,7 +379,7 @@ impl Hooks for MemberHooks<'_> {
 /// The overrides that give rung peak `g` (G) to the scene's programme.
 pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
     let raw = scene.resolved()?;
-    let first = raw.shock.first().and_then(shock_size).map(|(_, v)| v);
+    let first = raw.shock.first().and_then(shock_table::ShockSpec::size).map(|(_, v)| v);
     let Some(first) = first.filter(|v| *v > 0.0) else {
         anyhow::bail!("the shock ladder needs a scene whose first [[shock]] has a size (peak_g, amplitude_g or scale)");
     };
@@ -406,7 +388,7 @@ pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
         .shock
         .iter()
         .enumerate()
-        .filter_map(|(k, s)| shock_size(s).map(|(field, v)| format!("shock[{k}].{field}={:?}", v * factor)))
+        .filter_map(|(k, s)| s.size().map(|(field, v)| format!("shock[{k}].{field}={:?}", v * factor)))
         .collect())
 }
 
@@ -579,22 +561,13 @@ pub fn ladder(
         let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
         // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
         // is not read.
-        let stats = crate::ensemble::point::point_stats(i, &refs, crate::ensemble::point::StoppedBy::Members);
+        let (verified, numerically_sensitive) = crate::ensemble::tally::verified(&refs);
         let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
         rungs.push(Rung {
             peak_g: settings.peaks_g[i],
-            members: stats.members,
-            recovered: stats.recovered,
-            dry_whirl: stats.dry_whirl,
-            rebound: stats.rebound,
-            diverged: stats.diverged,
-            p_recovered: stats.p_recovered,
-            p_lo: stats.p_lo,
-            p_hi: stats.p_hi,
-            recovery_median_s: stats.recovery_median_s,
-            recovery_p90_s: stats.recovery_p90_s,
-            verified: stats.verified,
-            numerically_sensitive: stats.numerically_sensitive,
+            tally: tally(&refs),
+            verified,
+            numerically_sensitive,
             complete: decided[i],
             duty: rung_duty(&duties),
             duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
@@ -602,7 +575,8 @@ pub fn ladder(
                 .collect(),
         });
     }
-    let safe_up_to_g = rungs.iter().take_while(|r| r.complete && r.p_lo >= settings.min_p).last().map(|r| r.peak_g);
+    let safe_up_to_g =
+        rungs.iter().take_while(|r| r.complete && r.tally.p_lo >= settings.min_p).last().map(|r| r.peak_g);
     let verified = rungs.iter().map(|r| r.verified).sum();
     let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();
     let simulated_s = counted.iter().flatten().map(|m| m.simulated_s).sum();

@@ -19,11 +19,17 @@ pub mod ladder;
 mod linear_check;
 pub mod loop_charts;
 pub mod margins;
+mod outcome;
+mod paths;
 pub mod rainflow;
 pub mod report;
 pub mod sensitivity;
 pub mod spec;
 pub mod vibration;
+
+pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
+use paths::roots;
+pub use paths::{relative_text, relative_to, shown, shown_relative};
 
 use crate::config::{load_scene, ConfigError, ControlMode, Scene};
 use crate::cosim::Launch;
@@ -32,7 +38,6 @@ use crate::ensemble::spec::MemberSetting;
 use crate::run::{run_into, Outcome};
 use anyhow::Context;
 use rayon::prelude::*;
-use serde::Serialize;
 use spec::{Assessment, ControllerSpec, Part};
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
@@ -58,144 +63,6 @@ pub struct AssessArgs {
     /// No progress lines.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// How a part of an assessment failed; each has its exit code.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Failure {
-    /// The rotor is not levitated before the shock, or the excitation drove it into the
-    /// touchdown bearing: nothing to grade (exit 9).
-    NotGradable,
-    /// The controller process was lost (exit 4).
-    PeerLost,
-    /// The controller's commands were non-finite past the scene's budget (exit 8).
-    InvalidCommands,
-    /// A run diverged (exit 3).
-    Diverged,
-    /// Interrupted by SIGINT/SIGTERM (exit 130).
-    Interrupted,
-    /// Anything else (exit 1).
-    Other,
-}
-
-impl Failure {
-    fn rank(self) -> u8 {
-        match self {
-            Failure::Interrupted => 6,
-            Failure::PeerLost => 5,
-            Failure::InvalidCommands => 4,
-            Failure::Diverged => 3,
-            Failure::NotGradable => 2,
-            Failure::Other => 1,
-        }
-    }
-}
-
-/// An assessment that wrote its report but could not measure everything.
-#[derive(Debug, thiserror::Error)]
-#[error("{message}; the report in {dir} holds what was measured and says what was not")]
-pub struct AssessError {
-    /// The gravest failure.
-    pub kind: Failure,
-    /// What failed, for each part.
-    pub message: String,
-    /// The report's folder.
-    pub dir: String,
-}
-
-/// A part's outcome.
-#[derive(Clone, Debug, Serialize)]
-pub struct PartOutcome<T> {
-    /// `measured`, `skipped`, `failed`, or `interrupted`.
-    pub status: &'static str,
-    /// Why it was not measured.
-    pub why: Option<String>,
-    /// How it failed.
-    pub failure: Option<Failure>,
-    /// The result.
-    pub result: Option<T>,
-    /// Wall time (s).
-    pub wall_s: f64,
-}
-
-impl<T> PartOutcome<T> {
-    fn measured(result: T, wall_s: f64) -> Self {
-        Self { status: "measured", why: None, failure: None, result: Some(result), wall_s }
-    }
-    fn skipped(why: &str) -> Self {
-        Self { status: "skipped", why: Some(why.to_string()), failure: None, result: None, wall_s: 0.0 }
-    }
-    fn failed(kind: Failure, why: String, wall_s: f64) -> Self {
-        let status = if kind == Failure::Interrupted { "interrupted" } else { "failed" };
-        Self { status, why: Some(why), failure: Some(kind), result: None, wall_s }
-    }
-}
-
-/// The sensitivity part: one result per axis and speed.
-#[derive(Clone, Debug, Serialize)]
-pub struct SensitivityPart {
-    /// Per axis and speed.
-    pub axes: Vec<sensitivity::AxisResult>,
-    /// The closed form of the law, where it has one (`pd`, `pd_delay` and the continuous PD on
-    /// the linear bearing): per speed-independent axis, its peak and zone.
-    pub closed_form: Option<ClosedFormPeak>,
-    /// The two-plane rotor: each plane's closed form (its load share as a planar rotor with the
-    /// plane's design, [`closed_form_of_plane`]), planes A then B; empty for the planar model.
-    pub closed_form_planes: Vec<ClosedFormPeak>,
-    /// A rotor whose axes couple through it (the flexible rotor): each axis' closed form at each
-    /// speed, the loops of all axes closed ([`coupled`]), with its difference from the
-    /// measurement; empty for the rigid rotors.
-    pub closed_form_axes: Vec<coupled::AxisClosedForm>,
-    /// Each measured axis' gain and phase margins, computed (the law's linear form on the
-    /// linear plant, where it has one) and measured (`L = 1/S − 1`) ([`margins`]).
-    pub margins: Vec<margins::AxisMargins>,
-    /// Simulated time of all the measurement's runs (s).
-    pub simulated_s: f64,
-    /// The settings.
-    pub settings: sensitivity::Settings,
-}
-
-/// The closed form's peak for comparison.
-#[derive(Clone, Debug, Serialize)]
-pub struct ClosedFormPeak {
-    /// The closed loop is stable.
-    pub stable: bool,
-    /// Peak frequency (Hz).
-    pub f_hz: Option<f64>,
-    /// Peak `|S|`.
-    pub s_abs: Option<f64>,
-    /// In dB.
-    pub s_db: Option<f64>,
-    /// Zone.
-    pub zone: String,
-    /// `|S|` in dB at each measured frequency of the first axis, for the chart.
-    pub curve: Vec<(f64, f64)>,
-}
-
-/// One controller's assessment.
-#[derive(Clone, Debug, Serialize)]
-pub struct ControllerReport {
-    /// Label.
-    pub label: String,
-    /// Its overrides of the scene.
-    pub set: Vec<String>,
-    /// Law, mode, rate.
-    pub law: String,
-    /// Controller mode.
-    pub mode: String,
-    /// Rate (Hz).
-    pub rate_hz: f64,
-    /// Stability margin.
-    pub sensitivity: PartOutcome<SensitivityPart>,
-    /// Vibration.
-    pub vibration: PartOutcome<vibration::Vibration>,
-    /// Shock ladder with the duty.
-    pub ladder: PartOutcome<ladder::LadderResult>,
-    /// The verdict line.
-    pub verdict: String,
-    /// Wall time of the whole (s).
-    pub wall_s: f64,
 }
 
 /// The axes a scene's loop has, by name: x then y (the planar model), x_A, y_A, x_B, y_B (the
@@ -650,55 +517,78 @@ fn assess_controller(
         };
     }
     if a.parts.contains(&Part::Ladder) && !interrupted() {
-        if !levitated {
-            let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
-            report.ladder = PartOutcome::failed(Failure::NotGradable, why, 0.0);
-        } else {
-            log(&format!("{}: shock ladder", c.label));
-            let t = Instant::now();
-            let b = bearing(&scene, a)?;
-            // A member may end once decided only where the probe measured the loop stable.
-            let stable = decay_at_speed.is_some_and(|s| s > 0.0);
-            let kind = |e: &anyhow::Error| {
-                if interrupted() {
-                    Failure::Interrupted
-                } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
-                    Failure::InvalidCommands
-                } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
-                    Failure::PeerLost
-                } else {
-                    Failure::Other
-                }
-            };
-            report.ladder = match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
-                Ok((l, Some(e))) => {
-                    let kind = kind(&e);
-                    PartOutcome {
-                        status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
-                        why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
-                        failure: Some(kind),
-                        result: Some(l),
-                        wall_s: t.elapsed().as_secs_f64(),
-                    }
-                }
-                Ok((l, None)) if l.interrupted => PartOutcome {
-                    status: "interrupted",
-                    why: Some("interrupted: the rungs marked incomplete were not decided".into()),
-                    failure: Some(Failure::Interrupted),
-                    result: Some(l),
-                    wall_s: t.elapsed().as_secs_f64(),
-                },
-                Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
-                Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
-            };
-        }
+        report.ladder = ladder_part(a, c, &scene, levitated, decay_at_speed, stop, log)?;
     }
+    if interrupted() {
+        mark_not_measured(&mut report, &a.parts);
+    }
+    report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
+    report.wall_s = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// The shock ladder of one controller: none where the rotor was not levitated before the
+/// shock; a member may end once decided only where the probe measured the loop stable.
+fn ladder_part(
+    a: &Assessment,
+    c: &ControllerSpec,
+    scene: &Scene,
+    levitated: bool,
+    decay_at_speed: Option<f64>,
+    stop: &AtomicBool,
+    log: &(dyn Fn(&str) + Sync),
+) -> anyhow::Result<PartOutcome<ladder::LadderResult>> {
+    let interrupted = || stop.load(Ordering::Relaxed);
+    if !levitated {
+        let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
+        return Ok(PartOutcome::failed(Failure::NotGradable, why, 0.0));
+    }
+    log(&format!("{}: shock ladder", c.label));
+    let t = Instant::now();
+    let b = bearing(scene, a)?;
+    let stable = decay_at_speed.is_some_and(|s| s > 0.0);
+    let kind = |e: &anyhow::Error| {
+        if interrupted() {
+            Failure::Interrupted
+        } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
+            Failure::InvalidCommands
+        } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
+            Failure::PeerLost
+        } else {
+            Failure::Other
+        }
+    };
+    Ok(match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
+        Ok((l, Some(e))) => {
+            let kind = kind(&e);
+            PartOutcome {
+                status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
+                why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
+                failure: Some(kind),
+                result: Some(l),
+                wall_s: t.elapsed().as_secs_f64(),
+            }
+        }
+        Ok((l, None)) if l.interrupted => PartOutcome {
+            status: "interrupted",
+            why: Some("interrupted: the rungs marked incomplete were not decided".into()),
+            failure: Some(Failure::Interrupted),
+            result: Some(l),
+            wall_s: t.elapsed().as_secs_f64(),
+        },
+        Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
+        Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
+    })
+}
+
+/// An interrupted assessment: each part asked for and not reached says so.
+fn mark_not_measured(report: &mut ControllerReport, parts: &[Part]) {
     for (status, part) in [
         (report.sensitivity.status, "sensitivity"),
         (report.vibration.status, "vibration"),
         (report.ladder.status, "ladder"),
     ] {
-        if status == "skipped" && interrupted() && a.parts.iter().any(|p| p.name() == part) {
+        if status == "skipped" && parts.iter().any(|p| p.name() == part) {
             match part {
                 "sensitivity" => {
                     report.sensitivity =
@@ -712,42 +602,6 @@ fn assess_controller(
             }
         }
     }
-    report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
-    report.wall_s = started.elapsed().as_secs_f64();
-    Ok(report)
-}
-
-/// The whole report.
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    /// Program and version.
-    pub program: String,
-    /// The assessment file or scene.
-    pub file: String,
-    /// The scene every controller runs.
-    pub scene: String,
-    /// The report's folder.
-    pub out: String,
-    /// The parts asked for.
-    pub parts: Vec<String>,
-    /// The bearing's basis (materials, static capacity, cycle threshold).
-    pub bearing: Option<duty::Bearing>,
-    /// The ladder's settings.
-    pub ladder_settings: ladder::Settings,
-    /// What the settings cannot answer (a ladder whose members cannot reach `min_p`), said at
-    /// load time on the terminal too.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-    /// One per controller.
-    pub controllers: Vec<ControllerReport>,
-    /// True when interrupted: the parts not measured say so.
-    pub interrupted: bool,
-    /// Wall time (s).
-    pub wall_s: f64,
-    /// Absolute folders and how the report shows them (relative to where the command ran): every
-    /// text of the report is written with them replaced ([`report::write`]).
-    #[serde(skip)]
-    pub roots: Vec<(String, String)>,
 }
 
 /// `plant assess`: loads everything first (bad input: exit 2 before anything runs), assesses
@@ -764,7 +618,63 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
             c.sets.insert(0, LOCKSTEP_WAIT.into());
         }
     }
-    // Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2).
+    let first = check_scenes(&a, stop)?;
+    let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
+    let _claim = crate::claim::claim(&dir, true)?;
+    let quiet = args.quiet;
+    let log = move |l: &str| {
+        if !quiet {
+            eprintln!("plant assess: {l}");
+        }
+    };
+    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
+    // Paths as seen from where the command ran: the report names no folder of this machine.
+    let cwd = std::env::current_dir().unwrap_or_default();
+    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, &cwd) };
+    let roots = roots(&cwd, &a.scene, &dir);
+    let mut report = Report {
+        program: format!("plant {}", env!("CARGO_PKG_VERSION")),
+        file: shown_here(&args.file),
+        scene: shown_here(&a.scene),
+        out: shown_here(&dir),
+        parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
+        bearing,
+        ladder_settings: a.ladder.clone(),
+        warnings: a.warnings.clone(),
+        controllers: Vec::new(),
+        interrupted: false,
+        wall_s: 0.0,
+        roots,
+    };
+    for c in &a.controllers {
+        let r = assess_controller(&a, c, stop, &log)?;
+        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
+        report.controllers.push(r);
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+    }
+    for c in a.controllers.iter().skip(report.controllers.len()) {
+        report.controllers.push(not_assessed(c));
+    }
+    report.interrupted = stop.load(Ordering::Relaxed);
+    report.wall_s = started.elapsed().as_secs_f64();
+    report::write(&dir, &report)?;
+    log(&format!("wrote {}", dir.join("report.html").display()));
+    failed(&report, &dir)?;
+    // A signal while the report was written: every part was measured and the report is whole,
+    // but the command was asked to stop (exit 130, as `run` and `soak` do).
+    if stop.load(Ordering::Relaxed) {
+        let message = "interrupted while the report was written (every part was measured)".to_string();
+        return Err(AssessError { kind: Failure::Interrupted, message, dir: dir.display().to_string() }.into());
+    }
+    Ok(dir)
+}
+
+/// Every controller's scene loads before anything runs (an unknown law, a bad key: exit 2), and
+/// its controller starts; the first controller's scene.
+fn check_scenes(a: &Assessment, stop: &AtomicBool) -> anyhow::Result<Option<Scene>> {
     let mut first = None;
     for c in &a.controllers {
         let scene = load_scene(&a.scene, &c.sets)?;
@@ -797,72 +707,29 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         }
         first.get_or_insert(scene);
     }
-    let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
-    let _claim = crate::claim::claim(&dir, true)?;
-    let quiet = args.quiet;
-    let log = move |l: &str| {
-        if !quiet {
-            eprintln!("plant assess: {l}");
-        }
-    };
-    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
-    // Paths as seen from where the command ran: the report names no folder of this machine.
-    let cwd = std::env::current_dir().unwrap_or_default();
-    let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, &cwd) };
-    let mut roots = Vec::new();
-    if !cwd.as_os_str().is_empty() {
-        let scene_dir = a.scene.parent().unwrap_or(Path::new("."));
-        let absolute = |p: &Path| shown(&cwd.join(p));
-        roots.push((absolute(scene_dir), shown_here(scene_dir)));
-        roots.push((absolute(&dir), shown_here(&dir)));
-        roots.push((shown(&cwd), ".".to_string()));
-        // The longest first: a folder inside another is replaced as itself.
-        roots.sort_by_key(|(abs, _)| std::cmp::Reverse(abs.len()));
-        roots.retain(|(abs, _)| abs != "/");
-    }
-    let mut report = Report {
-        program: format!("plant {}", env!("CARGO_PKG_VERSION")),
-        file: shown_here(&args.file),
-        scene: shown_here(&a.scene),
-        out: shown_here(&dir),
-        parts: a.parts.iter().map(|p| p.name().to_string()).collect(),
-        bearing,
-        ladder_settings: a.ladder.clone(),
-        warnings: a.warnings.clone(),
-        controllers: Vec::new(),
-        interrupted: false,
+    Ok(first)
+}
+
+/// A controller the interrupted assessment did not reach.
+fn not_assessed(c: &ControllerSpec) -> ControllerReport {
+    let mut r = ControllerReport {
+        label: c.label.clone(),
+        set: c.own.clone(),
+        law: String::new(),
+        mode: String::new(),
+        rate_hz: 0.0,
+        sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
+        verdict: String::new(),
         wall_s: 0.0,
-        roots,
     };
-    for c in &a.controllers {
-        let r = assess_controller(&a, c, stop, &log)?;
-        log(&format!("{}: {} ({:.1} s)", r.label, r.verdict, r.wall_s));
-        report.controllers.push(r);
-        if stop.load(Ordering::Relaxed) {
-            break;
-        }
-    }
-    for c in a.controllers.iter().skip(report.controllers.len()) {
-        let mut r = ControllerReport {
-            label: c.label.clone(),
-            set: c.own.clone(),
-            law: String::new(),
-            mode: String::new(),
-            rate_hz: 0.0,
-            sensitivity: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            vibration: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            ladder: PartOutcome::failed(Failure::Interrupted, "not measured: interrupted".into(), 0.0),
-            verdict: String::new(),
-            wall_s: 0.0,
-        };
-        r.verdict = "not assessed: interrupted".into();
-        report.controllers.push(r);
-    }
-    report.interrupted = stop.load(Ordering::Relaxed);
-    report.wall_s = started.elapsed().as_secs_f64();
-    report::write(&dir, &report)?;
-    log(&format!("wrote {}", dir.join("report.html").display()));
+    r.verdict = "not assessed: interrupted".into();
+    r
+}
+
+/// The worst failure of any part of any controller, as the command's error.
+fn failed(report: &Report, dir: &Path) -> anyhow::Result<()> {
     let failures: Vec<(Failure, String)> = report
         .controllers
         .iter()
@@ -886,73 +753,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
         };
         return Err(AssessError { kind: worst, message, dir: dir.display().to_string() }.into());
     }
-    // A signal while the report was written: every part was measured and the report is whole,
-    // but the command was asked to stop (exit 130, as `run` and `soak` do).
-    if stop.load(Ordering::Relaxed) {
-        let message = "interrupted while the report was written (every part was measured)".to_string();
-        return Err(AssessError { kind: Failure::Interrupted, message, dir: dir.display().to_string() }.into());
-    }
-    Ok(dir)
-}
-
-/// `path` relative to `cwd` (both taken lexically, `path` joined to `cwd` when relative), with
-/// `..` where it lies outside `cwd`: `/work/t/config/a.toml` from `/work/t` is `config/a.toml`,
-/// from `/work/u` `../t/config/a.toml`.
-pub fn shown_relative(path: &Path, cwd: &Path) -> String {
-    let abs = PathBuf::from(shown(&cwd.join(path)));
-    let base = PathBuf::from(shown(cwd));
-    let a: Vec<_> = abs.components().collect();
-    let b: Vec<_> = base.components().collect();
-    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
-    let mut out = PathBuf::new();
-    for _ in common..b.len() {
-        out.push("..");
-    }
-    for c in &a[common..] {
-        out.push(c);
-    }
-    if out.as_os_str().is_empty() {
-        ".".into()
-    } else {
-        out.display().to_string()
-    }
-}
-
-/// `text` with each absolute folder of `roots` (followed by `/`) replaced by how the report
-/// shows it (`.` drops out: `/work/t/runs/x` with `("/work/t", ".")` is `runs/x`).
-pub fn relative_text(text: &str, roots: &[(String, String)]) -> String {
-    let mut out = text.to_string();
-    for (abs, rel) in roots {
-        let to = if rel == "." { String::new() } else { format!("{rel}/") };
-        out = out.replace(&format!("{abs}/"), &to);
-    }
-    out
-}
-
-/// Where a relative path of an assessment file points.
-pub fn relative_to(file: &Path, path: &str) -> PathBuf {
-    file.parent().unwrap_or(Path::new(".")).join(path)
-}
-
-/// A path as the report shows it: `.` and each `dir/..` pair dropped, lexically
-/// (`config/assess/../paper-10g.toml` is shown `config/paper-10g.toml`); the scene is still
-/// loaded by the path as written, which a symbolic link could make differ.
-pub fn shown(path: &Path) -> String {
-    use std::path::Component;
-    let mut kept: Vec<Component> = Vec::new();
-    for c in path.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir if matches!(kept.last(), Some(Component::Normal(_))) => {
-                kept.pop();
-            }
-            c => kept.push(c),
-        }
-    }
-    if kept.is_empty() {
-        return ".".into();
-    }
-    kept.iter().collect::<PathBuf>().display().to_string()
+    Ok(())
 }
 
 #[cfg(test)]

@@ -2,6 +2,9 @@
 //! `report.html`, one self-contained page (the charts embedded as data URIs, no script, no
 //! network) with the verdict line of each controller at the top, one column each.
 
+mod ladder_table;
+mod verdict;
+
 use super::ladder::{LadderResult, Rung};
 use super::{ControllerReport, Report};
 use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
@@ -88,7 +91,7 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
     } else if r.vibration.status != "skipped" {
         parts.push(format!("vibration {}", r.vibration.status));
     }
-    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.members > 0)) {
+    if let Some(l) = r.ladder.result.as_ref().filter(|l| l.rungs.iter().any(|x| x.tally.members > 0)) {
         // An interrupted or failed ladder: its figures are those of the rungs decided so far.
         let so_far = match r.ladder.status {
             "measured" => String::new(),
@@ -100,9 +103,9 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
             parts.push(format!(
                 "at {duty_g} G{}: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
                 if rung.complete { "" } else { " (incomplete)" },
-                rung.p_recovered,
-                rung.p_lo,
-                rung.p_hi,
+                rung.tally.p_recovered,
+                rung.tally.p_lo,
+                rung.tally.p_hi,
                 d.contact_time_s.median.unwrap_or(f64::NAN),
                 d.friction_energy_j.median.unwrap_or(f64::NAN),
                 d.peak_ball_pressure_mpa.median.unwrap_or(f64::NAN)
@@ -117,7 +120,9 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
 /// The highest safe shock in words, with the interval that decides it: the safe rung's
 /// [lower, upper], or where none is safe the first rung's (the one that failed), and the counts.
 fn safe_words(l: &LadderResult, min_p: f64) -> String {
-    let interval = |x: &Rung| format!("{}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi);
+    let interval = |x: &Rung| {
+        format!("{}/{} recovered, [{:.2}, {:.2}]", x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi)
+    };
     match l.safe_up_to_g {
         Some(g) => {
             let at = l.rungs.iter().find(|x| x.peak_g == g).map(|x| format!(" ({} at {g} G)", interval(x)));
@@ -125,7 +130,7 @@ fn safe_words(l: &LadderResult, min_p: f64) -> String {
         }
         None => {
             let first =
-                l.rungs.iter().find(|x| x.members > 0).map(|x| format!(" (at {} G: {})", x.peak_g, interval(x)));
+                l.rungs.iter().find(|x| x.tally.members > 0).map(|x| format!(" (at {} G: {})", x.peak_g, interval(x)));
             format!("P(recovered) ≥ {min_p} at no rung{}", first.unwrap_or_default())
         }
     }
@@ -343,7 +348,12 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
         with.iter()
             .map(|(i, c, l)| Line {
                 label: format!("{}{suffix}", c.label),
-                points: l.rungs.iter().filter(|x| x.members > 0).filter_map(|x| f(x).map(|v| (x.peak_g, v))).collect(),
+                points: l
+                    .rungs
+                    .iter()
+                    .filter(|x| x.tally.members > 0)
+                    .filter_map(|x| f(x).map(|v| (x.peak_g, v)))
+                    .collect(),
                 colour: colour(*i),
                 dashed,
                 width: 2,
@@ -353,11 +363,18 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
     let bars: Vec<ErrorBars> = with
         .iter()
         .map(|(i, _, l)| {
-            (colour(*i), l.rungs.iter().filter(|x| x.members > 0).map(|x| (x.peak_g, x.p_lo, x.p_hi)).collect())
+            (
+                colour(*i),
+                l.rungs
+                    .iter()
+                    .filter(|x| x.tally.members > 0)
+                    .map(|x| (x.peak_g, x.tally.p_lo, x.tally.p_hi))
+                    .collect(),
+            )
         })
         .collect();
     // A ladder interrupted or stopped before any member was counted has nothing to draw.
-    let lines = series(&|x| Some(x.p_recovered), false, "");
+    let lines = series(&|x| Some(x.tally.p_recovered), false, "");
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_probability.png");
         let min_p = format!("{}", r.ladder_settings.min_p);
@@ -372,8 +389,8 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
         )?;
         out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
     }
-    let mut lines = series(&|x| x.recovery_median_s.map(|v| v * 1e3), false, " median");
-    lines.extend(series(&|x| x.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
+    let mut lines = series(&|x| x.tally.recovery_median_s.map(|v| v * 1e3), false, " median");
+    lines.extend(series(&|x| x.tally.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_recovery.png");
         chart(
@@ -549,6 +566,28 @@ pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
         }
     }
     let ladder = ladder_charts(dir, r)?;
+    let mut h = head(r);
+    h.push_str(&verdict::table(r));
+    h.push_str(&legend(r));
+    ladder_table::section(&mut h, dir, r, &ladder)?;
+    if !charts.is_empty() {
+        let _ = writeln!(h, "<h2>Sensitivity functions</h2><p class=\"note\">Measured by adding a sine to the sensor signal the controller reads, one axis at a time (stepped sine, settled, fitted by least squares over whole periods; docs/guide/assess.md). Horizontal lines: the zone boundaries at |S| = 3, 4, 5 (9.5, 12, 14 dB). Dashed black: the closed form of the law where it has one.</p>");
+        for (i, name) in &charts {
+            h.push_str(&image(dir, name, &format!("{}: |S| and |T|", r.controllers[*i].label))?);
+        }
+    }
+    h.push_str(&super::loop_charts::section(dir, r)?);
+    if let Some(b) = &r.bearing {
+        h.push_str(&duty_basis(b));
+    }
+    let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
+    let h = super::relative_text(&h, &r.roots);
+    crate::outfile::write(&dir.join("report.html"), h.as_bytes())?;
+    Ok(())
+}
+
+/// The page's head, title and the line saying what was run and where.
+fn head(r: &Report) -> String {
     let mut h = String::new();
     let title = format!("Controller assessment: {}", r.scene);
     let _ = write!(
@@ -580,271 +619,15 @@ figure{{margin:1em 0}}img{{max-width:100%;border:1px solid #ddd}}figcaption{{fon
     for w in &r.warnings {
         let _ = writeln!(h, "<p class=\"bad\"><b>Warning:</b> {}</p>", esc(w));
     }
-    // The verdict table: one column per controller.
-    let _ = writeln!(h, "<h2>Verdict</h2>\n<table><tr><th></th>");
-    for c in &r.controllers {
-        let _ = write!(h, "<th>{}</th>", esc(&c.label));
-    }
-    let row = |h: &mut String, name: &str, f: &dyn Fn(&ControllerReport) -> String| {
-        let _ = write!(h, "<tr><th>{name}</th>");
-        for c in &r.controllers {
-            let _ = write!(h, "<td>{}</td>", f(c));
-        }
-        let _ = writeln!(h, "</tr>");
-    };
-    row(&mut h, "verdict", &|c| format!("<b>{}</b>", esc(&c.verdict)));
-    row(&mut h, "law, mode, rate", &|c| format!("{} · {} · {:.0} Hz", esc(&c.law), esc(&c.mode), c.rate_hz));
-    row(&mut h, "overrides", &|c| {
-        c.set.iter().map(|s| format!("<code>{}</code>", esc(s))).collect::<Vec<_>>().join("<br>")
-    });
-    row(&mut h, "stability margin (ISO 14839-3)", &|c| match &c.sensitivity.result {
-        Some(s) => {
-            let not_all = match c.sensitivity.status {
-                "measured" => String::new(),
-                status => format!(
-                    "<span class=\"bad\">{status}</span>: {}<br>",
-                    esc(c.sensitivity.why.as_deref().unwrap_or(""))
-                ),
-            };
-            not_all
-                + &s.axes
-                    .iter()
-                    .map(|a| match &a.peak {
-                        Some(p) if a.stable => format!(
-                            "{} at {:.0} Hz: zone <b>{}</b>, |S| {:.2} ({:.2} dB) at {:.2} Hz",
-                            a.axis, a.speed_hz, a.zone, p.s_abs, p.s_db, p.f_hz
-                        ),
-                        _ => format!(
-                            "{} at {:.0} Hz: <b class=\"bad\">unstable</b> ({})",
-                            a.axis,
-                            a.speed_hz,
-                            esc(a.note.as_deref().unwrap_or(""))
-                        ),
-                    })
-                    .collect::<Vec<_>>()
-                    .join("<br>")
-        }
-        None => format!(
-            "<span class=\"bad\">{}</span>: {}",
-            c.sensitivity.status,
-            esc(c.sensitivity.why.as_deref().unwrap_or(""))
-        ),
-    });
-    row(
-        &mut h,
-        "gain and phase margins (computed: the law's linear form on the linear plant; measured: L = 1/S − 1)",
-        &|c| {
-            let all = c.sensitivity.result.as_ref().map(|s| s.margins.as_slice()).unwrap_or_default();
-            if all.is_empty() {
-                return "–".into();
-            }
-            let basis = if all.iter().all(|m| m.computed.is_none()) {
-                "<span class=\"note\">measured only: the law has no linear form here (a controller process, an FMU, \
-             or a law without one)</span><br>"
-            } else {
-                ""
-            };
-            basis.to_string()
-                + &all
-                    .iter()
-                    .map(|m| {
-                        let computed = m.computed.as_ref().map_or("no linear form".into(), super::margins::words);
-                        let measured =
-                            m.measured.as_ref().map_or("not measured (unstable)".into(), super::margins::words);
-                        format!("{} at {:.0} Hz: computed {computed}; measured {measured}", m.axis, m.speed_hz)
-                    })
-                    .collect::<Vec<_>>()
-                    .join("<br>")
-        },
-    );
-    row(&mut h, "closed form (where the law has one; two-plane: plane A's load share alone)", &|c| match c
-        .sensitivity
-        .result
-        .as_ref()
-        .and_then(|s| s.closed_form.as_ref())
-    {
-        Some(cf) if cf.stable => {
-            format!("zone {}, |S| {} ({} dB) at {} Hz", cf.zone, num(cf.s_abs, 2), num(cf.s_db, 2), num(cf.f_hz, 2))
-        }
-        Some(_) => "unstable".into(),
-        None => "–".into(),
-    });
-    row(&mut h, "closed form of the coupled loop (flexible rotor), per axis", &|c| {
-        let forms = c.sensitivity.result.as_ref().map(|s| s.closed_form_axes.as_slice()).unwrap_or_default();
-        if forms.is_empty() {
-            return "–".into();
-        }
-        forms
-            .iter()
-            .map(|f| match (f.stable, f.s_db) {
-                (true, Some(d)) => format!(
-                    "{} at {:.0} Hz: zone {}, {:.2} dB at {} Hz{}",
-                    f.axis,
-                    f.speed_hz,
-                    f.zone,
-                    d,
-                    num(f.f_hz, 2),
-                    f.measured_difference_db.map_or(String::new(), |m| format!(" (measured within {m:.2} dB)"))
-                ),
-                _ => format!("{} at {:.0} Hz: unstable", f.axis, f.speed_hz),
-            })
-            .collect::<Vec<_>>()
-            .join("<br>")
-    });
-    row(&mut h, "vibration (ISO 14839-2)", &|c| {
-        match &c.vibration.result {
-        Some(v) if v.planes.len() > 1 => format!(
-            "zone <b>{}</b> (plane {}): {} at {:.0} Hz; coil current swing {} A (RMS {} A; x_A / y_A / x_B / y_B) of {:.1} A",
-            v.zone,
-            v.plane,
-            v.planes
-                .iter()
-                .map(|p| format!(
-                    "plane {}: {:.2} µm = {:.3} C_min (C_min = {:.0} µm), zone {}",
-                    p.plane, p.peak_um, p.ratio, p.clearance_um, p.zone
-                ))
-                .collect::<Vec<_>>()
-                .join("; "),
-            v.speed_hz,
-            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_limit_a
-        ),
-        Some(v) => format!(
-            "zone <b>{}</b>: {:.2} µm = {:.3} C_min (C_min = {:.0} µm) at {:.0} Hz; coil current swing {} A (RMS {} A) of {:.1} A",
-            v.zone,
-            v.peak_um,
-            v.ratio,
-            v.clearance_um,
-            v.speed_hz,
-            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_limit_a
-        ),
-        None => format!("<span class=\"bad\">{}</span>: {}", c.vibration.status, esc(c.vibration.why.as_deref().unwrap_or(""))),
-    }
-    });
-    row(&mut h, "highest safe shock", &|c| match &c.ladder.result {
-        Some(l) if c.ladder.status != "measured" => format!(
-            "<span class=\"bad\">{}</span>: {}; the complete rungs: {}",
-            c.ladder.status,
-            esc(c.ladder.why.as_deref().unwrap_or("")),
-            l.safe_up_to_g.map_or("none safe".into(), |g| format!("safe up to {g} G"))
-        ),
-        Some(l) => match l.safe_up_to_g {
-            Some(g) => {
-                // Coloured by its value: green only from the duty rung (the design shock) up.
-                let class = safe_class(g, r.ladder_settings.duty_g);
-                let at = l.rungs.iter().find(|x| x.peak_g == g).map_or(String::new(), |x| {
-                    format!("; at {g} G {}/{} recovered, [{:.2}, {:.2}]", x.recovered, x.members, x.p_lo, x.p_hi)
-                });
-                format!(
-                    "<b class=\"{class}\">{g} G</b> (every rung up to it: lower bound ≥ {}{at})",
-                    r.ladder_settings.min_p
-                )
-            }
-            None => {
-                let first = l.rungs.iter().find(|x| x.members > 0).map_or(String::new(), |x| {
-                    format!(
-                        ": at {} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.peak_g, x.recovered, x.members, x.p_lo, x.p_hi
-                    )
-                });
-                format!(
-                    "<b class=\"bad\">none</b> (the first rung's lower bound is below {}{first})",
-                    r.ladder_settings.min_p
-                )
-            }
-        },
-        None => {
-            format!("<span class=\"bad\">{}</span>: {}", c.ladder.status, esc(c.ladder.why.as_deref().unwrap_or("")))
-        }
-    });
-    row(&mut h, "wall time", &|c| {
-        format!(
-            "{:.1} s (sensitivity {:.1} s, vibration {:.1} s, ladder {:.1} s)",
-            c.wall_s, c.sensitivity.wall_s, c.vibration.wall_s, c.ladder.wall_s
-        )
-    });
-    let _ = writeln!(h, "</table>");
-    h.push_str(&legend(r));
-    // The ladder table.
-    if r.controllers.iter().any(|c| c.ladder.result.is_some()) {
-        let _ = writeln!(h, "<h2>Shock ladder and the touchdown bearing's duty</h2>");
-        let _ = writeln!(h, "<p class=\"note\">Each rung is an ensemble over the rotor's angle at the shock's arrival; P(recovered) with its Wilson 95 % interval; recovery time from the shock's start to the last contact (median, p90); the duty per shock, median [p90] over the counted members. Members' setting: {}.</p>",
-            esc(&r.controllers.iter().find_map(|c| c.ladder.result.as_ref().map(|l| l.member_setting.clone())).unwrap_or_default()));
-        for c in r.controllers.iter() {
-            let Some(l) = &c.ladder.result else { continue };
-            let _ = writeln!(h, "<h3>{}</h3><table><tr><th>peak (G)</th><th>members</th><th>P(recovered) [95 %]</th><th>recovered / dry whirl / rebound / diverged</th><th>recovery median / p90 (ms)</th><th>contact (ms)</th><th>peak force (N)</th><th>rotor–race pressure (MPa)</th><th>most loaded ball (N / MPa)</th><th>friction energy (J)</th><th>race peak speed (rpm)</th><th>race peak accel. (krad/s²)</th><th>ball-load cycles ≥ {:.0} % Q₀</th></tr>",
-                esc(&c.label), r.bearing.map_or(50.0, |b| b.capacity_fraction * 100.0));
-            let mp = |s: &super::ladder::Spread, k: f64, dig: usize| {
-                format!("{} [{}]", num(s.median.map(|v| v * k), dig), num(s.p90.map(|v| v * k), dig))
-            };
-            // The duty's cells of one rung (or of one of the two-plane rotor's bearings).
-            let duty_cells = |d: &super::ladder::RungDuty| {
-                format!(
-                    "<td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
-                    mp(&d.contact_time_s, 1e3, 1),
-                    mp(&d.peak_contact_force_n, 1.0, 0),
-                    mp(&d.peak_race_pressure_mpa, 1.0, 0),
-                    num(d.peak_ball_load_n.median, 0),
-                    num(d.peak_ball_pressure_mpa.median, 0),
-                    mp(&d.friction_energy_j, 1.0, 2),
-                    mp(&d.race_peak_speed_rpm, 1.0, 0),
-                    mp(&d.race_peak_accel_rad_s2, 1e-3, 0),
-                    mp(&d.ball_cycles, 1.0, 1),
-                )
-            };
-            for x in &l.rungs {
-                let _ = writeln!(
-                    h,
-                    "<tr><td>{}</td><td>{}{}</td><td>{:.2} [{:.2}, {:.2}]</td><td>{}/{}/{}/{}</td><td>{} / {}</td>{}</tr>",
-                    x.peak_g,
-                    x.members,
-                    if x.complete { "" } else { " (incomplete)" },
-                    x.p_recovered,
-                    x.p_lo,
-                    x.p_hi,
-                    x.recovered,
-                    x.dry_whirl,
-                    x.rebound,
-                    x.diverged,
-                    num(x.recovery_median_s.map(|v| v * 1e3), 1),
-                    num(x.recovery_p90_s.map(|v| v * 1e3), 1),
-                    duty_cells(&x.duty),
-                );
-                // The two-plane rotor: each touchdown bearing's own duty under the rung's
-                // (which holds, figure by figure, the larger of the two).
-                for (k, d) in x.duty_planes.iter().enumerate() {
-                    let _ = writeln!(
-                        h,
-                        "<tr class=\"note\"><td></td><td colspan=\"4\">touchdown bearing {}</td>{}</tr>",
-                        ["A", "B"][k.min(1)],
-                        duty_cells(d)
-                    );
-                }
-            }
-            let _ = writeln!(h, "</table>");
-        }
-        for (name, alt) in &ladder {
-            h.push_str(&image(dir, name, alt)?);
-        }
-    }
-    if !charts.is_empty() {
-        let _ = writeln!(h, "<h2>Sensitivity functions</h2><p class=\"note\">Measured by adding a sine to the sensor signal the controller reads, one axis at a time (stepped sine, settled, fitted by least squares over whole periods; docs/guide/assess.md). Horizontal lines: the zone boundaries at |S| = 3, 4, 5 (9.5, 12, 14 dB). Dashed black: the closed form of the law where it has one.</p>");
-        for (i, name) in &charts {
-            h.push_str(&image(dir, name, &format!("{}: |S| and |T|", r.controllers[*i].label))?);
-        }
-    }
-    h.push_str(&super::loop_charts::section(dir, r)?);
-    if let Some(b) = &r.bearing {
-        let _ = writeln!(h, "<h2>Basis of the duty figures</h2><p class=\"note\">Taken at the output samples of each member's run. Rotor–race pressure: Hertz line contact of the shaft in the bore over the race width ({:.1} mm), steel E = {:.0} GPa, ν = {}; with a very conformal contact the half-width is not small against the radius, so it is Hertz's estimate outside its strict validity. Ball pressure: Hertz point contact of the most loaded ball on the inner raceway (ball {:.2} mm, pitch diameter {:.1} mm, groove conformity {}). Static capacity of one ball Q₀ = {:.0} N (the load giving {:.0} MPa, ISO 76's basis; C₀ = Z Q₀/5). Ball-load cycles: rainflow count of each ball's load, cycles with a range ≥ {:.0} % of Q₀, summed over the balls. Friction energy: ∫ |μ N v_slip| dt at the rotor–race contact. None of these figures is a life.</p>",
+    h
+}
+
+/// The note under the duty figures: what each one rests on.
+fn duty_basis(b: &super::duty::Bearing) -> String {
+    let mut h = String::new();
+    let _ = writeln!(h, "<h2>Basis of the duty figures</h2><p class=\"note\">Taken at the output samples of each member's run. Rotor–race pressure: Hertz line contact of the shaft in the bore over the race width ({:.1} mm), steel E = {:.0} GPa, ν = {}; with a very conformal contact the half-width is not small against the radius, so it is Hertz's estimate outside its strict validity. Ball pressure: Hertz point contact of the most loaded ball on the inner raceway (ball {:.2} mm, pitch diameter {:.1} mm, groove conformity {}). Static capacity of one ball Q₀ = {:.0} N (the load giving {:.0} MPa, ISO 76's basis; C₀ = Z Q₀/5). Ball-load cycles: rainflow count of each ball's load, cycles with a range ≥ {:.0} % of Q₀, summed over the balls. Friction energy: ∫ |μ N v_slip| dt at the rotor–race contact. None of these figures is a life.</p>",
             b.width_m * 1e3, b.materials.youngs_modulus_pa * 1e-9, b.materials.poisson, b.ball_diameter_m * 1e3, b.pitch_diameter_m * 1e3, b.materials.groove_conformity, b.ball_static_load_n, b.materials.static_pressure_pa * 1e-6, b.capacity_fraction * 100.0);
-    }
-    let _ = writeln!(h, "<p class=\"note\">Every figure is in <code>report.json</code>.</p></body></html>");
-    let h = super::relative_text(&h, &r.roots);
-    crate::outfile::write(&dir.join("report.html"), h.as_bytes())?;
-    Ok(())
+    h
 }
 
 #[cfg(test)]

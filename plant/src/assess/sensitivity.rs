@@ -45,10 +45,19 @@
 //! half-power width is `2ζ f`: at 0.2 % spacing the nearest point of a peak with ζ = 0.004 is
 //! within 0.1 % of it, 0.3 dB below it, and the parabola's vertex closer.
 
+mod decay;
+mod multisine;
+mod peak;
+
+pub use decay::decay;
+pub use peak::peak_of;
+
+use multisine::{Multi, MULTI_WINDOWS};
+
 use crate::hooks::{Excitation, Hooks};
 use crate::model::SensorSine;
 use crate::run::Sink;
-use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
+use nalgebra::{Complex, SMatrix, SVector};
 use serde::Serialize;
 use std::cell::Cell;
 use std::collections::VecDeque;
@@ -287,124 +296,6 @@ struct Tone {
     estimates: Vec<Complex<f64>>,
     /// The estimate once two consecutive windows agreed.
     settled: Option<Complex<f64>>,
-}
-
-/// The whole coarse grid at once: `E = a Σ sin(ω_j (t − t0) + φ_j)`, each `ω_j` a whole number
-/// of periods in the window (the tones are orthogonal over it), fitted per window on
-/// `[1, cos θ_j, sin θ_j, cos Ωt, sin Ωt]`, the tones and the constant by their correlation
-/// sums and the rotation's line by the Schur complement (it is not on the window's bins).
-struct Multi {
-    tones: Vec<Tone>,
-    /// Each tone's amplitude (V).
-    amplitude: f64,
-    t0: f64,
-    settle_left: u64,
-    window_ticks: u64,
-    in_window: u64,
-    windows: u32,
-    /// Σ 1, Σ v, Σ [cos Ωt, sin Ωt], Σ v [cos Ωt, sin Ωt], Σ cos²Ωt, Σ cos Ωt sin Ωt, Σ sin²Ωt.
-    n: f64,
-    sv: f64,
-    su: [f64; 2],
-    uv: [f64; 2],
-    uu: [f64; 3],
-    /// The last `E(t)` and its time.
-    e_now: f64,
-    e_at: f64,
-}
-
-/// Windows of a multisine before its unsettled tones go to the stepped sine.
-const MULTI_WINDOWS: u32 = 6;
-
-impl Multi {
-    /// `E(t)` (V), kept for the tick: the fit and the loop read the same value.
-    fn value(&mut self, t: f64) -> f64 {
-        if self.e_at != t {
-            self.e_now =
-                self.amplitude * self.tones.iter().map(|k| (k.omega * (t - self.t0) + k.phase).sin()).sum::<f64>();
-            self.e_at = t;
-        }
-        self.e_now
-    }
-
-    fn clear(&mut self) {
-        for k in &mut self.tones {
-            k.rv = [0.0; 2];
-            k.d = [0.0; 2];
-            k.b = [[0.0; 2]; 2];
-        }
-        self.in_window = 0;
-        self.n = 0.0;
-        self.sv = 0.0;
-        self.su = [0.0; 2];
-        self.uv = [0.0; 2];
-        self.uu = [0.0; 3];
-    }
-
-    /// Adds one tick: `v` what the controller read, `rot` `[cos Ωt, sin Ωt]` (zero at standstill).
-    fn add(&mut self, t: f64, v: f64, rot: [f64; 2]) {
-        for k in &mut self.tones {
-            let (sn, cs) = (k.omega * (t - self.t0) + k.phase).sin_cos();
-            k.rv[0] += cs * v;
-            k.rv[1] += sn * v;
-            k.d[0] += cs * cs;
-            k.d[1] += sn * sn;
-            k.b[0][0] += cs * rot[0];
-            k.b[0][1] += cs * rot[1];
-            k.b[1][0] += sn * rot[0];
-            k.b[1][1] += sn * rot[1];
-        }
-        self.n += 1.0;
-        self.sv += v;
-        self.su[0] += rot[0];
-        self.su[1] += rot[1];
-        self.uv[0] += rot[0] * v;
-        self.uv[1] += rot[1] * v;
-        self.uu[0] += rot[0] * rot[0];
-        self.uu[1] += rot[0] * rot[1];
-        self.uu[2] += rot[1] * rot[1];
-        self.in_window += 1;
-    }
-
-    /// Each tone's `S` over the window just ended (`at_speed`: with the rotation's line).
-    fn fit(&self, at_speed: bool) -> Vec<Complex<f64>> {
-        // The rotation's line [p, q] from the Schur complement of the orthogonal block.
-        let y = if at_speed {
-            let mut m = [self.uu[0], self.uu[1], self.uu[2]];
-            let mut w = self.uv;
-            let mut eliminate = |b: [f64; 2], d: f64, r: f64| {
-                if d > 0.0 {
-                    m[0] -= b[0] * b[0] / d;
-                    m[1] -= b[0] * b[1] / d;
-                    m[2] -= b[1] * b[1] / d;
-                    w[0] -= b[0] * r / d;
-                    w[1] -= b[1] * r / d;
-                }
-            };
-            eliminate(self.su, self.n, self.sv);
-            for k in &self.tones {
-                eliminate(k.b[0], k.d[0], k.rv[0]);
-                eliminate(k.b[1], k.d[1], k.rv[1]);
-            }
-            let det = m[0] * m[2] - m[1] * m[1];
-            if det.abs() > 0.0 {
-                [(m[2] * w[0] - m[1] * w[1]) / det, (m[0] * w[1] - m[1] * w[0]) / det]
-            } else {
-                [0.0; 2]
-            }
-        } else {
-            [0.0; 2]
-        };
-        self.tones
-            .iter()
-            .map(|k| {
-                let c = (k.rv[0] - k.b[0][0] * y[0] - k.b[0][1] * y[1]) / k.d[0];
-                let s = (k.rv[1] - k.b[1][0] * y[0] - k.b[1][1] * y[1]) / k.d[1];
-                // v = c cos θ + s sin θ = Re((c − i s) e^{iθ}); E = a sin θ = Re(−i a e^{iθ}).
-                Complex::new(c, -s) / Complex::new(0.0, -self.amplitude)
-            })
-            .collect()
-    }
 }
 
 /// One frequency being measured.
@@ -1034,132 +925,12 @@ fn near_rotation(f: f64, speed_hz: f64) -> bool {
     speed_hz > 0.0 && (f / speed_hz - 1.0).abs() < 0.02
 }
 
-/// The peak of `|S|` over the points (sorted by frequency): the vertex of the parabola through
-/// the largest and its neighbours in (ln f, dB), or the largest point itself at an end.
-pub fn peak_of(points: &[Point]) -> Option<Peak> {
-    let i = (0..points.len()).max_by(|&a, &b| points[a].s_db.total_cmp(&points[b].s_db))?;
-    let p = &points[i];
-    let at = |f: f64, db: f64, spacing: f64| Peak { f_hz: f, s_abs: 10f64.powf(db / 20.0), s_db: db, spacing };
-    if i == 0 || i + 1 == points.len() {
-        let spacing = if points.len() > 1 {
-            let j = if i == 0 { 1 } else { i - 1 };
-            (points[j].f_hz / p.f_hz).ln().abs()
-        } else {
-            f64::NAN
-        };
-        return Some(at(p.f_hz, p.s_db, spacing));
-    }
-    let (a, c) = (&points[i - 1], &points[i + 1]);
-    let (x0, x1, x2) = (a.f_hz.ln(), p.f_hz.ln(), c.f_hz.ln());
-    let (y0, y1, y2) = (a.s_db, p.s_db, c.s_db);
-    let spacing = (x1 - x0).max(x2 - x1);
-    // The parabola through three points: its vertex.
-    let d0 = (y1 - y0) / (x1 - x0);
-    let d1 = (y2 - y1) / (x2 - x1);
-    let curv = (d1 - d0) / (x2 - x0);
-    if curv >= 0.0 {
-        return Some(at(p.f_hz, p.s_db, spacing));
-    }
-    let xv = 0.5 * (x0 + x1) - d0 / (2.0 * curv);
-    let xv = xv.clamp(x0, x2);
-    let yv = y0 + d0 * (xv - x0) + curv * (xv - x0) * (xv - x1);
-    Some(at(xv.exp(), yv.max(y1), spacing))
-}
-
-/// The decay rate σ (1/s) and the dominant frequency (Hz) of a free response `(t, u)`, after
-/// removing its mean and, at speed, its component at the rotation frequency: a straight line
-/// through the logarithm of the block envelopes (blocks of two periods of the dominant
-/// frequency), over the blocks above 1e-4 of the first one.
-pub fn decay(samples: &[(f64, f64)], speed_hz: f64) -> (f64, f64) {
-    if samples.len() < 16 {
-        return (f64::NAN, f64::NAN);
-    }
-    let n = if speed_hz > 0.0 { 3 } else { 1 };
-    let mut normal = DMatrix::<f64>::zeros(n, n);
-    let mut rhs = DVector::<f64>::zeros(n);
-    let basis = |t: f64| {
-        let mut v = vec![1.0];
-        if speed_hz > 0.0 {
-            let w = TAU * speed_hz * t;
-            v.extend([w.cos(), w.sin()]);
-        }
-        DVector::from_vec(v)
-    };
-    // The fit of the steady part over the second half (where the decay has mostly gone).
-    for (t, u) in &samples[samples.len() / 2..] {
-        let b = basis(*t);
-        normal += &b * b.transpose();
-        rhs += &b * *u;
-    }
-    let fit = normal.lu().solve(&rhs).unwrap_or_else(|| DVector::zeros(n));
-    let r: Vec<(f64, f64)> = samples.iter().map(|(t, u)| (*t, u - basis(*t).dot(&fit))).collect();
-    // Dominant frequency from the zero crossings of the first half.
-    let half = &r[..r.len() / 2];
-    let crossings: Vec<f64> = half.windows(2).filter(|w| w[0].1 * w[1].1 < 0.0).map(|w| w[0].0).collect();
-    let span = r.last().map_or(0.0, |x| x.0) - r[0].0;
-    let f_d = if crossings.len() >= 3 {
-        (crossings.len() - 1) as f64 / (2.0 * (crossings[crossings.len() - 1] - crossings[0]))
-    } else {
-        1.0 / span.max(1e-9)
-    };
-    let block = (2.0 / f_d).max(span / 200.0).min(span / 8.0);
-    let mut env: Vec<(f64, f64)> = Vec::new();
-    let mut start = r[0].0;
-    let mut peak: f64 = 0.0;
-    for (t, u) in &r {
-        if *t >= start + block {
-            env.push((start + 0.5 * block, peak));
-            start += block;
-            peak = 0.0;
-        }
-        peak = peak.max(u.abs());
-    }
-    let Some(first) = env.first().map(|e| e.1) else { return (f64::NAN, f_d) };
-    let used: Vec<(f64, f64)> = env.iter().skip(1).filter(|e| e.1 > 1e-4 * first && e.1 > 0.0).copied().collect();
-    if used.len() < 3 {
-        // Gone within a few blocks: a fast decay; its rate from the first block down to 1e-4.
-        return ((1e4f64).ln() / (block * 3.0), f_d);
-    }
-    let m = used.len() as f64;
-    let (sx, sy) = used.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y.ln()));
-    let (mx, my) = (sx / m, sy / m);
-    let (sxy, sxx) =
-        used.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + (x - mx) * (y.ln() - my), b + (x - mx).powi(2)));
-    (-sxy / sxx, f_d)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn the_decay_of_a_damped_sine_with_an_unbalance_line() {
-        let (sigma, f) = (2.95, 47.0);
-        let s: Vec<(f64, f64)> = (0..20_000)
-            .map(|k| {
-                let t = k as f64 * 5e-5;
-                (t, 1.0 + (-sigma * t).exp() * (TAU * f * t).cos() + 0.05 * (TAU * 500.0 * t + 0.3).sin())
-            })
-            .collect();
-        let (got, fd) = decay(&s, 500.0);
-        assert!((got / sigma - 1.0).abs() < 0.05, "σ = {got}");
-        assert!((fd / f - 1.0).abs() < 0.02, "f = {fd}");
-        let grow: Vec<(f64, f64)> = s.iter().map(|(t, _)| (*t, (0.5 * t).exp() * (TAU * f * t).sin())).collect();
-        assert!(decay(&grow, 0.0).0 < 0.0);
-    }
-
-    #[test]
-    fn the_parabola_finds_a_peak_between_points() {
-        let f0 = 50.0;
-        let pts: Vec<Point> = [49.0, 50.3, 51.6]
-            .iter()
-            .map(|f: &f64| {
-                let db = 30.0 - 400.0 * (f / f0).ln().powi(2);
-                Point { f_hz: *f, s: [0.0; 2], s_db: db, t_db: db, amplitude_v: 0.0, windows: 2, settled: true }
-            })
-            .collect();
-        let p = peak_of(&pts).expect("peak");
-        assert!((p.f_hz / f0 - 1.0).abs() < 1e-9 && (p.s_db - 30.0).abs() < 1e-9, "{p:?}");
+    fn zones_by_the_peak_sensitivity() {
         assert_eq!(zone(2.9), "A");
         assert_eq!(zone(3.5), "B");
         assert_eq!(zone(4.5), "C");

@@ -188,6 +188,39 @@ fn count(key: &str, v: Option<i64>, default: usize, lo: i64, hi: i64) -> Result<
 /// Loads an assessment file, or a scene file as an assessment of its own controller (or of
 /// `laws`), with `set` for every controller.
 pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, ConfigError> {
+    let raw = read_raw(file)?;
+    let scene_path = super::relative_to(file, &raw.scene);
+    let mut base: Vec<String> = raw.set.clone();
+    base.extend(set.iter().cloned());
+    let probe = load_scene(&scene_path, &base)?;
+    let controllers = controllers(&raw.controller, &base, &probe, laws)?;
+    let parts = parts(raw.parts.as_deref())?;
+    // The smallest bearing plane's gap: the excitation's default amplitude and the bound of
+    // what is injected, so that it stays inside every plane's clearance.
+    let gap = (0..probe.planes()).map(|i| probe.plane(i).contact.gap).fold(f64::INFINITY, f64::min);
+    let sens = sensitivity_settings(&raw.sensitivity, gap)?;
+    let speeds = speeds(&raw.sensitivity)?;
+    let ladder = ladder_settings(&raw.ladder, &parts)?;
+    let materials = materials(&raw.duty)?;
+    let capacity_fraction = number("duty.capacity_fraction", raw.duty.capacity_fraction, 0.5, "", 0.0, 10.0)?;
+    // Warned, not refused: a short ladder still shows the shape of P(recovered) over the peaks,
+    // and quick checks run with few members; the report says what it cannot conclude.
+    let warnings = if parts.contains(&Part::Ladder) { ladder.unreachable().into_iter().collect() } else { Vec::new() };
+    Ok(Assessment {
+        scene: scene_path,
+        controllers,
+        parts,
+        speeds,
+        sensitivity: sens,
+        ladder,
+        materials,
+        capacity_fraction,
+        warnings,
+    })
+}
+
+/// The file as written, or a scene file read as an assessment of its own controller.
+fn read_raw(file: &Path) -> Result<RawFile, ConfigError> {
     let text = crate::input::read_text(file, crate::input::MAX_TOML_BYTES)
         .map_err(|source| ConfigError::Read { path: file.into(), source })?;
     let table: toml::Table = toml::from_str(&text)
@@ -207,10 +240,17 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             duty: RawDuty::default(),
         }
     };
-    let scene_path = super::relative_to(file, &raw.scene);
-    let mut base: Vec<String> = raw.set.clone();
-    base.extend(set.iter().cloned());
-    let probe = load_scene(&scene_path, &base)?;
+    Ok(raw)
+}
+
+/// The controllers compared: `laws` given on the command line, the file's `[[controller]]`
+/// tables, or the scene's own controller.
+fn controllers(
+    raw: &[RawController],
+    base: &[String],
+    probe: &crate::config::Scene,
+    laws: &[String],
+) -> Result<Vec<ControllerSpec>, ConfigError> {
     let mut controllers: Vec<ControllerSpec> = Vec::new();
     if !laws.is_empty() {
         for law in laws {
@@ -218,17 +258,17 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             if *law != probe.controller.law {
                 own.push("controller.params={}".into());
             }
-            controllers.push(ControllerSpec { label: law.clone(), sets: [base.clone(), own.clone()].concat(), own });
+            controllers.push(ControllerSpec { label: law.clone(), sets: [base.to_vec(), own.clone()].concat(), own });
         }
-    } else if raw.controller.is_empty() {
+    } else if raw.is_empty() {
         let label = if probe.controller.mode == crate::config::ControlMode::Continuous {
             "continuous PD".to_string()
         } else {
             probe.controller.law.clone()
         };
-        controllers.push(ControllerSpec { label, sets: base.clone(), own: Vec::new() });
+        controllers.push(ControllerSpec { label, sets: base.to_vec(), own: Vec::new() });
     } else {
-        for (i, c) in raw.controller.iter().enumerate() {
+        for (i, c) in raw.iter().enumerate() {
             if c.label.trim().is_empty() || controllers.iter().any(|x| x.label == c.label) {
                 return Err(bad(
                     &format!("controller[{i}].label"),
@@ -239,7 +279,7 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             }
             controllers.push(ControllerSpec {
                 label: c.label.clone(),
-                sets: [base.clone(), c.set.clone()].concat(),
+                sets: [base.to_vec(), c.set.clone()].concat(),
                 own: c.set.clone(),
             });
         }
@@ -247,7 +287,12 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
     if controllers.len() > 16 {
         return Err(bad("controller", controllers.len(), "controllers", "at most 16 in one report"));
     }
-    let parts = match &raw.parts {
+    Ok(controllers)
+}
+
+/// The parts measured (all three when not given).
+fn parts(list: Option<&[String]>) -> Result<Vec<Part>, ConfigError> {
+    Ok(match list {
         None => vec![Part::Sensitivity, Part::Vibration, Part::Ladder],
         Some(list) => {
             let mut out = Vec::new();
@@ -271,12 +316,12 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             }
             out
         }
-    };
-    // The smallest bearing plane's gap: the excitation's default amplitude and the bound of
-    // what is injected, so that it stays inside every plane's clearance.
-    let gap = (0..probe.planes()).map(|i| probe.plane(i).contact.gap).fold(f64::INFINITY, f64::min);
+    })
+}
+
+/// The `[sensitivity]` settings, the excitation bounded by the smallest plane's `gap` (m).
+fn sensitivity_settings(s: &RawSensitivity, gap: f64) -> Result<sensitivity::Settings, ConfigError> {
     let d = sensitivity::Settings::for_gap(gap);
-    let s = &raw.sensitivity;
     let k = |name: &str| format!("sensitivity.{name}");
     let gap_um = gap * 1e6;
     let sens = sensitivity::Settings {
@@ -318,7 +363,13 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         );
         return Err(bad(&k("f_min_hz"), sens.f_min_hz, "Hz", &why));
     }
-    let speeds = match &s.speeds {
+    Ok(sens)
+}
+
+/// The speeds at which the sensitivity is measured (standstill and rated when not given).
+fn speeds(s: &RawSensitivity) -> Result<Vec<Speed>, ConfigError> {
+    let k = |name: &str| format!("sensitivity.{name}");
+    Ok(match &s.speeds {
         None => vec![Speed::Standstill, Speed::Rated],
         Some(list) if !list.is_empty() => list
             .iter()
@@ -329,8 +380,11 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             })
             .collect::<Result<_, _>>()?,
         Some(_) => return Err(bad(&k("speeds"), "[]", "", "name at least one speed")),
-    };
-    let l = &raw.ladder;
+    })
+}
+
+/// The `[ladder]` settings; its `duty_g` must be one of its rungs when the ladder is measured.
+fn ladder_settings(l: &RawLadder, parts: &[Part]) -> Result<ladder::Settings, ConfigError> {
     let dl = ladder::Settings::default();
     let peaks = l.peaks_g.clone().unwrap_or(dl.peaks_g.clone());
     if peaks.is_empty()
@@ -363,7 +417,11 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
         let why = format!("must be one of ladder.peaks_g {:?} (the rung whose duty the verdict gives)", ladder.peaks_g);
         return Err(bad("ladder.duty_g", ladder.duty_g, "G", &why));
     }
-    let du = &raw.duty;
+    Ok(ladder)
+}
+
+/// The `[duty]` materials.
+fn materials(du: &RawDuty) -> Result<Materials, ConfigError> {
     let dm = Materials::default();
     let materials = Materials {
         youngs_modulus_pa: number(
@@ -385,21 +443,7 @@ pub fn load(file: &Path, set: &[String], laws: &[String]) -> Result<Assessment, 
             1e5,
         )? * 1e6,
     };
-    let capacity_fraction = number("duty.capacity_fraction", du.capacity_fraction, 0.5, "", 0.0, 10.0)?;
-    // Warned, not refused: a short ladder still shows the shape of P(recovered) over the peaks,
-    // and quick checks run with few members; the report says what it cannot conclude.
-    let warnings = if parts.contains(&Part::Ladder) { ladder.unreachable().into_iter().collect() } else { Vec::new() };
-    Ok(Assessment {
-        scene: scene_path,
-        controllers,
-        parts,
-        speeds,
-        sensitivity: sens,
-        ladder,
-        materials,
-        capacity_fraction,
-        warnings,
-    })
+    Ok(materials)
 }
 
 #[cfg(test)]

@@ -32,7 +32,6 @@ use crate::run::{run, Outcome, RunResult};
 use crate::status::Status;
 use crate::summary::{snake_name, Summary};
 use serde::{Deserialize, Serialize};
-use shock_table::ShockSpec;
 use std::sync::atomic::AtomicBool;
 
 /// Members whose Poincaré points are kept (for the bifurcation diagrams and `poincare.csv`).
@@ -173,27 +172,6 @@ pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
     ]
 }
 
-/// The field of a shock that sets its size, and its value.
-pub fn shock_size(s: &ShockSpec) -> Option<(&'static str, f64)> {
-    match s {
-        ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => Some(("peak_g", *p)),
-        ShockSpec::DoubleHalfSine { design_accel_g: Some(a), .. } => Some(("design_accel_g", *a)),
-        ShockSpec::DoubleHalfSine { .. } => None,
-        ShockSpec::HalfSine { peak_g, .. } => Some(("peak_g", *peak_g)),
-        ShockSpec::Sine { amplitude_g, .. } => Some(("amplitude_g", *amplitude_g)),
-        ShockSpec::Recorded { scale, .. } => Some(("scale", *scale)),
-    }
-}
-
-fn shock_direction(s: &ShockSpec) -> f64 {
-    match s {
-        ShockSpec::DoubleHalfSine { direction_deg, .. }
-        | ShockSpec::HalfSine { direction_deg, .. }
-        | ShockSpec::Sine { direction_deg, .. }
-        | ShockSpec::Recorded { direction_deg, .. } => *direction_deg,
-    }
-}
-
 /// `--set` overrides of a draw on a point's scene.
 ///
 /// The angle at the shock's arrival θ sets the unbalance phase at t = 0: with the spin held,
@@ -209,10 +187,10 @@ pub fn draw_overrides(scene: &Scene, spec: &EnsembleSpec, draw: &Draw) -> Vec<St
     }
     for (k, shock) in raw.shock.iter().enumerate() {
         if spec.direction_deg > 0.0 {
-            out.push(format!("shock[{k}].direction_deg={:?}", shock_direction(shock) + draw.direction_offset_deg));
+            out.push(format!("shock[{k}].direction_deg={:?}", shock.direction_deg() + draw.direction_offset_deg));
         }
         if spec.peak_rel > 0.0 {
-            if let Some((field, v)) = shock_size(shock) {
+            if let Some((field, v)) = shock.size() {
                 out.push(format!("shock[{k}].{field}={:?}", v * draw.peak_factor));
             }
         }

@@ -132,33 +132,7 @@ pub fn write_ensemble(
         })
         .collect();
 
-    // members.csv
-    let mut mw = csv::Writer::from_writer(Vec::new());
-    for (i, (members, _)) in counted.iter().enumerate() {
-        for m in members {
-            let c = m.counted();
-            mw.serialize(MemberRow {
-                point: i,
-                member: m.member,
-                value: values[i].0,
-                value2: values[i].1,
-                angle_deg: m.angle_deg,
-                drawn: m.drawn.join(" "),
-                mode: c.mode,
-                steady_class: c.steady_class,
-                period_k: c.period_k,
-                recovery_s: c.recovery_s,
-                contact_fraction: c.contact_fraction,
-                max_radius_m: c.max_radius_m,
-                max_contact_force_n: c.max_contact_force_n,
-                status: c.status,
-                verified: m.verified.is_some(),
-                first_mode: m.run.mode,
-                numerically_sensitive: m.sensitive(),
-            })?;
-        }
-    }
-    finish(mw, &dir.join("members.csv"))?;
+    write_members(counted, &values, dir)?;
 
     let base = grid.scene_for(0)?;
     let thresholds = sweep_thresholds(grid, &stats);
@@ -192,8 +166,74 @@ pub fn write_ensemble(
         return Ok("ensemble.csv, members.csv, ensemble.json and members.png".into());
     }
 
-    // points.csv: the single-run columns, then the statistics.
     let map = grid.axes.len() > 1;
+    write_points(&stats, counted, &values, map, dir)?;
+
+    // Charts: bifurcation diagrams with the probability band (1-D) or the probability map.
+    crate::ensemble::charts::sweep_charts(grid, dir, &stats, counted, &summary.thresholds)
+        .context("writing ensemble charts")?;
+    if map {
+        let pts: Vec<ModePoint> = stats
+            .iter()
+            .map(|s| ModePoint {
+                value: values[s.index].0.unwrap_or(f64::NAN),
+                value2: values[s.index].1,
+                mode: s.post_shock_mode,
+                poincare: &[],
+            })
+            .collect();
+        mode_plots(grid, dir, &pts, true).context("writing the mode map")?;
+        Ok("points.csv, members.csv, poincare.csv, sweep.json, map.png and map_modes.png".into())
+    } else {
+        Ok("points.csv, members.csv, poincare.csv, sweep.json, recovery_probability.png and the bifurcation diagrams"
+            .into())
+    }
+}
+
+/// `members.csv`: a row per counted member of every point.
+fn write_members(
+    counted: &[(Vec<&MemberResult>, StoppedBy)],
+    values: &[(Option<f64>, Option<f64>)],
+    dir: &Path,
+) -> anyhow::Result<()> {
+    let mut mw = csv::Writer::from_writer(Vec::new());
+    for (i, (members, _)) in counted.iter().enumerate() {
+        for m in members {
+            let c = m.counted();
+            mw.serialize(MemberRow {
+                point: i,
+                member: m.member,
+                value: values[i].0,
+                value2: values[i].1,
+                angle_deg: m.angle_deg,
+                drawn: m.drawn.join(" "),
+                mode: c.mode,
+                steady_class: c.steady_class,
+                period_k: c.period_k,
+                recovery_s: c.recovery_s,
+                contact_fraction: c.contact_fraction,
+                max_radius_m: c.max_radius_m,
+                max_contact_force_n: c.max_contact_force_n,
+                status: c.status,
+                verified: m.verified.is_some(),
+                first_mode: m.run.mode,
+                numerically_sensitive: m.sensitive(),
+            })?;
+        }
+    }
+    finish(mw, &dir.join("members.csv"))?;
+    Ok(())
+}
+
+/// `points.csv` (the single-run columns, then the statistics; `map`: a second swept value) and
+/// `poincare.csv` (the kept members' Poincaré points).
+fn write_points(
+    stats: &[PointStats],
+    counted: &[(Vec<&MemberResult>, StoppedBy)],
+    values: &[(Option<f64>, Option<f64>)],
+    map: bool,
+    dir: &Path,
+) -> anyhow::Result<()> {
     let mut w = csv_writer();
     let mut header: Vec<&str> = SINGLE_COLUMNS.to_vec();
     if map {
@@ -257,24 +297,5 @@ pub fn write_ensemble(
     }
     finish(w, &dir.join("points.csv"))?;
     finish(pw, &dir.join("poincare.csv"))?;
-
-    // Charts: bifurcation diagrams with the probability band (1-D) or the probability map.
-    crate::ensemble::charts::sweep_charts(grid, dir, &stats, counted, &summary.thresholds)
-        .context("writing ensemble charts")?;
-    if map {
-        let pts: Vec<ModePoint> = stats
-            .iter()
-            .map(|s| ModePoint {
-                value: values[s.index].0.unwrap_or(f64::NAN),
-                value2: values[s.index].1,
-                mode: s.post_shock_mode,
-                poincare: &[],
-            })
-            .collect();
-        mode_plots(grid, dir, &pts, true).context("writing the mode map")?;
-        Ok("points.csv, members.csv, poincare.csv, sweep.json, map.png and map_modes.png".into())
-    } else {
-        Ok("points.csv, members.csv, poincare.csv, sweep.json, recovery_probability.png and the bifurcation diagrams"
-            .into())
-    }
+    Ok(())
 }

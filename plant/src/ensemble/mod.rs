@@ -21,6 +21,7 @@ pub mod merge;
 pub mod point;
 pub mod spec;
 pub mod stats;
+pub mod tally;
 pub mod work;
 
 use crate::config::load_scene;

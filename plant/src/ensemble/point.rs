@@ -13,6 +13,7 @@ use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
+use crate::ensemble::tally::tally;
 use crate::grid::{Mode, Progress};
 use crate::status::Status;
 use serde::Serialize;
@@ -115,11 +116,6 @@ fn most_frequent<T: PartialEq + Copy>(items: &[T], order: &[T]) -> Option<T> {
 /// The statistics of a point's counted members (`members` sorted by index).
 pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedBy) -> PointStats {
     let n = members.len();
-    let count = |mode: Mode| members.iter().filter(|m| m.counted().mode == mode).count();
-    let recovered = count(Mode::Recovered);
-    let [p_lo, p_hi] = wilson(recovered, n);
-    let times: Vec<f64> =
-        members.iter().filter(|m| m.counted().mode == Mode::Recovered).filter_map(|m| m.counted().recovery_s).collect();
     let modes: Vec<Mode> = members.iter().map(|m| m.counted().mode).collect();
     let mode = most_frequent(&modes, &Mode::ALL);
     let classes: Vec<SteadyClass> = members.iter().map(|m| m.counted().steady_class).collect();
@@ -135,23 +131,25 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedB
     k_order.sort_unstable();
     k_order.dedup();
     let period_k = most_frequent(&ks, &k_order);
+    let t = tally(members);
+    let (verified, numerically_sensitive) = super::tally::verified(members);
     let whirl: Vec<f64> = members.iter().map(|m| m.counted().whirl_hz).collect();
     let max = |f: fn(&MemberResult) -> f64| members.iter().map(|m| f(m)).filter(|v| v.is_finite()).fold(0.0, f64::max);
     PointStats {
         index,
-        members: n,
-        recovered,
-        dry_whirl: count(Mode::DryWhirl),
-        rebound: count(Mode::Rebound),
-        diverged: count(Mode::Diverged),
-        p_recovered: if n > 0 { recovered as f64 / n as f64 } else { 0.0 },
-        p_lo,
-        p_hi,
-        recovery_median_s: quantile(&times, 0.5),
-        recovery_p90_s: quantile(&times, 0.9),
+        members: t.members,
+        recovered: t.recovered,
+        dry_whirl: t.dry_whirl,
+        rebound: t.rebound,
+        diverged: t.diverged,
+        p_recovered: t.p_recovered,
+        p_lo: t.p_lo,
+        p_hi: t.p_hi,
+        recovery_median_s: t.recovery_median_s,
+        recovery_p90_s: t.recovery_p90_s,
         worst_contact_force_n: max(|m| m.counted().max_contact_force_n),
-        verified: members.iter().filter(|m| m.verified.is_some()).count(),
-        numerically_sensitive: members.iter().filter(|m| m.sensitive()).count(),
+        verified,
+        numerically_sensitive,
         stopped_by,
         post_shock_mode: mode,
         steady_class: class,

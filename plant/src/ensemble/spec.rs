@@ -206,6 +206,53 @@ fn unknown_keys(t: &toml::Table, prefix: &str, allowed: &[&str]) -> Result<(), C
     }
 }
 
+/// The `[[ensemble.vary]]` tables: each key drawn once, from a range and a distribution.
+fn vary_list(t: &toml::Table) -> Result<Vec<Vary>, ConfigError> {
+    let mut vary = Vec::new();
+    match t.get("vary") {
+        None => {}
+        Some(toml::Value::Array(items)) => {
+            for (i, item) in items.iter().enumerate() {
+                let prefix = format!("vary[{i}].");
+                let v = item.as_table().ok_or_else(|| range(&format!("vary[{i}]"), item, "", "must be a table"))?;
+                unknown_keys(v, &prefix, &["key", "from", "to", "distribution"])?;
+                let key = string(v, &prefix, "key")?
+                    .ok_or_else(|| range(&format!("{prefix}key"), "(missing)", "", "is required"))?
+                    .to_string();
+                let get = |k: &str| {
+                    number(v, &prefix, k, "")?
+                        .ok_or_else(|| range(&format!("{prefix}{k}"), "(missing)", "", "is required"))
+                };
+                let (from, to) = (get("from")?, get("to")?);
+                if from > to {
+                    return Err(range(&format!("{prefix}to"), to, "", &format!("must be >= from = {from}")));
+                }
+                let distribution = match string(v, &prefix, "distribution")? {
+                    None | Some("uniform") => Distribution::Uniform,
+                    Some("log_uniform") => Distribution::LogUniform,
+                    Some(other) => {
+                        return Err(range(
+                            &format!("{prefix}distribution"),
+                            format!("\"{other}\""),
+                            "",
+                            "must be \"uniform\" or \"log_uniform\"",
+                        ))
+                    }
+                };
+                if distribution == Distribution::LogUniform && from <= 0.0 {
+                    return Err(range(&format!("{prefix}from"), from, "", "must be > 0 with \"log_uniform\""));
+                }
+                if vary.iter().any(|x: &Vary| x.key == key) {
+                    return Err(range(&format!("{prefix}key"), format!("\"{key}\""), "", "is drawn twice"));
+                }
+                vary.push(Vary { key, from, to, distribution });
+            }
+        }
+        Some(other) => return Err(range("vary", other, "", "must be an array of tables ([[ensemble.vary]])")),
+    }
+    Ok(vary)
+}
+
 impl EnsembleSpec {
     /// Validates an `[ensemble]` table (the checks that need no scene; the draws' ranges are
     /// checked against each point's scene by [`crate::sweep::Sweep::load`]).
@@ -269,48 +316,7 @@ impl EnsembleSpec {
         if !(0.0..=1.0).contains(&verify_rebound) {
             return Err(range("verify_rebound", verify_rebound, "", "must be between 0 and 1"));
         }
-        let mut vary = Vec::new();
-        match t.get("vary") {
-            None => {}
-            Some(toml::Value::Array(items)) => {
-                for (i, item) in items.iter().enumerate() {
-                    let prefix = format!("vary[{i}].");
-                    let v = item.as_table().ok_or_else(|| range(&format!("vary[{i}]"), item, "", "must be a table"))?;
-                    unknown_keys(v, &prefix, &["key", "from", "to", "distribution"])?;
-                    let key = string(v, &prefix, "key")?
-                        .ok_or_else(|| range(&format!("{prefix}key"), "(missing)", "", "is required"))?
-                        .to_string();
-                    let get = |k: &str| {
-                        number(v, &prefix, k, "")?
-                            .ok_or_else(|| range(&format!("{prefix}{k}"), "(missing)", "", "is required"))
-                    };
-                    let (from, to) = (get("from")?, get("to")?);
-                    if from > to {
-                        return Err(range(&format!("{prefix}to"), to, "", &format!("must be >= from = {from}")));
-                    }
-                    let distribution = match string(v, &prefix, "distribution")? {
-                        None | Some("uniform") => Distribution::Uniform,
-                        Some("log_uniform") => Distribution::LogUniform,
-                        Some(other) => {
-                            return Err(range(
-                                &format!("{prefix}distribution"),
-                                format!("\"{other}\""),
-                                "",
-                                "must be \"uniform\" or \"log_uniform\"",
-                            ))
-                        }
-                    };
-                    if distribution == Distribution::LogUniform && from <= 0.0 {
-                        return Err(range(&format!("{prefix}from"), from, "", "must be > 0 with \"log_uniform\""));
-                    }
-                    if vary.iter().any(|x: &Vary| x.key == key) {
-                        return Err(range(&format!("{prefix}key"), format!("\"{key}\""), "", "is drawn twice"));
-                    }
-                    vary.push(Vary { key, from, to, distribution });
-                }
-            }
-            Some(other) => return Err(range("vary", other, "", "must be an array of tables ([[ensemble.vary]])")),
-        }
+        let vary = vary_list(t)?;
         let spec = Self {
             members,
             seed,

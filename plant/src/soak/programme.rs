@@ -283,16 +283,6 @@ fn random_shocks(r: &RawRandom) -> Result<Vec<ShockSpec>, ConfigError> {
     Ok(shocks)
 }
 
-fn peak_of(spec: &ShockSpec) -> f64 {
-    match spec {
-        ShockSpec::DoubleHalfSine { peak_g: Some(p), .. } => *p,
-        ShockSpec::DoubleHalfSine { design_accel_g: Some(a0), .. } => a0 / 2.0,
-        ShockSpec::HalfSine { peak_g, .. } => *peak_g,
-        ShockSpec::Sine { amplitude_g, .. } => *amplitude_g,
-        _ => f64::NAN,
-    }
-}
-
 /// Most RSS samples over a soak (rows of `rss.csv`).
 pub const MAX_RSS_SAMPLES: f64 = 1e6;
 
@@ -328,49 +318,7 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
     }
     check_criteria(&raw.criteria)?;
 
-    // Shocks: exactly one of [random] and [[shock]].
-    let (specs, list_key) = match (&raw.random, raw.shock.is_empty()) {
-        (Some(r), true) => (random_shocks(r)?, "random.spacing_s"),
-        (None, false) => (raw.shock.clone(), "shock"),
-        (Some(_), false) => {
-            return Err(range("random", "and [[shock]]", "", "give either [random] or [[shock]], not both"))
-        }
-        (None, true) => return Err(range("shock", "none", "", "give [random] or at least one [[shock]]")),
-    };
-    let programme = shock_table::programme_from_specs(&specs, dir)?;
-    let mut shocks = Vec::with_capacity(specs.len());
-    for (spec, shock) in specs.iter().zip(&programme.shocks) {
-        shocks.push(PlannedShock {
-            start_s: shock.start,
-            peak_g: peak_of(spec),
-            direction_deg: shock.direction().to_degrees(),
-            duration_s: shock.pulse.duration(),
-        });
-    }
-    for (j, pair) in shocks.windows(2).enumerate() {
-        let (a, b) = (&pair[0], &pair[1]);
-        let need = a.duration_s + hold;
-        if b.start_s - a.start_s < need - 1e-12 {
-            let key = if list_key == "shock" { format!("shock[{}].start_s", j + 1) } else { list_key.to_string() };
-            let value = if list_key == "shock" {
-                b.start_s.to_string()
-            } else {
-                format!("{:?}", raw.random.as_ref().map(|r| r.spacing_s).unwrap_or_default())
-            };
-            return Err(range(
-                &key,
-                value,
-                "s",
-                &format!(
-                    "shock {} starts {:.4} s after shock {j}, which needs its pulse ({:.4} s) plus recovery.hold_s \
-                     ({hold} s) = {need:.4} s: shocks must be in time order and must not overlap",
-                    j + 1,
-                    b.start_s - a.start_s,
-                    a.duration_s
-                ),
-            ));
-        }
-    }
+    let (specs, shocks, list_key) = planned_shocks(&raw, dir, hold)?;
     let last = shocks.last().map_or(0.0, |s| s.start_s + s.duration_s);
 
     // The scene: its file, the programme's overrides, the command line's, then the programme's
@@ -388,23 +336,9 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
         "output.plots=false".to_string(),
     ];
     // Shock files (recorded pulses) are relative to the programme file, like its other paths.
-    // A bound of the scene's duration is the programme's to blame: its last shock's end plus
-    // `settle_s` (the scene would name `scene.duration_s`, which the programme sets).
-    let scene = base.with_shocks(&specs, dir, &programme_set).map_err(|e| match e {
-        ConfigError::Range { key, value, unit, why } if key == "scene.duration_s" || why.contains("scene.duration_s") => {
-            let (blame, shown) = if settle >= last || list_key != "shock" {
-                ("settle_s".to_string(), settle.to_string())
-            } else {
-                (format!("shock[{}].start_s", shocks.len() - 1), shocks[shocks.len() - 1].start_s.to_string())
-            };
-            let why = format!(
-                "the soak lasts its last shock's end ({last} s) plus settle_s ({settle} s) = {} s, so {key} = {value}{unit}: {why}",
-                last + settle
-            );
-            range(&blame, shown, "s", &why)
-        }
-        e => e,
-    })?;
+    let scene = base
+        .with_shocks(&specs, dir, &programme_set)
+        .map_err(|e| blame_duration(e, settle, last, list_key, &shocks))?;
     // One RSS sample per tick at most, and a bounded number of them (each is a row of rss.csv
     // and a few numbers in memory).
     let period = scene.controller.period;
@@ -439,6 +373,82 @@ pub fn load(path: &Path, cli_set: &[String]) -> Result<Programme, ConfigError> {
         criteria: raw.criteria.clone(),
         raw,
     })
+}
+
+/// The programme's shocks (exactly one of `[random]` and `[[shock]]`), in time order and each
+/// far enough from the one before for its pulse and `hold` (s); the key that names their
+/// spacing (`shock` or `random.spacing_s`).
+fn planned_shocks(
+    raw: &RawProgramme,
+    dir: &Path,
+    hold: f64,
+) -> Result<(Vec<ShockSpec>, Vec<PlannedShock>, &'static str), ConfigError> {
+    // Shocks: exactly one of [random] and [[shock]].
+    let (specs, list_key) = match (&raw.random, raw.shock.is_empty()) {
+        (Some(r), true) => (random_shocks(r)?, "random.spacing_s"),
+        (None, false) => (raw.shock.clone(), "shock"),
+        (Some(_), false) => {
+            return Err(range("random", "and [[shock]]", "", "give either [random] or [[shock]], not both"))
+        }
+        (None, true) => return Err(range("shock", "none", "", "give [random] or at least one [[shock]]")),
+    };
+    let programme = shock_table::programme_from_specs(&specs, dir)?;
+    let mut shocks = Vec::with_capacity(specs.len());
+    for (spec, shock) in specs.iter().zip(&programme.shocks) {
+        shocks.push(PlannedShock {
+            start_s: shock.start,
+            peak_g: spec.peak_g(),
+            direction_deg: shock.direction().to_degrees(),
+            duration_s: shock.pulse.duration(),
+        });
+    }
+    for (j, pair) in shocks.windows(2).enumerate() {
+        let (a, b) = (&pair[0], &pair[1]);
+        let need = a.duration_s + hold;
+        if b.start_s - a.start_s < need - 1e-12 {
+            let key = if list_key == "shock" { format!("shock[{}].start_s", j + 1) } else { list_key.to_string() };
+            let value = if list_key == "shock" {
+                b.start_s.to_string()
+            } else {
+                format!("{:?}", raw.random.as_ref().map(|r| r.spacing_s).unwrap_or_default())
+            };
+            return Err(range(
+                &key,
+                value,
+                "s",
+                &format!(
+                    "shock {} starts {:.4} s after shock {j}, which needs its pulse ({:.4} s) plus recovery.hold_s \
+                     ({hold} s) = {need:.4} s: shocks must be in time order and must not overlap",
+                    j + 1,
+                    b.start_s - a.start_s,
+                    a.duration_s
+                ),
+            ));
+        }
+    }
+    Ok((specs, shocks, list_key))
+}
+
+/// A bound of the scene's duration is the programme's to blame: its last shock's end (`last`,
+/// s) plus `settle` (s); the scene would name `scene.duration_s`, which the programme sets.
+fn blame_duration(e: ConfigError, settle: f64, last: f64, list_key: &str, shocks: &[PlannedShock]) -> ConfigError {
+    match e {
+        ConfigError::Range { key, value, unit, why }
+            if key == "scene.duration_s" || why.contains("scene.duration_s") =>
+        {
+            let (blame, shown) = if settle >= last || list_key != "shock" {
+                ("settle_s".to_string(), settle.to_string())
+            } else {
+                (format!("shock[{}].start_s", shocks.len() - 1), shocks[shocks.len() - 1].start_s.to_string())
+            };
+            let why = format!(
+                "the soak lasts its last shock's end ({last} s) plus settle_s ({settle} s) = {} s, so {key} = {value}{unit}: {why}",
+                last + settle
+            );
+            range(&blame, shown, "s", &why)
+        }
+        e => e,
+    }
 }
 
 fn check_criteria(c: &Criteria) -> Result<(), ConfigError> {

@@ -166,18 +166,67 @@ impl Hooks for SoakHooks<'_> {
 pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Finished, SoakError> {
     let started = Instant::now();
     let dir = opts.dir;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("creating output folder {}", dir.display()))
+        .map_err(SoakError::Io)?;
+    let programme = checkpoint::fingerprint(prog).context("the programme as a value").map_err(SoakError::Io)?;
+    // A resumed soak: everything checked before a file is touched.
+    let saved = if opts.resume { Some(resumable(dir, prog)?) } else { None };
+    let files = open_files(dir, prog, saved.as_ref())?;
+    let checkpoints =
+        Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
+    let snapshots = checkpoints.queue.clone();
+    let mut sink = new_sink(prog, saved.as_ref(), files.soak_csv, files.envelope_csv, checkpoints);
+    let mut hooks = new_hooks(prog, &opts, started, files.rss_csv, files.rss, snapshots);
+    let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
+    // Offloaded in realtime only, as before `plant run` offloaded on a spare core: the soak's
+    // checkpoints pass from the loop's hooks to its sink, an order not examined with the sink on
+    // a thread of its own outside realtime (where no checkpoint is taken).
+    let result = match run_into_offloaded(
+        &prog.scene,
+        &launch,
+        &mut hooks,
+        &mut sink,
+        saved.as_ref().map(|c| &c.plant),
+        When::Realtime,
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            write_not_started(dir, prog, programme_file, &e)?;
+            return Err(e.into());
+        }
+    };
+    if let Some(bar) = &hooks.bar {
+        bar.finish_and_clear();
+    }
+    sink.finish();
+    if let Some(e) = sink.checkpoints.error.take() {
+        hooks.note(&format!(
+            "warning: a checkpoint could not be written ({e:#}): --resume continues from the last one written"
+        ));
+    }
+    if let Some(e) = sink.error.take().or(hooks.error.take()) {
+        return Err(SoakError::Io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
+    }
+    write_results(prog, programme_file, &opts, result, &sink, &mut hooks)
+}
+
+/// The soak's row files and the RSS samples so far.
+struct Files {
+    soak_csv: RowFile,
+    envelope_csv: RowFile,
+    rss_csv: RowFile,
+    rss: Vec<RssSample>,
+}
+
+/// A new soak: `scene.toml` and the row files written afresh (an earlier soak's checkpoint
+/// removed); a resumed one (`saved`): the files reopened at the checkpoint's lengths.
+fn open_files(dir: &Path, prog: &Programme, saved: Option<&Checkpoint>) -> Result<Files, SoakError> {
     let io = SoakError::Io;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating output folder {}", dir.display())).map_err(io)?;
-    let scene = &prog.scene;
-    let programme = checkpoint::fingerprint(prog).context("the programme as a value").map_err(io)?;
     let soak_header: Vec<&str> = SOAK_CSV_HEADER.split(',').collect();
     let envelope_header: Vec<&str> = ENVELOPE_CSV_HEADER.split(',').collect();
     let rss_header: Vec<&str> = RSS_CSV_HEADER.split(',').collect();
-    let starts: Vec<f64> = prog.shocks.iter().map(|s| s.start_s).collect();
-
-    // A resumed soak: everything checked before a file is touched.
-    let saved = if opts.resume { Some(resumable(dir, prog)?) } else { None };
-    let (soak_csv, envelope_csv, rss_csv, rss) = match &saved {
+    match saved {
         None => {
             // A checkpoint of an earlier soak in this folder would not describe this one's files.
             match std::fs::remove_file(checkpoint::path(dir)) {
@@ -186,18 +235,18 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
                 }
                 _ => {}
             }
-            let resolved = scene.to_toml().context("serialising the resolved scene").map_err(io)?;
+            let resolved = prog.scene.to_toml().context("serialising the resolved scene").map_err(io)?;
             crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
             let create = |name: &str, header: &[&str]| {
                 let path = dir.join(name);
                 RowFile::create(&path, header).with_context(|| format!("creating {}", path.display())).map_err(io)
             };
-            (
-                create("soak.csv", &soak_header)?,
-                create("envelope.csv", &envelope_header)?,
-                create("rss.csv", &rss_header)?,
-                Vec::new(),
-            )
+            Ok(Files {
+                soak_csv: create("soak.csv", &soak_header)?,
+                envelope_csv: create("envelope.csv", &envelope_header)?,
+                rss_csv: create("rss.csv", &rss_header)?,
+                rss: Vec::new(),
+            })
         }
         Some(c) => {
             let reopen = |name: &str, header: &[&str], len: u64| {
@@ -207,24 +256,30 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
             let (rss_csv, rss) = rss_until(dir, &rss_header, c.plant.t_s).map_err(io)?;
             // The killed soak's controller log, kept before the resumed one writes its own.
             crate::outfile::keep_aside(&dir.join("controller.log")).map_err(io)?;
-            (
-                reopen("soak.csv", &soak_header, c.soak_csv_bytes)?,
-                reopen("envelope.csv", &envelope_header, c.envelope_csv_bytes)?,
+            Ok(Files {
+                soak_csv: reopen("soak.csv", &soak_header, c.soak_csv_bytes)?,
+                envelope_csv: reopen("envelope.csv", &envelope_header, c.envelope_csv_bytes)?,
                 rss_csv,
                 rss,
-            )
+            })
         }
-    };
+    }
+}
 
-    let checkpoints =
-        Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
-    let snapshots = checkpoints.queue.clone();
-    // The monitor from its checkpoint, or new.
-    let (tracker, envelope, figures, rows) = match &saved {
+/// The soak's sink, its monitor from the checkpoint (`saved`) or new.
+fn new_sink<'a>(
+    prog: &'a Programme,
+    saved: Option<&Checkpoint>,
+    soak_csv: RowFile,
+    envelope_csv: RowFile,
+    checkpoints: Checkpoints,
+) -> SoakSink<'a> {
+    let scene = &prog.scene;
+    let (tracker, envelope, figures, rows) = match saved {
         Some(c) => (c.tracker.clone(), c.envelope.clone(), c.figures.clone(), c.rows),
         None => (
             monitor::ShockTracker::new(
-                starts.clone(),
+                prog.shocks.iter().map(|s| s.start_s).collect(),
                 scene.duration,
                 scene.output_interval,
                 prog.clear_radius[0],
@@ -235,7 +290,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
             0,
         ),
     };
-    let mut sink = SoakSink {
+    SoakSink {
         tracker,
         envelope,
         planned: &prog.shocks,
@@ -246,8 +301,21 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         error: None,
         rows,
         checkpoints,
-    };
-    // The wall clock goes on from the last RSS sample's of the soak resumed.
+    }
+}
+
+/// The loop's hooks: the progress display, and the RSS samples going on from `rss` (those of
+/// the soak resumed, whose wall clock goes on from its last sample's).
+fn new_hooks<'a>(
+    prog: &Programme,
+    opts: &Options<'a>,
+    started: Instant,
+    rss_csv: RowFile,
+    rss: Vec<RssSample>,
+    snapshots: Arc<Mutex<VecDeque<Snapshot>>>,
+) -> SoakHooks<'a> {
+    let scene = &prog.scene;
+    let starts: Vec<f64> = prog.shocks.iter().map(|s| s.start_s).collect();
     let wall_before = Duration::from_secs_f64(rss.last().map_or(0.0, |s| s.wall_s));
     let started = started.checked_sub(wall_before).unwrap_or(started);
     let half = 0.5 * scene.controller.period;
@@ -260,7 +328,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         );
         bar
     });
-    let mut hooks = SoakHooks {
+    SoakHooks {
         stop: opts.stop,
         progress: opts.progress,
         bar,
@@ -285,49 +353,37 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         rss_csv,
         error: None,
         snapshots,
-    };
-    let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
-    // Offloaded in realtime only, as before `plant run` offloaded on a spare core: the soak's
-    // checkpoints pass from the loop's hooks to its sink, an order not examined with the sink on
-    // a thread of its own outside realtime (where no checkpoint is taken).
-    let mut result = match run_into_offloaded(
-        scene,
-        &launch,
-        &mut hooks,
-        &mut sink,
-        saved.as_ref().map(|c| &c.plant),
-        When::Realtime,
-    ) {
-        Ok(r) => r,
-        Err(e) => {
-            // The programme loaded: the folder records why the soak did not start.
-            let record = serde_json::json!({
-                "programme": prog.name,
-                "programme_file": programme_file.display().to_string(),
-                "status": e.status(),
-                "error": e.to_string(),
-                "simulated_s": 0.0,
-                "planned_s": scene.duration,
-                "shocks": prog.shocks.len(),
-                "passed": false,
-            });
-            crate::output::write_json(&dir.join("soak.json"), &record).context("writing soak.json").map_err(io)?;
-            return Err(e.into());
-        }
-    };
-    if let Some(bar) = &hooks.bar {
-        bar.finish_and_clear();
     }
-    sink.finish();
-    if let Some(e) = sink.checkpoints.error.take() {
-        hooks.note(&format!(
-            "warning: a checkpoint could not be written ({e:#}): --resume continues from the last one written"
-        ));
-    }
-    if let Some(e) = sink.error.take().or(hooks.error.take()) {
-        return Err(io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
-    }
+}
 
+/// The programme loaded but the soak did not start: `soak.json` records why.
+fn write_not_started(dir: &Path, prog: &Programme, programme_file: &Path, e: &SetupError) -> Result<(), SoakError> {
+    let record = serde_json::json!({
+        "programme": prog.name,
+        "programme_file": programme_file.display().to_string(),
+        "status": e.status(),
+        "error": e.to_string(),
+        "simulated_s": 0.0,
+        "planned_s": prog.scene.duration,
+        "shocks": prog.shocks.len(),
+        "passed": false,
+    });
+    crate::output::write_json(&dir.join("soak.json"), &record).context("writing soak.json").map_err(SoakError::Io)
+}
+
+/// `soak.json` and the plots of a soak that ran; the checkpoint removed once it completed.
+fn write_results(
+    prog: &Programme,
+    programme_file: &Path,
+    opts: &Options,
+    mut result: crate::run::SinkRun,
+    sink: &SoakSink,
+    hooks: &mut SoakHooks,
+) -> Result<Finished, SoakError> {
+    let io = SoakError::Io;
+    let dir = opts.dir;
+    let scene = &prog.scene;
+    let started = hooks.started;
     // A signal that comes once the loop has completed, while the outputs are written: every
     // output is still written, and the soak is `interrupted` (exit 130).
     let stopped = || opts.stop.load(Ordering::Relaxed);

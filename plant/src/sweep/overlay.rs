@@ -175,6 +175,18 @@ fn short(v: f64) -> String {
 /// `plant overlay`: checks every folder (exit 2 on bad input), then writes the chart and the
 /// table into `--out`.
 pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
+    let curves = read_curves(args)?;
+    let (key, log) = (curves[0].key.clone(), curves[0].log);
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join("overlay"));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    write_table(&curves, &key, &out)?;
+    write_chart(args, &curves, &key, log, &out)?;
+    eprintln!("plant overlay: {} sweeps of {key} → {}/overlay.png, overlay.csv", curves.len(), out.display());
+    Ok(())
+}
+
+/// Every folder's sweep, labelled; refused unless all share one x axis (key and spacing).
+fn read_curves(args: &OverlayArgs) -> anyhow::Result<Vec<Curve>> {
     if !args.labels.is_empty() && args.labels.len() != args.sweeps.len() {
         return Err(bad(format!(
             "--label given {} times for {} sweep folders: give one per folder, or none",
@@ -211,11 +223,11 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
             )));
         }
     }
-    let (key, log) = (first.key.clone(), first.log);
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join("overlay"));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    Ok(curves)
+}
 
-    // overlay.csv
+/// `overlay.csv`: a row per point of every curve.
+fn write_table(curves: &[Curve], key: &str, out: &Path) -> anyhow::Result<()> {
     let mut w = csv_writer();
     w.write_record([
         "label",
@@ -229,12 +241,12 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
         "p_hi",
         "numerically_sensitive",
     ])?;
-    for c in &curves {
+    for c in curves {
         for p in &c.points {
             w.write_record([
                 c.label.clone(),
                 c.dir.display().to_string(),
-                key.clone(),
+                key.to_string(),
                 e(p.value.unwrap_or(f64::NAN)),
                 p.members.to_string(),
                 p.recovered.to_string(),
@@ -247,9 +259,13 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
     }
     finish(w, &out.join("overlay.csv"))?;
 
-    // overlay.png: x in the axis's own scale (log10 for a log axis), the 0.5 crossings in the
-    // legend.
-    let unit = unit_of(&key);
+    Ok(())
+}
+
+/// `overlay.png`: x in the axis's own scale (log10 for a log axis), the 0.5 crossings in the
+/// legend.
+fn write_chart(args: &OverlayArgs, curves: &[Curve], key: &str, log: bool, out: &Path) -> anyhow::Result<()> {
+    let unit = unit_of(key);
     let x_of = |v: f64| if log { v.log10() } else { v };
     let xs: Vec<Vec<f64>> =
         curves.iter().map(|c| c.points.iter().map(|p| x_of(p.value.unwrap_or(f64::NAN))).collect()).collect();
@@ -259,7 +275,7 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
     let step = all.windows(2).map(|w| w[1] - w[0]).filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min);
     let n = curves.len();
     let offset = if args.no_offset || n < 2 || !step.is_finite() { 0.0 } else { 0.5 * step / (n - 1) as f64 };
-    let axis = if log { format!("log10({key})") } else { key.clone() };
+    let axis = if log { format!("log10({key})") } else { key.to_string() };
     let mut x_label = args.x_label.clone().unwrap_or_else(|| match unit {
         Some(u) if !log => format!("{axis} ({u})"),
         _ => axis.clone(),
@@ -311,7 +327,6 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
         .collect();
     let title = args.title.clone().unwrap_or_else(|| format!("probability of recovery against {key}"));
     plot::probability(&out.join("overlay.png"), &title, &x_label, &drawn, offset).context("writing overlay.png")?;
-    eprintln!("plant overlay: {n} sweeps of {key} → {}/overlay.png, overlay.csv", out.display());
     Ok(())
 }
 

@@ -25,7 +25,6 @@ use super::rotor::DOF_PER_NODE;
 use crate::integrate::System;
 use crate::model::{parked_race_spin_accel, race_dynamics, Control, RaceInput, Spin};
 use crate::two_plane;
-use controller::saturate;
 use nalgebra::{DMatrix, DVector, Vector2};
 use shock_table::Programme;
 use std::sync::Arc;
@@ -153,27 +152,7 @@ impl Model {
             let amb = at(nodes.amb);
             let delta = amb.0;
             let sensor = || if nodes.sensor == nodes.amb { amb } else { at(nodes.sensor) };
-            out.current = match self.control[i] {
-                Control::Continuous(gains) => {
-                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (x, v) = sensor();
-                    saturate(gains.current((x * a_s).into(), (v * a_s).into()), bearing.current_limit)
-                }
-                Control::ContinuousExcited(gains, sine) => {
-                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (x, v) = sensor();
-                    let (e, e_dot) = sine.at(t);
-                    let u = x * a_s + Vector2::from(e);
-                    let u_dot = v * a_s + Vector2::from(e_dot);
-                    saturate(gains.current(u.into(), u_dot.into()), bearing.current_limit)
-                }
-                Control::Held(c) => c,
-                Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
-            };
-            out.amb_force = match self.control[i] {
-                Control::Magnets { plus, minus } => bearing.amb.magnet_force(delta, plus.into(), minus.into()),
-                _ => bearing.amb.force(delta, out.current.into()),
-            };
+            (out.current, out.amb_force) = self.control[i].amb(t, bearing, delta, sensor);
             let race = RaceInput::of(y, RACE[i]);
             let (x, v) = (RACE[i], RACE[i] + V);
             if self.race_parked[i] {

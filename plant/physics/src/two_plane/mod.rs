@@ -47,7 +47,6 @@ use crate::force::balls::BallForce;
 use crate::force::rotor_race::RotorRaceForce;
 use crate::integrate::System;
 use crate::model::{self, parked_race_spin_accel, race_dynamics, Control, RaceInput, Spin};
-use controller::saturate;
 use nalgebra::Vector2;
 use shock_table::Programme;
 
@@ -231,29 +230,7 @@ impl Model {
         for (i, (plane, out)) in p.planes.iter().zip(&mut planes).enumerate() {
             let bearing = &plane.params;
             let (delta, velocity) = at_station(y, plane.station);
-            out.current = match self.control[i] {
-                Control::Continuous(gains) => {
-                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (s, s_dot) = at_station(y, plane.sensor);
-                    saturate(gains.current((s * a_s).into(), (s_dot * a_s).into()), bearing.current_limit)
-                }
-                Control::ContinuousExcited(gains, sine) => {
-                    // The excitation is added at the sensor, before the PD (its rate to the rate).
-                    let a_s = bearing.loop_constants.sensor_gain_v_per_m;
-                    let (s, s_dot) = at_station(y, plane.sensor);
-                    let (e, e_dot) = sine.at(t);
-                    let u = s * a_s + Vector2::from(e);
-                    let u_dot = s_dot * a_s + Vector2::from(e_dot);
-                    saturate(gains.current(u.into(), u_dot.into()), bearing.current_limit)
-                }
-                Control::Held(c) => c,
-                Control::Magnets { plus, minus } => [(plus[0] - minus[0]) * 0.5, (plus[1] - minus[1]) * 0.5],
-            };
-            out.amb_force = match self.control[i] {
-                // Unipolar amplifiers: each magnet's own current.
-                Control::Magnets { plus, minus } => bearing.amb.magnet_force(delta, plus.into(), minus.into()),
-                _ => bearing.amb.force(delta, out.current.into()),
-            };
+            (out.current, out.amb_force) = self.control[i].amb(t, bearing, delta, || at_station(y, plane.sensor));
             let race = RaceInput::of(y, RACE[i]);
             let (x, v) = (RACE[i], RACE[i] + V);
             if self.race_parked[i] {
