@@ -211,3 +211,31 @@ fn the_imported_pids_sensitivity_matches_rosss_run_amb_sensitivity() {
         assert!((f - ross_f).abs() <= within, "at {speed_hz} Hz: peak at {f} Hz against ROSS's {ross_f} Hz");
     }
 }
+
+/// Issue 38 item 7: the shipped scene `config/ross-amb-10g.toml` (the AMB machine as ROSS 3.1
+/// saved it, `config/ross/amb-machine.toml`, the same file as the fixture of the ROSS comparison)
+/// runs in lockstep with the file's PID, cut to 40 ms with the shock at 7 ms: both planes touch
+/// down and the law is `ross_pid` with the file's gains.
+#[test]
+fn the_shipped_ross_scene_runs_in_lockstep_with_its_pid() {
+    let root = common::workspace_root();
+    assert_eq!(
+        common::read_text(&root.join("config/ross/amb-machine.toml")),
+        common::read_text(&root.join("plant/physics/tests/fixtures/ross/amb_machine_ambs.toml")),
+        "the shipped machine is the compared one"
+    );
+    let dir = TempDir::new("ross-amb-shipped");
+    let out = dir.join("run");
+    let sets = ["scene.duration_s=0.04", "shock[0].start_s=0.007", "output.plots=false"];
+    let run = output_within(&mut plant_run(&common::scene("ross-amb-10g.toml"), &out, &sets), RUN);
+    assert_exit(&run, 0);
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "completed", "{summary:#}");
+    assert_eq!(summary["model"]["law"], "ross_pid");
+    assert_eq!(summary["model"]["ross_ambs"][0]["pid"]["kp"], 7000.0, "{:#}", summary["model"]["ross_ambs"]);
+    for p in ["a", "b"] {
+        assert!(summary["planes"][p]["first_contact_s"].as_f64().is_some(), "plane {p} never touched");
+        let force = summary["planes"][p]["max_contact_force_n"].as_f64().unwrap();
+        assert!(force > 100.0, "plane {p}: {force} N");
+    }
+}
