@@ -553,3 +553,55 @@ fn ross_magnetic_bearing_element_is_read_by_rosss_formulas_and_refused_with_its_
         assert!(err.contains(expect), "{to}: {err}\nshould contain: {expect}");
     }
 }
+
+/// Issue 38 item 6: ROSS's UFU AMB rig and the AMB machine with ROSS `MagneticBearingElement`s
+/// (`scripts/ross/amb_compare.py`, ROSS 3.1.0, committed `amb_compare.json` and the two files):
+/// each element read from the file, its equivalent stiffness and damping at ROSS's evaluation
+/// whirl frequency by the reader's constants (`MagneticBearing::equivalent_at`) put at its node
+/// as a linear bearing, and the natural frequencies at rest and at speed against ROSS's
+/// `run_modal(speed, frequency = f_eval)`, one for one, within 0.5 %.
+#[test]
+fn amb_machines_natural_frequencies_match_rosss_run_modal() {
+    let text = std::fs::read_to_string(fixture("amb_compare.json")).expect("ROSS's figures");
+    let ross: Value = serde_json::from_str(&text).expect("JSON");
+    let f_eval = ross["f_eval_rad_s"].as_f64().unwrap();
+    for (name, machine) in ross["machines"].as_object().expect("machines") {
+        let path = fixture(machine["rotor_file"].as_str().unwrap());
+        let file = ross::parse_file_with_ambs(&std::fs::read_to_string(&path).unwrap(), name).expect("the file reads");
+        assert!(file.bearings.is_empty(), "{name}: plain bearings {:?}", file.bearings.len());
+        assert_eq!(file.magnetics.len(), 2, "{name}");
+        let mut rotor = file.rotor.clone();
+        for m in &file.magnetics {
+            let (k, c) = m.equivalent_at(f_eval);
+            let (rk, rc) = (machine["kxx_at_f_eval"].as_f64().unwrap(), machine["cxx_at_f_eval"].as_f64().unwrap());
+            assert!((k - rk).abs() <= 1e-9 * rk.abs().max(1.0), "{name}: k_eq {k} against ROSS's {rk}");
+            assert!((c - rc).abs() <= 1e-9 * rc.abs().max(1.0), "{name}: c_eq {c} against ROSS's {rc}");
+            rotor.bearings.push(LinearBearing {
+                node: m.node,
+                stiffness: [[k, 0.0], [0.0, k]],
+                damping: [[c, 0.0], [0.0, c]],
+                mass: [[0.0; 2]; 2],
+            });
+        }
+        let mass = machine["mass_kg"].as_f64().unwrap();
+        assert!((rotor.mass() - mass).abs() < 1e-9 * mass, "{name}: mass {} against ROSS's {mass}", rotor.mass());
+        let full = Linear::full(&rotor.matrices()).prepare().unwrap();
+        for entry in machine["modal"].as_array().unwrap() {
+            let speed = entry["speed_rad_s"].as_f64().unwrap();
+            let (wd, whirl) = (floats(&entry["wd_rad_s"]), whirls(&entry["whirl"]));
+            let lateral: Vec<f64> = wd.iter().zip(&whirl).filter(|(_, w)| w.is_some()).map(|(f, _)| *f).collect();
+            let ours = full.modes(speed, lateral.len() + 2).unwrap();
+            eprintln!("{name} at {:.0} Hz: | mode | ROSS (Hz) | ours (Hz) | difference |", speed / TAU);
+            for (k, (mode, f)) in ours.iter().zip(&lateral).enumerate() {
+                let err = (mode.wd - f) / f;
+                eprintln!("| {} | {:.4} | {:.4} | {:.1e} % |", k + 1, f / TAU, mode.wd / TAU, 100.0 * err);
+                assert!(
+                    err.abs() < 5e-3,
+                    "{name} at {speed} rad/s, mode {}: ours {} against ROSS's {f} rad/s",
+                    k + 1,
+                    mode.wd
+                );
+            }
+        }
+    }
+}
