@@ -149,10 +149,12 @@ impl ControlLaw for RossPid {
         let h = 0.5 * ki * self.period_s;
         let g = kd * n_f * a / (a + n_f);
         let b = [kp + h + g, -kp * (1.0 + p) + h * (1.0 - p) - 2.0 * g, (kp - h) * p + g];
-        Some(crate::law::LinearLaw {
-            pd: crate::law::LinearPd { kp: 1.0, kd: 0.0 },
-            filter: Some((b, [-(1.0 + p), p])),
-        })
+        // Without the integral term (ROSS's UFU rig has ki_pid = 0) the numerator vanishes at
+        // z = 1 as the denominator does: the first-order filter (b₀ + (b₀ + b₁) z⁻¹)/(1 − p z⁻¹)
+        // that remains, not the pole at z = 1 whose rounded cancellation read the closed loop as
+        // unstable (a pole of modulus 1.000022 on the UFU rig).
+        let filter = if ki == 0.0 { ([b[0], b[0] + b[1], 0.0], [-p, 0.0]) } else { (b, [-(1.0 + p), p]) };
+        Some(crate::law::LinearLaw { pd: crate::law::LinearPd { kp: 1.0, kd: 0.0 }, filter: Some(filter) })
     }
 
     fn reset(&mut self) {
@@ -224,7 +226,17 @@ mod tests {
     /// as the law does on small motions, sample by sample, from rest.
     #[test]
     fn its_linear_form_is_the_law() {
-        let g = RossPidGains { kp: 0.28, ki: 2.8, kd: 1.33e-4, n_f: 5000.0 };
+        for ki in [2.8, 0.0] {
+            linear_form_answers_as_the_law(RossPidGains { kp: 0.28, ki, kd: 1.33e-4, n_f: 5000.0 });
+        }
+        // Without the integral term, no pole at z = 1 is left to cancel: the filter is first order.
+        let law = RossPid::new(RossPidGains { kp: 0.28, ki: 0.0, kd: 1.33e-4, n_f: 5000.0 }, 1.5, [0.0; 2], 5e-5, 1.0);
+        let (b, a) = law.linear().unwrap().filter.unwrap();
+        assert_eq!((b[2], a[1]), (0.0, 0.0));
+        assert!(a[0].abs() < 1.0, "{a:?}");
+    }
+
+    fn linear_form_answers_as_the_law(g: RossPidGains) {
         let (t, amp, bias) = (5e-5, 1.5, [0.0, 0.4]);
         let mut law = RossPid::new(g, amp, bias, t, f64::INFINITY);
         let linear = law.linear().unwrap();
