@@ -16,6 +16,8 @@ pub(crate) enum Mark {
     Dashed(RGBColor),
     /// A dotted line.
     Dotted(RGBColor),
+    /// A light filled band (an interval).
+    Band(RGBColor),
     /// A filled circle.
     Dot(RGBColor),
     /// A filled square.
@@ -110,6 +112,7 @@ pub(crate) fn draw_mark(
             }
             Ok(())
         }
+        Mark::Band(c) => area.draw(&Rectangle::new([(x, y - 6), (x + w, y + 6)], c.mix(0.22).filled())),
         Mark::Dot(c) => area.draw(&Circle::new((mid, y), 7, c.filled())),
         Mark::Square(c) => area.draw(&Rectangle::new([(mid - 6, y - 6), (mid + 6, y + 6)], c.filled())),
         Mark::Cross(c) => area.draw(&Cross::new((mid, y), 6, c.stroke_width(2))),
