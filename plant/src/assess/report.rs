@@ -132,6 +132,7 @@ fn safe_words(l: &LadderResult, min_p: f64) -> String {
 }
 
 /// A line of a chart.
+#[derive(Clone)]
 struct Line {
     label: String,
     points: Vec<(f64, f64)>,
@@ -164,8 +165,31 @@ fn chart(
     ensure_font(path)?;
     crate::plot::draw_png(path, WIDE_SIZE, |root| {
         let area = titled_root(root, path, title)?;
+        let area = legend_rows(&area, path, lines)?;
         panel(&area, path, labels, x_log, lines, hlines, bars)
     })
+}
+
+/// The legend of `lines` in rows at the top of `area`, never over the curves or the reference
+/// lines' labels; returns the area below it.
+fn legend_rows<'a>(
+    area: &crate::plot::Area<'a>,
+    path: &Path,
+    lines: &[Line],
+) -> Result<crate::plot::Area<'a>, PlotError> {
+    let mut entries: Vec<(String, crate::plot::Mark)> = Vec::new();
+    for l in lines {
+        let mark = match l.dash {
+            Dash::Solid => crate::plot::Mark::Line(l.colour),
+            Dash::Dashed => crate::plot::Mark::Dashed(l.colour),
+            Dash::Dotted => crate::plot::Mark::Dotted(l.colour),
+        };
+        // Panels share one legend: each series once.
+        if !entries.iter().any(|(label, _)| *label == l.label) {
+            entries.push((l.label.clone(), mark));
+        }
+    }
+    crate::plot::legend_strip(area, &entries, path)
 }
 
 /// One x–y plot on `area` (the body of [`chart`]; a chart of several panels draws one each).
@@ -209,19 +233,6 @@ fn panel(
     let x_log = x_log && x0 > 0.0 && x1 / x0 >= 10.0;
     let (x0, x1) = if x_log { crate::plot::log_padded(x0, x1) } else { (x0, x1) };
     let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
-    // The legend in rows above the plot, never over the curves or the reference lines' labels.
-    let entries: Vec<(String, crate::plot::Mark)> = lines
-        .iter()
-        .map(|l| {
-            let mark = match l.dash {
-                Dash::Solid => crate::plot::Mark::Line(l.colour),
-                Dash::Dashed => crate::plot::Mark::Dashed(l.colour),
-                Dash::Dotted => crate::plot::Mark::Dotted(l.colour),
-            };
-            (l.label.clone(), mark)
-        })
-        .collect();
-    let area = &crate::plot::legend_strip(area, &entries, path)?;
     macro_rules! body {
         ($chart:expr) => {{
             let mut c = $chart;
@@ -300,10 +311,15 @@ fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotErro
         ZONE_DB.iter().map(|(db, l)| (*db, format!("ISO 14839-3 zone {l} ({db:.1} dB)"))).collect();
     let zones: Vec<(f64, &str)> = zone_labels.iter().map(|(db, l)| (*db, l.as_str())).collect();
     ensure_font(path)?;
-    // Taller than wide charts: each panel's legend takes rows above it.
-    let size = if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1 + 200) } else { WIDE_SIZE };
+    // Taller than wide charts: the legend takes rows above the panels.
+    let size =
+        if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1 + 100) } else { (WIDE_SIZE.0, WIDE_SIZE.1 + 100) };
     crate::plot::draw_png(path, size, |root| {
         let area = titled_root(root, path, &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label))?;
+        // One legend over the panels (the same series in each; the speed is the panel's), so
+        // that the panels' plots line up.
+        let all: Vec<Line> = panels.iter().flat_map(|(_, lines)| lines.iter().cloned()).collect();
+        let area = legend_rows(&area, path, &all)?;
         let areas = area.split_evenly((1, panels.len().max(1)));
         for ((speed, lines), sub) in panels.iter().zip(&areas) {
             let x = if *speed > 0.0 {
@@ -324,7 +340,8 @@ fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line
     let mut lines = Vec::new();
     let at = |a: &&super::sensitivity::AxisResult| speed.is_none_or(|sp| a.speed_hz == sp);
     for (i, a) in s.axes.iter().filter(|a| !a.points.is_empty()).filter(at).enumerate() {
-        let name = format!("{} at {:.0} Hz", a.axis, a.speed_hz);
+        // The speed is the panel's (its x label) when the lines are one speed's.
+        let name = if speed.is_some() { a.axis.to_string() } else { format!("{} at {:.0} Hz", a.axis, a.speed_hz) };
         lines.push(Line {
             label: format!("|S| {name}"),
             points: a.points.iter().map(|p| (p.f_hz, p.s_db)).collect(),
@@ -354,7 +371,11 @@ fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line
     for (i, f) in s.closed_form_axes.iter().filter(|f| speed.is_none_or(|sp| f.speed_hz == sp) && f.stable).enumerate()
     {
         lines.push(Line {
-            label: format!("|S| closed form {} at {:.0} Hz, all axes' loops", f.axis, f.speed_hz),
+            label: if speed.is_some() {
+                format!("|S| closed form {}, all axes' loops", f.axis)
+            } else {
+                format!("|S| closed form {} at {:.0} Hz, all axes' loops", f.axis, f.speed_hz)
+            },
             points: f.curve.clone(),
             colour: colour(i),
             dash: Dash::Dashed,
