@@ -20,7 +20,7 @@
 
 use crate::config::{load_scene, Rotor, Scene};
 use crate::machine::Linearised;
-use crate::plot::{self, Scale, Series};
+use crate::plot;
 use crate::run::{plane_gains, run, Outcome, Quiet};
 use crate::trace::{col, colb};
 use anyhow::Context;
@@ -383,55 +383,62 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
     Ok(written)
 }
 
-/// `campbell.png`: each mode's frequency against the spin speed, and the synchronous line
-/// `f = speed` where the unbalance excites a mode (up to 1.5 times the highest mode).
+/// `campbell.png`: each mode's frequency against the spin speed as points (a name per speed
+/// comes from the mode's shape there, and lines would jump where modes cross), the rigid-body
+/// modes on a panel of their own beside every mode when the rotor bends, and the synchronous
+/// line `f = speed` where the unbalance excites a mode ([`plot::campbell`]).
 fn chart(path: &Path, name: &str, rows: &[ModeRow]) -> Result<(), plot::PlotError> {
     use plant_physics::flex::Whirl as W;
-    // One line per (whirl, mode), in the order the rows first name them; the rigid rotor's four
-    // as before (forward and backward cylindrical, then conical).
+    // One set of points per (whirl, mode), the rigid rotor's four first (forward and backward
+    // cylindrical, then conical), then each bending mode's.
     let mut modes: Vec<(W, ModeName)> = Vec::new();
     for r in rows {
         if !modes.contains(&(r.whirl, r.mode)) {
             modes.push((r.whirl, r.mode));
         }
     }
-    let order = |m: &(W, ModeName)| {
-        let kind = match m.1 .0 {
-            ModeKind::Cylindrical => 0,
-            ModeKind::Conical => 1,
-            ModeKind::Bending(n) => 1 + n,
-        };
-        let whirl = match m.0 {
-            W::Forward => 0,
-            W::Backward => 1,
-            W::Mixed => 2,
-        };
-        (kind, whirl)
+    let kind = |m: &ModeName| match m.0 {
+        ModeKind::Cylindrical => 0,
+        ModeKind::Conical => 1,
+        ModeKind::Bending(n) => 1 + n as usize,
     };
-    modes.sort_by_key(order);
-    let lines: Vec<(String, Vec<f64>, Vec<f64>)> = modes
+    let whirl = |w: &W| match w {
+        W::Forward => 0,
+        W::Backward => 1,
+        W::Mixed => 2,
+    };
+    modes.sort_by_key(|m| (kind(&m.1), whirl(&m.0)));
+    let points: Vec<(Vec<f64>, Vec<f64>)> = modes
         .iter()
         .map(|(w, s)| {
-            let (x, y): (Vec<f64>, Vec<f64>) =
-                rows.iter().filter(|r| r.whirl == *w && r.mode == *s).map(|r| (r.speed_hz, r.frequency_hz)).unzip();
-            let whirl = crate::summary::snake_name(w);
-            (format!("{whirl} {}", s.name().replace('_', " ")), x, y)
+            rows.iter().filter(|r| r.whirl == *w && r.mode == *s).map(|r| (r.speed_hz, r.frequency_hz)).unzip()
         })
         .collect();
-    let top = rows.iter().map(|r| r.frequency_hz).fold(0.0, f64::max) * 1.5;
-    let max_speed = rows.iter().map(|r| r.speed_hz).fold(0.0, f64::max);
-    let end = top.min(max_speed);
-    let sync = (vec![0.0, end], vec![0.0, end]);
-    let mut series: Vec<Series> = lines.iter().map(|(l, x, y)| Series { label: l.as_str(), x, y }).collect();
-    series.push(Series { label: "1× spin (unbalance)", x: &sync.0, y: &sync.1 });
-    plot::lines(
-        path,
-        &format!("{name} — Campbell diagram, continuous PD (linearised)"),
-        "spin speed (Hz)",
-        "whirl frequency (Hz)",
-        &series,
-        Scale::Linear,
-    )
+    // A colour per mode shape, a marker per whirl (forward ● filled, backward △ and mixed □ as
+    // outlines); past the palette's ten shapes the colours come round again with ◆ and □.
+    let shape = |k: usize, w: &W| {
+        use plot::Shape::*;
+        match (k / 10 % 2, w) {
+            (0, W::Forward) => Circle,
+            (0, W::Backward) => Triangle,
+            (1, W::Forward) => Diamond,
+            _ => Square,
+        }
+    };
+    let series: Vec<plot::ModePoints> = modes
+        .iter()
+        .zip(&points)
+        .map(|((w, s), (x, y))| plot::ModePoints {
+            label: format!("{} {}", crate::summary::snake_name(w), s.name().replace('_', " ")),
+            colour: plot::colour(kind(s)),
+            shape: shape(kind(s), w),
+            open: *w != W::Forward,
+            x,
+            y,
+            rigid: kind(s) < 2,
+        })
+        .collect();
+    plot::campbell(path, &format!("{name} — Campbell diagram, continuous PD (linearised)"), &series)
 }
 
 #[cfg(test)]

@@ -634,7 +634,12 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
 fn write_mid_orbit(dir: &Path, scene: &Scene, mid: &ChartData) -> anyhow::Result<Option<&'static str>> {
     let (x, y) = mid.orbit();
     let title = format!("{} — rotor orbit at mid-span relative to housing", scene.name);
-    match plot::orbit(&dir.join("orbit_mid.png"), &title, &x, &y, scene.plane(0).contact.gap) {
+    // Bearing A's circle named as such: unnamed, it reads as a bearing at mid-span.
+    let circle = plot::RefCircle {
+        label: "touchdown clearance of bearing A, not at mid-span",
+        radius_m: scene.plane(0).contact.gap,
+    };
+    match plot::orbit_with_circles(&dir.join("orbit_mid.png"), &title, &x, &y, &[circle]) {
         Err(plot::PlotError::NoData { .. }) => Ok(Some("orbit_mid.png")),
         other => other.map(|()| None).context("writing orbit_mid.png"),
     }

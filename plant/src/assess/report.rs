@@ -137,12 +137,21 @@ fn safe_words(l: &LadderResult, min_p: f64) -> String {
 }
 
 /// A line of a chart.
+#[derive(Clone)]
 struct Line {
     label: String,
     points: Vec<(f64, f64)>,
     colour: RGBColor,
-    dashed: bool,
+    dash: Dash,
     width: u32,
+}
+
+/// A line's style: with its colour, what tells two series apart.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Dash {
+    Solid,
+    Dashed,
+    Dotted,
 }
 
 /// Error bars of one series: its colour and `(x, low, high)` per bar.
@@ -161,8 +170,31 @@ fn chart(
     ensure_font(path)?;
     crate::plot::draw_png(path, WIDE_SIZE, |root| {
         let area = titled_root(root, path, title)?;
+        let area = legend_rows(&area, path, lines)?;
         panel(&area, path, labels, x_log, lines, hlines, bars)
     })
+}
+
+/// The legend of `lines` in rows at the top of `area`, never over the curves or the reference
+/// lines' labels; returns the area below it.
+fn legend_rows<'a>(
+    area: &crate::plot::Area<'a>,
+    path: &Path,
+    lines: &[Line],
+) -> Result<crate::plot::Area<'a>, PlotError> {
+    let mut entries: Vec<(String, crate::plot::Mark)> = Vec::new();
+    for l in lines {
+        let mark = match l.dash {
+            Dash::Solid => crate::plot::Mark::Line(l.colour),
+            Dash::Dashed => crate::plot::Mark::Dashed(l.colour),
+            Dash::Dotted => crate::plot::Mark::Dotted(l.colour),
+        };
+        // Panels share one legend: each series once.
+        if !entries.iter().any(|(label, _)| *label == l.label) {
+            entries.push((l.label.clone(), mark));
+        }
+    }
+    crate::plot::legend_strip(area, &entries, path)
 }
 
 /// One x–y plot on `area` (the body of [`chart`]; a chart of several panels draws one each).
@@ -201,6 +233,10 @@ fn panel(
     }
     let pad = ((y1 - y0) * 0.06).max(1e-9);
     let (y0, y1) = (y0 - pad, y1 + pad);
+    // A band narrower than a decade is drawn on a linear axis (a log axis gets no tick inside
+    // it); a log axis spans at least two labelled powers of ten.
+    let x_log = x_log && x0 > 0.0 && x1 / x0 >= 10.0;
+    let (x0, x1) = if x_log { crate::plot::log_padded(x0, x1) } else { (x0, x1) };
     let fmt_y = |v: &f64| format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string();
     macro_rules! body {
         ($chart:expr) => {{
@@ -211,8 +247,18 @@ fn panel(
                     RGBColor(120, 120, 120).stroke_width(1),
                 )))
                 .map_err(draw_err(path))?;
-                c.draw_series(std::iter::once(Text::new(label.to_string(), (x0, *y), crate::plot::font(16))))
-                    .map_err(draw_err(path))?;
+                // The label sits on its line at the right end, clear of the next one's and of
+                // the curves' low-frequency peaks.
+                let above = plotters::style::text_anchor::Pos::new(
+                    plotters::style::text_anchor::HPos::Right,
+                    plotters::style::text_anchor::VPos::Bottom,
+                );
+                c.draw_series(std::iter::once(Text::new(
+                    label.to_string(),
+                    (x1, *y),
+                    crate::plot::font(16).pos(above),
+                )))
+                .map_err(draw_err(path))?;
             }
             for (col, b) in bars {
                 for (x, lo, hi) in b {
@@ -224,36 +270,29 @@ fn panel(
                 let style = l.colour.stroke_width(l.width);
                 let pts: Vec<(f64, f64)> =
                     l.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
-                if l.dashed {
-                    c.draw_series(DashedLineSeries::new(pts.clone(), 8, 6, style)).map_err(draw_err(path))?
-                } else {
-                    c.draw_series(LineSeries::new(pts.clone(), style)).map_err(draw_err(path))?
-                }
-                .label(l.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
-                if !l.dashed && pts.len() < 40 {
+                match l.dash {
+                    Dash::Solid => c.draw_series(LineSeries::new(pts.clone(), style)).map_err(draw_err(path))?,
+                    Dash::Dashed => {
+                        c.draw_series(DashedLineSeries::new(pts.clone(), 8, 6, style)).map_err(draw_err(path))?
+                    }
+                    Dash::Dotted => {
+                        c.draw_series(DashedLineSeries::new(pts.clone(), 2, 4, style)).map_err(draw_err(path))?
+                    }
+                };
+                if l.dash == Dash::Solid && pts.len() < 40 {
                     c.draw_series(pts.iter().map(|p| Circle::new(*p, 3, l.colour.filled()))).map_err(draw_err(path))?;
                 }
             }
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(crate::plot::font(16))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(draw_err(path))?;
         }};
     }
     if x_log {
         let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
         let mut c = builder(area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
-        let fmt_x = |v: &f64| format!("{v}");
-        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+        draw_mesh(&mut c, x_label, y_label, &crate::plot::log_ticks, &fmt_y, path)?;
         body!(c);
     } else {
         let mut c = builder(area).build_cartesian_2d(x0..x1, y0..y1).map_err(draw_err(path))?;
-        let fmt_x = |v: &f64| format!("{v}");
-        draw_mesh(&mut c, x_label, y_label, &fmt_x, &fmt_y, path)?;
+        draw_mesh(&mut c, x_label, y_label, &crate::plot::linear_ticks(x0, x1), &fmt_y, path)?;
         body!(c);
     }
     Ok(())
@@ -272,11 +311,20 @@ fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotErro
     if panels.iter().all(|(_, lines)| lines.iter().all(|l| l.points.is_empty())) {
         return Ok(false);
     }
-    let zones: Vec<(f64, &str)> = ZONE_DB.to_vec();
+    // Each boundary named for what it is: the ISO 14839-3 zone boundary of the peak |S|.
+    let zone_labels: Vec<(f64, String)> =
+        ZONE_DB.iter().map(|(db, l)| (*db, format!("ISO 14839-3 zone {l} ({db:.1} dB)"))).collect();
+    let zones: Vec<(f64, &str)> = zone_labels.iter().map(|(db, l)| (*db, l.as_str())).collect();
     ensure_font(path)?;
-    let size = if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1) } else { WIDE_SIZE };
+    // Taller than wide charts: the legend takes rows above the panels.
+    let size =
+        if panels.len() > 1 { (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1 + 100) } else { (WIDE_SIZE.0, WIDE_SIZE.1 + 100) };
     crate::plot::draw_png(path, size, |root| {
         let area = titled_root(root, path, &format!("{}: sensitivity S and T per axis (ISO 14839-3)", c.label))?;
+        // One legend over the panels (the same series in each; the speed is the panel's), so
+        // that the panels' plots line up.
+        let all: Vec<Line> = panels.iter().flat_map(|(_, lines)| lines.iter().cloned()).collect();
+        let area = legend_rows(&area, path, &all)?;
         let areas = area.split_evenly((1, panels.len().max(1)));
         for ((speed, lines), sub) in panels.iter().zip(&areas) {
             let x = if *speed > 0.0 {
@@ -297,13 +345,16 @@ fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line
     let mut lines = Vec::new();
     let at = |a: &&super::sensitivity::AxisResult| speed.is_none_or(|sp| a.speed_hz == sp);
     for (i, a) in s.axes.iter().filter(|a| !a.points.is_empty()).filter(at).enumerate() {
-        let name = format!("{} at {:.0} Hz", a.axis, a.speed_hz);
+        // The speed is the panel's (its x label) when the lines are one speed's.
+        let name = if speed.is_some() { a.axis.to_string() } else { format!("{} at {:.0} Hz", a.axis, a.speed_hz) };
         lines.push(Line {
             label: format!("|S| {name}"),
             points: a.points.iter().map(|p| (p.f_hz, p.s_db)).collect(),
             colour: colour(i),
-            dashed: false,
-            width: 2,
+            dash: Dash::Solid,
+            // x axes wider than y axes: the two often coincide, and the wider line shows around
+            // the narrower one drawn over it.
+            width: if a.axis.starts_with('x') { 5 } else { 2 },
         });
         lines.push(Line {
             label: format!("|T| {name}"),
@@ -312,23 +363,27 @@ fn sensitivity_lines(s: &super::SensitivityPart, speed: Option<f64>) -> Vec<Line
                 let RGBColor(r, g, b) = colour(i);
                 RGBColor(r / 2 + 110, g / 2 + 110, b / 2 + 110)
             },
-            dashed: true,
-            width: 1,
+            dash: Dash::Dotted,
+            width: 2,
         });
     }
     if let Some(cf) = &s.closed_form {
         // The two-plane rotor: plane A's load share as a planar rotor, not the coupled loop.
         let label = if s.closed_form_planes.is_empty() { "|S| closed form" } else { "|S| closed form, plane A alone" };
-        lines.push(Line { label: label.into(), points: cf.curve.clone(), colour: BLACK, dashed: true, width: 2 });
+        lines.push(Line { label: label.into(), points: cf.curve.clone(), colour: BLACK, dash: Dash::Dashed, width: 2 });
     }
     // The coupled loop's closed form of each axis (the flexible rotor).
     for (i, f) in s.closed_form_axes.iter().filter(|f| speed.is_none_or(|sp| f.speed_hz == sp) && f.stable).enumerate()
     {
         lines.push(Line {
-            label: format!("|S| closed form {} at {:.0} Hz, all axes' loops", f.axis, f.speed_hz),
+            label: if speed.is_some() {
+                format!("|S| closed form {}, all axes' loops", f.axis)
+            } else {
+                format!("|S| closed form {} at {:.0} Hz, all axes' loops", f.axis, f.speed_hz)
+            },
             points: f.curve.clone(),
             colour: colour(i),
-            dashed: true,
+            dash: Dash::Dashed,
             width: 1,
         });
     }
@@ -355,7 +410,7 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
                     .filter_map(|x| f(x).map(|v| (x.peak_g, v)))
                     .collect(),
                 colour: colour(*i),
-                dashed,
+                dash: if dashed { Dash::Dashed } else { Dash::Solid },
                 width: 2,
             })
             .collect()
@@ -377,7 +432,7 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
     let lines = series(&|x| Some(x.tally.p_recovered), false, "");
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_probability.png");
-        let min_p = format!("{}", r.ladder_settings.min_p);
+        let min_p = format!("required probability (min_p = {})", r.ladder_settings.min_p);
         chart(
             &p,
             "Probability of recovery against the shock's peak (Wilson 95 % intervals)",
@@ -423,7 +478,7 @@ fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, String)>, PlotEr
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("duty_ball_pressure.png");
         let limit = r.bearing.map(|b| b.materials.static_pressure_pa * 1e-6);
-        let hl: Vec<(f64, &str)> = limit.map(|l| vec![(l, "static capacity")]).unwrap_or_default();
+        let hl: Vec<(f64, &str)> = limit.map(|l| vec![(l, "the balls' static pressure limit")]).unwrap_or_default();
         chart(
             &p,
             "Peak Hertz pressure of the most loaded ball (inner raceway)",

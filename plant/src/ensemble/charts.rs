@@ -63,11 +63,26 @@ fn band_panel(
     stats: &[PointStats],
     thresholds: &[(f64, [f64; 2])],
 ) -> anyhow::Result<()> {
+    // The title, then the legend in a strip above the plot, never over the band or the curve.
+    let area = match caption {
+        Some(c) => &area.titled(c, (FONT, 26)).map_err(draw_err(path))?,
+        None => area,
+    };
+    let grey = RGBColor(0x60, 0x60, 0x60);
+    let mut entries = vec![
+        ("95 % interval (Wilson)".to_string(), plot::Mark::Band(BLUE)),
+        ("P(recovered), members counted per point".to_string(), plot::Mark::LineMarker(BLUE, plot::Shape::Circle)),
+        ("P = 0.5".to_string(), plot::Mark::Line(grey)),
+    ];
+    if stats.iter().any(|s| s.numerically_sensitive > 0) {
+        entries.push(("numerically sensitive members".into(), plot::Mark::Open(SENSITIVE, plot::Shape::Circle)));
+    }
+    if !thresholds.is_empty() {
+        entries.push(("P = 0.5 crossing and its interval".into(), plot::Mark::Line(BLACK)));
+    }
+    let area = &plot::legend_strip(area, &entries, path)?;
     let mut b = ChartBuilder::on(area);
     b.margin(12).x_label_area_size(55).y_label_area_size(80);
-    if let Some(c) = caption {
-        b.caption(c, (FONT, 26));
-    }
     let mut chart = b.build_cartesian_2d(xr.0..xr.1, -0.03f64..1.03f64).map_err(draw_err(path))?;
     chart
         .configure_mesh()
@@ -85,19 +100,11 @@ fn band_panel(
         .map(|(x, s)| (*x, s.p_hi))
         .chain(x.iter().zip(stats).rev().map(|(x, s)| (*x, s.p_lo)))
         .collect();
-    chart
-        .draw_series(std::iter::once(Polygon::new(band, BLUE.mix(0.22).filled())))
-        .map_err(draw_err(path))?
-        .label("95 % interval (Wilson)")
-        .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 22, y + 6)], BLUE.mix(0.22).filled()));
-    chart
-        .draw_series(LineSeries::new([(xr.0, 0.5), (xr.1, 0.5)], RGBColor(0x60, 0x60, 0x60).stroke_width(1)))
-        .map_err(draw_err(path))?;
+    chart.draw_series(std::iter::once(Polygon::new(band, BLUE.mix(0.22).filled()))).map_err(draw_err(path))?;
+    chart.draw_series(LineSeries::new([(xr.0, 0.5), (xr.1, 0.5)], grey.stroke_width(1))).map_err(draw_err(path))?;
     chart
         .draw_series(LineSeries::new(x.iter().zip(stats).map(|(x, s)| (*x, s.p_recovered)), BLUE.stroke_width(2)))
-        .map_err(draw_err(path))?
-        .label("P(recovered), members counted per point")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 22, y)], BLUE.stroke_width(2)));
+        .map_err(draw_err(path))?;
     chart
         .draw_series(x.iter().zip(stats).map(|(x, s)| Circle::new((*x, s.p_recovered), 4, BLUE.filled())))
         .map_err(draw_err(path))?;
@@ -106,40 +113,16 @@ fn band_panel(
     if !sensitive.is_empty() {
         chart
             .draw_series(sensitive.iter().map(|p| Circle::new(*p, 9, SENSITIVE.stroke_width(2))))
-            .map_err(draw_err(path))?
-            .label("numerically sensitive members")
-            .legend(|(x, y)| Circle::new((x + 11, y), 7, SENSITIVE.stroke_width(2)));
+            .map_err(draw_err(path))?;
     }
-    for (i, (v, [lo, hi])) in thresholds.iter().enumerate() {
-        let s = chart
+    for (v, [lo, hi]) in thresholds {
+        chart
             .draw_series([
                 PathElement::new([(*lo, 0.5), (*hi, 0.5)], BLACK.stroke_width(3)),
                 PathElement::new([(*v, 0.38), (*v, 0.62)], BLACK.stroke_width(2)),
             ])
             .map_err(draw_err(path))?;
-        if i == 0 {
-            s.label("P = 0.5 crossing and its interval")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 22, y)], BLACK.stroke_width(3)));
-        }
     }
-    // The legend goes where the curve is not: mid-height (between the bands of P = 0 and
-    // P = 1) on the side away from the first crossing; without a crossing, the corner away
-    // from the curve's end.
-    let high_end = stats.last().is_some_and(|s| s.p_recovered > 0.5);
-    let position = match thresholds.first() {
-        Some((v, _)) if *v < 0.5 * (xr.0 + xr.1) => SeriesLabelPosition::MiddleRight,
-        Some(_) => SeriesLabelPosition::MiddleLeft,
-        None if high_end => SeriesLabelPosition::LowerRight,
-        None => SeriesLabelPosition::UpperRight,
-    };
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FONT, 17))
-        .position(position)
-        .draw()
-        .map_err(draw_err(path))?;
     Ok(())
 }
 
@@ -193,6 +176,13 @@ pub fn sweep_charts(
                 .titled(&format!("{scene}: bifurcation diagram, {c}(nT) against {key}"), (FONT, 26))
                 .map_err(draw_err(&path))?;
             let (upper, lower) = root.split_vertically(560);
+            // The modes' legend in a strip above the upper panel, never over the points.
+            let entries: Vec<(String, plot::Mark)> = groups
+                .iter()
+                .filter(|g| !g.2.is_empty())
+                .map(|(name, colour, _)| (name.name().to_string(), plot::Mark::Dot(*colour)))
+                .collect();
+            let upper = plot::legend_strip(&upper, &entries, &path)?;
             let mut chart = ChartBuilder::on(&upper)
                 .margin(12)
                 .x_label_area_size(40)
@@ -208,22 +198,10 @@ pub fn sweep_charts(
                 .bold_line_style(RGBColor(0xc8, 0xc8, 0xc8))
                 .draw()
                 .map_err(draw_err(&path))?;
-            for (name, colour, pts) in groups.iter().filter(|g| !g.2.is_empty()) {
+            for (_, colour, pts) in groups.iter().filter(|g| !g.2.is_empty()) {
                 let colour = *colour;
-                chart
-                    .draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled())))
-                    .map_err(draw_err(&path))?
-                    .label(name.name())
-                    .legend(move |(x, y)| Circle::new((x + 11, y), 5, colour.filled()));
+                chart.draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled()))).map_err(draw_err(&path))?;
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT, 17))
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(draw_err(&path))?;
             band_panel(&lower, &path, None, &x_label, (&x, xr), stats, &t)
         })?;
     }
@@ -253,10 +231,19 @@ fn probability_map(
         }
     };
     let (xe, ye) = (edges(x), edges(y));
+    let n1 = x.len();
     plot::draw_png(path, (1200, 800), |root| -> anyhow::Result<()> {
         root.fill(&WHITE).map_err(draw_err(path))?;
         let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
         let root = root.titled(&title, (FONT, 26)).map_err(draw_err(path))?;
+        let crossed: Vec<(f64, f64)> =
+            stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
+        // The crosses' legend in a strip above the map, never over its cells.
+        let root = if crossed.is_empty() {
+            root
+        } else {
+            plot::legend_strip(&root, &[("numerically sensitive members".into(), plot::Mark::Cross(SENSITIVE))], path)?
+        };
         let (main, bar) = root.split_horizontally(1030);
         let mut chart = ChartBuilder::on(&main)
             .margin(12)
@@ -273,30 +260,15 @@ fn probability_map(
             .axis_desc_style((FONT, 20))
             .draw()
             .map_err(draw_err(path))?;
-        let n1 = x.len();
         chart
             .draw_series(stats.iter().map(|s| {
                 let (c, r) = (s.index % n1, s.index / n1);
                 Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.p_recovered).filled())
             }))
             .map_err(draw_err(path))?;
-        let crossed: Vec<(f64, f64)> =
-            stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
-        if !crossed.is_empty() {
-            chart
-                .draw_series(crossed.iter().map(|p| Cross::new(*p, 6, SENSITIVE.stroke_width(2))))
-                .map_err(draw_err(path))?
-                .label("numerically sensitive members")
-                .legend(|(x, y)| Cross::new((x + 10, y), 6, SENSITIVE.stroke_width(2)));
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT, 17))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(draw_err(path))?;
-        }
+        chart
+            .draw_series(crossed.iter().map(|p| Cross::new(*p, 6, SENSITIVE.stroke_width(2))))
+            .map_err(draw_err(path))?;
         let mut bc = ChartBuilder::on(&bar)
             .margin_top(12)
             .margin_bottom(67)

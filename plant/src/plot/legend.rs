@@ -1,5 +1,4 @@
-//! Legends: inside the chart in the corner that hides the fewest points,
-//! or in a strip of centred rows above it.
+//! Legends: a strip of centred rows above the chart, never over the data.
 
 use std::path::Path;
 
@@ -8,60 +7,6 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{draw_err, font, Area, PlotError, LEGEND_PX};
 
-/// The corner whose legend box would cover the fewest points.
-///
-/// `points` are axis fractions in `[0, 1]` (y up); `box_frac` is the legend
-/// size as fractions of the plotting area.
-pub(crate) fn quiet_corner<'p>(
-    points: impl Iterator<Item = (f64, f64)> + Clone + 'p,
-    box_frac: (f64, f64),
-) -> SeriesLabelPosition {
-    let (bw, bh) = (box_frac.0 + 0.02, box_frac.1 + 0.02);
-    let corners = [
-        (SeriesLabelPosition::UpperRight, 1.0 - bw, 1.0, 1.0 - bh, 1.0),
-        (SeriesLabelPosition::UpperLeft, 0.0, bw, 1.0 - bh, 1.0),
-        (SeriesLabelPosition::LowerRight, 1.0 - bw, 1.0, 0.0, bh),
-        (SeriesLabelPosition::LowerLeft, 0.0, bw, 0.0, bh),
-    ];
-    let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
-    for (pos, x0, x1, y0, y1) in corners {
-        let n = points.clone().filter(|&(fx, fy)| fx >= x0 && fx <= x1 && fy >= y0 && fy <= y1).count();
-        if n < best.0 {
-            best = (n, pos);
-        }
-    }
-    best.1
-}
-
-/// Estimated legend box size in pixels for the given entries.
-pub(crate) fn legend_size(area: &Area<'_>, labels: &[String]) -> (f64, f64) {
-    let style = font(LEGEND_PX);
-    let w = labels.iter().filter_map(|l| area.estimate_text_size(l, &style).ok()).map(|(w, _)| w).max().unwrap_or(0);
-    // Text plus plotters' legend area (30 px) and margins (2 × 10 px);
-    // lines are about 1.2 font heights apart.
-    (f64::from(w) + 50.0, labels.len() as f64 * f64::from(LEGEND_PX) * 1.25 + 20.0)
-}
-
-pub(crate) fn draw_legend<'a, CT>(
-    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
-    pos: SeriesLabelPosition,
-    path: &Path,
-) -> Result<(), PlotError>
-where
-    CT: plotters::coord::CoordTranslate,
-{
-    chart
-        .configure_series_labels()
-        .position(pos)
-        .margin(10)
-        .legend_area_size(30)
-        .label_font(font(LEGEND_PX))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .map_err(draw_err(path))
-}
-
 /// A legend symbol.
 #[derive(Clone, Copy)]
 pub(crate) enum Mark {
@@ -69,10 +14,20 @@ pub(crate) enum Mark {
     Line(RGBColor),
     /// A dashed line.
     Dashed(RGBColor),
+    /// A dotted line.
+    Dotted(RGBColor),
+    /// A light filled band (an interval).
+    Band(RGBColor),
     /// A filled circle.
     Dot(RGBColor),
     /// A filled square.
     Square(RGBColor),
+    /// A cross (×).
+    Cross(RGBColor),
+    /// A marker alone (a series drawn as points).
+    Marker(RGBColor, Shape),
+    /// A hollow marker alone: its outline, so that a filled one at the same point stays visible.
+    Open(RGBColor, Shape),
     /// A solid line with a filled marker on it.
     LineMarker(RGBColor, Shape),
 }
@@ -151,20 +106,45 @@ pub(crate) fn draw_mark(
             area.draw(&PathElement::new(vec![(x, y), (x + 10, y)], c.stroke_width(2)))?;
             area.draw(&PathElement::new(vec![(x + 16, y), (x + w, y)], c.stroke_width(2)))
         }
+        Mark::Dotted(c) => {
+            for k in (0..w).step_by(6) {
+                area.draw(&PathElement::new(vec![(x + k, y), (x + k + 2, y)], c.stroke_width(2)))?;
+            }
+            Ok(())
+        }
+        Mark::Band(c) => area.draw(&Rectangle::new([(x, y - 6), (x + w, y + 6)], c.mix(0.22).filled())),
         Mark::Dot(c) => area.draw(&Circle::new((mid, y), 7, c.filled())),
         Mark::Square(c) => area.draw(&Rectangle::new([(mid - 6, y - 6), (mid + 6, y + 6)], c.filled())),
+        Mark::Cross(c) => area.draw(&Cross::new((mid, y), 6, c.stroke_width(2))),
+        Mark::Marker(c, shape) => draw_shape(area, shape, (mid, y), c.filled()),
+        Mark::Open(c, shape) => draw_shape(area, shape, (mid, y), c.stroke_width(2)),
         Mark::LineMarker(c, shape) => {
             area.draw(&PathElement::new(vec![(x, y), (x + w, y)], c.stroke_width(2)))?;
-            match shape {
-                Shape::Circle => area.draw(&Circle::new((mid, y), 6, c.filled())),
-                Shape::Square => area.draw(&Rectangle::new([(mid - 5, y - 5), (mid + 5, y + 5)], c.filled())),
-                Shape::Triangle => {
-                    area.draw(&Polygon::new(vec![(mid, y - 6), (mid + 6, y + 5), (mid - 6, y + 5)], c.filled()))
-                }
-                Shape::Diamond => {
-                    area.draw(&Polygon::new(vec![(mid, y - 7), (mid + 7, y), (mid, y + 7), (mid - 7, y)], c.filled()))
-                }
-            }
+            draw_shape(area, shape, (mid, y), c.filled())
         }
+    }
+}
+
+/// A marker of `shape` in `style` (filled or an outline) centred on `(x, y)` (pixels).
+fn draw_shape(
+    area: &Area<'_>,
+    shape: Shape,
+    (mid, y): (i32, i32),
+    style: ShapeStyle,
+) -> Result<(), DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>> {
+    let outline = |pts: Vec<(i32, i32)>| {
+        if style.filled {
+            area.draw(&Polygon::new(pts, style))
+        } else {
+            let mut closed = pts.clone();
+            closed.push(pts[0]);
+            area.draw(&PathElement::new(closed, style))
+        }
+    };
+    match shape {
+        Shape::Circle => area.draw(&Circle::new((mid, y), 6, style)),
+        Shape::Square => area.draw(&Rectangle::new([(mid - 5, y - 5), (mid + 5, y + 5)], style)),
+        Shape::Triangle => outline(vec![(mid, y - 6), (mid + 6, y + 5), (mid - 6, y + 5)]),
+        Shape::Diamond => outline(vec![(mid, y - 7), (mid + 7, y), (mid, y + 7), (mid - 7, y)]),
     }
 }

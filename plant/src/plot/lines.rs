@@ -5,9 +5,9 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::axes::{linear_ticks, log_padded, log_ticks, padded, AxisMap};
+use super::axes::{linear_ticks, log_padded, log_ticks, padded};
 use super::decimate::decimate_min_max;
-use super::legend::{draw_legend, legend_size, quiet_corner};
+use super::legend::{legend_strip, Mark};
 use super::*;
 
 /// Draws lines against a shared x axis (radius vs time, race speed vs time,
@@ -17,7 +17,9 @@ use super::*;
 /// min, max, last), so peaks survive on traces of millions of samples.
 /// Non-finite samples, and on a [`Scale::Log10`] y axis samples `<= 0`,
 /// are skipped and leave a gap. A legend is drawn when there is more than
-/// one series, in the corner that hides the fewest points.
+/// one series, in a strip above the plot (never over the data). Each series
+/// has its own colour and line style: the palette's ten colours solid, then
+/// the same ten dashed ([`series_style`]).
 ///
 /// # Errors
 /// [`PlotError::NoData`] if no series has a drawable point,
@@ -67,7 +69,14 @@ pub fn lines(
     ensure_font(path)?;
     crate::plot::draw_png(path, WIDE_SIZE, |root| {
         let area = titled_root(root, path, title)?;
-        let (pw, ph) = plot_pixels(&area, path)?;
+        let area = if series.len() > 1 {
+            let entries: Vec<(String, Mark)> =
+                series.iter().enumerate().map(|(i, s)| (s.label.to_string(), series_style(i).mark())).collect();
+            legend_strip(&area, &entries, path)?
+        } else {
+            area
+        };
+        let (pw, _) = plot_pixels(&area, path)?;
 
         // Only points inside the axes are drawn (plotters does not clip to the
         // plotting area); this matters only for values beyond ±AXIS_LIMIT or
@@ -77,64 +86,79 @@ pub fn lines(
         let pieces: Vec<Vec<Vec<(f64, f64)>>> =
             series.iter().map(|s| decimate_min_max(s.x, s.y, x_range.0, x_range.1, pw, inside)).collect();
 
-        let labels: Vec<String> = series.iter().map(|s| s.label.to_string()).collect();
-        let legend_pos = if series.len() > 1 {
-            let (lw, lh) = legend_size(&area, &labels);
-            let xm = AxisMap { lo: x_range.0, hi: x_range.1, log: false };
-            let ym = AxisMap { lo: y_range.0, hi: y_range.1, log };
-            let pts = pieces.iter().flatten().flatten().map(move |&(x, y)| (xm.frac(x), ym.frac(y)));
-            Some(quiet_corner(pts, (lw / pw as f64, lh / ph as f64)))
-        } else {
-            None
-        };
-
         let x_fmt = linear_ticks(x_range.0, x_range.1);
         if log {
             let y_coord: LogCoord<f64> = (y_range.0..y_range.1).log_scale().into();
             let mut chart = builder(&area).build_cartesian_2d(x_range.0..x_range.1, y_coord).map_err(draw_err(path))?;
             draw_mesh(&mut chart, x_label, y_label, &x_fmt, &log_ticks, path)?;
-            draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
+            draw_pieces(&mut chart, &pieces, path)?;
         } else {
             let y_fmt = linear_ticks(y_range.0, y_range.1);
             let mut chart = builder(&area)
                 .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
                 .map_err(draw_err(path))?;
             draw_mesh(&mut chart, x_label, y_label, &x_fmt, &y_fmt, path)?;
-            draw_pieces(&mut chart, &pieces, &labels, legend_pos, path)?;
+            draw_pieces(&mut chart, &pieces, path)?;
         }
         Ok(())
     })
 }
 
+/// The colour and line style of series `i`: the palette's ten colours solid, the next ten
+/// dashed, so that no two of twenty series look alike (a Campbell diagram of a flexible rotor
+/// has more than ten).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct SeriesStyle {
+    pub(crate) colour: RGBColor,
+    pub(crate) dashed: bool,
+}
+
+pub(crate) fn series_style(i: usize) -> SeriesStyle {
+    SeriesStyle { colour: colour(i), dashed: (i / PALETTE.len()) % 2 == 1 }
+}
+
+impl SeriesStyle {
+    /// Its legend symbol.
+    pub(crate) fn mark(&self) -> Mark {
+        if self.dashed {
+            Mark::Dashed(self.colour)
+        } else {
+            Mark::Line(self.colour)
+        }
+    }
+}
+
 pub(crate) fn draw_pieces<'a, Y>(
     chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, Y>>,
     pieces: &[Vec<Vec<(f64, f64)>>],
-    labels: &[String],
-    legend_pos: Option<SeriesLabelPosition>,
     path: &Path,
 ) -> Result<(), PlotError>
 where
     Y: Ranged<ValueType = f64>,
 {
-    for (i, (series_pieces, label)) in pieces.iter().zip(labels).enumerate() {
-        let c = colour(i);
+    for (i, series_pieces) in pieces.iter().enumerate() {
+        let SeriesStyle { colour: c, dashed } = series_style(i);
         let style = c.stroke_width(2);
         // An isolated sample between gaps is shown as a dot.
         chart
             .draw_series(series_pieces.iter().filter(|p| p.len() == 1).map(|p| Circle::new(p[0], 2, c.filled())))
             .map_err(draw_err(path))?;
+        if dashed {
+            // A dashed series is dashed along each piece as a whole (its dashes are short
+            // paths, so the mitre spikes below do not arise).
+            for p in series_pieces.iter().filter(|p| p.len() > 1) {
+                chart.draw_series(DashedLineSeries::new(p.iter().copied(), 10, 6, style)).map_err(draw_err(path))?;
+            }
+            continue;
+        }
         // Drawn segment by segment: plotters joins the segments of a wide
         // path with unlimited mitres, which throws long spikes off the
         // sharp turns of a dense, decimated trace.
-        let anno = chart
+        chart
             .draw_series(
                 series_pieces.iter().flat_map(|p| p.windows(2)).map(|w| PathElement::new(vec![w[0], w[1]], style)),
             )
             .map_err(draw_err(path))?;
-        anno.label(label.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
-    }
-    if let Some(pos) = legend_pos {
-        draw_legend(chart, pos, path)?;
     }
     Ok(())
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::axes::{finite_bounds, log_padded, log_ticks};
-use super::legend::draw_legend;
+use super::legend::{legend_strip, Mark, Shape};
 use super::*;
 
 /// Draws series on log-log axes, each point marked and joined in order (work-precision
@@ -40,6 +40,16 @@ pub fn loglog(
     ensure_font(path)?;
     crate::plot::draw_png(path, WIDE_SIZE, |root| {
         let area = titled_root(root, path, title)?;
+        // The legend in a strip above the plot, never over the data.
+        let entries: Vec<(String, Mark)> = series
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.label.to_string(), Mark::LineMarker(colour(i), Shape::Circle)))
+            .chain(
+                crosses.iter().enumerate().map(|(j, g)| (g.label.to_string(), Mark::Cross(colour(series.len() + j)))),
+            )
+            .collect();
+        let area = legend_strip(&area, &entries, path)?;
         let x_coord: LogCoord<f64> = (xr.0..xr.1).log_scale().into();
         let y_coord: LogCoord<f64> = (yr.0..yr.1).log_scale().into();
         let mut chart = builder(&area).build_cartesian_2d(x_coord, y_coord).map_err(draw_err(path))?;
@@ -50,22 +60,13 @@ pub fn loglog(
             chart
                 .draw_series(p.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))))
                 .map_err(draw_err(path))?;
-            chart
-                .draw_series(p.iter().map(|q| Circle::new(*q, 4, c.filled())))
-                .map_err(draw_err(path))?
-                .label(s.label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+            chart.draw_series(p.iter().map(|q| Circle::new(*q, 4, c.filled()))).map_err(draw_err(path))?;
         }
         for (j, g) in crosses.iter().enumerate() {
             let c = colour(series.len() + j);
             let p: Vec<(f64, f64)> = g.x.iter().zip(g.y).map(|(a, b)| (*a, *b)).filter(|p| ok(p.0, p.1)).collect();
-            chart
-                .draw_series(p.iter().map(|q| Cross::new(*q, 6, c.stroke_width(2))))
-                .map_err(draw_err(path))?
-                .label(g.label)
-                .legend(move |(x, y)| Cross::new((x + 12, y), 6, c.stroke_width(2)));
+            chart.draw_series(p.iter().map(|q| Cross::new(*q, 6, c.stroke_width(2)))).map_err(draw_err(path))?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, path)?;
         Ok(())
     })
 }

@@ -4,7 +4,15 @@
 //! One room per job: [`axes`] (ranges and tick labels), [`decimate`]
 //! (what of a long trace is drawn), [`legend`] (where legends go), and one
 //! file per chart kind ([`lines()`], [`orbit()`], [`scatter()`],
-//! [`heatmap()`], [`loglog()`], [`probability()`]); this file holds the shared style.
+//! [`heatmap()`], [`loglog()`], [`probability()`], [`campbell()`]); this file holds the
+//! shared style.
+//!
+//! # What every chart holds
+//!
+//! Tick labels on every axis (a log axis always spans at least two labelled powers of ten),
+//! the legend outside the data (a strip above the plot), a colour and line style of its own
+//! for each series (the palette's ten colours solid, then dashed), and reference lines and
+//! circles labelled for what they are.
 //!
 //! Every chart is a PNG with a white background, a grid, a title in 28 px
 //! and axis labels in 20 px DejaVu Sans. The font is embedded (the `dejavu`
@@ -35,9 +43,9 @@
 //!
 //! # Legends
 //!
-//! [`lines`] and [`scatter`] put the legend inside the chart, in the corner
-//! that hides the fewest drawn points. [`orbit`] puts it in a row above the
-//! chart, because inside it would hide part of a reference circle.
+//! Every chart kind puts its legend in centred rows above the plot
+//! (`legend::legend_strip`): inside, a legend hides data or a reference line,
+//! whichever corner it takes.
 //!
 //! # Axis ranges
 //!
@@ -49,10 +57,14 @@
 //! circles.
 
 mod axes;
+pub(crate) use axes::{linear_ticks, log_padded, log_ticks};
+mod campbell;
+pub(crate) use campbell::{campbell, ModePoints};
 mod decimate;
 mod heatmap;
 pub(crate) use heatmap::viridis;
 mod legend;
+pub(crate) use legend::{legend_strip, Mark, Shape};
 mod lines;
 mod loglog;
 mod orbit;

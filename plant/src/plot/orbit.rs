@@ -9,8 +9,8 @@ use super::decimate::{finite_pieces, stride_indices};
 use super::legend::{legend_strip, Mark};
 use super::*;
 
-/// Draws a rotor orbit relative to the housing, in µm, with the clearance
-/// circle of radius `clearance_m`, into a 900×900 PNG at `path`.
+/// Draws a rotor orbit relative to the housing, in µm, with the touchdown
+/// clearance circle of radius `clearance_m` (the bearing's at the orbit's plane), into a 900×900 PNG at `path`.
 ///
 /// Inputs are in metres. The axes are centred on the housing and scaled
 /// equally, so a circle looks round. The start and end points are marked.
@@ -21,7 +21,7 @@ use super::*;
 /// # Errors
 /// As [`orbit_with_circles`].
 pub fn orbit(path: &Path, title: &str, x_m: &[f64], y_m: &[f64], clearance_m: f64) -> Result<(), PlotError> {
-    orbit_with_circles(path, title, x_m, y_m, &[RefCircle { label: "clearance", radius_m: clearance_m }])
+    orbit_with_circles(path, title, x_m, y_m, &[RefCircle { label: "touchdown clearance", radius_m: clearance_m }])
 }
 
 /// Draws a rotor orbit like [`orbit`], with any number of dashed reference

@@ -67,6 +67,8 @@ pub fn probability(
             .iter()
             .enumerate()
             .map(|(k, c)| (c.label.to_string(), Mark::LineMarker(colour(k), Shape::ALL[k % Shape::ALL.len()])))
+            // The reference line named for what it is.
+            .chain(std::iter::once(("P = 0.5".to_string(), Mark::Dashed(RGBColor(0x70, 0x70, 0x70)))))
             .collect();
         let area = legend_strip(&area, &entries, path)?;
         let mut chart = builder(&area).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;

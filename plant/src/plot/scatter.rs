@@ -5,7 +5,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::axes::{centred, equalise, finite_bounds, linear_ticks, padded, AxisMap};
-use super::legend::{draw_legend, legend_size, quiet_corner};
+use super::legend::{legend_strip, Mark};
 use super::*;
 
 /// Draws groups of markers (Poincaré maps, bifurcation diagrams) in
@@ -14,7 +14,7 @@ use super::*;
 ///
 /// Each group draws at most one marker per pixel, so maps of millions of
 /// points stay fast. Non-finite points are skipped. A legend is drawn when
-/// there is more than one group.
+/// there is more than one group, in a strip above the plot (never over the data).
 ///
 /// # Errors
 /// [`PlotError::NoData`] if no point is finite, [`PlotError::BadInput`] if
@@ -43,6 +43,13 @@ pub fn scatter(
     let size = if equal_axes { SQUARE_SIZE } else { WIDE_SIZE };
     crate::plot::draw_png(path, size, |root| {
         let area = titled_root(root, path, title)?;
+        let area = if groups.len() > 1 {
+            let entries: Vec<(String, Mark)> =
+                groups.iter().enumerate().map(|(i, g)| (g.label.to_string(), Mark::Dot(colour(i)))).collect();
+            legend_strip(&area, &entries, path)?
+        } else {
+            area
+        };
         let (pw, ph) = plot_pixels(&area, path)?;
         let (mut xr, mut yr) = (padded(xb.0, xb.1), padded(yb.0, yb.1));
         if equal_axes {
@@ -59,7 +66,6 @@ pub fn scatter(
         let xm = AxisMap { lo: xr.0, hi: xr.1, log: false };
         let ym = AxisMap { lo: yr.0, hi: yr.1, log: false };
         let mut occupied = vec![false; pw * ph];
-        let mut kept_all: Vec<(f64, f64)> = Vec::new();
         // Marker size: smaller as the map gets denser.
         let radius = match groups.iter().map(|g| g.x.len()).sum::<usize>() {
             0..=2_000 => 3,
@@ -84,18 +90,7 @@ pub fn scatter(
                 }
             }
             let c = colour(i);
-            chart
-                .draw_series(kept.iter().map(|&p| Circle::new(p, radius, c.filled())))
-                .map_err(draw_err(path))?
-                .label(g.label)
-                .legend(move |(x, y)| Circle::new((x + 12, y), 5, c.filled()));
-            kept_all.extend(kept.iter().map(|&(x, y)| (xm.frac(x), ym.frac(y))));
-        }
-        if groups.len() > 1 {
-            let labels: Vec<String> = groups.iter().map(|g| g.label.to_string()).collect();
-            let (lw, lh) = legend_size(&area, &labels);
-            let pos = quiet_corner(kept_all.iter().copied(), (lw / pw as f64, lh / ph as f64));
-            draw_legend(&mut chart, pos, path)?;
+            chart.draw_series(kept.iter().map(|&p| Circle::new(p, radius, c.filled()))).map_err(draw_err(path))?;
         }
         Ok(())
     })

@@ -341,3 +341,119 @@ fn probability_draws_every_curve_and_refuses_uneven_slices() {
     let nothing = [ProbabilityCurve { label: "none", x: &[f64::NAN], p: &[0.5], lo: &[0.4], hi: &[0.6] }];
     assert!(matches!(probability(&dir.join("n.png"), "n", "x", &nothing, 0.0), Err(PlotError::NoData { .. })));
 }
+
+/// The top row of the plotting area: where the y axis begins, the first dark vertical run of
+/// 30 rows or more near x = 130 px (legend marks and text are shorter; data drawn on the axis
+/// may break the run further down, never above its start).
+fn plot_top(img: &Image) -> usize {
+    let dark = |x: usize, y: usize| img.rgb[y * img.width + x].iter().all(|v| *v < 60);
+    let mut top = usize::MAX;
+    for x in 120..140 {
+        let mut run = 0;
+        for y in 0..img.height {
+            run = if dark(x, y) { run + 1 } else { 0 };
+            if run == 30 {
+                top = top.min(y + 1 - 30);
+                break;
+            }
+        }
+    }
+    assert!(top < img.height / 3, "no y axis found near the top: {top}");
+    top
+}
+
+/// Pixels of colour `c` above row `top`.
+fn count_above(img: &Image, c: RGBColor, top: usize) -> usize {
+    img.rgb[..top * img.width].iter().filter(|p| **p == [c.0, c.1, c.2]).count()
+}
+
+/// Every chart kind with a legend puts it above the plot, never over the data: each series'
+/// legend mark lies above the y axis' top, and no data are drawn there.
+#[test]
+fn legends_lie_above_the_plot() {
+    let dir = temp_dir("legends");
+    let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-3).collect();
+    let ys: Vec<Vec<f64>> = (0..3).map(|k| t.iter().map(|t| (t * 7.0 + k as f64).sin() + k as f64).collect()).collect();
+    let s: Vec<Series> = ys.iter().map(|y| Series { label: "a series", x: &t, y }).collect();
+    let p = dir.join("lines.png");
+    lines(&p, "lines", "t (s)", "v", &s, Scale::Linear).unwrap();
+    let g = [PointGroup { label: "one", x: &t, y: &ys[0] }, PointGroup { label: "two", x: &t, y: &ys[1] }];
+    let q = dir.join("scatter.png");
+    scatter(&q, "scatter", "x", "y", &g, false).unwrap();
+    let pos: Vec<f64> = t.iter().map(|t| t + 0.01).collect();
+    let r = dir.join("loglog.png");
+    loglog(
+        &r,
+        "loglog",
+        "x",
+        "y",
+        &[Series { label: "line", x: &pos, y: &pos }],
+        &[PointGroup { label: "crosses", x: &pos[..10], y: &pos[..10] }],
+    )
+    .unwrap();
+    for (path, n) in [(&p, 3), (&q, 2), (&r, 2)] {
+        let img = Image::read(path);
+        let top = plot_top(&img);
+        for i in 0..n {
+            let above = count_above(&img, colour(i), top);
+            assert!(above >= 10, "{}: series {i}'s legend mark is not above the plot (row {top})", path.display());
+        }
+    }
+}
+
+/// Twenty series, twenty looks: the palette's ten colours solid, then dashed.
+#[test]
+fn each_of_twenty_series_has_a_style_of_its_own() {
+    let styles: Vec<_> = (0..20).map(super::lines::series_style).collect();
+    for (i, a) in styles.iter().enumerate() {
+        for b in &styles[i + 1..] {
+            assert_ne!(a, b, "series {i} repeats a style");
+        }
+    }
+    assert!(!styles[9].dashed && styles[10].dashed);
+}
+
+/// A Campbell diagram draws each mode's points in its colour; with bending modes, the
+/// rigid-body modes get a panel of their own on the left (their points in both halves), the
+/// bending modes only the right one.
+#[test]
+fn campbell_puts_the_rigid_body_modes_beside_the_bending_modes() {
+    let dir = temp_dir("campbell");
+    let speeds: Vec<f64> = (0..21).map(|i| i as f64 * 10.0).collect();
+    let rigid: Vec<f64> = speeds.iter().map(|s| 50.0 + 0.05 * s).collect();
+    let bending: Vec<f64> = speeds.iter().map(|s| 500.0 + 0.1 * s).collect();
+    let mode = |label: &str, k: usize, y: &'static [f64], rigid: bool, x: &'static [f64]| ModePoints {
+        label: label.into(),
+        colour: colour(k),
+        shape: Shape::Circle,
+        open: false,
+        x,
+        y,
+        rigid,
+    };
+    let (speeds, rigid, bending): (&'static [f64], &'static [f64], &'static [f64]) =
+        (speeds.leak(), rigid.leak(), bending.leak());
+    let p = dir.join("flexible.png");
+    campbell(&p, "flexible", &[mode("rigid", 0, rigid, true, speeds), mode("bending", 2, bending, false, speeds)])
+        .unwrap();
+    let img = Image::read(&p);
+    assert_eq!((img.width, img.height), (1800, 900));
+    let top = plot_top(&img) + 2;
+    let half = |c: RGBColor, right: bool| {
+        let xs = if right { img.width / 2..img.width } else { 0..img.width / 2 };
+        (top..img.height - 80)
+            .flat_map(|y| xs.clone().map(move |x| (x, y)))
+            .filter(|(x, y)| img.rgb[y * img.width + x] == [c.0, c.1, c.2])
+            .count()
+    };
+    let counts = (half(colour(0), false), half(colour(0), true), half(colour(2), true), half(colour(2), false));
+    assert!(counts.0 > 200 && counts.1 > 200, "rigid-body points in both panels: {counts:?}, top {top}");
+    assert!(half(colour(2), true) > 200, "bending points on the right");
+    assert_eq!(half(colour(2), false), 0, "no bending point on the rigid-body panel");
+    let q = dir.join("rigid.png");
+    campbell(&q, "rigid", &[mode("rigid", 0, rigid, true, speeds)]).unwrap();
+    assert_drawn(&q, WIDE_SIZE, colour(0), 200);
+    assert!(matches!(campbell(&dir.join("none.png"), "none", &[]), Err(PlotError::NoData { .. })));
+    let short = ModePoints { x: &speeds[..3], ..mode("short", 0, rigid, true, speeds) };
+    assert!(matches!(campbell(&dir.join("bad.png"), "bad", &[short]), Err(PlotError::BadInput { .. })));
+}
