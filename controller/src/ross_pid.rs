@@ -151,8 +151,7 @@ impl ControlLaw for RossPid {
         let b = [kp + h + g, -kp * (1.0 + p) + h * (1.0 - p) - 2.0 * g, (kp - h) * p + g];
         // Without the integral term (ROSS's UFU rig has ki_pid = 0) the numerator vanishes at
         // z = 1 as the denominator does: the first-order filter (b₀ + (b₀ + b₁) z⁻¹)/(1 − p z⁻¹)
-        // that remains, not the pole at z = 1 whose rounded cancellation read the closed loop as
-        // unstable (a pole of modulus 1.000022 on the UFU rig).
+        // that remains, not a pole on the unit circle that only rounding cancels.
         let filter = if ki == 0.0 { ([b[0], b[0] + b[1], 0.0], [-p, 0.0]) } else { (b, [-(1.0 + p), p]) };
         Some(crate::law::LinearLaw { pd: crate::law::LinearPd { kp: 1.0, kd: 0.0 }, filter: Some(filter) })
     }
