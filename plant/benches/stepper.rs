@@ -83,7 +83,7 @@ fn state(c: &mut Criterion) {
         let snap = plant.snapshot();
         let json = serde_json::to_vec(&snap).expect("json");
         let path = dir.join(format!("{label}.json"));
-        snap.write(&path).expect("write");
+        plant::snapshot::write(&snap, &path).expect("write");
         let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         eprintln!("{label}: state of {} numbers; JSON {} bytes, the file {bytes} bytes", snap.state.len(), json.len());
         c.bench_function(&format!("snapshot/{label}/take"), |b| b.iter(|| black_box(plant.snapshot())));
@@ -96,7 +96,9 @@ fn state(c: &mut Criterion) {
         c.bench_function(&format!("snapshot/{label}/from_json"), |b| {
             b.iter(|| serde_json::from_slice::<Snapshot>(black_box(&json)).expect("json"))
         });
-        c.bench_function(&format!("snapshot/{label}/write_file"), |b| b.iter(|| snap.write(&path).expect("write")));
+        c.bench_function(&format!("snapshot/{label}/write_file"), |b| {
+            b.iter(|| plant::snapshot::write(&snap, &path).expect("write"))
+        });
         c.bench_function(&format!("snapshot/{label}/read_file"), |b| {
             b.iter(|| Snapshot::read(black_box(&path)).expect("read"))
         });

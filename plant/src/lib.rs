@@ -14,8 +14,9 @@
 #![warn(missing_docs)]
 
 pub use plant_physics::{force, integrate, model, park};
-pub use run::stepper::Plant;
-pub use run::{digital, stepper};
+// The simulation's modules at their old paths (`plant::config`, `plant::Plant`, …): the
+// `plant-sim` crate's.
+pub use plant_sim::{config, digital, hardware, hooks, initial, invalid, machine, rng, sensor, stepper, Plant};
 
 pub mod analysis;
 pub mod argument;
@@ -27,32 +28,24 @@ pub mod campbell;
 pub mod check;
 pub mod claim;
 pub mod compare;
-pub mod config;
 pub mod cosim;
 pub mod ensemble;
 pub mod exit;
 pub mod figures;
 pub mod fmu_export;
 pub mod grid;
-pub mod hardware;
-pub mod hooks;
-pub mod initial;
 pub mod input;
 pub mod interrupt;
-pub mod invalid;
 pub mod linear;
-pub mod machine;
 pub mod offload;
 pub mod outfile;
 pub mod output;
 pub mod plot;
 pub mod record;
 pub mod recording;
-pub mod rng;
 pub mod robustness;
 pub mod row_file;
 pub mod run;
-pub mod sensor;
 pub mod snapshot;
 pub mod soak;
 pub mod stability;
@@ -61,3 +54,11 @@ pub mod summary;
 pub mod sweep;
 pub mod table;
 pub mod trace;
+
+/// A shipped scene (`config/FILE`) with `sets` applied, for the library's tests.
+#[cfg(test)]
+pub(crate) fn shipped(file: &str, sets: &[&str]) -> config::Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config").join(file);
+    config::load_scene(&path, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+        .unwrap_or_else(|e| panic!("config/{file} {sets:?}: {e}"))
+}

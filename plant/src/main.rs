@@ -372,7 +372,7 @@ impl Hooks for CliHooks {
 
     fn state_saved(&mut self, at: f64, snapshot: plant::snapshot::Snapshot) {
         let path = self.dir.join(plant::snapshot::Snapshot::file_name(at));
-        match snapshot.write(&path) {
+        match plant::snapshot::write(&snapshot, &path) {
             Ok(()) => self.note(&format!("state at t = {} s saved in {}", snapshot.t_s, path.display())),
             Err(e) => {
                 self.note(&format!("warning: {e}"));

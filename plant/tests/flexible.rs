@@ -1,4 +1,4 @@
-//! The flexible rotor in the plant (`rotor.model = "flexible"`, `plant/src/machine/flexible.rs`):
+//! The flexible rotor in the plant (`rotor.model = "flexible"`, `plant/sim/src/machine/flexible.rs`):
 //! its `Machine` at its nodes, and a stiff shaft against the rigid two-plane rotor. Here, not in
 //! the module, so that `machine` does not depend on `config` and `run` (tests/tests/modules.rs).
 

@@ -391,7 +391,7 @@ fn guide_default(note: &str) -> GuideDefault {
     }
 }
 
-/// Every key that `scene_table!` declares (plant/src/config/raw.rs) is in the guide's key table,
+/// Every key that `scene_table!` declares (plant/sim/src/config/raw.rs) is in the guide's key table,
 /// with the declared default where the guide gives one, and the guide gives no default for a
 /// key that is not declared.
 #[test]
@@ -442,7 +442,11 @@ fn the_guides_scene_keys_and_defaults_are_the_declared_ones() {
             }
         }
     }
-    assert!(problems.is_empty(), "docs/guide/scenes.md against plant/src/config/raw.rs:\n  {}", problems.join("\n  "));
+    assert!(
+        problems.is_empty(),
+        "docs/guide/scenes.md against plant/sim/src/config/raw.rs:\n  {}",
+        problems.join("\n  ")
+    );
 }
 
 #[test]

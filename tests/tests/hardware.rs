@@ -3,7 +3,7 @@
 //! against the linear analysis, the trace's coil columns and the summary's saturation time, bad
 //! input. The coil's step responses against their closed forms are the physics crate's tests
 //! (`plant/physics/src/amplifier.rs`); the runout at the centre and the low-pass's lag, the
-//! plant's (`plant/src/hardware.rs`, `plant/src/sensor.rs`).
+//! plant's (`plant/sim/src/hardware.rs`, `plant/sim/src/sensor.rs`).
 
 mod common;
 

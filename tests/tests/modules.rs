@@ -248,6 +248,12 @@ fn plant_has_no_module_cycle() {
 }
 
 #[test]
+fn plant_sim_has_no_module_cycle() {
+    let found = cycles_of("plant/sim");
+    assert!(found.is_empty(), "module cycles:\n  {}", found.join("\n  "));
+}
+
+#[test]
 fn controller_has_no_module_cycle() {
     let found = cycles_of("controller");
     assert!(found.is_empty(), "controller module cycles:\n  {}", found.join("\n  "));

@@ -1,9 +1,9 @@
 //! The plant as an FMI 2.0 co-simulation FMU: the C API an importer (Simulink's FMU block,
-//! OMSimulator, FMPy) calls, around [`plant::Plant`], the value `plant run` steps.
+//! OMSimulator, FMPy) calls, around [`plant_sim::Plant`], the value `plant run` steps.
 //!
 //! `plant fmu SCENE --out plant.fmu` packs this library as `binaries/linux64/<id>.so` with
 //! the scene in `resources/scene.toml` and the `modelDescription.xml` that
-//! [`plant::fmu_export::Model`] makes from it. At `fmi2Instantiate` the library loads that
+//! [`plant_sim::fmi::Model`] makes from it. At `fmi2Instantiate` the library loads that
 //! scene and makes the same model, so a value reference means here what it means in the file.
 //!
 //! What the library promises (docs/guide/fmu-plant.md):
@@ -19,7 +19,7 @@
 //!   bounds, a corrupt serialised state, a diverging plant (with its time and state in the
 //!   log) each return `fmi2Error` with a log line; a panic never crosses the C boundary.
 //! - The FMU state (`fmi2GetFMUstate`, `fmi2SerializeFMUstate`) is the whole instance: the
-//!   parameters, inputs, the plant's [`plant::snapshot::Snapshot`] and the outputs; a state
+//!   parameters, inputs, the plant's [`plant_sim::snapshot::Snapshot`] and the outputs; a state
 //!   restored, in this instance or in a fresh one in another process, continues bit for bit.
 //!
 //! Instances are independent (no global state): several may live in one process.
@@ -28,11 +28,11 @@
 
 mod fmi3;
 
-use plant::fmu_export::{Model, Output, Role, Variable};
-use plant::run::Sink;
-use plant::snapshot::Snapshot;
-use plant::stepper::{Command, Plant};
-use plant::trace::{col, Record};
+use plant_sim::fmi::{Model, Output, Role, Variable};
+use plant_sim::rows::{col, Record};
+use plant_sim::run::Sink;
+use plant_sim::snapshot::Snapshot;
+use plant_sim::stepper::{Command, Plant};
 use serde::{Deserialize, Serialize};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -215,7 +215,7 @@ impl Instance {
     /// The plant of the current parameters, at t = 0, the inputs as its initial command.
     fn build(&self, values: &[f64]) -> Result<Sim, String> {
         let overrides = self.overrides(values);
-        let mut scene = plant::fmu_export::load_fmu_scene(&self.resources, &overrides)
+        let mut scene = plant_sim::fmi::load_fmu_scene(&self.resources, &overrides)
             .map_err(|e| format!("the scene with the parameters set ({}): {e}", overrides.join(", ")))?;
         // The last tick of a scene whose duration is not on the tick grid would be cut short at
         // the duration: move the duration onto the grid (steps past it go on whole ticks).
@@ -233,7 +233,7 @@ impl Instance {
             if let Some(d) = fixed {
                 let mut with = overrides.clone();
                 with.push(format!("scene.duration_s={d:?}"));
-                scene = plant::fmu_export::load_fmu_scene(&self.resources, &with)
+                scene = plant_sim::fmi::load_fmu_scene(&self.resources, &with)
                     .map_err(|e| format!("the scene with its duration on the tick grid: {e}"))?;
             }
         }
@@ -281,7 +281,7 @@ impl Instance {
                 plant.record(&mut last);
                 // A plant always hands over its row; without one the outputs are NaN, which
                 // fmi2DoStep refuses as a diverged plant rather than a panic.
-                fresh = last.0.unwrap_or(Record::planar([f64::NAN; plant::trace::WIDTH]));
+                fresh = last.0.unwrap_or(Record::planar([f64::NAN; plant_sim::rows::WIDTH]));
                 &fresh
             }
         };
@@ -594,7 +594,7 @@ impl Instance {
 
 /// Where the plant of `scene` starts, in words: `plant run`'s initial state of the scene, which
 /// the scene's controller design sets (docs/guide/fmu-plant.md, "Where the plant starts").
-fn start_words(scene: &plant::config::Scene) -> String {
+fn start_words(scene: &plant_sim::config::Scene) -> String {
     let c = &scene.controller;
     let i = &scene.initial;
     let orbit = if i.unbalance_orbit {
@@ -768,7 +768,7 @@ fn new_instance(
         return fail("no resource location: the FMU's resources/ folder holds its scene".into());
     };
     let resources = resource_path(&location);
-    let scene = match plant::fmu_export::load_fmu_scene(&resources, &[]) {
+    let scene = match plant_sim::fmi::load_fmu_scene(&resources, &[]) {
         Ok(s) => s,
         Err(e) => return fail(format!("the FMU's scene ({}): {e}", resources.join("scene.toml").display())),
     };
@@ -876,10 +876,10 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
         let Some(cats) = slice(categories, n) else { return inst.error("fmi2SetDebugLogging: categories is NULL") };
         for &cat in cats {
             let name = text(cat).unwrap_or_default();
-            if !plant::fmu_export::LOG_CATEGORIES.iter().any(|(c, _)| *c == name) {
+            if !plant_sim::fmi::LOG_CATEGORIES.iter().any(|(c, _)| *c == name) {
                 return inst.error(&format!(
                     "fmi2SetDebugLogging: no log category {name:?}; this FMU's are {}",
-                    plant::fmu_export::LOG_CATEGORIES.map(|c| c.0).join(", ")
+                    plant_sim::fmi::LOG_CATEGORIES.map(|c| c.0).join(", ")
                 ));
             }
         }

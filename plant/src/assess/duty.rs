@@ -247,7 +247,7 @@ impl Sink for DutySink<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::shipped;
+    use crate::shipped;
     use crate::trace::Trace;
 
     /// Every layout of the plant's state (bare, with amplifiers, with unipolar amplifiers; planar

@@ -2,11 +2,11 @@
 //! `coupled`): one source of truth, held from this side (assess reads `crate::linear`, so the
 //! comparison lives here, not in `linear`).
 
-use crate::config::shipped;
 use crate::linear::build;
 use crate::linear::law::{self, LinearLaw};
 use crate::linear::margins::margins;
 use crate::linear::tests::{rel, worst_difference};
+use crate::shipped;
 use nalgebra::Complex;
 
 type C64 = Complex<f64>;

@@ -408,7 +408,7 @@ mod tests {
         for (file, planes, tolerance) in
             [("cosim-10g.toml", 1, 1e-12), ("two-plane-asymmetric-10g.toml", 2, 1e-12), ("flexible-10g.toml", 2, 1e-9)]
         {
-            let scene = crate::config::shipped(file, &[]);
+            let scene = crate::shipped(file, &[]);
             let depths = with_machine(&scene, held_bias(&scene).unwrap(), Depths);
             assert_eq!(depths.len(), planes, "{file}");
             for (i, (touching, depth, [dx, dy])) in depths.into_iter().enumerate() {

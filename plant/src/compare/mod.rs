@@ -383,7 +383,7 @@ fn recovered(seconds: f64) -> String {
 mod tests {
     use super::*;
 
-    use crate::config::shipped as scene;
+    use crate::shipped as scene;
 
     /// A chart of a two-plane rotor names each plane's gap and draws each plane's radius (it
     /// used plane A's gap for the whole rotor).

@@ -48,19 +48,7 @@ const MISS_BUDGET_MIN_DUE: u64 = 1000;
 /// respawned at every tick (about 145 ms each: an hour for a 1.5 s scene, issue 31 item 8).
 pub const MAX_RECONNECTIONS: u32 = 8;
 
-/// Why the loop must stop at this tick.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Halt {
-    /// The controller is gone (or silent past `controller.lockstep_timeout_ms`) and no other
-    /// took its place.
-    Lost(String),
-    /// SIGINT/SIGTERM to the plant.
-    Interrupted(String),
-    /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
-    MissBudget(String),
-    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
-    OverrunBudget(String),
-}
+pub use plant_sim::digital::Halt;
 
 /// What a lockstep wait saw besides the reply it waited for.
 #[derive(Default)]
@@ -332,3 +320,39 @@ impl Session {
 
 /// Why a loss was declared when the controller said it was stopped (SIGINT/SIGTERM to it).
 const STOPPED_BY_SIGNAL: &str = "the controller was stopped by a signal (it sent STOPPING)";
+
+/// The digital loop's view of the session ([`plant_sim::digital::Remote`]): each method the
+/// session's own.
+impl plant_sim::digital::Remote for Session {
+    type Report = CosimReport;
+
+    fn inherent_delay(&self) -> u32 {
+        Session::inherent_delay(self)
+    }
+
+    fn controller_pid(&self) -> Option<u32> {
+        Session::controller_pid(self)
+    }
+
+    fn command(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
+        Session::command(self, sample, hooks)
+    }
+
+    fn tick_started(&self) -> Option<Instant> {
+        Session::tick_started(self)
+    }
+
+    fn miss_budget_exceeded(&self, min_due: u64) -> Option<String> {
+        Session::miss_budget_exceeded(self, min_due)
+    }
+
+    fn overrun_budget_exceeded(&self, min_ticks: u64) -> Option<String> {
+        Session::overrun_budget_exceeded(self, min_ticks)
+    }
+
+    fn finish(self, t_s: f64, seq: u64, invalid_replies: u64) -> CosimReport {
+        let mut report = Session::finish(self, t_s, seq);
+        report.invalid_replies = invalid_replies;
+        report
+    }
+}

@@ -139,7 +139,7 @@ fn bisect(mut lo: f64, mut hi: f64, h: &dyn Fn(f64) -> f64, at_lo: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::shipped;
+    use crate::shipped;
     use std::f64::consts::TAU;
 
     /// The planar rotor on its continuous PD, by hand: `G_o = −(k_e + k_s + j c_e ω) /

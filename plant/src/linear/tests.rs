@@ -4,7 +4,7 @@
 
 use super::law::{self, LinearLaw};
 use super::{build, Built};
-use crate::config::shipped;
+use crate::shipped;
 use nalgebra::{Complex, DMatrix, Matrix2};
 use std::f64::consts::{SQRT_2, TAU};
 

@@ -9,88 +9,20 @@
 //! integrator restarts at every tick. The trace is recorded at the output
 //! rate (dense output inside macro steps).
 
-pub mod digital;
-pub mod stepper;
+pub use plant_sim::run::{bias_of, plane_gains, settings_with, Outcome, PlaneStates, RunError, Sink, TickCost};
+pub use plant_sim::{digital, stepper};
 
 use crate::config::{ControlMode, Scene};
-use crate::cosim::stats::Tet;
 use crate::cosim::{CosimError, CosimReport, Launch, Session};
 use crate::digital::{DigitalLoop, Source};
 pub use crate::hooks::{Hooks, Quiet};
-use crate::integrate::{IntegrationError, Settings, Stats};
+use crate::integrate::Stats;
 use crate::snapshot::{DigitalState, Snapshot, SnapshotError};
 use crate::stepper::{Command, Plant};
 use crate::trace::{Record, Trace};
-use controller::{build_rotor_law, saturate, PdGains, RotorLaw, ROTOR_AXES};
+use controller::{build_rotor_law, RotorLaw};
+use plant_sim::run::PlantError;
 use std::time::Instant;
-
-/// Why a run stopped before its end.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RunError {
-    /// The integrator failed (non-finite state, step-size underflow, stall).
-    #[error("numerical divergence: {0}")]
-    Integration(#[from] IntegrationError),
-    /// A body left the clearance by more than the guard: the contact model has failed.
-    #[error("numerical divergence at t = {t} s: {what} = {value_m:.4e} m exceeds the guard {limit_m:.4e} m; state {state:?}")]
-    RadiusGuard {
-        /// Time (s).
-        t: f64,
-        /// Which radius.
-        what: &'static str,
-        /// Its value (m).
-        value_m: f64,
-        /// The limit (m).
-        limit_m: f64,
-        /// The state.
-        state: Vec<f64>,
-    },
-}
-
-impl RunError {
-    /// Time at which the run failed (s).
-    pub fn time(&self) -> f64 {
-        match self {
-            RunError::Integration(
-                IntegrationError::NonFinite { t, .. }
-                | IntegrationError::StepSizeUnderflow { t, .. }
-                | IntegrationError::TooManySteps { t, .. },
-            ) => *t,
-            RunError::RadiusGuard { t, .. } => *t,
-        }
-    }
-
-    /// The state the run failed in (SI, ordered as [`crate::model::ix`]).
-    pub fn state(&self) -> &[f64] {
-        match self {
-            RunError::Integration(
-                IntegrationError::NonFinite { state, .. }
-                | IntegrationError::StepSizeUnderflow { state, .. }
-                | IntegrationError::TooManySteps { state, .. },
-            ) => state,
-            RunError::RadiusGuard { state, .. } => state,
-        }
-    }
-}
-
-/// How a run ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
-    /// Ran to the scene's duration.
-    Completed,
-    /// Stopped by a numerical failure.
-    Diverged(RunError),
-    /// Stopped on request (Ctrl-C), or the controller process was stopped by a signal.
-    Interrupted,
-    /// The controller process was lost and none took its place (co-simulation).
-    PeerLost(String),
-    /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
-    MissBudget(String),
-    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
-    OverrunBudget(String),
-    /// The law's commands were non-finite past `controller.max_invalid_burst` or
-    /// `controller.max_invalid_fraction` ([`crate::invalid`]).
-    InvalidCommands(String),
-}
 
 /// Why a run could not start.
 #[derive(Debug, thiserror::Error)]
@@ -112,31 +44,19 @@ pub enum SetupError {
     Thread(std::io::Error),
 }
 
-/// Where the loop's output samples go (at the scene's output rate, from the
-/// integrator's dense output): a [`Trace`] in memory (`plant compare`, sweeps,
-/// benches), the streaming run folder of `plant run` ([`crate::output`]), an
-/// online monitor for `plant soak`. The loop itself keeps nothing per sample or
-/// per tick (co-simulation latencies go to fixed-size histograms).
-pub trait Sink {
-    /// The sample at one output time: the state's row(s) with the forces the model gives there.
-    fn sample(&mut self, record: &Record);
-
-    /// The same sample's bearing planes, after [`Sink::sample`], for a sink that needs what a
-    /// row does not hold (the race's angle and acceleration, each ball's load: the
-    /// assessment's touchdown-bearing duty): `planes` hands each plane's
-    /// [`crate::machine::PlaneState`] to a visitor, computed only if the sink asks. The default
-    /// ignores it.
-    fn planes(&mut self, _planes: &dyn PlaneStates) {}
+impl From<PlantError> for SetupError {
+    fn from(e: PlantError) -> Self {
+        match e {
+            PlantError::Law(e) => SetupError::Law(e),
+            PlantError::State(e) => SetupError::State(e),
+        }
+    }
 }
 
-/// The bearing planes of one output sample, as the rotor model gives them
-/// ([`crate::machine::Machine::plane_states`]).
-pub trait PlaneStates {
-    /// The sample's time (s).
-    fn time(&self) -> f64;
-
-    /// Hands each plane's state to `visit`, with the plane's index.
-    fn visit(&self, visit: &mut dyn FnMut(usize, &crate::machine::PlaneState<'_>));
+/// Whether `scene`'s plant can start from `snapshot` ([`plant_sim::start::check_start`]), before
+/// anything starts or is written.
+pub fn check_start(scene: &Scene, snapshot: &Snapshot) -> Result<(), SetupError> {
+    Ok(plant_sim::start::check_start(scene, snapshot)?)
 }
 
 impl Sink for Trace {
@@ -152,25 +72,6 @@ pub struct RunResult {
     pub trace: Trace,
     /// How the run went.
     pub run: SinkRun,
-}
-
-/// Continuous PD gains of each bearing plane's design (one for the planar model).
-pub fn plane_gains(scene: &Scene) -> Result<Vec<PdGains>, controller::LawError> {
-    scene.plane_designs().iter().map(|d| PdGains::from_design(&d.pd(), &d.constants)).collect()
-}
-
-/// Integrator settings for a scene's model of `N` state components, absolute tolerances `atol`.
-pub fn settings_with<const N: usize>(scene: &Scene, atol: [f64; N]) -> Settings<N> {
-    let s = &scene.integrator;
-    Settings {
-        method: s.method,
-        substeps: s.substeps,
-        rtol: s.rtol,
-        atol,
-        h_max: scene.controller.period,
-        max_steps: 1_000_000,
-        ..Settings::new(s.method)
-    }
 }
 
 /// Runs a scene from its initial state; a co-simulation starts the
@@ -225,15 +126,6 @@ impl SinkRun {
     }
 }
 
-/// What the ticks of a run cost.
-#[derive(Clone, Debug, Default)]
-pub struct TickCost {
-    /// The most evaluations of the model the integrator made in one tick.
-    pub max_rhs_evals: u64,
-    /// The plant's execution time per tick (co-simulation runs, or [`Hooks::time_ticks`]).
-    pub tet: Option<Box<Tet>>,
-}
-
 /// Runs a scene from its initial state, sending every output sample (from
 /// `t = 0`, at the scene's output rate) to `sink`.
 pub fn run_into(
@@ -279,91 +171,6 @@ pub fn run_into_from(
     run_from(scene, source, hooks, sink, from)
 }
 
-/// Whether `scene`'s plant can start from `snapshot` ([`Plant::restore`] into a fresh one): the
-/// check made before anything starts or is written.
-///
-/// In order: the format and the scene's fingerprint (another scene named as such), the seal
-/// recomputed from this scene and the snapshot's fields ([`Snapshot::check_seal`]), then each
-/// field against the scene and the physics (the plant's restore, the digital loop's part here).
-pub fn check_start(scene: &Scene, snapshot: &Snapshot) -> Result<(), SetupError> {
-    let mut plant = Plant::new(scene, &Command::Continuous(None))?;
-    snapshot.check_against(plant.fingerprint())?;
-    snapshot.check_seal(plant.fingerprint())?;
-    check_digital(scene, snapshot)?;
-    plant.restore(snapshot)?;
-    Ok(())
-}
-
-/// The digital loop's part of `snapshot` against `scene`: commands within the amplifiers'
-/// limits (they are saturated before they enter the delay line), and the samples the law read
-/// last those of the ticks before the snapshot's, in order, on the controller's grid.
-fn check_digital(scene: &Scene, snapshot: &Snapshot) -> Result<(), SnapshotError> {
-    let Some(d) = &snapshot.digital else { return Ok(()) };
-    let limits = scene.rotor_design().current_limits();
-    for (k, c) in d.in_flight.iter().enumerate() {
-        for (a, (&i, &limit)) in c.iter().zip(&limits).enumerate() {
-            if i.is_nan() || i.abs() > limit {
-                return Err(SnapshotError::field(
-                    format!("digital.in_flight[{k}][{a}]"),
-                    format!("{i} A"),
-                    format!("within the amplifier's current limit, ±{limit} A"),
-                ));
-            }
-        }
-    }
-    if d.recent.len() > crate::digital::RECENT {
-        return Err(SnapshotError::field(
-            "digital.recent",
-            format!("{} samples", d.recent.len()),
-            format!("at most {}", crate::digital::RECENT),
-        ));
-    }
-    let period = scene.controller.period;
-    let n = d.recent.len() as u64;
-    let planes = scene.rotor_design().planes().len() as u32;
-    for (k, r) in d.recent.iter().enumerate() {
-        let field = |name: &str| format!("digital.recent[{k}].{name}");
-        // The last sample read is that of the tick before the snapshot's.
-        let seq = (snapshot.tick + k as u64).checked_sub(n);
-        if Some(r.seq) != seq {
-            return Err(SnapshotError::field(
-                field("seq"),
-                r.seq,
-                format!("the ticks before the snapshot's tick {} in order, here {seq:?}", snapshot.tick),
-            ));
-        }
-        if (r.t_s - r.seq as f64 * period).abs() > 1e-9 * period.max(r.t_s.abs()) {
-            return Err(SnapshotError::field(
-                field("t_s"),
-                format!("{} s", r.t_s),
-                format!("tick {} of {period} s", r.seq),
-            ));
-        }
-        if r.axes != 2 * planes {
-            return Err(SnapshotError::field(field("axes"), r.axes, format!("{} ({planes} planes)", 2 * planes)));
-        }
-        if !(0.0..std::f64::consts::TAU).contains(&r.angle_rad) {
-            return Err(SnapshotError::field(
-                field("angle_rad"),
-                format!("{} rad", r.angle_rad),
-                "the keyphasor's angle in [0, 2π)",
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
-/// limit (unused axes 0).
-pub fn bias_of(scene: &Scene, gains: &[PdGains]) -> [f64; ROTOR_AXES] {
-    let mut bias = [0.0; ROTOR_AXES];
-    for (i, g) in gains.iter().enumerate() {
-        let b = saturate(g.bias_a, scene.plane(i).current_limit);
-        bias[2 * i..2 * i + 2].copy_from_slice(&b);
-    }
-    bias
-}
-
 /// Runs a scene with `law` in this process, as `controller.mode = "sampled"` runs a law of
 /// the registry (whatever the scene's mode): the sensor read at each tick, the command
 /// saturated, delayed `delay_samples` ticks and held. A lockstep run of the same law in a
@@ -380,7 +187,7 @@ pub fn run_law_into(
 /// The loop, from a command source, from the scene's initial state or `from`.
 fn run_from(
     scene: &Scene,
-    mut source: Source,
+    mut source: Source<Session>,
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
     from: Option<&Snapshot>,
@@ -424,7 +231,7 @@ fn run_from(
 fn drive(
     scene: &Scene,
     plant: &mut Plant,
-    mut digital: DigitalLoop,
+    mut digital: DigitalLoop<Session>,
     hooks: &mut dyn Hooks,
     sink: &mut dyn Sink,
     (resumed, primed): (bool, Result<(), Outcome>),
@@ -494,3 +301,6 @@ fn drive(
         voltage_saturation_s: plant.voltage_saturation(),
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -10,7 +10,7 @@ use super::two_plane::RaceFailure;
 use super::{FailureState, Linearised, Machine, PlaneState, WhirlMode};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
-use crate::trace::{self, Record};
+use crate::rows::{self, Record};
 use nalgebra::Vector2;
 use plant_physics::flex::linear::{OpenLoop, PlanePd};
 use plant_physics::flex::machine::{ix, Model, Params as FlexParams, State, MAX_MODES, N};
@@ -144,10 +144,10 @@ impl Machine<N> for Model {
             let (pos, vel) = touchdown(self, y, i);
             let race = ix::RACE[i];
             let race = [y[race], y[race + 1], y[race + ix::V], y[race + 1 + ix::V], y[race + 2 + ix::V]];
-            trace::plane_values([pos.x, pos.y], [vel.x, vel.y], race, &ev.planes[i])
+            rows::plane_values([pos.x, pos.y], [vel.x, vel.y], race, &ev.planes[i])
         };
         let mut r =
-            trace::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y));
+            rows::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y));
         let (mid, _) = self.node(y, mid_span(self));
         r.mid = Some([mid.x, mid.y]);
         r
@@ -275,7 +275,7 @@ impl FlexibleLinear {
 }
 
 impl Linearised for FlexibleLinear {
-    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<WhirlMode>> {
+    fn whirl_modes(&self, speed: f64) -> Result<Vec<WhirlMode>, super::WhirlError> {
         Ok(self
             .open
             .whirl_modes(&self.pd, speed, self.f_max_hz)?

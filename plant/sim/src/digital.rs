@@ -4,16 +4,16 @@
 //! At tick `k` the loop takes the plant's sample ([`crate::stepper::Plant::sample`]), adds an
 //! excitation's sine at the summing point if a sensitivity measurement asks for one
 //! ([`Hooks::excitation`]), asks the law for its command (the PD inside the derivative, a law
-//! in this process, or the controller process over the wire, [`crate::cosim`]), saturates it,
+//! in this process, or the controller process over the wire: a [`Remote`], the CLI's
+//! co-simulation session), saturates it,
 //! holds the last valid command in place of a non-finite one within the budget
 //! ([`crate::invalid`]), and delays it `delay_samples` ticks (less the transport's own sample in
 //! realtime): the command applied over tick `k` was computed from sample `k − d`.
 //!
-//! Every mode drives this one loop ([`crate::run`]); `check.rs`'s replay feeds a recorded
-//! run's samples through the same command path ([`CommandPath`]).
+//! Every mode drives this one loop (the CLI's `plant::run`); `plant::check`'s replay feeds a
+//! recorded run's samples through the same command path ([`CommandPath`]).
 
 use crate::config::Scene;
-use crate::cosim::{CosimReport, Halt, Session};
 use crate::hooks::Hooks;
 use crate::invalid::InvalidCommands;
 use crate::run::Outcome;
@@ -22,14 +22,49 @@ use controller::{saturate_axes, RotorLaw, RotorSample, ROTOR_AXES};
 use std::collections::VecDeque;
 use std::time::Instant;
 
+/// Why the loop must stop at this tick (a [`Remote`]'s answer).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Halt {
+    /// The controller is gone (or silent past `controller.lockstep_timeout_ms`) and no other
+    /// took its place.
+    Lost(String),
+    /// SIGINT/SIGTERM to the plant.
+    Interrupted(String),
+    /// Realtime: the deadline-miss fraction exceeded `controller.max_miss_fraction`.
+    MissBudget(String),
+    /// Realtime: the plant-overrun fraction exceeded `controller.max_overrun_fraction`.
+    OverrunBudget(String),
+}
+
+/// A law in another process, as the loop sees it: the CLI's co-simulation session
+/// (`plant::cosim::Session`, over iceoryx2). The seam keeps the transport out of this crate.
+pub trait Remote {
+    /// What the remote reports when the run ends (the co-simulation's figures).
+    type Report;
+    /// Ticks of delay the transport itself adds (realtime: one sample).
+    fn inherent_delay(&self) -> u32;
+    /// The controller process serving now, if connected.
+    fn controller_pid(&self) -> Option<u32>;
+    /// The (saturated) command for `sample`, or why the loop must stop.
+    fn command(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt>;
+    /// Realtime: when the plant woke for the current tick.
+    fn tick_started(&self) -> Option<Instant>;
+    /// `Some(why)` when the deadline misses are past their budget (`min_due` ticks at least).
+    fn miss_budget_exceeded(&self, min_due: u64) -> Option<String>;
+    /// `Some(why)` when the plant's overruns are past their budget (`min_ticks` at least).
+    fn overrun_budget_exceeded(&self, min_ticks: u64) -> Option<String>;
+    /// Ends the session at `t_s` after `seq` ticks, `invalid_replies` of them non-finite.
+    fn finish(self, t_s: f64, seq: u64, invalid_replies: u64) -> Self::Report;
+}
+
 /// Where the command of each tick comes from.
-pub enum Source {
+pub enum Source<R: Remote> {
     /// The PD inside the derivative.
     Continuous,
     /// The law in this process: one per plane (decentralised) or one of the whole rotor.
     InProcess(Box<dyn RotorLaw>),
     /// The law in the controller process.
-    Cosim(Box<Session>),
+    Cosim(Box<R>),
 }
 
 /// Saturation, the invalid-command budget and the delay line: what happens to a law's answer
@@ -121,8 +156,8 @@ impl CommandPath {
 pub const RECENT: usize = 32;
 
 /// The digital loop of one run (module doc).
-pub struct DigitalLoop {
-    source: Source,
+pub struct DigitalLoop<R: Remote> {
+    source: Source<R>,
     path: CommandPath,
     controller_pid: Option<u32>,
     /// The last [`RECENT`] samples the law read, a ring (`recent_next` the oldest once full).
@@ -131,10 +166,10 @@ pub struct DigitalLoop {
     recent_next: usize,
 }
 
-impl DigitalLoop {
+impl<R: Remote> DigitalLoop<R> {
     /// The loop of `scene`, its commands from `source`, `bias` before any (A, per axis),
     /// saturated at `limits`.
-    pub fn new(scene: &Scene, source: Source, bias: [f64; ROTOR_AXES], limits: [f64; ROTOR_AXES]) -> Self {
+    pub fn new(scene: &Scene, source: Source<R>, bias: [f64; ROTOR_AXES], limits: [f64; ROTOR_AXES]) -> Self {
         let inherent = match &source {
             Source::Cosim(session) => session.inherent_delay(),
             _ => 0,
@@ -258,7 +293,7 @@ impl DigitalLoop {
 
     /// Ends the loop at `t` (s): the run's outcome judged over all its ticks (a run that
     /// completed may still be past a budget), and the co-simulation's figures.
-    pub fn finish(self, mut outcome: Outcome, t: f64, period: f64) -> (Outcome, Option<CosimReport>, u64) {
+    pub fn finish(self, mut outcome: Outcome, t: f64, period: f64) -> (Outcome, Option<R::Report>, u64) {
         if outcome == Outcome::Completed {
             if let Some(why) = self.path.at_end() {
                 outcome = Outcome::InvalidCommands(why);
@@ -274,9 +309,7 @@ impl DigitalLoop {
                         outcome = Outcome::OverrunBudget(why);
                     }
                 }
-                let mut report = session.finish(t, (t / period).round() as u64);
-                report.invalid_replies = invalid;
-                Some(report)
+                Some(session.finish(t, (t / period).round() as u64, invalid))
             }
             _ => None,
         };

@@ -31,8 +31,8 @@
 pub use crate::config::hardware::Hardware;
 use crate::machine::{FailureState, Machine, PlaneState};
 use crate::model::{Control, Params, Release};
+use crate::rows::{col, colb, Record, WIDTH_MAGNETS};
 use crate::sensor::{runout, runout_rate};
-use crate::trace::{col, colb, Record, WIDTH_MAGNETS};
 use plant_physics::integrate::System;
 use std::cell::RefCell;
 
@@ -449,7 +449,7 @@ mod tests {
     use crate::sensor::Sensor;
 
     fn realistic(sets: &[&str]) -> crate::config::Scene {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/realistic-10g.toml");
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/realistic-10g.toml");
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         load_scene(&file, &sets).expect("the realistic scene")
     }

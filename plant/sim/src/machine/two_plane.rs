@@ -4,7 +4,7 @@
 use super::{FailureState, Machine, PlaneState};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
-use crate::trace::{self, Record};
+use crate::rows::{self, Record};
 use nalgebra::Vector2;
 use plant_physics::two_plane::{self, ix, Model, State, N};
 use serde::Serialize;
@@ -119,7 +119,7 @@ impl Machine<N> for Model {
     }
 
     fn record(&self, t: f64, y: &State) -> Record {
-        trace::two_plane_record(self, t, y)
+        rows::two_plane_record(self, t, y)
     }
 
     fn contact_state(&self, levitated: &State) -> State {
@@ -184,7 +184,7 @@ impl Machine<N> for Model {
 }
 
 impl super::Linearised for plant_physics::two_plane::linear::LinearRotor {
-    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<super::WhirlMode>> {
+    fn whirl_modes(&self, speed: f64) -> Result<Vec<super::WhirlMode>, super::WhirlError> {
         use plant_physics::flex::{linear::ModeKind, Whirl};
         use plant_physics::two_plane::linear::{Shape, Whirl as RigidWhirl};
         // In the order `LinearRotor::modes` gives (campbell.csv's rows as before).

@@ -40,7 +40,7 @@ impl SplitMix64 {
     /// or axis, the same wherever it is made.
     ///
     /// ```
-    /// use plant::rng::SplitMix64;
+    /// use plant_sim::rng::SplitMix64;
     /// let (mut a, mut b) = (SplitMix64::stream(7, 0), SplitMix64::stream(7, 1));
     /// assert_ne!(a.next_u64(), b.next_u64());
     /// assert_eq!(SplitMix64::stream(7, 1).next_u64(), SplitMix64::stream(7, 1).next_u64());
@@ -65,7 +65,7 @@ impl SplitMix64 {
     /// Uniform in `[lo, hi)`.
     ///
     /// ```
-    /// let u = plant::rng::SplitMix64::new(7).uniform([1.0, 20.0]);
+    /// let u = plant_sim::rng::SplitMix64::new(7).uniform([1.0, 20.0]);
     /// assert!((1.0..20.0).contains(&u));
     /// ```
     #[inline]

@@ -10,7 +10,7 @@
 //! `complete`.
 //!
 //! ```
-//! use plant::invalid::InvalidCommands;
+//! use plant_sim::invalid::InvalidCommands;
 //! let mut check = InvalidCommands::new([0.0, 0.5], 2, 1.0);
 //! let s = |k: u64| controller::Sample { seq: k, t_s: k as f64 * 5e-5, ..Default::default() };
 //! assert_eq!(check.check([0.1, 0.6], &s(0)).unwrap().command, [0.1, 0.6]);

@@ -537,7 +537,7 @@ fn flatten(prefix: &str, table: &toml::Table, out: &mut Vec<(String, String)>) {
 /// A shipped scene (`config/FILE`) with `sets` applied, for the library's tests.
 #[cfg(test)]
 pub(crate) fn shipped(file: &str, sets: &[&str]) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("config").join(file);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config").join(file);
     load_scene(&path, &sets.iter().map(|s| s.to_string()).collect::<Vec<_>>())
         .unwrap_or_else(|e| panic!("config/{file} {sets:?}: {e}"))
 }
@@ -604,7 +604,7 @@ mod tests {
         let text = toml::Table::from_iter([("current_limit_a".to_string(), toml::Value::String("big".into()))]);
         assert!(check_controller_overrides(&text, 2.0).is_err());
         // The scene a run folder records refuses them too: nothing of a refused table is set.
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/cosim-10g.toml");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/cosim-10g.toml");
         let scene = load_scene(&path, &[]).unwrap();
         let mode = toml::Table::from_iter([
             ("damping_ratio".to_string(), toml::Value::Float(0.05)),

@@ -18,7 +18,7 @@ pub use planar::PlanarFailure;
 pub use two_plane::{RaceFailure, TwoPlaneFailure};
 
 use crate::model::{Control, Params, Release};
-use crate::trace::Record;
+use crate::rows::Record;
 use controller::{saturate, PdGains};
 use nalgebra::Vector2;
 use plant_physics::integrate::System;
@@ -46,7 +46,18 @@ pub struct WhirlMode {
 pub trait Linearised {
     /// The whirl modes at spin speed `speed` (rad/s), ascending in frequency: the rigid rotor's
     /// four, and a flexible rotor's bending modes below its cutoff beside them.
-    fn whirl_modes(&self, speed: f64) -> anyhow::Result<Vec<WhirlMode>>;
+    fn whirl_modes(&self, speed: f64) -> Result<Vec<WhirlMode>, WhirlError>;
+}
+
+/// Why a linearised rotor's whirl modes could not be computed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum WhirlError {
+    /// The two-plane rotor's eigenvalues.
+    #[error("{0}")]
+    TwoPlane(#[from] plant_physics::two_plane::linear::ModesError),
+    /// The flexible rotor's eigenvalues.
+    #[error("{0}")]
+    Flexible(#[from] plant_physics::flex::modes::ModesError),
 }
 
 /// One bearing plane's state at an output time, for a sink that needs what a row does not hold

@@ -4,7 +4,7 @@ use super::{FailureState, Machine, PlaneState};
 use crate::model::ix::*;
 use crate::model::{Control, Model, Params, Release, State, N};
 use crate::park;
-use crate::trace::{self, Record};
+use crate::rows::{self, Record};
 use nalgebra::Vector2;
 use serde::Serialize;
 
@@ -81,7 +81,7 @@ impl Machine<N> for Model {
     }
 
     fn record(&self, t: f64, y: &State) -> Record {
-        Record::planar(trace::row(self, t, y))
+        Record::planar(rows::row(self, t, y))
     }
 
     fn contact_state(&self, levitated: &State) -> State {
