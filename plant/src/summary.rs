@@ -84,14 +84,8 @@ impl ModelInfo {
             law: c.law.clone(),
             controller_rate_hz: 1.0 / c.period,
             delay_samples: c.delay_samples,
-            ross_bearings: match &scene.rotor {
-                crate::config::Rotor::Flexible(f) => f.file_bearings.clone(),
-                _ => Vec::new(),
-            },
-            ross_ambs: match &scene.rotor {
-                crate::config::Rotor::Flexible(f) => f.file_ambs.clone(),
-                _ => Vec::new(),
-            },
+            ross_bearings: scene.rotor.params().file_bearings().to_vec(),
+            ross_ambs: scene.rotor.params().file_ambs().to_vec(),
         }
     }
 }

@@ -1,12 +1,12 @@
-//! No module cycle in `plant/src` or `controller/src`: at every level of each library's module
+//! No module cycle in `plant/src`, `plant/sim/src` or `controller/src`: at every level of each library's module
 //! tree, the modules under one parent import each other without a cycle (`sweep` and
 //! `ensemble` used to import each other, and the laws the registry that lists them).
 //!
 //! Each library is read from its `lib.rs` down its `mod` declarations (inline modules
 //! included), tokenised with `proc-macro2` (comments and string contents are not paths). Every
 //! path that starts at `crate::`, `$crate::`, `super::` or `self::` — in a `use` tree or in code
-//! — is resolved to the module it names (through the crate root's `pub use` re-exports, so
-//! `crate::ControlLaw` is `law`). A path from module `a::x::…` to `a::y::…` is an edge `x → y`
+//! — is resolved to the module it names (through every module's `use` items, re-exports
+//! included, so `crate::ControlLaw` is `law` and, under `config`, `super::Rotor` is `rotor`). A path from module `a::x::…` to `a::y::…` is an edge `x → y`
 //! under parent `a`; a path between a module and its own ancestor or descendant is not (a
 //! parent re-exporting its children, a child reading its parent's types). The test fails
 //! naming each cycle.
@@ -22,8 +22,11 @@ type ModPath = Vec<String>;
 #[derive(Default)]
 struct Library {
     modules: BTreeSet<ModPath>,
-    /// Crate-root re-exports: name → the path it comes from.
-    root_uses: BTreeMap<String, ModPath>,
+    /// Every module's `use` items (re-exports and imports): (module, name) → the absolute path
+    /// the name comes from, so that `super::Rotor` through `config`'s `pub use rotor::Rotor` is
+    /// `config::rotor` (issue 41: `config::rotor` and `config::validate` once imported each
+    /// other through their parent's re-exports, unseen).
+    reexports: BTreeMap<(ModPath, String), ModPath>,
     /// (module, a path it uses, already made absolute).
     uses: Vec<(ModPath, ModPath)>,
 }
@@ -129,11 +132,20 @@ impl Library {
                         }
                     }
                 }
-                TokenTree::Ident(id) if id == "use" && at.is_empty() => {
-                    // The crate root's `pub use module::{Item, …}`: where each name comes from.
+                TokenTree::Ident(id) if id == "use" => {
+                    // A `use` item at this module: where each name it brings in comes from.
                     for p in paths(&tokens[i + 1..]) {
-                        if let (Some(name), true) = (p.last(), p.len() > 1) {
-                            self.root_uses.insert(name.clone(), p.clone());
+                        let Some(name) = p.last().filter(|_| p.len() > 1) else { continue };
+                        let target = match p[0].as_str() {
+                            "crate" | "super" | "self" => absolute(at, &p),
+                            // A path from a child module of this one (2018 paths), else an
+                            // outside crate's (not this library's).
+                            first => self
+                                .declared_child(file, dir_root, first)
+                                .then(|| at.iter().chain(&p).cloned().collect()),
+                        };
+                        if let Some(target) = target {
+                            self.reexports.insert((at.to_vec(), name.clone()), target);
                         }
                     }
                 }
@@ -143,22 +155,32 @@ impl Library {
         }
     }
 
-    /// The module a path names: its longest prefix that is a module, through the root's
-    /// re-exports.
+    /// Whether module `name` is declared in `file` (a child of the module being read).
+    fn declared_child(&self, file: &Path, dir_root: bool, name: &str) -> bool {
+        module_file(file, dir_root, name).is_some()
+    }
+
+    /// The module a path names: its longest prefix that is a module, then through the `use`
+    /// items of that module (a re-export, at any level) to where the next name comes from.
     fn module_of(&self, path: &[String]) -> ModPath {
-        if let Some(first) = path.first() {
-            if !self.modules.contains(&vec![first.clone()]) {
-                if let Some(target) = self.root_uses.get(first) {
-                    if target.first() != Some(first) {
-                        return self.module_of(target);
-                    }
-                }
-            }
-        }
+        self.module_of_depth(path, 0)
+    }
+
+    fn module_of_depth(&self, path: &[String], depth: usize) -> ModPath {
         let mut best = ModPath::new();
         for n in 1..=path.len() {
             if self.modules.contains(&path[..n]) {
                 best = path[..n].to_vec();
+            }
+        }
+        if depth < 16 {
+            if let Some(next) = path.get(best.len()) {
+                if let Some(target) = self.reexports.get(&(best.clone(), next.clone())) {
+                    let followed: ModPath = target.iter().chain(&path[best.len() + 1..]).cloned().collect();
+                    if followed != path {
+                        return self.module_of_depth(&followed, depth + 1);
+                    }
+                }
             }
         }
         best
@@ -264,7 +286,14 @@ fn the_reader_finds_a_cycle_and_resolves_paths() {
     let dir = std::env::temp_dir().join(format!("modules-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.join("a")).unwrap();
-    std::fs::write(dir.join("lib.rs"), "pub mod a; pub mod b; mod c; pub use c::Thing;\n// use crate::b;\n").unwrap();
+    std::fs::create_dir_all(dir.join("d")).unwrap();
+    std::fs::write(dir.join("lib.rs"), "pub mod a; pub mod b; mod c; pub mod d; pub use c::Thing;\n// use crate::b;\n")
+        .unwrap();
+    // A cycle through a parent's re-exports only (issue 41: `config::rotor` and
+    // `config::validate` once imported each other so, unseen).
+    std::fs::write(dir.join("d/mod.rs"), "mod p; mod q; pub use p::P; pub use self::q::Q;\n").unwrap();
+    std::fs::write(dir.join("d/p.rs"), "pub struct P(super::Q);\n").unwrap();
+    std::fs::write(dir.join("d/q.rs"), "use super::P; pub struct Q(Option<Box<P>>);\n").unwrap();
     std::fs::write(dir.join("a/mod.rs"), "pub mod x; pub mod y; pub use x::X;\n").unwrap();
     std::fs::write(dir.join("a/x.rs"), "use super::y::Y; pub struct X; fn f() { let _ = \"crate::b\"; }\n").unwrap();
     std::fs::write(dir.join("a/y.rs"), "pub struct Y(crate::a::x::X);\n").unwrap();
@@ -278,5 +307,6 @@ fn the_reader_finds_a_cycle_and_resolves_paths() {
     assert!(root.contains(&("c".into(), "b".into())), "{root:?}");
     assert_eq!(cycles(root), vec![vec!["b".to_string(), "c".to_string()]]);
     assert!(!root.contains(&("a".into(), "b".into())), "a string or a comment is not a path: {root:?}");
+    assert_eq!(cycles(&edges[&vec!["d".to_string()]]), vec![vec!["p".to_string(), "q".to_string()]]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -13,6 +13,7 @@
 pub mod closed_form;
 pub mod coupled;
 pub mod duty;
+mod failure;
 pub mod hertz;
 pub mod ladder;
 #[cfg(test)]

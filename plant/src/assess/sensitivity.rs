@@ -268,7 +268,7 @@ pub enum MeasureError {
     #[error("{why}")]
     Run {
         /// How.
-        kind: super::Failure,
+        kind: super::failure::Failure,
         /// What happened.
         why: String,
     },
@@ -426,11 +426,11 @@ impl<'a> Measure<'a> {
         }
         let Some(stable) = self.stable else {
             let why = "the measurement did not get past its probe".into();
-            return Err(MeasureError::Run { kind: super::Failure::Other, why });
+            return Err(MeasureError::Run { kind: super::failure::Failure::Other, why });
         };
         if stable && !matches!(self.phase, Phase::Done) {
             let why = format!("the measurement stopped at t = {simulated_s:.3} s before its last frequency");
-            return Err(MeasureError::Run { kind: super::Failure::Other, why });
+            return Err(MeasureError::Run { kind: super::failure::Failure::Other, why });
         }
         self.points.sort_by(|a, b| a.f_hz.total_cmp(&b.f_hz));
         let peak = if stable { peak_of(&self.points) } else { None };

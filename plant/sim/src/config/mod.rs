@@ -13,6 +13,7 @@
 
 pub mod fmu;
 pub mod hardware;
+pub mod models;
 pub mod overrides;
 pub mod raw;
 pub mod rotor;
@@ -23,7 +24,7 @@ pub use raw::{
     ControlMode, DragChoice, Fallback, ForceLaw, Pacing, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
     ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
-pub use rotor::Rotor;
+pub use rotor::{Rotor, RotorParams};
 pub use validate::{finite, non_negative, positive, range, validate};
 
 use crate::integrate::Method;

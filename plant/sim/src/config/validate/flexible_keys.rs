@@ -3,15 +3,12 @@
 //! scene and the rigid rotor's geometry keys refused in a flexible one.
 
 use super::*;
+use crate::config::models::flexible::{CUTOFF_HZ, MODAL_DAMPING};
 use plant_physics::flex::{self, machine, Reduction};
 use std::sync::Arc;
 
 /// Reduced coordinates the flexible state has room for.
 const MAX_BASIS: usize = machine::MAX_MODES;
-/// Cutoff when none is given (Hz).
-pub(super) const CUTOFF_HZ: f64 = 2000.0;
-/// Modal damping ratio when none is given.
-pub(super) const MODAL_DAMPING: f64 = 0.005;
 
 /// The flexible rotor's keys given in a rigid scene, refused by name.
 pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
@@ -271,19 +268,4 @@ pub(in crate::config) fn file_bearings_note(raw: &RawScene, params: &machine::Pa
          (summary.json model.ross_bearings)",
         kept.join(", ")
     ))
-}
-
-/// Writes the flexible rotor's defaults into the raw scene, and the mass and polar inertia its
-/// shaft has (what the scene's `mass_kg` and `polar_inertia_kg_m2` are replaced by), so that the
-/// resolved `scene.toml` states them.
-pub(in crate::config) fn record_flexible(raw: &mut RawScene, params: &machine::Params) {
-    let r = &mut raw.rotor;
-    r.mass_kg = params.machine.rotor.mass;
-    r.polar_inertia_kg_m2 = params.machine.rotor.polar_inertia;
-    r.sensor_a_node.get_or_insert(params.nodes[0].sensor);
-    r.sensor_b_node.get_or_insert(params.nodes[1].sensor);
-    r.touchdown_a_node.get_or_insert(params.nodes[0].touchdown);
-    r.touchdown_b_node.get_or_insert(params.nodes[1].touchdown);
-    r.cutoff_hz.get_or_insert(CUTOFF_HZ);
-    r.modal_damping.get_or_insert(MODAL_DAMPING);
 }

@@ -33,7 +33,7 @@ use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
 use std::path::Path;
 
-// The rotor models' keys, each built by the model's arm of `Rotor::from_raw`
+// The rotor models' keys, each built by the model's arm of `rotor_of::rotor_from_raw`
 // (config/rotor.rs) with the bearing planes of `bearing`.
 pub(super) mod bearing;
 mod checks;
@@ -41,6 +41,7 @@ mod controller_keys;
 pub(super) mod flexible_keys;
 mod hardware_keys;
 mod ross_ambs;
+mod rotor_of;
 pub(super) mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
@@ -134,8 +135,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     };
     let whole =
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
-    // The rotor model, built from the scene by its own arm of `Rotor::from_raw`.
-    let mut rotor = Rotor::from_raw(&raw, &whole, base_dir)?;
+    // The rotor model, built from the scene by its own arm of `rotor_of::rotor_from_raw`.
+    let mut rotor = rotor_of::rotor_from_raw(&raw, &whole, base_dir)?;
     // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
     // AMBs: the run's first line says so.
     if let Rotor::Flexible(f) = &mut rotor {

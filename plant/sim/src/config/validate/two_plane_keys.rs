@@ -171,18 +171,3 @@ pub(in crate::config) fn two_plane_params(raw: &RawScene, whole: &Share) -> Resu
         planes: [plane(0)?, plane(1)?],
     })
 }
-
-/// Writes the two-plane rotor's defaults into the raw scene (as the user would have written
-/// them, in the file's units), so that the resolved `scene.toml` states them.
-pub(in crate::config) fn record_two_plane(raw: &mut RawScene) {
-    let r = &mut raw.rotor;
-    r.transverse_inertia_kg_m2.get_or_insert(0.414);
-    r.couple_unbalance_urad.get_or_insert(0.0);
-    r.couple_unbalance_phase_deg.get_or_insert(0.0);
-    let a = *r.bearing_a_mm.get_or_insert(-180.0);
-    let b = *r.bearing_b_mm.get_or_insert(180.0);
-    r.sensor_a_mm.get_or_insert(a);
-    r.sensor_b_mm.get_or_insert(b);
-    r.end_a_mm.get_or_insert(-230.0);
-    r.end_b_mm.get_or_insert(230.0);
-}
