@@ -3,14 +3,15 @@
 //! with friction, AMB force law, housing moved by a base shock), its
 //! integrators, and scene runs with their outputs.
 //!
-//! Layout: [`force`] holds one kernel per force law; [`model`] the pure
-//! derivative; [`integrate`] the hand-written integrators; [`park`] the parked
-//! race (these four are the `plant-physics` crate's, re-exported); [`config`] the
-//! scene files; [`run`] the loop that owns time ([`hooks`] what it reports
-//! while it runs); [`trace`] the rows of a run and `trace.csv`, [`record`]
-//! the one pass over them (bounded stores in [`bounded`]), [`summary`] and
-//! [`analysis`] their figures, [`status`] how a run ended, [`output`] the run
-//! folder ([`claim`]: one live process per folder) and [`plot`] the charts.
+//! Layout: the simulation is the `plant-sim` crate's ([`config`] the scene, [`machine`] the
+//! rotor models, [`Plant`] the plant as a value, [`digital`] the digital loop, [`hooks`] what a
+//! run reports while it runs), the physics the `plant-physics` crate's ([`force`], [`model`],
+//! [`integrate`], [`park`]), both re-exported. This crate is the CLI on them, in layers, each
+//! importing only from those below it: [`util`] (shared rooms: files in and out, signals,
+//! endings), [`results`] (the rows, their analysis, figures and charts), [`run`] (the loop that
+//! owns time, the co-simulation), [`outputs`] (the run folder, `summary.json`, the recording,
+//! the FMU file), [`studies`] (report card, comparisons, soaks, sweeps, ensembles, benches). Each
+//! module is also re-exported at the crate root, its old path.
 #![warn(missing_docs)]
 
 pub use plant_physics::{force, integrate, model, park};
@@ -18,42 +19,22 @@ pub use plant_physics::{force, integrate, model, park};
 // `plant-sim` crate's.
 pub use plant_sim::{config, digital, hardware, hooks, initial, invalid, machine, rng, sensor, stepper, Plant};
 
-pub mod analysis;
-pub mod argument;
-pub mod assess;
-pub mod atomic;
-pub mod bench;
-pub mod bounded;
-pub mod campbell;
-pub mod check;
-pub mod claim;
-pub mod compare;
-pub mod cosim;
-pub mod ensemble;
-pub mod exit;
-pub mod figures;
-pub mod fmu_export;
-pub mod grid;
-pub mod input;
-pub mod interrupt;
-pub mod linear;
-pub mod offload;
-pub mod outfile;
-pub mod output;
-pub mod plot;
-pub mod record;
-pub mod recording;
-pub mod robustness;
-pub mod row_file;
+// The layers, each importing only from those below it (util < results < run < outputs <
+// studies; tests/tests/modules.rs fails on a cycle between them).
+pub mod outputs;
+pub mod results;
 pub mod run;
-pub mod snapshot;
-pub mod soak;
-pub mod stability;
-pub mod status;
-pub mod summary;
-pub mod sweep;
-pub mod table;
-pub mod trace;
+pub mod studies;
+pub mod util;
+
+// Every module at its old path (`plant::trace`, `plant::assess`, …).
+pub use outputs::{fmu_export, output, recording, status, summary};
+pub use results::{analysis, bounded, figures, plot, record, snapshot, trace};
+pub use run::{cosim, offload};
+pub use studies::{
+    assess, bench, campbell, check, compare, ensemble, grid, linear, robustness, soak, stability, sweep,
+};
+pub use util::{argument, atomic, claim, exit, input, interrupt, outfile, row_file, table};
 
 /// A shipped scene (`config/FILE`) with `sets` applied, for the library's tests.
 #[cfg(test)]

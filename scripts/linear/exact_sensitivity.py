@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The sampled planar loop's sensitivity in 60-digit decimal arithmetic: the figures
-plant/src/linear/tests.rs holds the exported model against (the standard library only).
+plant/src/studies/linear/tests.rs holds the exported model against (the standard library only).
 
 config/cosim-10g.toml: one axis m x'' = k_s x + k_i i (m = 11.5 kg, k_s = 4.32e5 N/m,
 k_i = 216 N/A), sensor A_s = 25 000 V/m, the PD i_k = -A_a (k_p v_k + k_d (v_k - v_{k-1}) / T)

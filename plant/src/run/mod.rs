@@ -9,6 +9,9 @@
 //! integrator restarts at every tick. The trace is recorded at the output
 //! rate (dense output inside macro steps).
 
+pub mod cosim;
+pub mod offload;
+
 pub use plant_sim::run::{bias_of, plane_gains, settings_with, Outcome, PlaneStates, RunError, Sink, TickCost};
 pub use plant_sim::{digital, stepper};
 

@@ -28,7 +28,7 @@ impl Session {
         }
     }
 
-    pub(in crate::cosim) fn lockstep(
+    pub(in crate::run::cosim) fn lockstep(
         &mut self,
         sample: &RotorSample,
         hooks: &mut dyn Hooks,

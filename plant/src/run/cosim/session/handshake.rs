@@ -87,7 +87,7 @@ fn rt_throttling_warning(settings: &CosimSettings, rt_runtime_us: Option<i64>) -
 /// (measured on the 10 G scene, spinning: 0 deadline misses in 10 of 10 runs, each the
 /// lockstep trace bit for bit; at one priority a spinning plant starves the controller, and
 /// one below the plant, a sleeping plant's clock preempts a controller still at work).
-pub(in crate::cosim) fn controller_priority(settings: &CosimSettings) -> u32 {
+pub(in crate::run::cosim) fn controller_priority(settings: &CosimSettings) -> u32 {
     match settings.realtime_priority {
         0 => 0,
         p if shares_core(settings) => (p + 1).min(99),
@@ -120,7 +120,7 @@ impl Session {
         )
     }
 
-    pub(in crate::cosim) fn open(
+    pub(in crate::run::cosim) fn open(
         mode: ControlMode,
         settings: CosimSettings,
         hello: Hello,
