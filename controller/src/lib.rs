@@ -75,6 +75,7 @@
 //! with every law of the registry ([`ALL_LAWS`]).
 #![warn(missing_docs)]
 
+pub mod cores;
 pub mod design;
 pub mod discrete_pd;
 pub mod discretisation;

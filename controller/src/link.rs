@@ -675,12 +675,7 @@ pub fn policy(pid: u32) -> &'static str {
     }
 }
 
-/// Number of CPU cores online.
-pub fn cores_online() -> usize {
-    // SAFETY: sysconf has no preconditions.
-    let n = unsafe { libc::sysconf(libc::_SC_NPROCESSORS_ONLN) };
-    usize::try_from(n).unwrap_or(1).max(1)
-}
+pub use crate::cores::cores_online;
 
 #[cfg(test)]
 mod tests {

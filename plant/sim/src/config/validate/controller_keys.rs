@@ -43,7 +43,7 @@ pub(super) fn cosim_settings(ctl: &RawController) -> Result<CosimSettings, Confi
     let pin_cores = match ctl.pin_cores.as_slice() {
         [] => None,
         &[plant, controller] => {
-            let cores = controller::link::cores_online();
+            let cores = controller::cores::cores_online();
             for core in [plant, controller] {
                 if core >= cores {
                     return Err(range(
