@@ -89,32 +89,7 @@ pub fn heatmap(
 
         let mut chart = builder(&main).build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(draw_err(path))?;
 
-        // Rasterise: each pixel shows the largest value of the cells it touches.
-        let mut pixels = vec![f64::NAN; pw * ph];
-        let to_px = |v: f64, lo: f64, hi: f64, n: usize| (v - lo) / (hi - lo) * n as f64;
-        let px_span = |a: f64, b: f64, lo: f64, hi: f64, n: usize| {
-            let (p, q) = (to_px(a.min(b), lo, hi, n), to_px(a.max(b), lo, hi, n));
-            let p0 = (p.floor().max(0.0) as usize).min(n - 1);
-            let p1 = (q.ceil() as usize).clamp(p0 + 1, n);
-            p0..p1
-        };
-        let cols: Vec<Range<usize>> = (0..x.len()).map(|c| px_span(xe[c], xe[c + 1], xr.0, xr.1, pw)).collect();
-        for (r, row) in z.iter().enumerate() {
-            let rows = px_span(ye[r], ye[r + 1], yr.0, yr.1, ph);
-            for (c, &v) in row.iter().enumerate() {
-                if !v.is_finite() {
-                    continue;
-                }
-                for py in rows.clone() {
-                    let line = &mut pixels[py * pw..(py + 1) * pw];
-                    for p in &mut line[cols[c].clone()] {
-                        if p.is_nan() || *p < v {
-                            *p = v;
-                        }
-                    }
-                }
-            }
-        }
+        let pixels = rasterise(z, (&xe, &ye), (xr, yr), (pw, ph));
         {
             let plot = chart.plotting_area().strip_coord_spec();
             for py in 0..ph {
@@ -144,40 +119,87 @@ pub fn heatmap(
             .draw()
             .map_err(draw_err(path))?;
 
-        // Colour bar, with the same top and bottom as the plotting area.
-        let mut bar_chart = ChartBuilder::on(&bar)
-            .margin_top(10)
-            .margin_bottom(10)
-            .margin_left(10)
-            .margin_right(10)
-            .x_label_area_size(70)
-            .right_y_label_area_size(100)
-            .build_cartesian_2d(0f64..1f64, z0..z1)
-            .map_err(draw_err(path))?;
-        let steps = 256;
-        bar_chart
-            .draw_series((0..steps).map(|k| {
-                let a = z0 + (z1 - z0) * k as f64 / steps as f64;
-                let b = z0 + (z1 - z0) * (k + 1) as f64 / steps as f64;
-                Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / steps as f64).filled())
-            }))
-            .map_err(draw_err(path))?;
-        let z_fmt = linear_ticks(z0, z1);
-        bar_chart
-            .configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_labels(MAX_TICKS)
-            .y_desc(z_label)
-            .y_label_formatter(&z_fmt)
-            .label_style(font(TICK_PX))
-            .axis_desc_style(font(LABEL_PX))
-            .axis_style(BLACK)
-            .set_all_tick_mark_size(6)
-            .draw()
-            .map_err(draw_err(path))?;
+        colour_bar(&bar, path, (z0, z1), z_label)?;
         Ok(())
     })
+}
+
+/// Each pixel of a `pw` × `ph` plotting area over `xr` × `yr` holds the largest finite value of
+/// the cells (edges `xe`, `ye`) it touches; NaN where none does. Row 0 is the bottom.
+fn rasterise(
+    z: &[Vec<f64>],
+    (xe, ye): (&[f64], &[f64]),
+    (xr, yr): ((f64, f64), (f64, f64)),
+    (pw, ph): (usize, usize),
+) -> Vec<f64> {
+    let mut pixels = vec![f64::NAN; pw * ph];
+    let to_px = |v: f64, lo: f64, hi: f64, n: usize| (v - lo) / (hi - lo) * n as f64;
+    let px_span = |a: f64, b: f64, lo: f64, hi: f64, n: usize| {
+        let (p, q) = (to_px(a.min(b), lo, hi, n), to_px(a.max(b), lo, hi, n));
+        let p0 = (p.floor().max(0.0) as usize).min(n - 1);
+        let p1 = (q.ceil() as usize).clamp(p0 + 1, n);
+        p0..p1
+    };
+    let cols: Vec<Range<usize>> = (0..xe.len() - 1).map(|c| px_span(xe[c], xe[c + 1], xr.0, xr.1, pw)).collect();
+    for (r, row) in z.iter().enumerate() {
+        let rows = px_span(ye[r], ye[r + 1], yr.0, yr.1, ph);
+        for (c, &v) in row.iter().enumerate() {
+            if !v.is_finite() {
+                continue;
+            }
+            for py in rows.clone() {
+                let line = &mut pixels[py * pw..(py + 1) * pw];
+                for p in &mut line[cols[c].clone()] {
+                    if p.is_nan() || *p < v {
+                        *p = v;
+                    }
+                }
+            }
+        }
+    }
+    pixels
+}
+
+/// The colour bar beside a heat map, over `z0..z1`, with the same top and bottom as the
+/// plotting area.
+fn colour_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    path: &Path,
+    (z0, z1): (f64, f64),
+    z_label: &str,
+) -> Result<(), PlotError> {
+    let mut bar_chart = ChartBuilder::on(bar)
+        .margin_top(10)
+        .margin_bottom(10)
+        .margin_left(10)
+        .margin_right(10)
+        .x_label_area_size(70)
+        .right_y_label_area_size(100)
+        .build_cartesian_2d(0f64..1f64, z0..z1)
+        .map_err(draw_err(path))?;
+    let steps = 256;
+    bar_chart
+        .draw_series((0..steps).map(|k| {
+            let a = z0 + (z1 - z0) * k as f64 / steps as f64;
+            let b = z0 + (z1 - z0) * (k + 1) as f64 / steps as f64;
+            Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / steps as f64).filled())
+        }))
+        .map_err(draw_err(path))?;
+    let z_fmt = linear_ticks(z0, z1);
+    bar_chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(MAX_TICKS)
+        .y_desc(z_label)
+        .y_label_formatter(&z_fmt)
+        .label_style(font(TICK_PX))
+        .axis_desc_style(font(LABEL_PX))
+        .axis_style(BLACK)
+        .set_all_tick_mark_size(6)
+        .draw()
+        .map_err(draw_err(path))?;
+    Ok(())
 }
 
 /// Converts a grid of magnitudes to decibels, `20·log10(|v| / reference)`
