@@ -130,57 +130,14 @@ impl Session {
         hooks: &mut dyn Hooks,
     ) -> Result<Session, CosimError> {
         let run_id = wire::str_of(&hello.run_id).into_owned();
-        let program = match &launch.controller {
-            ControllerProcess::Spawn(Some(path)) => Some(Program::Builtin(path.clone())),
-            ControllerProcess::Spawn(None) => Some(match &settings.command {
-                Some(argv) => process::resolve(argv)?,
-                None => Program::Builtin(process::controller_exe_next_to_current()?),
-            }),
-            ControllerProcess::External => None,
-        };
+        let program = program_of(launch, &settings)?;
         // Before any service of the run is opened: a second plant under a live run id never
         // touches the first one's services.
         let lock = controller::lock::acquire(&run_id, "plant")?;
         if let Some([plant_core, _]) = settings.pin_cores {
             link::pin_to_core(plant_core).map_err(CosimError::Pin)?;
         }
-        let mut scheduling = Scheduling { realtime_priority: settings.realtime_priority, ..Default::default() };
-        if settings.realtime_priority > 0 {
-            // Before the controller is started: it inherits the policy (and is told to lock its
-            // own memory through the environment).
-            for refused in link::realtime(settings.realtime_priority as i32) {
-                hooks.note(&format!(
-                    "warning: controller.realtime_priority = {}: the plant could not take {refused}; running without it",
-                    settings.realtime_priority
-                ));
-                scheduling.refused.push(format!("plant: {refused}"));
-            }
-        }
-        scheduling.plant = link::policy(0).to_string();
-        let mut idle_latency = None;
-        if mode == ControlMode::Realtime {
-            scheduling.pacing = Some(format!("{:?}", settings.pacing).to_lowercase());
-            scheduling.rt_runtime_us = link::rt_runtime_us();
-            if let Some(why) = rt_throttling_warning(&settings, scheduling.rt_runtime_us) {
-                hooks.note(&why);
-            }
-            if settings.realtime_priority > 0 {
-                match link::hold_zero_idle_latency() {
-                    Ok(f) => {
-                        idle_latency = Some(f);
-                        scheduling.idle_latency_us = Some(0);
-                    }
-                    Err(e) => {
-                        hooks.note(&format!(
-                            "warning: controller.realtime_priority = {}: cannot hold the idle latency at 0 ({e}); \
-                             idle cores may wake slower",
-                            settings.realtime_priority
-                        ));
-                        scheduling.refused.push(format!("plant: {e}"));
-                    }
-                }
-            }
-        }
+        let (scheduling, idle_latency) = scheduling_of(mode, &settings, hooks);
         let log = OutputLog::create(launch.log.as_deref())
             .map_err(|e| CosimError::Spawn {
                 path: launch.log.clone().unwrap_or_default(),
@@ -229,19 +186,7 @@ impl Session {
             watchdog: None,
             settings,
         };
-        // On a shared core the controller runs above the plant; the watchdog above both.
-        let above = controller_priority(&s.settings);
-        if let Some([core, _]) = s.settings.pin_cores {
-            if shares_core(&s.settings) && above > 0 && s.scheduling.plant == "fifo" {
-                s.watchdog = super::super::watchdog::Watchdog::start(core, (above as i32 + 1).min(99));
-                if s.watchdog.is_none() {
-                    hooks.note(
-                        "warning: cannot start the plant's watchdog on the shared core: a controller that stops \
-                         blocking between frames would hold the core",
-                    );
-                }
-            }
-        }
+        s.start_watchdog(hooks);
         if s.program.is_none() {
             hooks.note(&format!(
                 "waiting up to {} s for a controller: start `controller --run-id {}`",
@@ -253,6 +198,22 @@ impl Session {
         s.event("connected", 0.0, 0, s.controller.clone());
         s.wall_start = Instant::now();
         Ok(s)
+    }
+
+    /// On a shared core the controller runs above the plant; the watchdog above both.
+    fn start_watchdog(&mut self, hooks: &mut dyn Hooks) {
+        let above = controller_priority(&self.settings);
+        if let Some([core, _]) = self.settings.pin_cores {
+            if shares_core(&self.settings) && above > 0 && self.scheduling.plant == "fifo" {
+                self.watchdog = super::super::watchdog::Watchdog::start(core, (above as i32 + 1).min(99));
+                if self.watchdog.is_none() {
+                    hooks.note(
+                        "warning: cannot start the plant's watchdog on the shared core: a controller that stops \
+                         blocking between frames would hold the core",
+                    );
+                }
+            }
+        }
     }
 
     pub(super) fn spawn(&mut self) -> Result<(), CosimError> {
@@ -408,6 +369,67 @@ fn controller_overrides(ack: &Ack) -> Result<Option<toml::Table>, String> {
         Some(toml::Value::Table(t)) if doc.is_empty() => Ok(Some(t)),
         _ => Err(format!("its overrides must be one [controller] table, got: {text}")),
     }
+}
+
+/// The controller process a run starts: the built-in one beside the plant, `controller.command`,
+/// or none (an external controller the user starts).
+fn program_of(launch: &Launch, settings: &CosimSettings) -> Result<Option<Program>, CosimError> {
+    Ok(match &launch.controller {
+        ControllerProcess::Spawn(Some(path)) => Some(Program::Builtin(path.clone())),
+        ControllerProcess::Spawn(None) => Some(match &settings.command {
+            Some(argv) => process::resolve(argv)?,
+            None => Program::Builtin(process::controller_exe_next_to_current()?),
+        }),
+        ControllerProcess::External => None,
+    })
+}
+
+/// The plant's scheduling before the controller starts (which inherits it): the realtime
+/// policy asked for, what was refused (each a warning), and in realtime mode the pacing and the
+/// idle latency held at 0 (the file that holds it, kept open for the run).
+fn scheduling_of(
+    mode: ControlMode,
+    settings: &CosimSettings,
+    hooks: &mut dyn Hooks,
+) -> (Scheduling, Option<std::fs::File>) {
+    let mut scheduling = Scheduling { realtime_priority: settings.realtime_priority, ..Default::default() };
+    if settings.realtime_priority > 0 {
+        // Before the controller is started: it inherits the policy (and is told to lock its
+        // own memory through the environment).
+        for refused in link::realtime(settings.realtime_priority as i32) {
+            hooks.note(&format!(
+                "warning: controller.realtime_priority = {}: the plant could not take {refused}; running without it",
+                settings.realtime_priority
+            ));
+            scheduling.refused.push(format!("plant: {refused}"));
+        }
+    }
+    scheduling.plant = link::policy(0).to_string();
+    let mut idle_latency = None;
+    if mode == ControlMode::Realtime {
+        scheduling.pacing = Some(format!("{:?}", settings.pacing).to_lowercase());
+        scheduling.rt_runtime_us = link::rt_runtime_us();
+        if let Some(why) = rt_throttling_warning(settings, scheduling.rt_runtime_us) {
+            hooks.note(&why);
+        }
+        if settings.realtime_priority > 0 {
+            match link::hold_zero_idle_latency() {
+                Ok(f) => {
+                    idle_latency = Some(f);
+                    scheduling.idle_latency_us = Some(0);
+                }
+                Err(e) => {
+                    hooks.note(&format!(
+                        "warning: controller.realtime_priority = {}: cannot hold the idle latency at 0 ({e}); \
+                         idle cores may wake slower",
+                        settings.realtime_priority
+                    ));
+                    scheduling.refused.push(format!("plant: {e}"));
+                }
+            }
+        }
+    }
+    (scheduling, idle_latency)
 }
 
 #[cfg(test)]
