@@ -22,7 +22,6 @@ use crate::config::{load_scene, Rotor, Scene};
 use crate::machine::Linearised;
 use crate::plot;
 use crate::run::{plane_gains, run, Outcome, Quiet};
-use crate::trace::{col, colb};
 use anyhow::Context;
 use nalgebra::{Complex, DMatrix};
 use plant_physics::flex::linear::ModeKind;
@@ -269,7 +268,7 @@ pub fn free_decay(scene: &Scene, speed_hz: f64) -> anyhow::Result<Vec<Fitted>> {
         r.run.outcome
     );
     anyhow::ensure!(
-        r.trace.contact_force_n.iter().all(|f| *f == 0.0),
+        r.trace.loads.contact_force_n.iter().all(|f| *f == 0.0),
         "the free decay at {speed_hz} Hz touched a race: not a free decay"
     );
     let (za, zb) = (machine.planes[0].station, machine.planes[1].station);
@@ -278,8 +277,8 @@ pub fn free_decay(scene: &Scene, speed_hz: f64) -> anyhow::Result<Vec<Fitted>> {
     let (mut zeta, mut tilt) = (Vec::new(), Vec::new());
     for rec in r.trace.records().step_by(step) {
         let b = rec.b.context("a two-plane trace")?;
-        let phi = C64::new(b[colb::SLOPE], b[colb::SLOPE + 1]);
-        let at_a = C64::new(rec.a[col::DX_M], rec.a[col::DY_M]);
+        let phi = C64::new(b.tilt.slope_x_rad, b.tilt.slope_y_rad);
+        let at_a = C64::new(rec.a.motion.dx_m, rec.a.motion.dy_m);
         zeta.push(at_a - phi * za);
         tilt.push(phi * half);
     }

@@ -51,6 +51,7 @@ pub mod recording;
 pub mod rng;
 pub mod robustness;
 pub mod row_file;
+pub mod rows;
 pub mod run;
 pub mod sensor;
 pub mod snapshot;

@@ -104,8 +104,10 @@ fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow:
     // Each plane's radius and coil current of each law's run.
     let planes: Vec<(String, crate::trace::Trace)> = runs.iter().flat_map(|(l, r)| plane_traces(l, &r.trace)).collect();
     let radius: Vec<Vec<f64>> = planes.iter().map(|(_, t)| t.radius().iter().map(|v| v * 1e6).collect()).collect();
-    let current: Vec<Vec<f64>> =
-        planes.iter().map(|(_, t)| t.ix_a.iter().zip(&t.iy_a).map(|(x, y)| x.hypot(*y)).collect()).collect();
+    let current: Vec<Vec<f64>> = planes
+        .iter()
+        .map(|(_, t)| t.loads.ix_a.iter().zip(&t.loads.iy_a).map(|(x, y)| x.hypot(*y)).collect())
+        .collect();
     let series = |ys: &[Vec<f64>]| -> Vec<(String, Vec<f64>, Vec<f64>)> {
         planes.iter().zip(ys).map(|((l, t), y)| (l.clone(), t.t_s.clone(), y.clone())).collect()
     };
@@ -124,8 +126,8 @@ fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow:
             let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start).collect();
             (
                 l.clone(),
-                idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
-                idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+                idx.iter().map(|&i| tr.motion.dx_m[i] * 1e6).collect(),
+                idx.iter().map(|&i| tr.motion.dy_m[i] * 1e6).collect(),
             )
         })
         .collect();

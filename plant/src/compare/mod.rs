@@ -129,9 +129,9 @@ fn free_decay(
     sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
     let Some(r) = finished(&with(scene_path, base, &sets)?, stop)? else { return Ok(None) };
     let tr = &r.trace;
-    let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
+    let free = tr.loads.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
     Ok(Some((
-        damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]),
+        damping_from_decay(&tr.t_s[..free], &tr.motion.dx_m[..free]),
         free < tr.len(),
         r.run.outcome == Outcome::Completed,
     )))
@@ -255,9 +255,9 @@ impl Window {
         let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start && tr.t_s[i] <= start + WINDOW).collect();
         Window {
             t_ms: idx.iter().map(|&i| (tr.t_s[i] - start) * 1e3).collect(),
-            radius_um: idx.iter().map(|&i| tr.dx_m[i].hypot(tr.dy_m[i]) * 1e6).collect(),
-            x_um: idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
-            y_um: idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+            radius_um: idx.iter().map(|&i| tr.motion.dx_m[i].hypot(tr.motion.dy_m[i]) * 1e6).collect(),
+            x_um: idx.iter().map(|&i| tr.motion.dx_m[i] * 1e6).collect(),
+            y_um: idx.iter().map(|&i| tr.motion.dy_m[i] * 1e6).collect(),
         }
     }
 }

@@ -178,5 +178,9 @@ pub fn compare_realtime(
 
 /// Two traces hold the same numbers, bit for bit.
 fn same_bits(a: &crate::trace::Trace, b: &crate::trace::Trace) -> bool {
-    a.len() == b.len() && a.rows().zip(b.rows()).all(|(x, y)| x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()))
+    a.len() == b.len()
+        && a.rows().zip(b.rows()).all(|(x, y)| {
+            use crate::trace::Columns as _;
+            x.values().iter().zip(&y.values()).all(|(p, q)| p.to_bits() == q.to_bits())
+        })
 }

@@ -7,7 +7,7 @@ use super::programme::PlannedShock;
 use crate::row_file::RowFile;
 use crate::run::Sink;
 use crate::snapshot::Snapshot;
-use crate::trace::{col, Record};
+use crate::trace::Record;
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -148,7 +148,7 @@ impl Sink for SoakSink<'_> {
         self.rows += 1;
         // Of a two-plane rotor: the larger radius and contact force of the planes, and clear
         // while each plane is inside its own clear radius.
-        let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
+        let of = |r: &crate::trace::Row| (r.motion.dx_m.hypot(r.motion.dy_m), r.loads.contact_force_n);
         let (mut radius, mut force) = of(&record.a);
         let mut within = radius < self.clear_radius[0];
         if record.planes() == 2 {
@@ -156,7 +156,7 @@ impl Sink for SoakSink<'_> {
             within &= rb < self.clear_radius[1];
             (radius, force) = (radius.max(rb), force.max(fb));
         }
-        let t = record.a[col::T_S];
+        let t = record.a.t_s;
         if let Some(r) = self.envelope.sample(t, radius, force) {
             self.write_bin(r);
         }
