@@ -54,6 +54,7 @@ impl Serialize for ModeName {
     }
 }
 
+crate::table::table_row! {
 /// One mode at one speed: a row of `campbell.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModeRow {
@@ -68,7 +69,9 @@ pub struct ModeRow {
     /// Damping ratio.
     pub damping_ratio: f64,
 }
+}
 
+crate::table::table_row! {
 /// A mode of a free decay against the linearisation's: a row of `decay.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct DecayRow {
@@ -88,6 +91,7 @@ pub struct DecayRow {
     pub linear_damping_ratio: f64,
     /// The free decay's.
     pub decay_damping_ratio: f64,
+}
 }
 
 /// What `plant campbell` is asked.
@@ -313,10 +317,9 @@ pub fn match_modes(speed_hz: f64, linear: &[Mode; 4], fitted: &[Fitted]) -> Vec<
 }
 
 /// Header of `campbell.csv`.
-pub const CAMPBELL_HEADER: &str = "speed_hz,mode,whirl,frequency_hz,damping_ratio";
+pub const CAMPBELL_HEADER: &str = ModeRow::HEADER;
 /// Header of `decay.csv`.
-pub const DECAY_HEADER: &str =
-    "speed_hz,mode,whirl,linear_hz,decay_hz,error_rel,linear_damping_ratio,decay_damping_ratio";
+pub const DECAY_HEADER: &str = DecayRow::HEADER;
 
 /// `plant campbell` (module doc); returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {

@@ -154,8 +154,7 @@ mod tests {
     use super::*;
 
     fn row(t: f64, dx: f64, force: f64) -> Row {
-        let mut r = Row::default();
-        r.t_s = t;
+        let mut r = Row { t_s: t, ..Row::default() };
         r.motion.dx_m = dx;
         r.loads.contact_force_n = force;
         r

@@ -408,8 +408,7 @@ mod tests {
         let mut a = Analyzer::new(spec, None);
         for k in 0..=4000 {
             let t = t0 + k as f64 * 1e-4;
-            let mut r = Row::default();
-            r.t_s = t;
+            let mut r = Row { t_s: t, ..Row::default() };
             r.spin.rotor_angle_rad = spec.speed * t;
             r.motion.dx_m = 2e-6 * (spec.speed * t).cos();
             r.motion.dy_m = 2e-6 * (spec.speed * t).sin();

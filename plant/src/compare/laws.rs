@@ -3,6 +3,7 @@
 
 use super::*;
 
+crate::table::table_row! {
 /// One law of a law comparison (`plant compare --laws`): a row of `laws.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct LawRow {
@@ -30,10 +31,10 @@ pub struct LawRow {
     #[serde(with = "sci")]
     pub whirl_hz: f64,
 }
+}
 
 /// Header of `laws.csv`.
-pub const LAWS_HEADER: &str =
-    "law,mode,status,recovery_s,post_shock_mode,max_contact_force_n,contact_time_s,steady_contact_fraction,whirl_hz";
+pub const LAWS_HEADER: &str = LawRow::HEADER;
 
 /// Runs the scene once per law (in the scene's controller mode, so a co-simulation scene runs
 /// the controller process), and writes `laws.csv` and overlaid plots of the whole run. The

@@ -40,6 +40,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Window after the shock for the deviation (s).
 pub const WINDOW: f64 = 0.1;
 
+crate::table::table_row! {
 /// One compared configuration: a row of `compare.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RateRow {
@@ -64,6 +65,7 @@ pub struct RateRow {
     pub recover_s: f64,
     /// Post-shock mode.
     pub post_shock_mode: MotionMode,
+}
 }
 
 fn with(path: &Path, base: &[String], extra: &[String]) -> anyhow::Result<Scene> {
@@ -239,7 +241,7 @@ pub fn compare(
 }
 
 /// Header of `compare.csv`.
-pub const COMPARE_HEADER: &str = "rate_hz,mode,status,rms_dev_m,max_dev_m,damping_ratio,recover_s,post_shock_mode";
+pub const COMPARE_HEADER: &str = RateRow::HEADER;
 
 /// The first [`WINDOW`] after the shock of one run, in ms and µm.
 struct Window {

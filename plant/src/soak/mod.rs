@@ -41,7 +41,7 @@ pub const SOAK_CSV_HEADER: &str = "index,start_s,peak_g,direction_deg,duration_s
 max_contact_force_n,contact_time_s,contact_episodes,max_radius_m,complete";
 
 /// Header of `envelope.csv`.
-pub const ENVELOPE_CSV_HEADER: &str = "t_s,max_radius_m,max_contact_force_n";
+pub const ENVELOPE_CSV_HEADER: &str = monitor::EnvelopeRow::HEADER;
 
 /// Header of `rss.csv`.
 pub const RSS_CSV_HEADER: &str = "t_sim_s,wall_s,plant_rss_kib,controller_rss_kib";
