@@ -61,6 +61,27 @@ macro_rules! table_row {
 }
 pub(crate) use table_row;
 
+/// A [`table_row!`] of text fields, for a table written as records of strings (each field
+/// formatted by its writer): `into_fields` gives the fields in the columns' order, so that the
+/// header and the record come from the one list of fields.
+macro_rules! text_row {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($(#[$fmeta:meta])* $field:ident),* $(,)? }) => {
+        $crate::table::table_row! {
+            $(#[$meta])*
+            #[derive(Clone, Debug, Default, PartialEq)]
+            $vis struct $name { $($(#[$fmeta])* pub $field: String),* }
+        }
+
+        impl $name {
+            /// The fields, in the columns' order.
+            pub fn into_fields(self) -> Vec<String> {
+                vec![$(self.$field),*]
+            }
+        }
+    };
+}
+pub(crate) use text_row;
+
 /// The length of `names` joined by commas (bytes).
 pub const fn joined_len(names: &[&str]) -> usize {
     let mut n = names.len().saturating_sub(1);

@@ -190,12 +190,20 @@ wall_s_per_sim_s,peak_force_rel_diff,max_radius_rel_diff,contact_fraction_diff,s
     for (derived, shipped) in cases {
         assert_eq!(derived, shipped);
     }
+    // A sweep's `points.csv`: the single-run columns, then an ensemble's.
+    let single = "value,post_shock_mode,steady_class,period_k,contact_fraction,whirl_hz,max_radius_m,\
+max_contact_force_n,status,index";
+    let ensemble = "members,recovered,dry_whirl,rebound,diverged,p_recovered,p_lo,p_hi,recovery_median_s,\
+recovery_p90_s,worst_contact_force_n,verified,numerically_sensitive,sensitive,stopped_by";
+    assert_eq!(plant::grid::outputs::SINGLE_COLUMNS.join(","), single);
+    assert_eq!(plant::ensemble::merge::ENSEMBLE_COLUMNS.join(","), ensemble);
 }
 
-/// No header constant in `plant/src` is a string literal: each is derived from its row type
-/// (`table_row!`, or the trace's typed rows). The two exceptions are files whose rows are not
-/// one struct: `soak.csv` (a shock's schedule beside its figures) and `rss.csv` (named apart
-/// from its sample's fields).
+/// No header constant in `plant/src` is a string literal (`…_HEADER: &str = "…"`) or a
+/// literal list of names (`…_COLUMNS: [&str; n] = [`): each is derived from its row type
+/// (`table_row!`, `text_row!`, or the trace's typed rows). The two exceptions are files whose
+/// rows are not one struct: `soak.csv` (a shock's schedule beside its figures) and `rss.csv`
+/// (named apart from its sample's fields).
 #[test]
 fn no_header_constant_is_a_hand_written_list() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -220,6 +228,11 @@ fn no_header_constant_is_a_hand_written_list() {
             let value = if value.is_empty() { lines.get(i + 1).map_or("", |l| l.trim()) } else { value };
             let exception = name.ends_with("SOAK_CSV") || name.ends_with("RSS_CSV");
             if value.starts_with('"') && !exception {
+                literal.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
+            }
+        }
+        for (i, line) in lines.iter().enumerate() {
+            if line.contains("_COLUMNS: [&str;") {
                 literal.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
             }
         }
