@@ -77,8 +77,8 @@ mod tests {
         let (ra, _) = m.radii(&y, 0);
         assert!((ra - 1.5 * gap).abs() < 1e-9 * gap, "{ra}");
         let rec = m.record(0.0, &y);
-        assert!(rec.a[12] > 0.0, "contact force at A: {}", rec.a[12]);
-        assert_eq!(rec.b.unwrap()[9], 0.0, "no contact at B");
+        assert!(rec.a.loads.contact_force_n > 0.0, "contact force at A: {}", rec.a.loads.contact_force_n);
+        assert_eq!(rec.b.unwrap().loads.contact_force_n, 0.0, "no contact at B");
     }
 
     /// The mid-span columns (`mid_dx_m`, `mid_dy_m`): a rigid motion reads at the mid-span node
@@ -102,13 +102,13 @@ mod tests {
         let y = Model::from_rigid(&m.params, &rigid);
         let rec = m.record(0.0, &y);
         let mid = rec.mid.expect("a flexible record has the mid-span columns");
-        assert!((mid[0] - (3e-6 + 1e-5 * z[node])).abs() < 1e-12, "{mid:?}");
-        assert!((mid[1] - (-2e-6 - 4e-5 * z[node])).abs() < 1e-12, "{mid:?}");
+        assert!((mid.mid_dx_m - (3e-6 + 1e-5 * z[node])).abs() < 1e-12, "{mid:?}");
+        assert!((mid.mid_dy_m - (-2e-6 - 4e-5 * z[node])).abs() < 1e-12, "{mid:?}");
         // Written and read back, after every other column.
         let mut trace = plant::trace::Trace::default();
         trace.push(&rec);
         let mut later = rec;
-        later.a[0] = 1e-3;
+        later.a.t_s = 1e-3;
         trace.push(&later);
         let dir = std::env::temp_dir().join(format!("flexible-mid-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -125,7 +125,7 @@ mod tests {
         let mut recorder = plant::record::Recorder::new(&scene, true);
         trace.records().for_each(|r| recorder.push(&r));
         let (x, y) = recorder.finish(None).mid_chart.expect("a mid-span chart").orbit();
-        assert_eq!((x[0], y[0]), (mid[0], mid[1]));
+        assert_eq!((x[0], y[0]), (mid.mid_dx_m, mid.mid_dy_m));
         let twin = plant::bench::models::rigid_twin(&scene).unwrap();
         assert!(plant::record::Recorder::new(&twin, true).finish(None).mid_chart.is_none());
     }
@@ -329,8 +329,8 @@ mod convergence {
         let tb = plant::run::run(b, quiet).expect("runs").trace;
         assert_eq!(ta.len(), tb.len());
         let (ba, bb) = (ta.b.as_ref().unwrap(), tb.b.as_ref().unwrap());
-        let cols = |t: &plant::trace::Trace, b: &plant::trace::TraceB, i: usize| {
-            [t.dx_m[i], t.dy_m[i], b.b_dx_m[i], b.b_dy_m[i]]
+        let cols = |t: &plant::trace::Trace, b: &[plant::trace::RowB], i: usize| {
+            [t.motion.dx_m[i], t.motion.dy_m[i], b[i].motion.dx_m, b[i].motion.dy_m]
         };
         let (mut diff, mut size) = (0.0f64, 0.0f64);
         for i in 0..ta.len() {

@@ -34,7 +34,7 @@ fn race_rests_on_the_lowest_ball_with_the_hertz_sag() {
     // And the race stays there while the rotor is levitated.
     let s = scene(|r| r.scene.duration_s = 0.05);
     let tr = completed(&s).trace;
-    for (x, y) in tr.xb_m.iter().zip(&tr.yb_m) {
+    for (x, y) in tr.motion.xb_m.iter().zip(&tr.motion.yb_m) {
         assert!(x.abs() < 1e-12 && (y - expected).abs() < 1e-11, "race moved: ({x}, {y})");
     }
 }
@@ -67,7 +67,7 @@ fn levitated_loop_has_the_designed_frequency_and_damping() {
             r.initial.rotor_x_um = 20.0;
         });
         let tr = completed(&s).trace;
-        let p = peaks(&tr.t_s, &tr.dx_m);
+        let p = peaks(&tr.t_s, &tr.motion.dx_m);
         assert!(p.len() > 10, "too few peaks: {}", p.len());
         let n = p.len() - 1;
         let period = (p[n].0 - p[0].0) / n as f64;
@@ -79,7 +79,7 @@ fn levitated_loop_has_the_designed_frequency_and_damping() {
         let xi_measured = decrement / (TAU * TAU + decrement * decrement).sqrt();
         assert!((xi_measured - xi).abs() < 0.02 * xi, "damping ratio {xi_measured} vs {xi}");
         // y stays centred: the gravity bias holds the weight exactly.
-        assert!(tr.dy_m.iter().all(|y| y.abs() < 1e-9), "y moved");
+        assert!(tr.motion.dy_m.iter().all(|y| y.abs() < 1e-9), "y moved");
     }
 }
 
@@ -102,9 +102,9 @@ fn steady_unbalance_orbit_matches_the_linear_response() {
     for i in 0..tr.len() {
         if tr.t_s[i] > 0.1 {
             // (x + j y) e^{−jθ}
-            let (s, c) = tr.rotor_angle_rad[i].sin_cos();
-            sum_re += tr.dx_m[i] * c + tr.dy_m[i] * s;
-            sum_im += tr.dy_m[i] * c - tr.dx_m[i] * s;
+            let (s, c) = tr.spin.rotor_angle_rad[i].sin_cos();
+            sum_re += tr.motion.dx_m[i] * c + tr.motion.dy_m[i] * s;
+            sum_im += tr.motion.dy_m[i] * c - tr.motion.dx_m[i] * s;
             n += 1.0;
         }
     }
@@ -139,8 +139,8 @@ fn energy_is_conserved_without_damping_friction_and_drive_work() {
     let tr = completed(&s).trace;
     let p = s.plane(0);
     let energy = |i: usize| {
-        let (x, y, vx, vy) = (tr.dx_m[i], tr.dy_m[i], tr.vx_m_s[i], tr.vy_m_s[i]);
-        let (xb, yb, vxb, vyb) = (tr.xb_m[i], tr.yb_m[i], tr.vxb_m_s[i], tr.vyb_m_s[i]);
+        let (x, y, vx, vy) = (tr.motion.dx_m[i], tr.motion.dy_m[i], tr.motion.vx_m_s[i], tr.motion.vy_m_s[i]);
+        let (xb, yb, vxb, vyb) = (tr.motion.xb_m[i], tr.motion.yb_m[i], tr.motion.vxb_m_s[i], tr.motion.vyb_m_s[i]);
         let d = (x - xb).hypot(y - yb) - 0.15e-3;
         let contact = if d > 0.0 { 1.988e9 * d.powf(19.0 / 9.0) * 9.0 / 19.0 } else { 0.0 };
         let balls: f64 = (0..19)
@@ -162,7 +162,7 @@ fn energy_is_conserved_without_damping_friction_and_drive_work() {
             + 0.048 * 9.80665 * yb
     };
     let e0 = energy(0);
-    let touched = tr.contact_force_n.iter().any(|f| *f > 0.0);
+    let touched = tr.loads.contact_force_n.iter().any(|f| *f > 0.0);
     assert!(touched, "the rotor never hit the race: the test exercises nothing");
     let mut worst: f64 = 0.0;
     for i in 0..tr.len() {
@@ -188,16 +188,16 @@ fn friction_spins_the_race_up_in_the_rotor_direction() {
         completed(&s).trace
     };
     let tr = shocked(0.1);
-    assert!(tr.contact_force_n.iter().any(|f| *f > 0.0), "no contact: the shock is too weak for the test");
-    let max_speed = tr.race_speed_rad_s.iter().copied().fold(f64::MIN, f64::max);
-    let min_speed = tr.race_speed_rad_s.iter().copied().fold(f64::MAX, f64::min);
+    assert!(tr.loads.contact_force_n.iter().any(|f| *f > 0.0), "no contact: the shock is too weak for the test");
+    let max_speed = tr.loads.race_speed_rad_s.iter().copied().fold(f64::MIN, f64::max);
+    let min_speed = tr.loads.race_speed_rad_s.iter().copied().fold(f64::MAX, f64::min);
     assert!(max_speed > 100.0, "race did not spin up: {max_speed} rad/s");
     assert!(min_speed > -1.0, "race turned against the rotor: {min_speed} rad/s");
     // Never faster than the rotor surface can drive it (rolling without slip).
     assert!(max_speed <= TAU * 500.0 * 19.85 / 20.0 * 1.001, "{max_speed}");
     // Without friction nothing drives the race.
     let tr = shocked(0.0);
-    assert!(tr.race_speed_rad_s.iter().all(|w| w.abs() < 1e-9));
+    assert!(tr.loads.race_speed_rad_s.iter().all(|w| w.abs() < 1e-9));
 }
 
 /// The 10 G study shock at `start_s`.
@@ -224,11 +224,15 @@ fn free_spin_loses_speed_to_rubbing_and_the_drive_restores_it() {
     };
     let tr = run_with(0.0);
     let omega0 = TAU * 500.0;
-    let last = *tr.rotor_speed_rad_s.last().expect("rows");
+    let last = *tr.spin.rotor_speed_rad_s.last().expect("rows");
     assert!(last < omega0 - 1e-3, "no speed loss: {last} vs {omega0}");
     // Speed loss equals the friction impulse: Δω = −(r_r / J_r) ∫ F_t dt (trapezoid on the trace).
-    let impulse: f64 =
-        tr.t_s.windows(2).zip(tr.friction_force_n.windows(2)).map(|(t, f)| 0.5 * (f[0] + f[1]) * (t[1] - t[0])).sum();
+    let impulse: f64 = tr
+        .t_s
+        .windows(2)
+        .zip(tr.loads.friction_force_n.windows(2))
+        .map(|(t, f)| 0.5 * (f[0] + f[1]) * (t[1] - t[0]))
+        .sum();
     let expected = omega0 - 19.85e-3 / 5.81e-3 * impulse;
     assert!(
         (last - expected).abs() < 0.02 * (omega0 - expected),
@@ -237,7 +241,7 @@ fn free_spin_loses_speed_to_rubbing_and_the_drive_restores_it() {
         omega0 - expected
     );
     // With a speed loop the drive makes up part of the loss.
-    let driven = *run_with(0.05).rotor_speed_rad_s.last().expect("rows");
+    let driven = *run_with(0.05).spin.rotor_speed_rad_s.last().expect("rows");
     assert!(driven > last, "drive did not help: {driven} vs {last}");
 }
 
@@ -253,7 +257,7 @@ fn nonlinear_bearing_matches_the_linear_loop_at_small_amplitude() {
         r.initial.rotor_x_um = 2.0;
     });
     let tr = completed(&s).trace;
-    let p = peaks(&tr.t_s, &tr.dx_m);
+    let p = peaks(&tr.t_s, &tr.motion.dx_m);
     let n = p.len() - 1;
     let f = n as f64 / (p[n].0 - p[0].0);
     let f_expected = (1e6_f64 / 11.5).sqrt() * (1.0 - 0.02_f64 * 0.02).sqrt() / TAU;
@@ -272,8 +276,8 @@ fn nonlinear_bearing_matches_the_linear_loop_at_small_amplitude() {
             r.initial.rotor_x_um = 140.0;
         });
         let tr = completed(&s).trace;
-        assert!((tr.t_s[1] - 5e-5).abs() < 1e-15 && (tr.dx_m[1] - 140e-6).abs() < 2e-8, "{}", tr.dx_m[1]);
-        tr.vx_m_s[1]
+        assert!((tr.t_s[1] - 5e-5).abs() < 1e-15 && (tr.motion.dx_m[1] - 140e-6).abs() < 2e-8, "{}", tr.motion.dx_m[1]);
+        tr.motion.vx_m_s[1]
     };
     let (ki, ks, k_e, x, s0) = (216.0, 4.32e5, 1e6, 140e-6, 1e-3_f64);
     let i = -(k_e + ks) * x / ki;
@@ -318,13 +322,13 @@ fn palmgren_drag_spins_the_race_down_between_impacts_and_a_fixed_cage_runs_the_s
     let j_b = 2.33e-5;
     let mut checked = Vec::new();
     for k in 2..tr.t_s.len() - 3 {
-        let clear = (k - 2..=k + 3).all(|i| tr.contact_force_n[i] == 0.0);
-        let omega = 0.5 * (tr.race_speed_rad_s[k] + tr.race_speed_rad_s[k + 1]);
+        let clear = (k - 2..=k + 3).all(|i| tr.loads.contact_force_n[i] == 0.0);
+        let omega = 0.5 * (tr.loads.race_speed_rad_s[k] + tr.loads.race_speed_rad_s[k + 1]);
         if !(clear && omega > 100.0) {
             continue;
         }
-        let load = 0.5 * (tr.ball_force_n[k] + tr.ball_force_n[k + 1]);
-        let measured = (tr.race_speed_rad_s[k + 1] - tr.race_speed_rad_s[k]) / (tr.t_s[k + 1] - tr.t_s[k]);
+        let load = 0.5 * (tr.loads.ball_force_n[k] + tr.loads.ball_force_n[k + 1]);
+        let measured = (tr.loads.race_speed_rad_s[k + 1] - tr.loads.race_speed_rad_s[k]) / (tr.t_s[k + 1] - tr.t_s[k]);
         let expected = -palmgren_n_m(omega, load) / j_b;
         checked.push(((measured - expected).abs() / expected.abs(), omega));
     }
@@ -344,8 +348,8 @@ fn palmgren_drag_spins_the_race_down_between_impacts_and_a_fixed_cage_runs_the_s
     // A fixed cage: the same shock runs, and the race neither turns backwards nor outruns the
     // rotor's surface.
     let fixed = run_with(&|r| r.touchdown.cage = plant::model::Cage::Fixed);
-    assert!(fixed.contact_force_n.iter().any(|f| *f > 0.0), "no contact");
-    assert!(fixed.race_speed_rad_s.iter().all(|w| *w > -1.0 && *w <= TAU * 500.0 * 19.85 / 20.0 * 1.001));
+    assert!(fixed.loads.contact_force_n.iter().any(|f| *f > 0.0), "no contact");
+    assert!(fixed.loads.race_speed_rad_s.iter().all(|w| *w > -1.0 && *w <= TAU * 500.0 * 19.85 / 20.0 * 1.001));
 }
 
 #[test]
@@ -364,19 +368,20 @@ fn sensor_noise_and_adc_reach_the_sampled_loop_reproducibly() {
     };
     let ideal = with(0.0, 0, 1);
     let noisy = with(0.01, 0, 1);
-    assert_eq!(noisy.ix_a, with(0.01, 0, 1).ix_a, "same seed, same run");
-    assert_ne!(noisy.ix_a, with(0.01, 0, 2).ix_a, "another seed, another run");
+    assert_eq!(noisy.loads.ix_a, with(0.01, 0, 1).loads.ix_a, "same seed, same run");
+    assert_ne!(noisy.loads.ix_a, with(0.01, 0, 2).loads.ix_a, "another seed, another run");
     // i = −A_a (k_p u_k + k_d (u_k − u_{k−1}) / T): white noise σ on u gives a current noise of
     // σ √((k_p + k_d/T)² + (k_d/T)²), k_p = (k_e + k_s)/(k_i A_s), k_d = c_e/(k_i A_s).
     let (kp, kd, period) =
         (1.432e6 / (216.0 * 25_000.0), 2.0 * 0.01 * (1e6_f64 * 11.5).sqrt() / (216.0 * 25_000.0), 2e-5);
     let expected = 0.01 * ((kp + kd / period).powi(2) + (kd / period).powi(2)).sqrt();
-    let dev =
-        (noisy.ix_a.iter().zip(&ideal.ix_a).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / ideal.len() as f64).sqrt();
+    let dev = (noisy.loads.ix_a.iter().zip(&ideal.loads.ix_a).map(|(a, b)| (a - b).powi(2)).sum::<f64>()
+        / ideal.len() as f64)
+        .sqrt();
     assert!((dev - expected).abs() < 0.15 * expected, "current noise {dev} A, expected {expected} A");
     // A coarse 6-bit ADC (0.31 V steps = 12.5 µm) makes the commanded current take few values.
     let coarse = with(0.0, 6, 1);
-    let mut levels: Vec<i64> = coarse.ix_a.iter().map(|i| (i * 1e9).round() as i64).collect();
+    let mut levels: Vec<i64> = coarse.loads.ix_a.iter().map(|i| (i * 1e9).round() as i64).collect();
     levels.sort_unstable();
     levels.dedup();
     assert!(levels.len() < 10, "{} current levels", levels.len());

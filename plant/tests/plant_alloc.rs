@@ -38,7 +38,7 @@ struct Largest(f64);
 impl Sink for Largest {
     fn sample(&mut self, record: &Record) {
         let r = &record.a;
-        self.0 = self.0.max(r[plant::trace::col::DX_M].hypot(r[plant::trace::col::DY_M]));
+        self.0 = self.0.max(r.motion.dx_m.hypot(r.motion.dy_m));
     }
 }
 

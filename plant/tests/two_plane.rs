@@ -6,7 +6,7 @@
 
 use plant::config::{load_scene, Scene};
 use plant::run::{run, Outcome, Quiet};
-use plant::trace::Trace;
+use plant::trace::{Columns as _, Trace};
 use std::path::{Path, PathBuf};
 
 fn shipped(name: &str) -> PathBuf {
@@ -36,7 +36,7 @@ fn assert_bit_identical(planar: &Trace, two: &Trace) -> usize {
     for (i, (p, r)) in planar.rows().zip(two.records()).enumerate() {
         for plane in 0..2 {
             let q = r.plane(plane);
-            for (c, (a, b)) in p.iter().zip(&q).enumerate() {
+            for (c, (a, b)) in p.values().iter().zip(&q.values()).enumerate() {
                 assert_eq!(
                     a.to_bits(),
                     b.to_bits(),
@@ -47,7 +47,7 @@ fn assert_bit_identical(planar: &Trace, two: &Trace) -> usize {
         }
         let [sa, sb] = r.slopes().unwrap();
         assert!(sa == 0.0 && sb == 0.0, "row {i}: slopes {sa:e}, {sb:e}");
-        contact_rows += usize::from(p[plant::trace::col::CONTACT_FORCE_N] > 0.0);
+        contact_rows += usize::from(p.loads.contact_force_n > 0.0);
     }
     contact_rows
 }

@@ -106,8 +106,8 @@ fn an_out_of_tree_rust_controller_runs_in_lockstep_and_its_law_gives_the_trace()
     // And the same law run in the plant's process gives the same trace.
     let in_process = plant::check::run_law(&scene, &pd_notch::LAW, &mut plant::run::Quiet).expect("the run");
     let trace = Csv::read(&out.join("trace.csv"));
-    assert_eq!(in_process.trace.ix_a, trace.column("ix_a"));
-    assert_eq!(in_process.trace.dy_m, trace.column("dy_m"));
+    assert_eq!(in_process.trace.loads.ix_a, trace.column("ix_a"));
+    assert_eq!(in_process.trace.motion.dy_m, trace.column("dy_m"));
 }
 
 /// Issue 10 item 4: the contract a command gets. The plant runs it exactly, with `--run-id

@@ -322,6 +322,6 @@ fn every_non_finite_current_of_a_law_in_process_is_invalid() {
             "{value:?}: {outcome:?}"
         );
         assert_eq!(run.run.invalid_commands, 11, "{value:?}");
-        assert!(run.trace.ix_a.iter().chain(&run.trace.iy_a).all(|i| i.is_finite()), "{value:?}");
+        assert!(run.trace.loads.ix_a.iter().chain(&run.trace.loads.iy_a).all(|i| i.is_finite()), "{value:?}");
     }
 }

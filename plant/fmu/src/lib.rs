@@ -29,7 +29,7 @@
 mod fmi3;
 
 use plant_sim::fmi::{Model, Output, Role, Variable};
-use plant_sim::rows::{col, Record};
+use plant_sim::rows::{Columns as _, Record, Row};
 use plant_sim::run::Sink;
 use plant_sim::snapshot::Snapshot;
 use plant_sim::stepper::{Command, Plant};
@@ -275,13 +275,13 @@ impl Instance {
         let t = plant.time();
         let fresh;
         let row = match row {
-            Some(r) if (r.a[col::T_S] - t).abs() <= 1e-9 * sim.period => r,
+            Some(r) if (r.a.t_s - t).abs() <= 1e-9 * sim.period => r,
             _ => {
                 let mut last = LastRow(None);
                 plant.record(&mut last);
                 // A plant always hands over its row; without one the outputs are NaN, which
                 // fmi2DoStep refuses as a diverged plant rather than a panic.
-                fresh = last.0.unwrap_or(Record::planar([f64::NAN; plant_sim::rows::WIDTH]));
+                fresh = last.0.unwrap_or(Record::planar(Row::NAN));
                 &fresh
             }
         };
@@ -294,16 +294,13 @@ impl Instance {
                     Output::Sensor(axis) => s.sensor_v[axis],
                     Output::Speed => s.speed_rad_s,
                     Output::Angle => s.angle_rad,
-                    Output::RotorX(i) => row.plane(i)[col::DX_M],
-                    Output::RotorY(i) => row.plane(i)[col::DY_M],
-                    Output::Radius(i) => {
-                        let r = row.plane(i);
-                        r[col::DX_M].hypot(r[col::DY_M])
-                    }
-                    Output::ContactForce(i) => row.plane(i)[col::CONTACT_FORCE_N],
-                    Output::RaceSpeed(i) => row.plane(i)[col::RACE_SPEED_RAD_S],
-                    Output::HousingX => row.a[col::HOUSING_X_M],
-                    Output::HousingY => row.a[col::HOUSING_Y_M],
+                    Output::RotorX(i) => row.plane(i).motion.dx_m,
+                    Output::RotorY(i) => row.plane(i).motion.dy_m,
+                    Output::Radius(i) => row.plane(i).radius(),
+                    Output::ContactForce(i) => row.plane(i).loads.contact_force_n,
+                    Output::RaceSpeed(i) => row.plane(i).loads.race_speed_rad_s,
+                    Output::HousingX => row.a.housing.housing_x_m,
+                    Output::HousingY => row.a.housing.housing_y_m,
                 },
                 _ => f64::NAN,
             })

@@ -31,7 +31,7 @@
 pub use crate::config::hardware::Hardware;
 use crate::machine::{FailureState, Machine, PlaneState};
 use crate::model::{Control, Params, Release};
-use crate::rows::{col, colb, Record, WIDTH_MAGNETS};
+use crate::rows::{Record, RowHw, RowMagnets};
 use crate::sensor::{runout, runout_rate};
 use plant_physics::integrate::System;
 use std::cell::RefCell;
@@ -369,17 +369,17 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
         let mut r = m.record(t, &iy);
         drop(m);
         let a = self.reference_current(y, 0);
-        r.a[col::IX_A] = a[0];
-        r.a[col::IY_A] = a[1];
+        r.a.loads.ix_a = a[0];
+        r.a.loads.iy_a = a[1];
         if let (2, Some(b)) = (M::PLANES, r.b.as_mut()) {
             let c = self.reference_current(y, 1);
-            b[colb::CURRENT] = c[0];
-            b[colb::CURRENT + 1] = c[1];
+            b.loads.ix_a = c[0];
+            b.loads.iy_a = c[1];
         }
         let x = split::<N, NA>(y).1;
         let magnet = |at: usize| x[at].max(0.0);
         if self.hw.amplified() {
-            let mut hw = [f64::NAN; 8];
+            let mut hw = RowHw::NAN;
             for i in 0..M::PLANES {
                 for j in 0..2 {
                     let ax = 2 * i + j;
@@ -390,21 +390,18 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
                         }
                         (None, _) => (self.reference_current(y, i)[j], f64::NAN),
                     };
-                    hw[4 * i + j] = current;
-                    hw[4 * i + 2 + j] = voltage;
+                    hw.planes[i].set_axis(j, current, voltage);
                 }
             }
             r.hw = Some(hw);
         }
         if self.hw.is_unipolar() {
-            let mut row = [f64::NAN; WIDTH_MAGNETS];
+            let mut row = RowMagnets::NAN;
             for i in (0..M::PLANES).filter(|&i| self.hw.unipolar[i].is_some()) {
                 for j in 0..2 {
                     let ax = 2 * i + j;
-                    row[8 * i + 2 * j] = magnet(ex::CURRENT + ax);
-                    row[8 * i + 2 * j + 1] = magnet(ex::MINUS_CURRENT + ax);
-                    row[8 * i + 4 + 2 * j] = volts.plus[ax];
-                    row[8 * i + 4 + 2 * j + 1] = volts.minus[ax];
+                    let currents = [magnet(ex::CURRENT + ax), magnet(ex::MINUS_CURRENT + ax)];
+                    row.planes[i].set_axis(j, currents, [volts.plus[ax], volts.minus[ax]]);
                 }
             }
             r.magnets = Some(row);

@@ -537,7 +537,7 @@ pub fn analyze_dir(dir: &Path, stop: &std::sync::atomic::AtomicBool) -> Result<A
     let end = scene.duration + 1e-9 * scene.duration.max(scene.output_interval);
     let mut beyond = None;
     let whole = crate::trace::read_rows(&trace_path, |r| {
-        let t = r.a[crate::trace::col::T_S];
+        let t = r.a.t_s;
         if t > end {
             beyond = Some((rows as u64 + 2, t));
             return false;
@@ -671,8 +671,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         prepare(&dir, &scene).unwrap();
         let mut folder = RunFolder::create(&dir, &scene).unwrap();
-        let mut row = [f64::NAN; crate::trace::WIDTH];
-        row[crate::trace::col::T_S] = 0.0;
+        let row = crate::trace::Row { t_s: 0.0, ..<crate::trace::Row as crate::trace::Columns>::NAN };
         folder.push(&Record::planar(row));
         let state = vec![f64::NAN; crate::model::N];
         let run = SinkRun {

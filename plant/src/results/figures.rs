@@ -5,7 +5,7 @@
 
 use crate::analysis::AnalysisSpec;
 use crate::config::Scene;
-use crate::trace::{col, Row, Trace};
+use crate::trace::{Row, Trace};
 
 /// The analysis setting of a scene: Poincaré section at spin phase 0, periodicity tolerance 1e-3 r_0
 /// (r_0 of plane A, for a two-plane rotor).
@@ -89,9 +89,9 @@ impl FiguresBuilder {
     /// The next row.
     pub fn push(&mut self, r: &Row) {
         self.commit();
-        let (t, force) = (r[col::T_S], r[col::CONTACT_FORCE_N]);
-        let rpm = r[col::RACE_SPEED_RAD_S].abs() * 60.0 / std::f64::consts::TAU;
-        self.pending = Some([t, r[col::DX_M].hypot(r[col::DY_M]), force, rpm]);
+        let (t, force) = (r.t_s, r.loads.contact_force_n);
+        let rpm = r.loads.race_speed_rad_s.abs() * 60.0 / std::f64::consts::TAU;
+        self.pending = Some([t, r.motion.dx_m.hypot(r.motion.dy_m), force, rpm]);
         self.rows += 1;
         self.contact_rows += u64::from(force > 0.0);
         if force > 0.0 && self.first_contact.is_none() {
@@ -154,10 +154,9 @@ mod tests {
     use super::*;
 
     fn row(t: f64, dx: f64, force: f64) -> Row {
-        let mut r = [0.0; crate::trace::WIDTH];
-        r[col::T_S] = t;
-        r[col::DX_M] = dx;
-        r[col::CONTACT_FORCE_N] = force;
+        let mut r = Row { t_s: t, ..Row::default() };
+        r.motion.dx_m = dx;
+        r.loads.contact_force_n = force;
         r
     }
 

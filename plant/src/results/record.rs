@@ -15,7 +15,7 @@ use crate::analysis::{Analysis, AnalysisData, Analyzer};
 use crate::bounded::{MinMaxBins, Strided};
 use crate::config::Scene;
 use crate::figures::{analysis_spec, plane_analysis_spec, Figures, FiguresBuilder};
-use crate::trace::{col, Record, Row};
+use crate::trace::{Record, Row};
 
 /// Bins of the time axis of a run's time charts.
 pub const CHART_BINS: usize = 4096;
@@ -55,14 +55,14 @@ impl ChartData {
     }
 
     fn push(&mut self, r: &Row) {
-        let ms = r[col::T_S] * 1e3;
-        let (x, y) = (r[col::DX_M], r[col::DY_M]);
+        let ms = r.t_s * 1e3;
+        let (x, y) = (r.motion.dx_m, r.motion.dy_m);
         self.radius_um.push(ms, x.hypot(y) * 1e6);
-        self.race_rpm.push(ms, r[col::RACE_SPEED_RAD_S] * 60.0 / std::f64::consts::TAU);
-        self.current_a[0].push(ms, r[col::IX_A]);
-        self.current_a[1].push(ms, r[col::IY_A]);
-        self.force_n[0].push(ms, r[col::CONTACT_FORCE_N]);
-        self.force_n[1].push(ms, r[col::FRICTION_FORCE_N]);
+        self.race_rpm.push(ms, r.loads.race_speed_rad_s * 60.0 / std::f64::consts::TAU);
+        self.current_a[0].push(ms, r.loads.ix_a);
+        self.current_a[1].push(ms, r.loads.iy_a);
+        self.force_n[0].push(ms, r.loads.contact_force_n);
+        self.force_n[1].push(ms, r.loads.friction_force_n);
         if self.first_finite.is_none() && x.is_finite() && y.is_finite() {
             self.first_finite = Some((self.orbit.seen(), (x, y)));
         }
@@ -181,7 +181,7 @@ impl Recorder {
         if let Some((tilt, bins)) = &mut self.tilt {
             tilt.push(r);
             if let (Some(bins), Some([a, b])) = (bins, r.slopes()) {
-                bins.push(r.a[col::T_S] * 1e3, a.hypot(b) * 1e6);
+                bins.push(r.a.t_s * 1e3, a.hypot(b) * 1e6);
             }
         }
         if let Some(m) = &mut self.mid_span {
@@ -189,8 +189,8 @@ impl Recorder {
         }
         if let (Some(c), Some(m)) = (&mut self.mid, r.mid) {
             let mut row = r.a;
-            row[col::DX_M] = m[0];
-            row[col::DY_M] = m[1];
+            row.motion.dx_m = m.mid_dx_m;
+            row.motion.dy_m = m.mid_dy_m;
             c.push(&row);
         }
     }

@@ -1,152 +1,82 @@
-//! The recorded time series of a run: one [`Row`] per output sample, kept
+//! The recorded time series of a run: one [`Record`] per output sample, kept
 //! columnar in memory ([`Trace`]) or streamed to `trace.csv` as it is made
 //! ([`TraceWriter`]), and read back strictly ([`read_rows`]).
 //!
-//! `trace.csv` is a header row with [`Trace::COLUMNS`], then one line per
-//! sample, every number in Rust's shortest round-trip scientific notation
-//! (`{:e}`: `-4.3e-4`, `0e0`; non-finite values as `NaN`, `inf`, `-inf`), so
-//! that a trace read back is bit-identical to the run's samples.
+//! `trace.csv` is a header row with the columns of [`Layout::names`] (the typed rows of
+//! [`plant_sim::rows`] name them), then one line per sample, every number in Rust's shortest
+//! round-trip scientific notation (`{:e}`: `-4.3e-4`, `0e0`; non-finite values as `NaN`,
+//! `inf`, `-inf`), so that a trace read back is bit-identical to the run's samples.
 
 use crate::row_file::RowFile;
-pub use plant_sim::rows::*;
+pub use plant_sim::rows::{
+    plane_values, row, two_bearing_record, two_plane_record, Coils, Columns, Housing, HousingColumns, Layout, Loads,
+    LoadsColumns, Magnets, Mid, Motion, MotionColumns, PerPlane, PlaneValues, Record, Row, RowB, RowHw, RowMagnets,
+    RowMid, Spin, SpinColumns, Tilt, WIDTH, WIDTH_B, WIDTH_HW, WIDTH_MAGNETS, WIDTH_MID,
+};
 use std::path::{Path, PathBuf};
 
-macro_rules! columns {
-    ($(#[$meta:meta])* $name:ident: $row:ty; $($field:ident : $doc:literal),* $(,)?; $($extra:ident : $ety:ty : $edoc:literal),*) => {
-        $(#[$meta])*
-        #[derive(Clone, Debug, Default)]
-        pub struct $name { $(#[doc = $doc] pub $field: Vec<f64>,)* $(#[doc = $edoc] pub $extra: $ety,)* }
-
-        impl $name {
-            /// CSV header names, in order.
-            pub const COLUMNS: &'static [&'static str] = &[$(stringify!($field)),*];
-
-            /// An empty trace with room for `n` rows.
-            pub fn with_capacity(n: usize) -> Self {
-                Self { $($field: Vec::with_capacity(n),)* $($extra: Default::default(),)* }
-            }
-
-            /// Appends one row of these columns.
-            pub fn push_row(&mut self, row: &$row) {
-                let mut i = 0;
-                $(self.$field.push(row[i]); i += 1;)*
-                debug_assert_eq!(i, row.len());
-            }
-
-            /// Row `i` of these columns.
-            pub fn row(&self, i: usize) -> $row {
-                [$(self.$field[i]),*]
-            }
-        }
-    };
-}
-
-columns! {
-    /// Trace columns (plane A's and the shared ones, the planar model's); each is one CSV
-    /// column named like the field. A two-plane run's trace also has plane B's and the tilt's
-    /// ([`TraceB`], in `b`).
-    Trace: Row;
-    t_s: "Time (s).",
-    dx_m: "Rotor x relative to the housing (m); two-plane: at bearing A.",
-    dy_m: "Rotor y relative to the housing (m); two-plane: at bearing A.",
-    vx_m_s: "Rotor x velocity relative to the housing (m/s); two-plane: at bearing A.",
-    vy_m_s: "Rotor y velocity relative to the housing (m/s); two-plane: at bearing A.",
-    xb_m: "Race x relative to the housing (m); two-plane: race A.",
-    yb_m: "Race y relative to the housing (m); two-plane: race A.",
-    vxb_m_s: "Race x velocity relative to the housing (m/s); two-plane: race A.",
-    vyb_m_s: "Race y velocity relative to the housing (m/s); two-plane: race A.",
-    rotor_angle_rad: "Rotor spin angle (rad).",
-    rotor_speed_rad_s: "Rotor spin speed (rad/s).",
-    race_speed_rad_s: "Race spin speed (rad/s); two-plane: race A.",
-    contact_force_n: "Rotor – race normal force (N); two-plane: plane A.",
-    friction_force_n: "Rotor – race friction force (N), signed like the slip; two-plane: plane A.",
-    ball_force_n: "Resultant of the ball forces on the race (N); two-plane: race A.",
-    ix_a: "Coil current, x (A); two-plane: bearing A.",
-    iy_a: "Coil current, y (A); two-plane: bearing A.",
-    housing_x_m: "Housing displacement, x (m).",
-    housing_y_m: "Housing displacement, y (m).";
-    b: Option<TraceB>: "A two-plane run's plane B and tilt columns (`None` for the planar model).",
-    hw: Option<TraceHw>: "A run with amplifiers: the coils' currents and voltages (`None` without).",
-    magnets: Option<TraceMagnets>: "A run with unipolar amplifiers: each magnet's current and voltage (`None` without).",
-    mid: Option<TraceMid>: "A flexible run's rotor at mid-span (`None` for the rigid rotors)."
-}
-
-columns! {
-    /// A flexible run's rotor at mid-span, after all other columns in `trace.csv`: the shaft's
-    /// node nearest the middle between its two touchdown-bearing nodes (MODEL.md §13.6), where
-    /// the first bending mode's deflection is largest; the rigid rotors have no such columns.
-    TraceMid: RowMid;
-    mid_dx_m: "Rotor x at mid-span relative to the housing (m), flexible rotor.",
-    mid_dy_m: "Rotor y at mid-span relative to the housing (m), flexible rotor.";
-}
-
-columns! {
-    /// The coils' real currents and voltages of a run with amplifiers (`amb.amplifier`), after
-    /// all other columns in `trace.csv` (plane B's four only in a two-plane run). The current
-    /// columns `ix_a`, `iy_a` (`b_ix_a`, `b_iy_a`) are then the commanded currents, the
-    /// references of the current loops.
-    TraceHw: RowHw;
-    ix_coil_a: "Coil current, x (A): the real current the force follows; two-plane: bearing A.",
-    iy_coil_a: "Coil current, y (A); two-plane: bearing A.",
-    vx_coil_v: "Coil voltage, x (V): the amplifier's output; two-plane: bearing A.",
-    vy_coil_v: "Coil voltage, y (V); two-plane: bearing A.",
-    b_ix_coil_a: "Coil current of bearing B, x (A).",
-    b_iy_coil_a: "Coil current of bearing B, y (A).",
-    b_vx_coil_v: "Coil voltage of bearing B, x (V).",
-    b_vy_coil_v: "Coil voltage of bearing B, y (V).";
-}
-
-columns! {
-    /// Each magnet's coil current and voltage of a run with unipolar amplifiers
-    /// (`amb.amplifier_topology = "unipolar"`, docs/MODEL.md §12.3), after all other columns in
-    /// `trace.csv` (plane B's eight only in a two-plane run). `plus` is the magnet on the + side
-    /// of the axis (it pulls the rotor toward +x, +y), `minus` the one on the − side. The coil
-    /// columns (`ix_coil_a`, `vx_coil_v`, …) are then the differential current `(i₊ − i₋)/2`
-    /// and voltage `(v₊ − v₋)/2`: what the bipolar amplifier's coil carries.
-    TraceMagnets: RowMagnets;
-    ix_plus_a: "Current of the +x magnet's coil (A); two-plane: bearing A.",
-    ix_minus_a: "Current of the −x magnet's coil (A); two-plane: bearing A.",
-    iy_plus_a: "Current of the +y (upper) magnet's coil (A); two-plane: bearing A.",
-    iy_minus_a: "Current of the −y (lower) magnet's coil (A); two-plane: bearing A.",
-    vx_plus_v: "Voltage on the +x magnet's coil (V); two-plane: bearing A.",
-    vx_minus_v: "Voltage on the −x magnet's coil (V); two-plane: bearing A.",
-    vy_plus_v: "Voltage on the +y magnet's coil (V); two-plane: bearing A.",
-    vy_minus_v: "Voltage on the −y magnet's coil (V); two-plane: bearing A.",
-    b_ix_plus_a: "Current of bearing B's +x magnet's coil (A).",
-    b_ix_minus_a: "Current of bearing B's −x magnet's coil (A).",
-    b_iy_plus_a: "Current of bearing B's +y magnet's coil (A).",
-    b_iy_minus_a: "Current of bearing B's −y magnet's coil (A).",
-    b_vx_plus_v: "Voltage on bearing B's +x magnet's coil (V).",
-    b_vx_minus_v: "Voltage on bearing B's −x magnet's coil (V).",
-    b_vy_plus_v: "Voltage on bearing B's +y magnet's coil (V).",
-    b_vy_minus_v: "Voltage on bearing B's −y magnet's coil (V).";
-}
-
-columns! {
-    /// A two-plane trace's plane B and tilt columns, after the planar ones in `trace.csv`:
-    /// plane B's columns are plane A's (the planar names) with the prefix `b_`.
-    TraceB: RowB;
-    b_dx_m: "Rotor x at bearing B relative to the housing (m).",
-    b_dy_m: "Rotor y at bearing B relative to the housing (m).",
-    b_vx_m_s: "Rotor x velocity at bearing B (m/s).",
-    b_vy_m_s: "Rotor y velocity at bearing B (m/s).",
-    b_xb_m: "Race B x relative to the housing (m).",
-    b_yb_m: "Race B y relative to the housing (m).",
-    b_vxb_m_s: "Race B x velocity (m/s).",
-    b_vyb_m_s: "Race B y velocity (m/s).",
-    b_race_speed_rad_s: "Race B spin speed (rad/s).",
-    b_contact_force_n: "Rotor – race B normal force (N).",
-    b_friction_force_n: "Rotor – race B friction force (N), signed like the slip.",
-    b_ball_force_n: "Resultant of race B's ball forces (N).",
-    b_ix_a: "Coil current of bearing B, x (A).",
-    b_iy_a: "Coil current of bearing B, y (A).",
-    slope_x_rad: "Slope a = dx/dz of the rotor axis (rad): the tilt about y.",
-    slope_y_rad: "Slope b = dy/dz of the rotor axis (rad): minus the tilt about x.",
-    slope_x_rate_rad_s: "Rate of the slope a (rad/s).",
-    slope_y_rate_rad_s: "Rate of the slope b (rad/s).";
+/// The samples of a run, in memory: the planar columns (plane A's and the shared ones, the
+/// planar model's) kept columnar, one `Vec` per column named like the column; a two-plane
+/// run's plane B and tilt, the coils, the magnets and the mid-span as rows, where the run has
+/// them.
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// Time (s).
+    pub t_s: Vec<f64>,
+    /// The motion at plane A (the planar model's only plane).
+    pub motion: MotionColumns,
+    /// The rotor's spin.
+    pub spin: SpinColumns,
+    /// The loads at plane A.
+    pub loads: LoadsColumns,
+    /// The housing.
+    pub housing: HousingColumns,
+    /// A two-plane run's plane B and tilt (`None` for the planar model).
+    pub b: Option<Vec<RowB>>,
+    /// A run with amplifiers: the coils' currents and voltages (`None` without).
+    pub hw: Option<Vec<RowHw>>,
+    /// A run with unipolar amplifiers: each magnet's current and voltage (`None` without).
+    pub magnets: Option<Vec<RowMagnets>>,
+    /// A flexible run's rotor at mid-span (`None` for the rigid rotors).
+    pub mid: Option<Vec<RowMid>>,
 }
 
 impl Trace {
+    /// The planar columns' names ([`Row`]'s), in order.
+    pub const COLUMNS: &'static [&'static str] = <Row as Columns>::NAMES;
+
+    /// An empty trace with room for `n` rows.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            t_s: Vec::with_capacity(n),
+            motion: MotionColumns::with_capacity(n),
+            spin: SpinColumns::with_capacity(n),
+            loads: LoadsColumns::with_capacity(n),
+            housing: HousingColumns::with_capacity(n),
+            ..Self::default()
+        }
+    }
+
+    /// Appends one planar row.
+    pub fn push_row(&mut self, r: &Row) {
+        self.t_s.push(r.t_s);
+        self.motion.push(&r.motion);
+        self.spin.push(&r.spin);
+        self.loads.push(&r.loads);
+        self.housing.push(&r.housing);
+    }
+
+    /// Planar row `i`.
+    pub fn row(&self, i: usize) -> Row {
+        Row {
+            t_s: self.t_s[i],
+            motion: self.motion.get(i),
+            spin: self.spin.get(i),
+            loads: self.loads.get(i),
+            housing: self.housing.get(i),
+        }
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.t_s.len()
@@ -164,28 +94,25 @@ impl Trace {
         // its run never grows inside the run's loop (a realtime tick that doubled 18 columns of
         // a two-plane trace took 1.5-2 ms).
         let room = self.t_s.capacity();
-        if let Some(b) = &r.b {
-            self.b.get_or_insert_with(|| TraceB::with_capacity(room)).push_row(b);
+        fn push<R: Copy>(rows: &mut Option<Vec<R>>, r: &Option<R>, room: usize) {
+            if let Some(r) = r {
+                rows.get_or_insert_with(|| Vec::with_capacity(room)).push(*r);
+            }
         }
-        if let Some(hw) = &r.hw {
-            self.hw.get_or_insert_with(|| TraceHw::with_capacity(room)).push_row(hw);
-        }
-        if let Some(m) = &r.magnets {
-            self.magnets.get_or_insert_with(|| TraceMagnets::with_capacity(room)).push_row(m);
-        }
-        if let Some(m) = &r.mid {
-            self.mid.get_or_insert_with(|| TraceMid::with_capacity(room)).push_row(m);
-        }
+        push(&mut self.b, &r.b, room);
+        push(&mut self.hw, &r.hw, room);
+        push(&mut self.magnets, &r.magnets, room);
+        push(&mut self.mid, &r.mid, room);
     }
 
     /// Sample `i`.
     pub fn record(&self, i: usize) -> Record {
         Record {
             a: self.row(i),
-            b: self.b.as_ref().map(|b| b.row(i)),
-            hw: self.hw.as_ref().map(|h| h.row(i)),
-            magnets: self.magnets.as_ref().map(|m| m.row(i)),
-            mid: self.mid.as_ref().map(|m| m.row(i)),
+            b: self.b.as_ref().map(|b| b[i]),
+            hw: self.hw.as_ref().map(|h| h[i]),
+            magnets: self.magnets.as_ref().map(|m| m[i]),
+            mid: self.mid.as_ref().map(|m| m[i]),
         }
     }
 
@@ -214,22 +141,26 @@ impl Trace {
 
     /// Rotor radius relative to the housing at each row (m) (at bearing A, two-plane).
     pub fn radius(&self) -> Vec<f64> {
-        self.dx_m.iter().zip(&self.dy_m).map(|(x, y)| x.hypot(*y)).collect()
+        self.motion.dx_m.iter().zip(&self.motion.dy_m).map(|(x, y)| x.hypot(*y)).collect()
     }
 
     /// Writes the trace as `trace.csv` (see the module docs).
     pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        let mut w = TraceWriter::create_with_columns(
-            path,
-            self.planes(),
-            self.hw.is_some(),
-            self.magnets.is_some(),
-            self.mid.is_some(),
-        )?;
+        let mut w = TraceWriter::with_layout(path, self.layout())?;
         for r in self.records() {
             w.write(&r)?;
         }
         w.flush()
+    }
+
+    /// The columns of this trace's `trace.csv`.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            planes: self.planes(),
+            coils: self.hw.is_some(),
+            magnets: self.magnets.is_some(),
+            mid: self.mid.is_some(),
+        }
     }
 
     /// Reads a `trace.csv` strictly (see [`read_rows`]).
@@ -251,14 +182,8 @@ impl Trace {
 pub struct TraceWriter {
     rows: RowFile,
     fields: Vec<String>,
-    /// Plane B columns written (0 or [`WIDTH_B`]).
-    b_cols: usize,
-    /// Coil columns written (0, or 4 per plane).
-    coils: usize,
-    /// Magnet columns written (0, or 8 per plane).
-    magnets: usize,
-    /// Mid-span columns written (0 or [`WIDTH_MID`]).
-    mid: usize,
+    /// The file's columns.
+    layout: Layout,
 }
 
 impl TraceWriter {
@@ -270,13 +195,13 @@ impl TraceWriter {
     }
 
     /// [`TraceWriter::create`], with each magnet's columns after all the others when
-    /// `unipolar` (a run with unipolar amplifiers, [`TraceMagnets`]).
+    /// `unipolar` (a run with unipolar amplifiers, [`Magnets`]).
     pub fn create_with_magnets(path: &Path, planes: usize, amplified: bool, unipolar: bool) -> std::io::Result<Self> {
         Self::create_with_columns(path, planes, amplified, unipolar, false)
     }
 
     /// [`TraceWriter::create_with_magnets`], with the rotor's mid-span columns after all the
-    /// others when `mid_span` (a flexible run, [`TraceMid`]).
+    /// others when `mid_span` (a flexible run, [`Mid`]).
     pub fn create_with_columns(
         path: &Path,
         planes: usize,
@@ -284,46 +209,27 @@ impl TraceWriter {
         unipolar: bool,
         mid_span: bool,
     ) -> std::io::Result<Self> {
-        let mid = if mid_span { WIDTH_MID } else { 0 };
-        let coils = if amplified { 4 * planes } else { 0 };
-        let magnets = if unipolar { 8 * planes } else { 0 };
-        let header: Vec<&str> = Trace::COLUMNS
-            .iter()
-            .chain(if planes == 2 { TraceB::COLUMNS } else { &[] })
-            .chain(&TraceHw::COLUMNS[..coils])
-            .chain(&TraceMagnets::COLUMNS[..magnets])
-            .chain(&TraceMid::COLUMNS[..mid])
-            .copied()
-            .collect();
+        Self::with_layout(path, Layout { planes, coils: amplified, magnets: unipolar, mid: mid_span })
+    }
+
+    /// Creates (truncates) `path` and writes the header of `layout`'s columns.
+    pub fn with_layout(path: &Path, layout: Layout) -> std::io::Result<Self> {
+        let header = layout.names();
         let rows = RowFile::create(path, &header)?;
-        Ok(Self {
-            fields: vec![String::with_capacity(32); header.len()],
-            rows,
-            b_cols: if planes == 2 { WIDTH_B } else { 0 },
-            coils,
-            magnets,
-            mid,
-        })
+        Ok(Self { fields: vec![String::with_capacity(32); header.len()], rows, layout })
     }
 
     /// Appends one sample (in memory until a chunk of whole rows is written out); a sample
-    /// without the trace's plane B columns fills them with `NaN`.
+    /// without some of the trace's columns (plane B's, …) fills them with `NaN`.
     pub fn write(&mut self, r: &Record) -> std::io::Result<()> {
         use std::fmt::Write as _;
-        let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
-        let hw = r.hw.unwrap_or([f64::NAN; WIDTH_HW]);
-        let magnets = r.magnets.unwrap_or([f64::NAN; WIDTH_MAGNETS]);
-        let mid = r.mid.unwrap_or([f64::NAN; WIDTH_MID]);
-        let values =
-            r.a.iter()
-                .chain(&b[..self.b_cols])
-                .chain(&hw[..self.coils])
-                .chain(&magnets[..self.magnets])
-                .chain(&mid[..self.mid]);
-        for (field, v) in self.fields.iter_mut().zip(values) {
-            field.clear();
-            let _ = write!(field, "{v:e}");
-        }
+        let mut fields = self.fields.iter_mut();
+        self.layout.put(r, &mut |v| {
+            if let Some(field) = fields.next() {
+                field.clear();
+                let _ = write!(field, "{v:e}");
+            }
+        });
         self.rows.row(&self.fields)
     }
 
@@ -377,8 +283,8 @@ pub const MAX_LINE_BYTES: usize = 64 << 10;
 /// file that is not a trace (a link to `/dev/zero`, a sparse file of zeros) is refused at
 /// once in bounded memory.
 ///
-/// The header must hold every name of [`Trace::COLUMNS`] (other columns are
-/// ignored); a two-plane trace also every name of [`TraceB::COLUMNS`] (a header
+/// The header must hold every name of [`Row`]'s columns (other columns are
+/// ignored); a two-plane trace also every name of [`RowB`]'s (a header
 /// with some but not all of them is refused, naming the first missing). Refused, naming the line and, where one is to blame, the
 /// column: a row with more or fewer fields than the header (a ragged row), a
 /// field that is not a number (`NaN`, `inf` and `-inf`, which the plant
@@ -411,44 +317,27 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
     }
     let header: Vec<String> = record.iter().map(|h| String::from_utf8_lossy(h).trim().to_string()).collect();
     let find = |name: &str| header.iter().position(|h| h == name);
-    let mut index = [0usize; WIDTH];
-    for (slot, name) in index.iter_mut().zip(Trace::COLUMNS) {
-        *slot = find(name).ok_or_else(|| bad(1, Some(name), format!("the header has no column `{name}`")))?;
+    let mut index = Vec::with_capacity(WIDTH);
+    for name in Row::NAMES {
+        index.push(find(name).ok_or_else(|| bad(1, Some(name), format!("the header has no column `{name}`")))?);
     }
-    let index_b = if TraceB::COLUMNS.iter().any(|name| find(name).is_some()) {
-        let mut index_b = [0usize; WIDTH_B];
-        for (slot, name) in index_b.iter_mut().zip(TraceB::COLUMNS) {
-            *slot = find(name).ok_or_else(|| {
-                bad(
-                    1,
-                    Some(name),
-                    format!("the header has plane B columns but not `{name}`: a two-plane trace has all of them"),
-                )
-            })?;
+    // An optional group's columns: all of them or none (`why` says so when some are missing).
+    let group = |names: &[&'static str], why: &str| -> Result<Option<Vec<usize>>, TraceError> {
+        if !names.iter().any(|name| find(name).is_some()) {
+            return Ok(None);
         }
-        Some(index_b)
-    } else {
-        None
-    };
-    // A flexible trace's mid-span columns: both or none.
-    let index_mid = if TraceMid::COLUMNS.iter().any(|name| find(name).is_some()) {
-        let mut index_mid = [0usize; WIDTH_MID];
-        for (slot, name) in index_mid.iter_mut().zip(TraceMid::COLUMNS) {
-            *slot = find(name).ok_or_else(|| {
-                bad(
-                    1,
-                    Some(name),
-                    format!("the header has mid-span columns but not `{name}`: a flexible trace has both"),
-                )
-            })?;
+        let mut index = Vec::with_capacity(names.len());
+        for name in names {
+            index.push(find(name).ok_or_else(|| bad(1, Some(name), format!("the header has {why} but not `{name}`")))?);
         }
-        Some(index_mid)
-    } else {
-        None
+        Ok(Some(index))
     };
+    let index_b =
+        group(RowB::NAMES, "plane B columns").map_err(|e| with_note(e, ": a two-plane trace has all of them"))?;
+    let index_mid = group(Mid::NAMES, "mid-span columns").map_err(|e| with_note(e, ": a flexible trace has both"))?;
     let mut previous_t = f64::NEG_INFINITY;
     let mut last_line = 1;
-    let mut values = [0.0; WIDTH];
+    let mut values = Vec::with_capacity(WIDTH);
     while reader.read_byte_record(&mut record).map_err(csv_err)? {
         let line = record.position().map_or(last_line + 1, |p| p.line());
         last_line = line;
@@ -459,34 +348,34 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
                 format!("{} fields where the header has {}: a ragged or cut row", record.len(), header.len()),
             ));
         }
-        let number = |i: usize, name: &str| {
-            let field = std::str::from_utf8(&record[i]).unwrap_or("").trim();
-            field.parse::<f64>().map_err(|_| bad(line, Some(name), format!("`{field}` is not a number")))
+        // The fields at `index` (the columns `names`), parsed into `values`.
+        let numbers = |index: &[usize], names: &[&str], values: &mut Vec<f64>| {
+            values.clear();
+            for (&i, name) in index.iter().zip(names) {
+                let field = std::str::from_utf8(&record[i]).unwrap_or("").trim();
+                values.push(
+                    field.parse::<f64>().map_err(|_| bad(line, Some(name), format!("`{field}` is not a number")))?,
+                );
+            }
+            Ok::<_, TraceError>(())
         };
-        for ((v, &i), name) in values.iter_mut().zip(&index).zip(Trace::COLUMNS) {
-            *v = number(i, name)?;
-        }
+        numbers(&index, Row::NAMES, &mut values)?;
+        let a = Row::from_values(&values);
         let b = match &index_b {
             Some(index_b) => {
-                let mut b = [0.0; WIDTH_B];
-                for ((v, &i), name) in b.iter_mut().zip(index_b).zip(TraceB::COLUMNS) {
-                    *v = number(i, name)?;
-                }
-                Some(b)
+                numbers(index_b, RowB::NAMES, &mut values)?;
+                Some(RowB::from_values(&values))
             }
             None => None,
         };
         let mid = match &index_mid {
             Some(index_mid) => {
-                let mut m = [0.0; WIDTH_MID];
-                for ((v, &i), name) in m.iter_mut().zip(index_mid).zip(TraceMid::COLUMNS) {
-                    *v = number(i, name)?;
-                }
-                Some(m)
+                numbers(index_mid, Mid::NAMES, &mut values)?;
+                Some(Mid::from_values(&values))
             }
             None => None,
         };
-        let t = values[col::T_S];
+        let t = a.t_s;
         if !t.is_finite() {
             return Err(bad(line, Some("t_s"), format!("time {t} is not finite")));
         }
@@ -495,7 +384,7 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
             return Err(bad(line, Some("t_s"), format!("time {how}: {t:e} s after {previous_t:e} s")));
         }
         previous_t = t;
-        if !row(&Record { a: values, b, hw: None, magnets: None, mid }) {
+        if !row(&Record { a, b, hw: None, magnets: None, mid }) {
             return Ok(false);
         }
     }
@@ -510,6 +399,16 @@ pub fn read_rows(path: &Path, mut row: impl FnMut(&Record) -> bool) -> Result<bo
         }
     }
     Ok(true)
+}
+
+/// `e` with `note` after what it says is wrong.
+fn with_note(e: TraceError, note: &str) -> TraceError {
+    match e {
+        TraceError::Malformed { path, line, column, what } => {
+            TraceError::Malformed { path, line, column, what: format!("{what}{note}") }
+        }
+        e => e,
+    }
 }
 
 /// A reader that fails (`InvalidData`, naming the line) as soon as a line grows past
@@ -555,7 +454,9 @@ pub fn window_error(trace: &Trace, reference: &Trace, t0: f64, t1: f64, gap: f64
         if (tt - t).abs() > 1e-9 {
             return (f64::INFINITY, f64::INFINITY);
         }
-        let e = (trace.dx_m[i] - reference.dx_m[i]).hypot(trace.dy_m[i] - reference.dy_m[i]) / gap;
+        let e = (trace.motion.dx_m[i] - reference.motion.dx_m[i])
+            .hypot(trace.motion.dy_m[i] - reference.motion.dy_m[i])
+            / gap;
         if !e.is_finite() {
             return (f64::INFINITY, f64::INFINITY);
         }
@@ -577,10 +478,9 @@ mod tests {
     fn trace(t: &[f64], dx: &[f64], dy: &[f64]) -> Trace {
         let mut tr = Trace::default();
         for i in 0..t.len() {
-            let mut row = [0.0; crate::trace::WIDTH];
-            row[0] = t[i];
-            row[1] = dx[i];
-            row[2] = dy[i];
+            let mut row = Row { t_s: t[i], ..Row::default() };
+            row.motion.dx_m = dx[i];
+            row.motion.dy_m = dy[i];
             tr.push_row(&row);
         }
         tr
@@ -634,9 +534,13 @@ mod tests {
     fn written_rows_read_back_bit_identical() {
         let mut tr = Trace::default();
         for i in 0..5 {
-            let mut r: Row = std::array::from_fn(|c| (i * WIDTH + c) as f64 * 1.234_567_890_123e-5 - 0.1);
-            r[col::T_S] = i as f64 * 5e-5;
-            r[col::CONTACT_FORCE_N] = if i == 2 { f64::NAN } else { 0.0 };
+            let mut c = 0;
+            let mut r = Row::take(&mut || {
+                c += 1;
+                ((i * WIDTH + c - 1) as f64) * 1.234_567_890_123e-5 - 0.1
+            });
+            r.t_s = i as f64 * 5e-5;
+            r.loads.contact_force_n = if i == 2 { f64::NAN } else { 0.0 };
             tr.push_row(&r);
         }
         let path = scratch("roundtrip", "");
@@ -647,7 +551,7 @@ mod tests {
         assert!(text.lines().nth(3).unwrap().contains(",NaN,"), "{text}");
         let back = Trace::read_csv(&path).unwrap();
         for i in 0..5 {
-            let (a, b) = (tr.row(i), back.row(i));
+            let (a, b) = (tr.row(i).values(), back.row(i).values());
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{a:?} vs {b:?}");
         }
         let _ = std::fs::remove_dir_all(path.parent().unwrap());
@@ -715,7 +619,7 @@ mod tests {
         assert!(e.contains("line 1") && e.contains("empty"), "{e}");
         // NaN is what the plant writes for a non-finite value: read as such.
         let path = scratch("nan-ok", &format!("{}\n{}\n", header(), line(0.0, "NaN")));
-        assert!(Trace::read_csv(&path).unwrap().dy_m[0].is_nan());
+        assert!(Trace::read_csv(&path).unwrap().motion.dy_m[0].is_nan());
         let _ = std::fs::remove_dir_all(path.parent().unwrap());
     }
 }

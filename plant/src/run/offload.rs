@@ -109,22 +109,20 @@ pub fn offload<S: Sink + Send, R>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trace::WIDTH;
+    use crate::trace::Row;
 
     /// A sink that keeps the times it was given, on whatever thread.
     struct Times(Vec<f64>, Option<String>);
 
     impl Sink for Times {
         fn sample(&mut self, r: &Record) {
-            self.0.push(r.a[0]);
+            self.0.push(r.a.t_s);
             self.1 = std::thread::current().name().map(String::from);
         }
     }
 
     fn record(t: f64) -> Record {
-        let mut a = [0.0; WIDTH];
-        a[0] = t;
-        Record::planar(a)
+        Record::planar(Row { t_s: t, ..Row::default() })
     }
 
     #[test]

@@ -31,7 +31,9 @@ impl Hooks for Saving {
 }
 
 fn rows(trace: &Trace) -> Vec<Vec<u64>> {
-    trace.records().map(|r| r.a.iter().chain(r.b.iter().flatten()).map(|v| v.to_bits()).collect()).collect()
+    use crate::trace::Columns as _;
+    let values = |r: crate::trace::Record| r.a.values().into_iter().chain(r.b.map(|b| b.values()).unwrap_or_default());
+    trace.records().map(|r| values(r).map(|v| v.to_bits()).collect()).collect()
 }
 
 /// The run loop restored at a tick writes the rows of the run that never stopped, bit for

@@ -22,7 +22,6 @@ use crate::config::{load_scene, Rotor, Scene};
 use crate::machine::Linearised;
 use crate::plot;
 use crate::run::{plane_gains, run, Outcome, Quiet};
-use crate::trace::{col, colb};
 use anyhow::Context;
 use nalgebra::{Complex, DMatrix};
 use plant_physics::flex::linear::ModeKind;
@@ -55,6 +54,7 @@ impl Serialize for ModeName {
     }
 }
 
+crate::table::table_row! {
 /// One mode at one speed: a row of `campbell.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModeRow {
@@ -69,7 +69,9 @@ pub struct ModeRow {
     /// Damping ratio.
     pub damping_ratio: f64,
 }
+}
 
+crate::table::table_row! {
 /// A mode of a free decay against the linearisation's: a row of `decay.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct DecayRow {
@@ -89,6 +91,7 @@ pub struct DecayRow {
     pub linear_damping_ratio: f64,
     /// The free decay's.
     pub decay_damping_ratio: f64,
+}
 }
 
 /// What `plant campbell` is asked.
@@ -269,7 +272,7 @@ pub fn free_decay(scene: &Scene, speed_hz: f64) -> anyhow::Result<Vec<Fitted>> {
         r.run.outcome
     );
     anyhow::ensure!(
-        r.trace.contact_force_n.iter().all(|f| *f == 0.0),
+        r.trace.loads.contact_force_n.iter().all(|f| *f == 0.0),
         "the free decay at {speed_hz} Hz touched a race: not a free decay"
     );
     let (za, zb) = (machine.planes[0].station, machine.planes[1].station);
@@ -278,8 +281,8 @@ pub fn free_decay(scene: &Scene, speed_hz: f64) -> anyhow::Result<Vec<Fitted>> {
     let (mut zeta, mut tilt) = (Vec::new(), Vec::new());
     for rec in r.trace.records().step_by(step) {
         let b = rec.b.context("a two-plane trace")?;
-        let phi = C64::new(b[colb::SLOPE], b[colb::SLOPE + 1]);
-        let at_a = C64::new(rec.a[col::DX_M], rec.a[col::DY_M]);
+        let phi = C64::new(b.tilt.slope_x_rad, b.tilt.slope_y_rad);
+        let at_a = C64::new(rec.a.motion.dx_m, rec.a.motion.dy_m);
         zeta.push(at_a - phi * za);
         tilt.push(phi * half);
     }
@@ -314,10 +317,9 @@ pub fn match_modes(speed_hz: f64, linear: &[Mode; 4], fitted: &[Fitted]) -> Vec<
 }
 
 /// Header of `campbell.csv`.
-pub const CAMPBELL_HEADER: &str = "speed_hz,mode,whirl,frequency_hz,damping_ratio";
+pub const CAMPBELL_HEADER: &str = ModeRow::HEADER;
 /// Header of `decay.csv`.
-pub const DECAY_HEADER: &str =
-    "speed_hz,mode,whirl,linear_hz,decay_hz,error_rel,linear_damping_ratio,decay_damping_ratio";
+pub const DECAY_HEADER: &str = DecayRow::HEADER;
 
 /// `plant campbell` (module doc); returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {

@@ -40,7 +40,7 @@ use crate::digital::CommandPath;
 use crate::hooks::Hooks;
 use crate::run::{RunResult, SetupError};
 use crate::sensor::Sensor;
-use crate::trace::{col, Trace, TraceError};
+use crate::trace::{Trace, TraceError};
 use controller::{ControlLaw, LawEntry, LawError, RotorLaw, RotorSample, ROTOR_AXES};
 use std::path::Path;
 
@@ -210,7 +210,7 @@ pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -
     let mut row: u64 = 0;
     let mut bad_time = None;
     crate::trace::read_rows(trace, |record| {
-        let t_row = record.a[col::T_S];
+        let t_row = record.a.t_s;
         // Row `row` closes the step of tick `(row − 1) / per_tick`; the command of that tick was
         // pushed when its sample (the row at its start) was read.
         if row > 0 {
@@ -218,7 +218,7 @@ pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -
             let mut differs = false;
             for p in 0..planes {
                 let r = record.plane(p);
-                let (trace_a, law_a) = ([r[col::IX_A], r[col::IY_A]], [applied[2 * p], applied[2 * p + 1]]);
+                let (trace_a, law_a) = ([r.loads.ix_a, r.loads.iy_a], [applied[2 * p], applied[2 * p + 1]]);
                 if trace_a.iter().zip(&law_a).all(|(t, l)| t.to_bits() == l.to_bits()) {
                     continue;
                 }
@@ -250,14 +250,14 @@ pub fn replay_rotor_trace(scene: &Scene, trace: &Path, law: &mut dyn RotorLaw) -
                 seq: k,
                 t_s,
                 axes: 2 * planes as u32,
-                speed_rad_s: a[col::ROTOR_SPEED_RAD_S],
-                angle_rad: controller::wrap_angle(a[col::ROTOR_ANGLE_RAD]),
+                speed_rad_s: a.spin.rotor_speed_rad_s,
+                angle_rad: controller::wrap_angle(a.spin.rotor_angle_rad),
                 ..Default::default()
             };
             for p in 0..planes {
                 let r = record.plane(p);
                 let gain = scene.plane(p).loop_constants.sensor_gain_v_per_m;
-                let v = sensor.read_with_gain([r[col::DX_M], r[col::DY_M]], gain);
+                let v = sensor.read_with_gain([r.motion.dx_m, r.motion.dy_m], gain);
                 sample.sensor_v[2 * p..2 * p + 2].copy_from_slice(&v);
             }
             let answer = path.saturate(law.update(&sample));
@@ -304,8 +304,8 @@ mod tests {
         let s = scene(&["controller.mode=\"sampled\"", "sensor.noise_v_rms=0.01", "sensor.adc_bits=14"]);
         let mine = run_law(&s, &controller::pd::LAW, &mut crate::run::Quiet).unwrap();
         let sampled = crate::run::run(&s, &mut crate::run::Quiet).unwrap();
-        assert_eq!(mine.trace.ix_a, sampled.trace.ix_a);
-        assert_eq!(mine.trace.dy_m, sampled.trace.dy_m);
+        assert_eq!(mine.trace.loads.ix_a, sampled.trace.loads.ix_a);
+        assert_eq!(mine.trace.motion.dy_m, sampled.trace.motion.dy_m);
         let dir = scratch("replay");
         crate::output::write_run(&dir, &s, &mine).unwrap();
         let same = replay(&dir, &controller::pd::LAW).unwrap();
@@ -393,7 +393,7 @@ mod tests {
         ]);
         let run = run_law(&lenient, &LAW, &mut crate::run::Quiet).unwrap();
         assert_eq!((run.run.outcome.clone(), run.run.invalid_commands), (crate::run::Outcome::Completed, 100));
-        assert!(run.trace.ix_a.iter().all(|i| i.is_finite()));
+        assert!(run.trace.loads.ix_a.iter().all(|i| i.is_finite()));
         let dir = scratch("replay-nan");
         crate::output::write_run(&dir, &lenient, &run).unwrap();
         let mut law = Nan(100);

@@ -30,6 +30,92 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::path::Path;
 
+/// A CSV row type: its columns (`COLUMNS`, the fields' names in order, as serde writes them)
+/// and its header line (`HEADER`), derived from the struct's own fields, so that a table's
+/// header is never a second hand-written list of its columns. Wrap the row struct's
+/// definition: `table_row! { #[derive(Serialize)] pub struct Row { pub a_m: f64, … } }`.
+///
+/// A declarative macro rather than a derive crate: serde gives a type's field names only
+/// through a `Deserialize` impl (which most of these write-only rows do not have) or an
+/// instance (which an empty table does not have); a proc-macro crate for a list of
+/// `stringify!`s would be a crate to build and keep. A row type whose serde attributes rename,
+/// skip or flatten a field must not use it (none does).
+macro_rules! table_row {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($(#[$fmeta:meta])* $fvis:vis $field:ident : $ty:ty),* $(,)? }) => {
+        $(#[$meta])*
+        $vis struct $name { $($(#[$fmeta])* $fvis $field: $ty,)* }
+
+        impl $name {
+            /// The table's columns: the fields' names, in order.
+            pub const COLUMNS: &'static [&'static str] = &[$(stringify!($field)),*];
+            /// The table's header line (without its line end): the columns joined by commas.
+            pub const HEADER: &'static str = {
+                const BYTES: [u8; $crate::table::joined_len($name::COLUMNS)] = $crate::table::join($name::COLUMNS);
+                match std::str::from_utf8(&BYTES) {
+                    Ok(s) => s,
+                    Err(_) => panic!("a column name is not UTF-8"),
+                }
+            };
+        }
+    };
+}
+pub(crate) use table_row;
+
+/// A [`table_row!`] of text fields, for a table written as records of strings (each field
+/// formatted by its writer): `into_fields` gives the fields in the columns' order, so that the
+/// header and the record come from the one list of fields.
+macro_rules! text_row {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($(#[$fmeta:meta])* $field:ident),* $(,)? }) => {
+        $crate::table::table_row! {
+            $(#[$meta])*
+            #[derive(Clone, Debug, Default, PartialEq)]
+            $vis struct $name { $($(#[$fmeta])* pub $field: String),* }
+        }
+
+        impl $name {
+            /// The fields, in the columns' order.
+            pub fn into_fields(self) -> Vec<String> {
+                vec![$(self.$field),*]
+            }
+        }
+    };
+}
+pub(crate) use text_row;
+
+/// The length of `names` joined by commas (bytes).
+pub const fn joined_len(names: &[&str]) -> usize {
+    let mut n = names.len().saturating_sub(1);
+    let mut i = 0;
+    while i < names.len() {
+        n += names[i].len();
+        i += 1;
+    }
+    n
+}
+
+/// `names` joined by commas, as `N` bytes ([`joined_len`]); at compile time, for a header
+/// constant.
+pub const fn join<const N: usize>(names: &[&str]) -> [u8; N] {
+    let mut out = [0u8; N];
+    let (mut k, mut i) = (0, 0);
+    while i < names.len() {
+        if i > 0 {
+            out[k] = b',';
+            k += 1;
+        }
+        let bytes = names[i].as_bytes();
+        let mut j = 0;
+        while j < bytes.len() {
+            out[k] = bytes[j];
+            k += 1;
+            j += 1;
+        }
+        i += 1;
+    }
+    assert!(k == N, "the header's length is not joined_len");
+    out
+}
+
 /// The rows as CSV text: a header from the row type's field names, then one record per row,
 /// `\n`-terminated.
 pub fn to_bytes<T: Serialize>(rows: &[T]) -> anyhow::Result<Vec<u8>> {

@@ -149,7 +149,7 @@ impl Machine<N> for Model {
         let mut r =
             rows::two_bearing_record(t, [y[ix::TR], y[ix::WR]], housing.disp, [plane(0), plane(1)], slopes(self, y));
         let (mid, _) = self.node(y, mid_span(self));
-        r.mid = Some([mid.x, mid.y]);
+        r.mid = Some(rows::Mid { mid_dx_m: mid.x, mid_dy_m: mid.y });
         r
     }
 

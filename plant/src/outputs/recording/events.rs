@@ -5,7 +5,7 @@
 
 use crate::config::Scene;
 use crate::summary::Summary;
-use crate::trace::{col, Record};
+use crate::trace::Record;
 
 /// Most contact onsets logged per plane: a rubbing rotor can touch at every other row, and a
 /// log is for a reader; the last one logged says that more followed.
@@ -55,7 +55,7 @@ impl Events {
 
     /// The events at or before this row, into `out`.
     pub fn row(&mut self, r: &Record, out: &mut Vec<Event>) {
-        let t = r.a[col::T_S];
+        let t = r.a.t_s;
         self.last_t = t;
         let count = self.shocks.len();
         while let Some(&(start, n)) = self.shocks.get(self.next_shock).filter(|(s, _)| *s <= t) {
@@ -68,7 +68,7 @@ impl Events {
         }
         let planes = self.contact.len();
         for (i, (touching, onsets)) in self.contact.iter_mut().enumerate() {
-            let now = r.plane(i)[col::CONTACT_FORCE_N] > 0.0;
+            let now = r.plane(i).loads.contact_force_n > 0.0;
             if now && !*touching {
                 *onsets += 1;
                 let plane = if planes == 2 { ["plane A: ", "plane B: "][i] } else { "" };

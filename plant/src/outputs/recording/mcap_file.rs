@@ -13,7 +13,7 @@ use super::events::{Event, Events, LOG_SCHEMA};
 use super::topics::{topics, Columns, Topic};
 use crate::config::Scene;
 use crate::summary::Summary;
-use crate::trace::{col, Record};
+use crate::trace::Record;
 use anyhow::Context;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -99,7 +99,7 @@ impl McapSink {
             return;
         }
         self.columns.values(r, &mut self.values);
-        let ns = nanoseconds(r.a[col::T_S]);
+        let ns = nanoseconds(r.a.t_s);
         self.events.row(r, &mut self.pending);
         let Some(writer) = self.writer.as_mut() else { return };
         let mut written = Ok(());

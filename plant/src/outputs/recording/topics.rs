@@ -12,9 +12,7 @@
 //! version did) cost 45 % more CPU time than the run without a recording.
 
 use crate::config::Scene;
-use crate::trace::{
-    Record, Trace, TraceB, TraceHw, TraceMagnets, TraceMid, WIDTH_B, WIDTH_HW, WIDTH_MAGNETS, WIDTH_MID,
-};
+use crate::trace::{Layout, Record};
 use std::fmt::Write as _;
 
 /// The trace's columns of a run of `scene`, in `trace.csv`'s order: the planar ones, plane B's
@@ -23,49 +21,31 @@ use std::fmt::Write as _;
 /// [`crate::trace::TraceWriter::create_with_columns`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Columns {
-    b: usize,
-    coils: usize,
-    magnets: usize,
-    mid: usize,
+    layout: Layout,
 }
 
 impl Columns {
     /// The columns `trace.csv` has for a run of `scene`.
     pub fn of(scene: &Scene) -> Self {
-        let planes = scene.planes();
-        Self {
-            b: if planes == 2 { WIDTH_B } else { 0 },
-            coils: if scene.hardware.amplified() { 4 * planes } else { 0 },
-            magnets: if scene.hardware.is_unipolar() { 8 * planes } else { 0 },
-            mid: if scene.rotor.bends() { WIDTH_MID } else { 0 },
-        }
+        let layout = Layout {
+            planes: scene.planes(),
+            coils: scene.hardware.amplified(),
+            magnets: scene.hardware.is_unipolar(),
+            mid: scene.rotor.bends(),
+        };
+        Self { layout }
     }
 
     /// The columns' names, in order.
     pub fn names(&self) -> Vec<&'static str> {
-        Trace::COLUMNS
-            .iter()
-            .chain(&TraceB::COLUMNS[..self.b])
-            .chain(&TraceHw::COLUMNS[..self.coils])
-            .chain(&TraceMagnets::COLUMNS[..self.magnets])
-            .chain(&TraceMid::COLUMNS[..self.mid])
-            .copied()
-            .collect()
+        self.layout.names()
     }
 
     /// A row's values of these columns, in order, into `out` (cleared first); what a row does
     /// not hold is NaN, as in `trace.csv`.
     pub fn values(&self, r: &Record, out: &mut Vec<f64>) {
         out.clear();
-        let b = r.b.unwrap_or([f64::NAN; WIDTH_B]);
-        let hw = r.hw.unwrap_or([f64::NAN; WIDTH_HW]);
-        let magnets = r.magnets.unwrap_or([f64::NAN; WIDTH_MAGNETS]);
-        let mid = r.mid.unwrap_or([f64::NAN; WIDTH_MID]);
-        out.extend_from_slice(&r.a);
-        out.extend_from_slice(&b[..self.b]);
-        out.extend_from_slice(&hw[..self.coils]);
-        out.extend_from_slice(&magnets[..self.magnets]);
-        out.extend_from_slice(&mid[..self.mid]);
+        self.layout.put(r, &mut |v| out.push(v));
     }
 }
 
@@ -203,7 +183,7 @@ mod tests {
 
     #[test]
     fn every_column_but_time_goes_to_exactly_one_topic() {
-        let all = Columns { b: WIDTH_B, coils: 8, magnets: 16, mid: WIDTH_MID };
+        let all = Columns { layout: Layout { planes: 2, coils: true, magnets: true, mid: true } };
         let topics = topics(&all);
         let mut carried: Vec<&str> = topics.iter().flat_map(|t| t.fields.iter().map(|f| f.column)).collect();
         carried.sort_unstable();

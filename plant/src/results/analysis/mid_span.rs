@@ -12,7 +12,7 @@
 //! zero for a rigid rotor whatever it does. As the run's other maxima, a row at or after a
 //! failure's time is left out ([`MidSpanAnalyzer::finish`]).
 
-use crate::trace::{col, Record};
+use crate::trace::Record;
 use serde::Serialize;
 
 /// The mid-span's figures in `summary.json` (`mid_span`).
@@ -51,9 +51,10 @@ impl MidSpanAnalyzer {
     pub fn push(&mut self, r: &Record) {
         let Some(m) = r.mid else { return };
         let (a, b) = (r.plane(0), r.plane(1));
-        let at = |k: usize| a[k] + self.weight * (b[k] - a[k]);
-        let bow = (m[0] - at(col::DX_M)).hypot(m[1] - at(col::DY_M));
-        if let Some(p) = self.pending.replace([r.a[col::T_S], m[0].hypot(m[1]), bow]) {
+        let at = |a: f64, b: f64| a + self.weight * (b - a);
+        let line = [at(a.motion.dx_m, b.motion.dx_m), at(a.motion.dy_m, b.motion.dy_m)];
+        let bow = (m.mid_dx_m - line[0]).hypot(m.mid_dy_m - line[1]);
+        if let Some(p) = self.pending.replace([r.a.t_s, m.mid_dx_m.hypot(m.mid_dy_m), bow]) {
             self.take(p);
         }
     }
@@ -92,18 +93,18 @@ impl MidSpanAnalyzer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trace::{colb, WIDTH, WIDTH_B};
+    use crate::trace::{Mid, Row, RowB};
 
     /// A sample at `t` with the rotor at `a` (touchdown A), `b` (touchdown B) and `m` (mid-span).
     fn sample(t: f64, a: [f64; 2], b: [f64; 2], m: [f64; 2]) -> Record {
-        let mut ra = [0.0; WIDTH];
-        ra[col::T_S] = t;
-        ra[col::DX_M] = a[0];
-        ra[col::DY_M] = a[1];
-        let mut rb = [0.0; WIDTH_B];
-        rb[colb::DX] = b[0];
-        rb[colb::DX + 1] = b[1];
-        Record { a: ra, b: Some(rb), hw: None, magnets: None, mid: Some(m) }
+        let mut ra = Row { t_s: t, ..Row::default() };
+        ra.motion.dx_m = a[0];
+        ra.motion.dy_m = a[1];
+        let mut rb = RowB::default();
+        rb.motion.dx_m = b[0];
+        rb.motion.dy_m = b[1];
+        let mid = Mid { mid_dx_m: m[0], mid_dy_m: m[1] };
+        Record { a: ra, b: Some(rb), hw: None, magnets: None, mid: Some(mid) }
     }
 
     /// A straight rotor has no bow however it moves; a bent one bows by its distance from the

@@ -19,7 +19,7 @@ pub mod tilt;
 
 use crate::bounded::Strided;
 use crate::plot::{self, PointGroup, Scale, Series};
-use crate::trace::{col, Row, Trace};
+use crate::trace::{Row, Trace};
 use classify::{MotionMode, SteadyClass};
 use poincare::{SectionBuilder, SectionPoint, SectionSample};
 use serde::Serialize;
@@ -193,21 +193,21 @@ impl Analyzer {
 
     /// The next row of the trace (times increasing).
     pub fn push(&mut self, r: &Row) {
-        let t = r[col::T_S];
+        let t = r.t_s;
         self.first.get_or_insert(t);
-        let (x, y) = (r[col::DX_M], r[col::DY_M]);
+        let (x, y) = (r.motion.dx_m, r.motion.dy_m);
         let sample = SectionSample {
             t_s: t,
-            angle_rad: r[col::ROTOR_ANGLE_RAD],
+            angle_rad: r.spin.rotor_angle_rad,
             pos_m: [x, y],
-            vel_m_s: [r[col::VX_M_S], r[col::VY_M_S]],
+            vel_m_s: [r.motion.vx_m_s, r.motion.vy_m_s],
         };
         let recent = &mut self.recent;
         self.section.push(sample, &mut |p| recent.push_back(p));
         if let Some(stft) = &mut self.stft {
             stft.push(t, x, y);
         }
-        self.window.push_back(WindowRow { t, x, y, contact: r[col::CONTACT_FORCE_N] });
+        self.window.push_back(WindowRow { t, x, y, contact: r.loads.contact_force_n });
         // Rows and points before `t − span` are before the final window, whose start is
         // `end − span` with `end ≥ t`.
         let cutoff = t - self.span;
@@ -408,12 +408,11 @@ mod tests {
         let mut a = Analyzer::new(spec, None);
         for k in 0..=4000 {
             let t = t0 + k as f64 * 1e-4;
-            let mut r: Row = [0.0; crate::trace::WIDTH];
-            r[col::T_S] = t;
-            r[col::ROTOR_ANGLE_RAD] = spec.speed * t;
-            r[col::DX_M] = 2e-6 * (spec.speed * t).cos();
-            r[col::DY_M] = 2e-6 * (spec.speed * t).sin();
-            r[col::CONTACT_FORCE_N] = if k < 10 { 5.0 } else { 0.0 };
+            let mut r = Row { t_s: t, ..Row::default() };
+            r.spin.rotor_angle_rad = spec.speed * t;
+            r.motion.dx_m = 2e-6 * (spec.speed * t).cos();
+            r.motion.dy_m = 2e-6 * (spec.speed * t).sin();
+            r.loads.contact_force_n = if k < 10 { 5.0 } else { 0.0 };
             a.push(&r);
         }
         a.finish().0

@@ -95,9 +95,9 @@ pub fn section(trace: &Trace, phase_rad: f64) -> Vec<SectionPoint> {
     for i in 0..trace.len() {
         let row = SectionSample {
             t_s: trace.t_s[i],
-            angle_rad: trace.rotor_angle_rad[i],
-            pos_m: [trace.dx_m[i], trace.dy_m[i]],
-            vel_m_s: [trace.vx_m_s[i], trace.vy_m_s[i]],
+            angle_rad: trace.spin.rotor_angle_rad[i],
+            pos_m: [trace.motion.dx_m[i], trace.motion.dy_m[i]],
+            vel_m_s: [trace.motion.vx_m_s[i], trace.motion.vy_m_s[i]],
         };
         builder.push(row, &mut |p| out.push(p));
     }
@@ -120,11 +120,11 @@ mod tests {
             let t = i as f64 * dt;
             let (a1, a2) = (tau * f * t - std::f64::consts::FRAC_PI_6, tau * w2 * t);
             tr.t_s.push(t);
-            tr.rotor_angle_rad.push(tau * f * t + 0.1);
-            tr.dx_m.push(2e-6 * a1.cos() + 10e-6 * a2.cos());
-            tr.dy_m.push(2e-6 * a1.sin() + 10e-6 * a2.sin());
-            tr.vx_m_s.push(-2e-6 * tau * f * a1.sin() - 10e-6 * tau * w2 * a2.sin());
-            tr.vy_m_s.push(2e-6 * tau * f * a1.cos() + 10e-6 * tau * w2 * a2.cos());
+            tr.spin.rotor_angle_rad.push(tau * f * t + 0.1);
+            tr.motion.dx_m.push(2e-6 * a1.cos() + 10e-6 * a2.cos());
+            tr.motion.dy_m.push(2e-6 * a1.sin() + 10e-6 * a2.sin());
+            tr.motion.vx_m_s.push(-2e-6 * tau * f * a1.sin() - 10e-6 * tau * w2 * a2.sin());
+            tr.motion.vy_m_s.push(2e-6 * tau * f * a1.cos() + 10e-6 * tau * w2 * a2.cos());
         }
         let phase = 1.0;
         let s = section(&tr, phase);
@@ -151,8 +151,8 @@ mod tests {
         for i in 0..=2000 {
             let t = i as f64 * 5e-5;
             tr.t_s.push(t);
-            tr.rotor_angle_rad.push(w * t);
-            for c in [&mut tr.dx_m, &mut tr.dy_m, &mut tr.vx_m_s, &mut tr.vy_m_s] {
+            tr.spin.rotor_angle_rad.push(w * t);
+            for c in [&mut tr.motion.dx_m, &mut tr.motion.dy_m, &mut tr.motion.vx_m_s, &mut tr.motion.vy_m_s] {
                 c.push(0.0);
             }
         }

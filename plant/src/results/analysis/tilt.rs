@@ -77,10 +77,10 @@ impl TiltAnalyzer {
         if tilt.is_finite() {
             self.max_tilt = self.max_tilt.max(tilt);
         }
-        let t = r.a[crate::trace::col::T_S];
+        let t = r.a.t_s;
         self.first.get_or_insert(t);
-        let (dx, dy) = (crate::trace::col::DX_M, crate::trace::col::DY_M);
-        self.window.push_back(Row { t, a: [r.a[dx], r.a[dy]], b: [b[dx], b[dy]], tilt });
+        let (a, b) = (&r.a.motion, &b.motion);
+        self.window.push_back(Row { t, a: [a.dx_m, a.dy_m], b: [b.dx_m, b.dy_m], tilt });
         let cutoff = t - self.spec.window_length();
         while self.window.front().is_some_and(|w| w.t < cutoff) {
             self.window.pop_front();
@@ -131,18 +131,17 @@ impl TiltAnalyzer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trace::{colb, Record, WIDTH, WIDTH_B};
+    use crate::trace::{Record, RowB};
 
     fn record(t: f64, a: [f64; 2], b: [f64; 2], slopes: [f64; 2]) -> Record {
-        let mut ra = [0.0; WIDTH];
-        ra[0] = t;
-        ra[1] = a[0];
-        ra[2] = a[1];
-        let mut rb = [0.0; WIDTH_B];
-        rb[colb::DX] = b[0];
-        rb[colb::DX + 1] = b[1];
-        rb[colb::SLOPE] = slopes[0];
-        rb[colb::SLOPE + 1] = slopes[1];
+        let mut ra = crate::trace::Row { t_s: t, ..Default::default() };
+        ra.motion.dx_m = a[0];
+        ra.motion.dy_m = a[1];
+        let mut rb = RowB::default();
+        rb.motion.dx_m = b[0];
+        rb.motion.dy_m = b[1];
+        rb.tilt.slope_x_rad = slopes[0];
+        rb.tilt.slope_y_rad = slopes[1];
         Record { a: ra, b: Some(rb), hw: None, magnets: None, mid: None }
     }
 

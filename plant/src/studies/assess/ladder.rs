@@ -32,7 +32,7 @@ use crate::ensemble::tally::{tally, Tally};
 use crate::grid::Point;
 use crate::hooks::Hooks;
 use crate::run::{run_into, Outcome, RunResult, Sink};
-use crate::trace::{col, Record, Trace};
+use crate::trace::{Record, Trace};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::cell::Cell;
@@ -308,14 +308,14 @@ impl Decision {
 
     /// One output sample.
     fn sample(&self, record: &Record) {
-        let t = record.a[col::T_S];
+        let t = record.a.t_s;
         let mut radius: f64 = 0.0;
         for (i, gap) in self.gaps.iter().enumerate().take(record.planes()) {
             let row = record.plane(i);
-            if row[col::CONTACT_FORCE_N] > 0.0 {
+            if row.loads.contact_force_n > 0.0 {
                 self.last_contact.set(t);
             }
-            radius = radius.max(row[col::DX_M].hypot(row[col::DY_M]) / gap);
+            radius = radius.max(row.motion.dx_m.hypot(row.motion.dy_m) / gap);
         }
         let k = (t / self.block).floor() as i64;
         let (index, peak) = self.current.get();

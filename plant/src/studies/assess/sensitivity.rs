@@ -897,7 +897,7 @@ pub struct ContactWatch {
 impl Sink for ContactWatch {
     fn sample(&mut self, record: &crate::trace::Record) {
         if self.touched.get().is_none() && super::vibration::touching(record, &self.gaps) {
-            self.touched.set(Some(record.a[crate::trace::col::T_S]));
+            self.touched.set(Some(record.a.t_s));
         }
     }
 }

@@ -11,7 +11,7 @@
 //! rotor is graded at each bearing plane against its own clearance; the worst plane governs.
 
 use crate::run::Sink;
-use crate::trace::{col, Record};
+use crate::trace::Record;
 use serde::Serialize;
 
 /// The ISO 14839-2 zone of a displacement ratio `d / C_min`.
@@ -76,7 +76,7 @@ pub struct PlaneVibration {
 pub fn touching(record: &Record, gaps: &[f64]) -> bool {
     (0..record.planes()).any(|i| {
         let r = record.plane(i);
-        let d = (r[col::DX_M] - r[col::XB_M]).hypot(r[col::DY_M] - r[col::YB_M]);
+        let d = (r.motion.dx_m - r.motion.xb_m).hypot(r.motion.dy_m - r.motion.yb_m);
         gaps.get(i).is_some_and(|g| d > *g)
     })
 }
@@ -159,7 +159,7 @@ impl VibrationSink {
 
 impl Sink for VibrationSink {
     fn sample(&mut self, record: &Record) {
-        let t = record.a[col::T_S];
+        let t = record.a.t_s;
         if self.touched.is_none() && touching(record, &self.gaps) {
             self.touched = Some(t);
         }
@@ -169,8 +169,8 @@ impl Sink for VibrationSink {
         self.n += 1.0;
         for i in 0..record.planes().min(self.gaps.len()) {
             let r = record.plane(i);
-            self.peak[i] = self.peak[i].max(r[col::DX_M].hypot(r[col::DY_M]));
-            for (j, a) in [r[col::IX_A], r[col::IY_A]].into_iter().enumerate() {
+            self.peak[i] = self.peak[i].max(r.motion.dx_m.hypot(r.motion.dy_m));
+            for (j, a) in [r.loads.ix_a, r.loads.iy_a].into_iter().enumerate() {
                 let k = 2 * i + j;
                 self.sum[k] += a;
                 self.sum2[k] += a * a;

@@ -72,7 +72,7 @@ pub fn reference(b: &BenchScene) -> anyhow::Result<Reference> {
     let check = run(&with_integrator(&b.scene, Method::Dp5, IntegratorSetting::Rtol(1e-11)), &mut Quiet)?;
     let floor =
         window_error(&check.trace, &r.trace, b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
-    let peak = r.trace.contact_force_n.iter().copied().fold(0.0, f64::max);
+    let peak = r.trace.loads.contact_force_n.iter().copied().fold(0.0, f64::max);
     Ok(Reference { trace: r.trace, floor, peak_contact_force: peak })
 }
 
@@ -279,7 +279,7 @@ pub fn accuracy(
 fn write_reference(path: &Path, trace: &Trace, t0: f64, t1: f64) -> anyhow::Result<()> {
     let rows: Vec<ReferenceRow> = (0..trace.len())
         .filter(|&i| trace.t_s[i] >= t0 - 1e-12 && trace.t_s[i] <= t1 + 1e-12)
-        .map(|i| ReferenceRow { t_s: trace.t_s[i], dx_m: trace.dx_m[i], dy_m: trace.dy_m[i] })
+        .map(|i| ReferenceRow { t_s: trace.t_s[i], dx_m: trace.motion.dx_m[i], dy_m: trace.motion.dy_m[i] })
         .collect();
     crate::table::write_with_header(path, rows::REFERENCE_HEADER, &rows)
 }

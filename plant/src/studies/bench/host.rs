@@ -26,10 +26,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Header of `host.csv`.
-pub const HOST_HEADER: &str =
-    "pacing,rate_hz,ticks,late_p50_us,late_p99_us,late_p999_us,late_max_us,over_period,over_period_fraction,\
-scheduling,load_1min";
+pub const HOST_HEADER: &str = HostRow::HEADER;
 
+crate::table::table_row! {
 /// One loop: a row of `host.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct HostRow {
@@ -63,6 +62,7 @@ pub struct HostRow {
     /// Load average over 1 min (`/proc/loadavg`) at the end.
     #[serde(with = "sci")]
     pub load_1min: f64,
+}
 }
 
 /// What `plant bench host` was asked to do.

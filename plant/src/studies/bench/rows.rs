@@ -18,8 +18,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Header of `accuracy.csv`, shared with the scipy peer's `peer.csv` (`bench/peer/run_peer.py`).
-pub const ACCURACY_HEADER: &str =
-    "scene,implementation,method,setting,rtol,substeps,status,err_rms,err_max,wall_s_per_sim_s,rhs_evals,sim_s";
+pub const ACCURACY_HEADER: &str = AccuracyRow::HEADER;
 
 /// One row of `accuracy.csv`: one implementation, method and setting on one scene.
 ///
@@ -41,6 +40,7 @@ impl std::fmt::Display for AccuracyStatus {
     }
 }
 
+crate::table::table_row! {
 /// The peer's rows are read by column name; a peer run that failed leaves its error columns
 /// (and possibly `rhs_evals`, `sim_s`) empty: `None` here, empty again when written.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -75,6 +75,7 @@ pub struct AccuracyRow {
     #[serde(with = "sci_or_empty")]
     pub sim_s: Option<f64>,
 }
+}
 
 impl AccuracyRow {
     /// The `setting`, `rtol` and `substeps` columns of an integrator setting.
@@ -102,8 +103,9 @@ pub fn read_accuracy(path: &Path) -> anyhow::Result<Vec<AccuracyRow>> {
 }
 
 /// Header of `stability.csv`.
-pub const STABILITY_HEADER: &str = "scene,method,largest_stable_step_s,substeps,estimated_step_s";
+pub const STABILITY_HEADER: &str = StabilityRow::HEADER;
 
+crate::table::table_row! {
 /// One row of `stability.csv`: the stability of one fixed-step method on one scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StabilityRow {
@@ -120,7 +122,9 @@ pub struct StabilityRow {
     #[serde(with = "sci")]
     pub estimated_step_s: f64,
 }
+}
 
+crate::table::table_row! {
 /// One row of `reference_<scene>.csv`: the reference rotor position over the error window,
 /// on the tick grid (the scipy peer reads it by column name).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -135,13 +139,15 @@ pub struct ReferenceRow {
     #[serde(with = "sci")]
     pub dy_m: f64,
 }
+}
 
 /// Header of `reference_<scene>.csv`.
-pub const REFERENCE_HEADER: &str = "t_s,dx_m,dy_m";
+pub const REFERENCE_HEADER: &str = ReferenceRow::HEADER;
 
 /// Header of `models.csv`.
-pub const MODELS_HEADER: &str = "scene,variant,err_rms,err_max,wall_s_per_sim_s,speedup";
+pub const MODELS_HEADER: &str = ModelRow::HEADER;
 
+crate::table::table_row! {
 /// One row of `models.csv`: one model variant on one scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelRow {
@@ -162,15 +168,16 @@ pub struct ModelRow {
     #[serde(serialize_with = "four_decimals", deserialize_with = "sci::deserialize")]
     pub speedup: f64,
 }
+}
 
 fn four_decimals<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(&format_args!("{v:.4}"))
 }
 
 /// Header of `models_flexible.csv`.
-pub const MACHINE_HEADER: &str = "scene,model,plane,peak_contact_force_n,contact_time_s,contact_fraction,\
-     friction_energy_j,recovery_s,max_radius_m,first_contact_s,post_shock_mode,err_rms,err_max,wall_s_per_sim_s,speedup";
+pub const MACHINE_HEADER: &str = MachineRow::HEADER;
 
+crate::table::table_row! {
 /// One row of `models_flexible.csv`: one touchdown bearing of one model of the shipped flexible
 /// machine (the flexible rotor, or the rigid two-plane rotor of its rigid body), from its run
 /// of the whole scene.
@@ -218,12 +225,12 @@ pub struct MachineRow {
     #[serde(serialize_with = "four_decimals", deserialize_with = "sci::deserialize")]
     pub speedup: f64,
 }
+}
 
 /// Header of `engineering.csv`.
-pub const ENGINEERING_HEADER: &str = "scene,setting,status,peak_contact_force_n,max_radius_m,contact_fraction,\
-     post_shock_mode,steady_class,wall_s_per_sim_s,peak_force_rel_diff,max_radius_rel_diff,contact_fraction_diff,\
-     same_mode";
+pub const ENGINEERING_HEADER: &str = EngineeringRow::HEADER;
 
+crate::table::table_row! {
 /// One row of `engineering.csv`: one run's figures and their differences from the scene's
 /// reference run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -261,6 +268,7 @@ pub struct EngineeringRow {
     pub contact_fraction_diff: f64,
     /// Same post-shock mode and steady class as the reference.
     pub same_mode: bool,
+}
 }
 
 #[cfg(test)]

@@ -32,11 +32,9 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// Header of `tick.csv`.
-pub const TICK_HEADER: &str = "setting,run,status,ticks,contact_ticks,integration_p50_us,integration_p99_us,\
-integration_p999_us,integration_max_us,contact_p50_us,contact_p99_us,contact_p999_us,contact_max_us,tick_p50_us,\
-tick_p999_us,tick_max_us,max_rhs_evals_per_tick,wall_time_s,post_shock_mode,max_contact_force_n,max_radius_m,\
-contact_fraction,scheduling,load_1min";
+pub const TICK_HEADER: &str = TickRow::HEADER;
 
+crate::table::table_row! {
 /// One run of one setting: a row of `tick.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct TickRow {
@@ -105,6 +103,7 @@ pub struct TickRow {
     #[serde(with = "sci")]
     pub load_1min: f64,
 }
+}
 
 /// Each bearing plane's control for a contact tick: its bias current, held (a planar model reads
 /// the first).
@@ -114,8 +113,9 @@ fn held_bias(scene: &Scene) -> anyhow::Result<[crate::model::Control; 2]> {
 }
 
 /// Header of `repeat.csv`.
-pub const REPEAT_HEADER: &str = "setting,repeats,rhs_evals,p50_us,p99_us,p999_us,max_us,scheduling,load_1min";
+pub const REPEAT_HEADER: &str = RepeatRow::HEADER;
 
+crate::table::table_row! {
 /// The same tick integrated again and again: a row of `repeat.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RepeatRow {
@@ -142,6 +142,7 @@ pub struct RepeatRow {
     /// The machine's load average over the last minute when it ended.
     #[serde(with = "sci")]
     pub load_1min: f64,
+}
 }
 
 /// Integrates one contact tick of `scene` (the realtime setting) `repeats` times from the same

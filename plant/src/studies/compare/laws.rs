@@ -3,6 +3,7 @@
 
 use super::*;
 
+crate::table::table_row! {
 /// One law of a law comparison (`plant compare --laws`): a row of `laws.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct LawRow {
@@ -30,10 +31,10 @@ pub struct LawRow {
     #[serde(with = "sci")]
     pub whirl_hz: f64,
 }
+}
 
 /// Header of `laws.csv`.
-pub const LAWS_HEADER: &str =
-    "law,mode,status,recovery_s,post_shock_mode,max_contact_force_n,contact_time_s,steady_contact_fraction,whirl_hz";
+pub const LAWS_HEADER: &str = LawRow::HEADER;
 
 /// Runs the scene once per law (in the scene's controller mode, so a co-simulation scene runs
 /// the controller process), and writes `laws.csv` and overlaid plots of the whole run. The
@@ -104,8 +105,10 @@ fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow:
     // Each plane's radius and coil current of each law's run.
     let planes: Vec<(String, crate::trace::Trace)> = runs.iter().flat_map(|(l, r)| plane_traces(l, &r.trace)).collect();
     let radius: Vec<Vec<f64>> = planes.iter().map(|(_, t)| t.radius().iter().map(|v| v * 1e6).collect()).collect();
-    let current: Vec<Vec<f64>> =
-        planes.iter().map(|(_, t)| t.ix_a.iter().zip(&t.iy_a).map(|(x, y)| x.hypot(*y)).collect()).collect();
+    let current: Vec<Vec<f64>> = planes
+        .iter()
+        .map(|(_, t)| t.loads.ix_a.iter().zip(&t.loads.iy_a).map(|(x, y)| x.hypot(*y)).collect())
+        .collect();
     let series = |ys: &[Vec<f64>]| -> Vec<(String, Vec<f64>, Vec<f64>)> {
         planes.iter().zip(ys).map(|((l, t), y)| (l.clone(), t.t_s.clone(), y.clone())).collect()
     };
@@ -124,8 +127,8 @@ fn law_plots(out: &Path, runs: &[(String, RunResult)], scene: &Scene) -> anyhow:
             let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start).collect();
             (
                 l.clone(),
-                idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
-                idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+                idx.iter().map(|&i| tr.motion.dx_m[i] * 1e6).collect(),
+                idx.iter().map(|&i| tr.motion.dy_m[i] * 1e6).collect(),
             )
         })
         .collect();

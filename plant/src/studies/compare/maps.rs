@@ -3,6 +3,7 @@
 
 use super::*;
 
+crate::table::table_row! {
 /// One point of a stability map: a row of `stability_map.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct MapPoint {
@@ -20,9 +21,10 @@ pub struct MapPoint {
     /// `unstable`, or `stable (<post-shock mode>)`.
     pub class: String,
 }
+}
 
 /// Header of `stability_map.csv`.
-pub const MAP_HEADER: &str = "map,rate_hz,value,damping_measured,class";
+pub const MAP_HEADER: &str = MapPoint::HEADER;
 
 /// Stability maps of the sampled law: rate × design damping ratio and rate × delay (samples).
 /// A point is unstable when its free decay grows (or diverges); a stable point is labelled

@@ -40,6 +40,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Window after the shock for the deviation (s).
 pub const WINDOW: f64 = 0.1;
 
+crate::table::table_row! {
 /// One compared configuration: a row of `compare.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RateRow {
@@ -64,6 +65,7 @@ pub struct RateRow {
     pub recover_s: f64,
     /// Post-shock mode.
     pub post_shock_mode: MotionMode,
+}
 }
 
 fn with(path: &Path, base: &[String], extra: &[String]) -> anyhow::Result<Scene> {
@@ -129,9 +131,9 @@ fn free_decay(
     sets.extend((0..shocks).map(|i| format!("shock[{i}].start_s=1000.0")));
     let Some(r) = finished(&with(scene_path, base, &sets)?, stop)? else { return Ok(None) };
     let tr = &r.trace;
-    let free = tr.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
+    let free = tr.loads.contact_force_n.iter().position(|f| *f > 0.0).unwrap_or(tr.len());
     Ok(Some((
-        damping_from_decay(&tr.t_s[..free], &tr.dx_m[..free]),
+        damping_from_decay(&tr.t_s[..free], &tr.motion.dx_m[..free]),
         free < tr.len(),
         r.run.outcome == Outcome::Completed,
     )))
@@ -239,7 +241,7 @@ pub fn compare(
 }
 
 /// Header of `compare.csv`.
-pub const COMPARE_HEADER: &str = "rate_hz,mode,status,rms_dev_m,max_dev_m,damping_ratio,recover_s,post_shock_mode";
+pub const COMPARE_HEADER: &str = RateRow::HEADER;
 
 /// The first [`WINDOW`] after the shock of one run, in ms and µm.
 struct Window {
@@ -255,9 +257,9 @@ impl Window {
         let idx: Vec<usize> = (0..tr.len()).filter(|&i| tr.t_s[i] >= start && tr.t_s[i] <= start + WINDOW).collect();
         Window {
             t_ms: idx.iter().map(|&i| (tr.t_s[i] - start) * 1e3).collect(),
-            radius_um: idx.iter().map(|&i| tr.dx_m[i].hypot(tr.dy_m[i]) * 1e6).collect(),
-            x_um: idx.iter().map(|&i| tr.dx_m[i] * 1e6).collect(),
-            y_um: idx.iter().map(|&i| tr.dy_m[i] * 1e6).collect(),
+            radius_um: idx.iter().map(|&i| tr.motion.dx_m[i].hypot(tr.motion.dy_m[i]) * 1e6).collect(),
+            x_um: idx.iter().map(|&i| tr.motion.dx_m[i] * 1e6).collect(),
+            y_um: idx.iter().map(|&i| tr.motion.dy_m[i] * 1e6).collect(),
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use super::*;
 
+crate::table::table_row! {
 /// One run of a realtime comparison (`plant compare --realtime`): a row of `realtime.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RealtimeRow {
@@ -62,11 +63,10 @@ pub struct RealtimeRow {
     #[serde(with = "sci")]
     pub load_1min: f64,
 }
+}
 
 /// Header of `realtime.csv`.
-pub const REALTIME_HEADER: &str = "run,mode,status,deadline_misses,deadline_miss_fraction,longest_miss_burst,\
-plant_overruns,tick_p999_us,tick_max_us,integration_p999_us,integration_max_us,latency_p999_us,post_shock_mode,\
-recovery_s,max_contact_force_n,max_radius_m,steady_contact_fraction,rms_dev_m,max_dev_m,same_as_lockstep,load_1min";
+pub const REALTIME_HEADER: &str = RealtimeRow::HEADER;
 
 /// Realtime against lockstep (`plant compare SCENE --realtime --runs N`): the scene in
 /// realtime `runs` times, and once in lockstep on the same integrator setting (the realtime
@@ -178,5 +178,9 @@ pub fn compare_realtime(
 
 /// Two traces hold the same numbers, bit for bit.
 fn same_bits(a: &crate::trace::Trace, b: &crate::trace::Trace) -> bool {
-    a.len() == b.len() && a.rows().zip(b.rows()).all(|(x, y)| x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()))
+    a.len() == b.len()
+        && a.rows().zip(b.rows()).all(|(x, y)| {
+            use crate::trace::Columns as _;
+            x.values().iter().zip(&y.values()).all(|(p, q)| p.to_bits() == q.to_bits())
+        })
 }

@@ -22,24 +22,46 @@ use anyhow::Context;
 use serde::Serialize;
 use std::path::Path;
 
-/// The columns `points.csv` gets after the single-run columns for an ensemble.
-pub const ENSEMBLE_COLUMNS: [&str; 15] = [
-    "members",
-    "recovered",
-    "dry_whirl",
-    "rebound",
-    "diverged",
-    "p_recovered",
-    "p_lo",
-    "p_hi",
-    "recovery_median_s",
-    "recovery_p90_s",
-    "worst_contact_force_n",
-    "verified",
-    "numerically_sensitive",
-    "sensitive",
-    "stopped_by",
-];
+crate::table::text_row! {
+    /// The fields an ensemble's `points.csv` row has after the single-run ones: the point's
+    /// statistics.
+    pub struct EnsembleFields {
+        /// Members counted.
+        members,
+        /// Members that recovered.
+        recovered,
+        /// Members in dry whirl.
+        dry_whirl,
+        /// Members rebounding.
+        rebound,
+        /// Members that diverged.
+        diverged,
+        /// Fraction recovered (`{:e}`).
+        p_recovered,
+        /// Its interval's lower end (`{:e}`).
+        p_lo,
+        /// Its interval's upper end (`{:e}`).
+        p_hi,
+        /// Median recovery time (s; empty: none).
+        recovery_median_s,
+        /// 90th percentile recovery time (s; empty: none).
+        recovery_p90_s,
+        /// Largest contact force of the members (N, `{:e}`).
+        worst_contact_force_n,
+        /// Members verified.
+        verified,
+        /// Members numerically sensitive.
+        numerically_sensitive,
+        /// Any member numerically sensitive.
+        sensitive,
+        /// Why the point's members stopped being drawn.
+        stopped_by,
+    }
+}
+
+/// The columns `points.csv` gets after the single-run columns for an ensemble:
+/// [`EnsembleFields`]'.
+pub const ENSEMBLE_COLUMNS: &[&str] = EnsembleFields::COLUMNS;
 
 /// One row of `members.csv`.
 #[derive(Serialize)]
@@ -266,23 +288,26 @@ fn write_points(
         if map {
             row.push(opt(v2));
         }
-        row.extend([
-            s.members.to_string(),
-            s.recovered.to_string(),
-            s.dry_whirl.to_string(),
-            s.rebound.to_string(),
-            s.diverged.to_string(),
-            e(s.p_recovered),
-            e(s.p_lo),
-            e(s.p_hi),
-            opt(s.recovery_median_s),
-            opt(s.recovery_p90_s),
-            e(s.worst_contact_force_n),
-            s.verified.to_string(),
-            s.numerically_sensitive.to_string(),
-            (s.numerically_sensitive > 0).to_string(),
-            crate::summary::snake_name(&s.stopped_by),
-        ]);
+        row.extend(
+            EnsembleFields {
+                members: s.members.to_string(),
+                recovered: s.recovered.to_string(),
+                dry_whirl: s.dry_whirl.to_string(),
+                rebound: s.rebound.to_string(),
+                diverged: s.diverged.to_string(),
+                p_recovered: e(s.p_recovered),
+                p_lo: e(s.p_lo),
+                p_hi: e(s.p_hi),
+                recovery_median_s: opt(s.recovery_median_s),
+                recovery_p90_s: opt(s.recovery_p90_s),
+                worst_contact_force_n: e(s.worst_contact_force_n),
+                verified: s.verified.to_string(),
+                numerically_sensitive: s.numerically_sensitive.to_string(),
+                sensitive: (s.numerically_sensitive > 0).to_string(),
+                stopped_by: crate::summary::snake_name(&s.stopped_by),
+            }
+            .into_fields(),
+        );
         w.write_record(&row)?;
         for m in members.iter().filter(|m| !m.poincare.is_empty()) {
             for (n, x, y) in &m.poincare {

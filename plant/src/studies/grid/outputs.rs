@@ -8,20 +8,35 @@ use crate::plot::{self, PointGroup};
 use anyhow::Context;
 use std::path::Path;
 
+crate::table::text_row! {
+    /// The leading fields of a `points.csv` row, for single runs and ensembles alike.
+    pub struct SingleFields {
+        /// The swept value (`{:e}`).
+        value,
+        /// The post-shock mode's name.
+        post_shock_mode,
+        /// The steady class's name.
+        steady_class,
+        /// The period in revolutions (empty: none).
+        period_k,
+        /// Contact fraction (`{:e}`).
+        contact_fraction,
+        /// Whirl frequency (Hz, `{:e}`).
+        whirl_hz,
+        /// Largest radius (m, `{:e}`).
+        max_radius_m,
+        /// Largest contact force (N, `{:e}`).
+        max_contact_force_n,
+        /// The run's status.
+        status,
+        /// The point's index.
+        index,
+    }
+}
+
 /// The leading columns of `points.csv`, for single runs and ensembles alike (`value2` follows
-/// them for maps).
-pub const SINGLE_COLUMNS: [&str; 10] = [
-    "value",
-    "post_shock_mode",
-    "steady_class",
-    "period_k",
-    "contact_fraction",
-    "whirl_hz",
-    "max_radius_m",
-    "max_contact_force_n",
-    "status",
-    "index",
-];
+/// them for maps): [`SingleFields`]'.
+pub const SINGLE_COLUMNS: &[&str] = SingleFields::COLUMNS;
 
 /// A number as the tables write it (`{:e}`).
 pub fn e(v: f64) -> String {
@@ -61,18 +76,19 @@ pub fn single_fields(
     status: &str,
     index: usize,
 ) -> Vec<String> {
-    vec![
-        e(value),
-        post_shock_mode.to_string(),
-        steady_class.to_string(),
-        period_k.map_or(String::new(), |k| k.to_string()),
-        e(contact_fraction),
-        e(whirl_hz),
-        e(max_radius_m),
-        e(max_contact_force_n),
-        status.to_string(),
-        index.to_string(),
-    ]
+    SingleFields {
+        value: e(value),
+        post_shock_mode: post_shock_mode.to_string(),
+        steady_class: steady_class.to_string(),
+        period_k: period_k.map_or(String::new(), |k| k.to_string()),
+        contact_fraction: e(contact_fraction),
+        whirl_hz: e(whirl_hz),
+        max_radius_m: e(max_radius_m),
+        max_contact_force_n: e(max_contact_force_n),
+        status: status.to_string(),
+        index: index.to_string(),
+    }
+    .into_fields()
 }
 
 /// What the mode diagrams draw of a point.

@@ -37,11 +37,10 @@ pub use run::{default_dir, run, Options, Progress, SoakError};
 pub const ENVELOPE_BIN_S: f64 = 0.005;
 
 /// Header of `soak.csv`.
-pub const SOAK_CSV_HEADER: &str = "index,start_s,peak_g,direction_deg,duration_s,recovered,recovery_s,\
-max_contact_force_n,contact_time_s,contact_episodes,max_radius_m,complete";
+pub const SOAK_CSV_HEADER: &str = sink::SoakFields::HEADER;
 
 /// Header of `envelope.csv`.
-pub const ENVELOPE_CSV_HEADER: &str = "t_s,max_radius_m,max_contact_force_n";
+pub const ENVELOPE_CSV_HEADER: &str = monitor::EnvelopeRow::HEADER;
 
 /// Header of `rss.csv`.
-pub const RSS_CSV_HEADER: &str = "t_sim_s,wall_s,plant_rss_kib,controller_rss_kib";
+pub const RSS_CSV_HEADER: &str = sink::RssFields::HEADER;

@@ -271,6 +271,7 @@ pub struct Envelope {
     any: bool,
 }
 
+crate::table::table_row! {
 /// One bin of an [`Envelope`]: its start (s) and maxima; a row of `envelope.csv`
 /// (read back by column name).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
@@ -281,6 +282,7 @@ pub struct EnvelopeRow {
     pub max_radius_m: f64,
     /// Largest contact force (N).
     pub max_contact_force_n: f64,
+}
 }
 
 impl Envelope {

@@ -7,7 +7,7 @@ use super::programme::PlannedShock;
 use crate::row_file::RowFile;
 use crate::run::Sink;
 use crate::snapshot::Snapshot;
-use crate::trace::{col, Record};
+use crate::trace::Record;
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -58,23 +58,54 @@ impl Checkpoints {
     }
 }
 
+crate::table::text_row! {
+    /// A row of `soak.csv`: a shock as planned beside its window's figures.
+    pub struct SoakFields {
+        /// Shock index (0-based).
+        index,
+        /// The shock's start (s).
+        start_s,
+        /// Peak acceleration (g).
+        peak_g,
+        /// Direction (degrees).
+        direction_deg,
+        /// Duration (s).
+        duration_s,
+        /// Recovered (1) or not (0).
+        recovered,
+        /// Recovery time (s; NaN if not recovered).
+        recovery_s,
+        /// Largest normal force (N).
+        max_contact_force_n,
+        /// Time in contact (s).
+        contact_time_s,
+        /// Transitions into contact.
+        contact_episodes,
+        /// Largest radius (m).
+        max_radius_m,
+        /// The window ran to its planned end (1) or not (0).
+        complete,
+    }
+}
+
 /// The fields of a shock's `soak.csv` row (`p` the shock as planned): what a resume compares
 /// the file's rows with.
-pub(crate) fn shock_row(f: &ShockFigures, p: &PlannedShock) -> [String; 12] {
-    [
-        f.index.to_string(),
-        f.start_s.to_string(),
-        p.peak_g.to_string(),
-        p.direction_deg.to_string(),
-        p.duration_s.to_string(),
-        u8::from(f.recovered).to_string(),
-        f.recovery_s.to_string(),
-        f.max_contact_force_n.to_string(),
-        f.contact_time_s.to_string(),
-        f.contact_episodes.to_string(),
-        f.max_radius_m.to_string(),
-        u8::from(f.complete).to_string(),
-    ]
+pub(crate) fn shock_row(f: &ShockFigures, p: &PlannedShock) -> Vec<String> {
+    SoakFields {
+        index: f.index.to_string(),
+        start_s: f.start_s.to_string(),
+        peak_g: p.peak_g.to_string(),
+        direction_deg: p.direction_deg.to_string(),
+        duration_s: p.duration_s.to_string(),
+        recovered: u8::from(f.recovered).to_string(),
+        recovery_s: f.recovery_s.to_string(),
+        max_contact_force_n: f.max_contact_force_n.to_string(),
+        contact_time_s: f.contact_time_s.to_string(),
+        contact_episodes: f.contact_episodes.to_string(),
+        max_radius_m: f.max_radius_m.to_string(),
+        complete: u8::from(f.complete).to_string(),
+    }
+    .into_fields()
 }
 
 impl SoakSink<'_> {
@@ -148,7 +179,7 @@ impl Sink for SoakSink<'_> {
         self.rows += 1;
         // Of a two-plane rotor: the larger radius and contact force of the planes, and clear
         // while each plane is inside its own clear radius.
-        let of = |r: &crate::trace::Row| (r[col::DX_M].hypot(r[col::DY_M]), r[col::CONTACT_FORCE_N]);
+        let of = |r: &crate::trace::Row| (r.motion.dx_m.hypot(r.motion.dy_m), r.loads.contact_force_n);
         let (mut radius, mut force) = of(&record.a);
         let mut within = radius < self.clear_radius[0];
         if record.planes() == 2 {
@@ -156,7 +187,7 @@ impl Sink for SoakSink<'_> {
             within &= rb < self.clear_radius[1];
             (radius, force) = (radius.max(rb), force.max(fb));
         }
-        let t = record.a[col::T_S];
+        let t = record.a.t_s;
         if let Some(r) = self.envelope.sample(t, radius, force) {
             self.write_bin(r);
         }
@@ -165,6 +196,20 @@ impl Sink for SoakSink<'_> {
         if let Some(f) = closed {
             self.write_shock(f);
         }
+    }
+}
+
+crate::table::text_row! {
+    /// A row of `rss.csv` as written: [`RssSample`]'s fields formatted.
+    pub struct RssFields {
+        /// Simulated time (s).
+        t_sim_s,
+        /// Wall time since the soak started (s, three decimals).
+        wall_s,
+        /// The plant's resident memory (KiB; empty: unknown).
+        plant_rss_kib,
+        /// The controller's resident memory (KiB; empty: unknown).
+        controller_rss_kib,
     }
 }
 
@@ -183,9 +228,15 @@ pub struct RssSample {
 
 impl RssSample {
     /// The row of `rss.csv` (an unknown size is an empty field).
-    pub fn fields(&self) -> [String; 4] {
+    pub fn fields(&self) -> Vec<String> {
         let show = |v: Option<u64>| v.map_or(String::new(), |v| v.to_string());
-        [self.t_s.to_string(), format!("{:.3}", self.wall_s), show(self.plant_kib), show(self.controller_kib)]
+        RssFields {
+            t_sim_s: self.t_s.to_string(),
+            wall_s: format!("{:.3}", self.wall_s),
+            plant_rss_kib: show(self.plant_kib),
+            controller_rss_kib: show(self.controller_kib),
+        }
+        .into_fields()
     }
 }
 
