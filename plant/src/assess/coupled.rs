@@ -71,6 +71,9 @@ fn law_of(scene: &Scene) -> Option<Law> {
 /// its whole open loop (the flexible rotor) and whose law is linear around levitation; `None`
 /// otherwise.
 pub fn closed_form_axes(scene: &Scene, settings: &Settings, speeds_hz: &[f64]) -> Option<Vec<AxisClosedForm>> {
+    if super::state_space_form::applies(scene) {
+        return super::state_space_form::closed_form_axes(scene, settings, speeds_hz);
+    }
     let open = scene.rotor.open_loop()?;
     let law = law_of(scene)?;
     let names = super::axis_names(scene);
@@ -127,9 +130,9 @@ fn loop_at(open: &OpenLoop, law: &Law, speed: f64, settings: &Settings) -> (Resp
 
 /// One axis' figures from its `|S|` as a function of frequency.
 /// Frequencies of the closed form's log grid (its peaks are then refined).
-const GRID: usize = 1500;
+pub(super) const GRID: usize = 1500;
 
-fn axis_form(
+pub(super) fn axis_form(
     name: &str,
     speed_hz: f64,
     stable: bool,
@@ -189,6 +192,9 @@ fn axis_form(
 
 /// Fills each closed form's `measured_difference_db` from the measured axes.
 pub fn compare(forms: &mut [AxisClosedForm], measured: &[sensitivity::AxisResult], scene: &Scene) {
+    if super::state_space_form::applies(scene) {
+        return super::state_space_form::compare(forms, measured, scene);
+    }
     let Some(open) = scene.rotor.open_loop() else { return };
     let Some(law) = law_of(scene) else { return };
     for form in forms.iter_mut() {

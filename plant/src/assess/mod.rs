@@ -25,6 +25,7 @@ pub mod rainflow;
 pub mod report;
 pub mod sensitivity;
 pub mod spec;
+mod state_space_form;
 pub mod vibration;
 
 pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
