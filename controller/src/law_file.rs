@@ -1,6 +1,7 @@
 //! A linear law read from a file (`[controller.params] file`): the JSON object a few lines of
-//! python-control or MATLAB write, or numpy's `.npz` of the same arrays (`np.savez`,
-//! `np.savez_compressed`; docs/guide/controllers.md), read through the project's
+//! python-control or MATLAB write, numpy's `.npz` of the same arrays (`np.savez`,
+//! `np.savez_compressed`; docs/guide/controllers.md) or MATLAB's level-5 `.mat` (`save`,
+//! scipy's `savemat`; [`crate::mat_file`]), read through the project's
 //! bounded, non-blocking reader (`shock_table::input`: a FIFO or a device is refused, never
 //! waited on). A relative path is taken from the current directory of the process that builds
 //! the law (the plant's, and the `controller` process it starts inherits it).
@@ -15,6 +16,8 @@ pub const MAX_LAW_FILE_BYTES: u64 = 16 << 20;
 /// The file's top-level object, with the reader to name `file` in refusals.
 pub struct LawFile {
     path: String,
+    /// What the file must hold (named when a key is missing).
+    needs: String,
     object: serde_json::Map<String, serde_json::Value>,
 }
 
@@ -25,21 +28,25 @@ impl LawFile {
         let bad = |why: String| p.error("file", format!("{path:?}"), "", why);
         let bytes = shock_table::input::read_bytes(Path::new(path), MAX_LAW_FILE_BYTES)
             .map_err(|e| bad(format!("cannot be read: {e}")))?;
+        if crate::mat_file::is_mat(&bytes) {
+            let object = crate::mat_file::read(&bytes).map_err(|e| bad(format!("is not a readable .mat file: {e}")))?;
+            return Ok(Self { path: path.to_string(), needs: needs.to_string(), object });
+        }
         if bytes.starts_with(b"PK\x03\x04") {
             let object = npz(&bytes).map_err(|e| bad(format!("is not a numpy .npz of float64 arrays: {e}")))?;
-            return Ok(Self { path: path.to_string(), object });
+            return Ok(Self { path: path.to_string(), needs: needs.to_string(), object });
         }
         let value: serde_json::Value = std::str::from_utf8(&bytes)
             .map_err(|e| e.to_string())
             .and_then(|text| serde_json::from_str(text).map_err(|e| e.to_string()))
             .map_err(|e| {
                 bad(format!(
-                    "is neither JSON nor numpy's .npz ({e}): expected a JSON object {needs} or an .npz of the \
-                     same arrays (a MATLAB .mat file is not read; see docs/guide/controllers.md)"
+                    "is neither JSON, numpy's .npz nor MATLAB's .mat ({e}): expected a JSON object {needs}, or an \
+                     .npz or a level-5 .mat of the same arrays (see docs/guide/linear.md)"
                 ))
             })?;
         match value {
-            serde_json::Value::Object(object) => Ok(Self { path: path.to_string(), object }),
+            serde_json::Value::Object(object) => Ok(Self { path: path.to_string(), needs: needs.to_string(), object }),
             other => Err(bad(format!("holds a JSON {}: expected an object {needs}", kind(&other)))),
         }
     }
@@ -48,16 +55,21 @@ impl LawFile {
         p.error("file", format!("{:?}", self.path), "", format!("its `{key}` {why}"))
     }
 
+    fn missing(&self, p: &ParamReader<'_>, key: &str) -> LawError {
+        self.bad(p, key, format!("is missing: expected {}", self.needs))
+    }
+
     /// Whether the file has `key`.
     pub fn has(&self, key: &str) -> bool {
         self.object.get(key).is_some_and(|v| !v.is_null())
     }
 
-    /// A finite number at `key`, if present (`null` is absent).
+    /// A finite number at `key`, if present (`null` is absent; a 1 × 1 matrix `[[x]]`, as a
+    /// `.mat` file holds every number, is its number).
     pub fn number(&self, p: &ParamReader<'_>, key: &str) -> Result<Option<f64>, LawError> {
         match self.object.get(key) {
             None | Some(serde_json::Value::Null) => Ok(None),
-            Some(v) => match v.as_f64().filter(|x| x.is_finite()) {
+            Some(v) => match one_by_one(v).as_f64().filter(|x| x.is_finite()) {
                 Some(x) => Ok(Some(x)),
                 None => Err(self.bad(p, key, format!("= {v}: expected a finite number"))),
             },
@@ -65,12 +77,22 @@ impl LawFile {
     }
 
     /// A non-empty array of finite numbers at `key` (a one-row matrix `[[…]]`, as MATLAB's
-    /// `jsonencode` and numpy's `tolist()` of a 2-D array write it, is taken as its row).
+    /// `jsonencode`, numpy's `tolist()` of a 2-D array and a `.mat` file hold it, is taken as its
+    /// row; a one-column matrix `[[a], [b]]` as its column).
     pub fn numbers(&self, p: &ParamReader<'_>, key: &str) -> Result<Vec<f64>, LawError> {
-        let Some(v) = self.object.get(key) else { return Err(self.bad(p, key, "is missing".into())) };
-        let items = match v {
-            serde_json::Value::Array(rows) if rows.len() == 1 && rows[0].is_array() => rows[0].as_array(),
-            other => other.as_array(),
+        let Some(v) = self.object.get(key) else { return Err(self.missing(p, key)) };
+        let column: Option<Vec<serde_json::Value>> = match v {
+            serde_json::Value::Array(rows)
+                if rows.len() > 1 && rows.iter().all(|r| r.as_array().is_some_and(|r| r.len() == 1)) =>
+            {
+                Some(rows.iter().map(one_by_one).cloned().collect())
+            }
+            _ => None,
+        };
+        let items = match (v, &column) {
+            (_, Some(column)) => Some(column),
+            (serde_json::Value::Array(rows), None) if rows.len() == 1 && rows[0].is_array() => rows[0].as_array(),
+            (other, None) => other.as_array(),
         };
         let Some(items) = items.filter(|a| !a.is_empty()) else {
             return Err(self.bad(p, key, format!("= {v}: expected a non-empty array of numbers")));
@@ -89,7 +111,7 @@ impl LawFile {
     /// A matrix (array of rows of finite numbers, every row as long as the first) at `key`; an
     /// empty one (`[]`) has no rows.
     pub fn matrix(&self, p: &ParamReader<'_>, key: &str) -> Result<Vec<Vec<f64>>, LawError> {
-        let Some(v) = self.object.get(key) else { return Err(self.bad(p, key, "is missing".into())) };
+        let Some(v) = self.object.get(key) else { return Err(self.missing(p, key)) };
         let Some(rows) = v.as_array() else {
             return Err(self.bad(p, key, "is not an array of rows".into()));
         };
@@ -123,6 +145,17 @@ impl LawFile {
             out.push(line);
         }
         Ok(out)
+    }
+}
+
+/// A 1 × 1 matrix's element (a row of one), else the value itself.
+fn one_by_one(v: &serde_json::Value) -> &serde_json::Value {
+    match v.as_array().map(Vec::as_slice) {
+        Some([row]) => match row.as_array().map(Vec::as_slice) {
+            Some([x]) => x,
+            _ => v,
+        },
+        _ => v,
     }
 }
 

@@ -88,6 +88,7 @@ pub mod law_file;
 pub mod link;
 #[cfg(feature = "ipc")]
 pub mod lock;
+pub mod mat_file;
 pub mod modal;
 pub mod notch;
 pub mod params;

@@ -171,14 +171,22 @@ fn read(p: &mut ParamReader<'_>, design: &RotorDesign) -> Result<DiscreteSs, Law
     let n = a.len();
     let size = |p: &ParamReader<'_>, key: &'static str, m: &[Vec<f64>], rows: usize, cols: usize, what: &str| {
         let (r, c) = (m.len(), m.first().map_or(0, Vec::len));
-        if (r, c) == (rows, cols) {
-            Ok(())
-        } else {
-            Err(p.error(key, format!("{m:?}"), "", format!("is {r} × {c}: expected {rows} × {cols} ({what})")))
+        let why = format!("is {r} × {c}: expected {rows} × {cols} ({what})");
+        match (&from_file, (r, c) == (rows, cols)) {
+            (_, true) => Ok(()),
+            // From a file: the file named, and the variable as it is called there.
+            (Some((path, _)), false) => {
+                Err(p.error("file", format!("{path:?}"), "", format!("its `{}` {why}", key.to_uppercase())))
+            }
+            (None, false) => Err(p.error(key, format!("{m:?}"), "", why)),
         }
     };
     if n == 0 || n > MAX_STATES {
-        return Err(p.error("a", format!("{a:?}"), "", format!("expected 1 to {MAX_STATES} states (rows)")));
+        let why = format!("expected 1 to {MAX_STATES} states (rows)");
+        return Err(match &from_file {
+            Some((path, _)) => p.error("file", format!("{path:?}"), "", format!("its `A` has {n} rows: {why}")),
+            None => p.error("a", format!("{a:?}"), "", why),
+        });
     }
     size(p, "a", &a, n, n, "square: states × states")?;
     size(p, "b", &b, n, axes, &format!("states × axes, this rotor has {axes} axes"))?;

@@ -127,6 +127,9 @@ def main():
                      "gain_margin_hz": float(w180 / TAU), "phase_margin_deg": float(pm), "phase_margin_hz": float(wc / TAU),
                      "s_peak_db": float(20 * np.log10(s_peak)), "s_peak_hz": float(grid[np.argmax(np.abs(1 / (1 + resp)))] / TAU)})
 
+    # The closed loop's poles (the other loops closed too): their largest modulus.
+    largest_pole = float(np.max(np.abs(ct.feedback(plant_d, law_d, sign=+1).poles())))
+
     # 4. The report card: the sensitivity at the speed (the ladder is `plant assess`'s
     # default parts; left out here: the shock run below is the one that matters).
     points = 24 if quick else 40
@@ -141,6 +144,7 @@ def main():
     sens = card["controllers"][0]["sensitivity"]["result"]
     margins = {m["axis"]: m for m in sens["margins"]}
     peaks = {a["axis"]: a["peak"] for a in sens["axes"]}
+    forms = {f["axis"]: f for f in sens["closed_form_axes"]}
 
     # 5. The shock.
     duration = ["--set", "scene.duration_s=0.1"] if quick else []
@@ -152,13 +156,18 @@ def main():
         m = margins[o["axis"]]
         c = m["computed"] or {}
         me = m["measured"] or {}
-        rows.append({"python_control": o, "computed": c, "measured": me, "peak": peaks[o["axis"]]})
+        o["largest_pole"] = largest_pole
+        form = {k: v for k, v in forms.get(o["axis"], {}).items() if k != "curve"}
+        rows.append({"python_control": o, "computed": c, "measured": me, "peak": peaks[o["axis"]],
+                     "closed_form": form})
         print(f"{o['axis']}: PM {o['phase_margin_deg']:.3f} deg at {o['phase_margin_hz']:.2f} Hz "
               f"(card: computed {c.get('phase_margin_deg')}, measured {me.get('phase_margin_deg')}); "
               f"GM {o['gain_margin_db']:.3f} dB at {o['gain_margin_hz']:.2f} Hz "
               f"(card: computed {c.get('gain_margin_db')} at {c.get('gain_margin_hz')} Hz); "
               f"|S| peak {o['s_peak_db']:.3f} dB at {o['s_peak_hz']:.1f} Hz "
-              f"(card: {peaks[o['axis']]['s_db']:.3f} dB at {peaks[o['axis']]['f_hz']:.1f} Hz)")
+              f"(card: {peaks[o['axis']]['s_db']:.3f} dB at {peaks[o['axis']]['f_hz']:.1f} Hz measured, "
+              f"{form.get('s_db')} dB at {form.get('f_hz')} Hz closed form); "
+              f"largest closed-loop pole {largest_pole:.12f} (card: {form.get('largest_pole')})")
     (out / "figures.json").write_text(json.dumps(rows, indent=1))
 
 

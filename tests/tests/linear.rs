@@ -1,5 +1,6 @@
 //! `plant linear` (docs/guide/linear.md): the linear plant of the shipped scenes loaded by
-//! numpy and python-control as a user would (`np.load`, `json.load`, `control.ss`), checked
+//! numpy, scipy and python-control as a user would (`np.load`, `json.load`, `scipy.io.loadmat`
+//! of `linear.mat`, the same matrices bit for bit, `control.ss`), checked
 //! against figures worked by hand from the scene files (read by Python's `tomllib`, not by the
 //! plant): the planar rotor's poles `±√(k_s/m)` and DC gain `−A_s k_i/k_s`, its frequency
 //! response with the amplifier, coil, back-EMF and sensor filter of realistic-10g, the
@@ -60,6 +61,7 @@ const SCENES: [&str; 6] =
 const CHECK: &str = r#"
 import json, sys, tomllib
 import numpy as np
+import scipy.io
 import control
 
 out, config = sys.argv[1], sys.argv[2]
@@ -81,6 +83,20 @@ def load(name):
     assert float(z["dt"]) == j["discrete"]["dt"] and int(z["delay_samples"]) == j["discrete"]["delay_samples"]
     assert j["format"] == "plant-linear" and j["version"] == 1
     assert set(z["input_units"]) == {"A"} and set(z["output_units"]) == {"V"}
+    # linear.mat as scipy reads it in MATLAB's classes (`mat_dtype=True`: what MATLAB's `load`
+    # gives; a matrix of whole numbers is stored as integers, as MATLAB's `save` does, its class
+    # double): the same matrices bit for bit, the numbers as 1 x 1, the names and units as n x 1
+    # cell arrays of text.
+    m = scipy.io.loadmat(f"{out}/{name}/linear.mat", mat_dtype=True)
+    for key in ["A", "B", "C", "D", "Ad", "Bd", "Cd", "Dd"]:
+        assert m[key].dtype == np.float64 and m[key].shape == z[key].shape, (name, key, m[key].shape)
+        assert np.ascontiguousarray(m[key]).tobytes() == np.ascontiguousarray(z[key]).tobytes(), (name, key)
+    for key in ["dt", "delay_samples", "speed_hz"]:
+        assert m[key].shape == (1, 1) and m[key][0, 0].tobytes() == z[key].tobytes(), (name, key)
+    for key in ["inputs", "input_units", "outputs", "output_units", "states", "state_units", "states_d",
+                "state_units_d", "format"]:
+        assert m[key].shape == (len(z[key]), 1), (name, key, m[key].shape)
+        assert [str(c[0]) for c in m[key][:, 0]] == [str(v) for v in z[key]], (name, key)
     return z, j, scene
 
 def close(a, b, tol):
@@ -621,11 +637,15 @@ fn state_space_runs_as_pd_on_the_two_plane_rotor_and_refuses_sizes_of_another() 
 /// python-control writes a law as JSON, as docs/guide/controllers.md shows (`json.dump` of the
 /// `TransferFunction`'s and the `StateSpace`'s fields); `plant run` with `file = …` writes the
 /// trace byte for byte that the same law written into `[controller.params]` writes, and so does
-/// numpy's `.npz` of the same arrays (`savez`, and `savez_compressed` with A in Fortran order).
-/// A FIFO and a MATLAB `.mat` are refused, exit 2, nothing written.
+/// numpy's `.npz` of the same arrays (`savez`, and `savez_compressed` with A in Fortran order),
+/// and scipy's `savemat` of them (MATLAB's level 5; the state-space law compressed, as MATLAB
+/// writes it). A FIFO, a file of another format, a `.mat` of another level, cut short, short
+/// of a variable or with one of another type or shape: refused naming the file and the
+/// variable, exit 2, nothing written.
 const WRITE_LAWS: &str = r#"
 import json, sys
 import numpy as np
+import scipy.io
 import control as ct
 out = sys.argv[1]
 wz, wp = 2 * np.pi * 150, 2 * np.pi * 1500
@@ -638,6 +658,17 @@ json.dump({"A": Kd.A.tolist(), "B": Kd.B.tolist(), "C": Kd.C.tolist(), "D": Kd.D
           open(f"{out}/ss.json", "w"))
 np.savez(f"{out}/tf.npz", num=C.num[0][0], den=C.den[0][0], dt=float(C.dt))
 np.savez_compressed(f"{out}/ss.npz", A=np.asfortranarray(Kd.A), B=Kd.B, C=Kd.C, D=Kd.D, dt=Kd.dt)
+# MATLAB's level 5 as scipy writes it: the tf uncompressed (dt the int 0 python-control holds),
+# the ss compressed (as MATLAB's `save` writes by default).
+scipy.io.savemat(f"{out}/tf.mat", {"num": C.num[0][0], "den": C.den[0][0], "dt": C.dt})
+scipy.io.savemat(f"{out}/ss.mat", {"A": Kd.A, "B": Kd.B, "C": Kd.C, "D": Kd.D, "dt": Kd.dt}, do_compression=True)
+# Refused: a missing variable, a variable of the wrong type, shape or number of dimensions.
+scipy.io.savemat(f"{out}/no-den.mat", {"num": C.num[0][0], "dt": 0.0})
+scipy.io.savemat(f"{out}/text-num.mat", {"num": "1, 2", "den": C.den[0][0]})
+scipy.io.savemat(f"{out}/b-shape.mat", {"A": Kd.A, "B": Kd.B[:, :1], "C": Kd.C, "D": Kd.D, "dt": Kd.dt})
+scipy.io.savemat(f"{out}/a-cube.mat", {"A": np.zeros((2, 2, 2)), "B": Kd.B, "C": Kd.C, "D": Kd.D, "dt": Kd.dt})
+whole = open(f"{out}/ss.mat", "rb").read()
+open(f"{out}/cut.mat", "wb").write(whole[:-10])
 print(f"num = {C.num[0][0].tolist()}\nden = {C.den[0][0].tolist()}")
 for k, m in zip("abcd", (Kd.A, Kd.B, Kd.C, Kd.D)):
     print(f"{k} = {m.tolist()}")
@@ -692,16 +723,37 @@ fn a_law_python_control_wrote_runs_as_the_same_law_in_the_scene() {
     assert!(ss_file == ss_inline, "state_space from python-control's JSON differs from the same in the scene");
     let ss_npz = run("ss-npz", &[law("state_space"), path("ss.npz")]);
     assert!(ss_npz == ss_inline, "state_space from numpy's compressed .npz (A in Fortran order) differs");
-    // Refused: a FIFO (never waited on) and a file of another format.
-    let fifo = dir.join("laws").join("fifo.json");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let tf_mat = run("tf-mat", &[law("transfer_function"), path("tf.mat")]);
+    assert!(tf_mat == tf_inline, "transfer_function from scipy's savemat differs from the same in the scene");
+    let ss_mat = run("ss-mat", &[law("state_space"), path("ss.mat")]);
+    assert!(ss_mat == ss_inline, "state_space from scipy's compressed savemat differs from the same in the scene");
+    // Refused: a FIFO (never waited on), a file of another format, a .mat of another level
+    // (v7.3 is HDF5: its header as MATLAB writes it, the HDF5 signature at 512), cut short, short
+    // of a variable, a variable of another type, shape or number of dimensions.
+    for fifo in ["fifo.json", "fifo.mat"] {
+        assert!(Command::new("mkfifo").arg(dir.join("laws").join(fifo)).status().unwrap().success());
+    }
     std::fs::write(dir.join("laws").join("law.mat"), b"MATLAB 5.0 MAT-file, Platform: GLNXA64\x00\xff").unwrap();
-    for (name, needles) in [
-        ("fifo.json", ["controller.params.file", "not a regular file"]),
-        ("law.mat", ["controller.params.file", "is neither JSON nor numpy's .npz"]),
+    let mut v73 =
+        b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Sun May 19 14:40:48 2024 HDF5 schema 1.00 .".to_vec();
+    v73.resize(512, b' ');
+    v73.extend_from_slice(b"\x89HDF\r\n\x1a\n\0\0\0\0");
+    std::fs::write(dir.join("laws").join("v73.mat"), v73).unwrap();
+    let tf = "controller.law=transfer_function";
+    let ss = "controller.law=state_space";
+    for (name, law, needles) in [
+        ("fifo.json", tf, &["controller.params.file", "not a regular file"][..]),
+        ("fifo.mat", ss, &["controller.params.file", "fifo.mat", "not a regular file"]),
+        ("law.mat", tf, &["controller.params.file", "law.mat", "shorter than a .mat file's 128-byte header"]),
+        ("v73.mat", tf, &["controller.params.file", "v73.mat", "v7.3 (HDF5)", "expected level 5", "-v7"]),
+        ("cut.mat", ss, &["controller.params.file", "cut.mat", "element 5", "truncated"]),
+        ("no-den.mat", tf, &["controller.params.file", "no-den.mat", "`den` is missing", "expected {\"num\""]),
+        ("text-num.mat", tf, &["text-num.mat", "variable `num` is text", "expected a real matrix"]),
+        ("b-shape.mat", ss, &["b-shape.mat", "`B` is 2 × 1: expected 2 × 2", "2 axes"]),
+        ("a-cube.mat", ss, &["a-cube.mat", "variable `A` is 2 × 2 × 2", "expected a matrix"]),
     ] {
-        let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.law=transfer_function", &path(name)];
-        common::refused(&format!("law-file-{name}"), &file, &sets, &needles);
+        let sets = ["scene.duration_s=0.01", "output.plots=false", "controller.mode=sampled", law, &path(name)];
+        common::refused(&format!("law-file-{name}"), &file, &sets, needles);
     }
 }
 
@@ -816,6 +868,15 @@ fn the_worked_loop_designs_in_python_control_and_the_report_card_agrees() {
         assert!((num(pc, "gain_margin_hz") / num(computed, "gain_margin_hz") - 1.0).abs() < 0.01, "{axis}: {r}");
         let s = num(pc, "s_peak_db");
         assert!((s - num(peak, "s_db")).abs() < 0.1, "{axis}: |S| peak {s} dB against {peak}");
+        // The card's closed form of the state_space law (its discrete system on the exported
+        // plant, every axis closed): python-control's peak on the same model, and its closed
+        // loop's poles.
+        let form = &r["closed_form"];
+        assert_eq!(form["stable"], true, "{axis}: {r}");
+        assert!((s - num(form, "s_db")).abs() < 0.01, "{axis}: |S| peak {s} dB against the closed form {form}");
+        assert!((num(pc, "s_peak_hz") / num(form, "f_hz") - 1.0).abs() < 0.005, "{axis}: {r}");
+        let pole = num(pc, "largest_pole");
+        assert!((pole / num(form, "largest_pole") - 1.0).abs() < 1e-9, "{axis}: largest pole {pole} against {form}");
         // A design, not a stub: stable, zone A (|S| below 9.5 dB), a phase margin above 30°.
         assert!(s < 9.5 && pm > 30.0, "{axis}: {r}");
     }

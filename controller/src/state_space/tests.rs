@@ -179,7 +179,8 @@ fn a_law_from_a_json_file_is_the_law_from_its_parameters() {
         assert_eq!(x.update(&s), y.update(&s));
     }
     let e = build_with(&RotorDesign::symmetric_study(), &file).err().unwrap().to_string();
-    assert!(e.contains("controller.params.b") && e.contains("expected 1 × 4"), "{e}");
+    // From a file: the file named, and the variable as it is called there.
+    assert!(e.contains("controller.params.file") && e.contains("its `B` is 1 × 2: expected 1 × 4"), "{e}");
     std::fs::write(&path, br#"{"A": [[-100.0]], "B": [[1.0, 0.5]]}"#).unwrap();
     let e = build_with(&planar(), &file).err().unwrap().to_string();
     assert!(e.contains("controller.params.file") && e.contains("its `C` is missing"), "{e}");

@@ -216,10 +216,7 @@ fn a_law_from_a_json_file_is_the_law_from_its_parameters() {
     let nan = Temp::new("nan.json", br#"{"num": ["x"], "den": [1.0]}"#);
     let cases: Vec<(String, Vec<&str>)> = vec![
         (npz.param(), vec!["controller.params.file", "x.npz", "is not a numpy .npz of float64 arrays"]),
-        (
-            mat.param(),
-            vec!["controller.params.file", "x.mat", "is neither JSON nor numpy's .npz", ".mat file is not read"],
-        ),
+        (mat.param(), vec!["controller.params.file", "x.mat", "is not a readable .mat file", "128-byte header"]),
         (array.param(), vec!["controller.params.file", "holds a JSON array: expected an object"]),
         (no_den.param(), vec!["controller.params.file", "its `den` is missing"]),
         (bad_dt.param(), vec!["controller.params.file", "its `dt` = 0.0001 s", "controller period, 0.00005 s"]),

@@ -127,9 +127,9 @@ fn loop_at(open: &OpenLoop, law: &Law, speed: f64, settings: &Settings) -> (Resp
 
 /// One axis' figures from its `|S|` as a function of frequency.
 /// Frequencies of the closed form's log grid (its peaks are then refined).
-const GRID: usize = 1500;
+pub(super) const GRID: usize = 1500;
 
-fn axis_form(
+pub(super) fn axis_form(
     name: &str,
     speed_hz: f64,
     stable: bool,

@@ -26,6 +26,7 @@ pub mod rainflow;
 pub mod report;
 pub mod sensitivity;
 pub mod spec;
+mod state_space_form;
 pub mod vibration;
 
 pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
@@ -352,8 +353,19 @@ fn sensitivity_part(
         .collect();
     let closed_form = closed.first().cloned().flatten();
     let closed_form_planes = if scene.planes() > 1 { closed.into_iter().flatten().collect() } else { Vec::new() };
-    let mut closed_form_axes = coupled::closed_form_axes(scene, &a.sensitivity, &speeds).unwrap_or_default();
-    coupled::compare(&mut closed_form_axes, &axes, scene);
+    // A `state_space` law's closed form on any rotor (from the matrices `plant linear` writes),
+    // else the coupled one of a rotor that gives its whole open loop.
+    let mut closed_form_axes = if state_space_form::applies(scene) {
+        state_space_form::closed_form_axes(scene, &a.sensitivity, &speeds)
+    } else {
+        coupled::closed_form_axes(scene, &a.sensitivity, &speeds)
+    }
+    .unwrap_or_default();
+    if state_space_form::applies(scene) {
+        state_space_form::compare(&mut closed_form_axes, &axes, scene);
+    } else {
+        coupled::compare(&mut closed_form_axes, &axes, scene);
+    }
     for f in &closed_form_axes {
         let peak = f.s_db.map_or(String::new(), |d| format!(", {d:.2} dB at {:.2} Hz", f.f_hz.unwrap_or(f64::NAN)));
         let diff = f.measured_difference_db.map_or(String::new(), |d| format!("; measured within {d:.2} dB"));

@@ -1,6 +1,7 @@
 //! The linear plant's files: `linear.json` (every matrix, name and unit; the schema is
-//! docs/guide/linear.md's) and `linear.npz` (numpy's zip of `.npy` arrays, the same keys).
-//! Pure: each returns the bytes, the command writes them.
+//! docs/guide/linear.md's), `linear.npz` (numpy's zip of `.npy` arrays) and `linear.mat`
+//! (MATLAB's level 5), the last two with the same names. Pure: each returns the bytes, the
+//! command writes them.
 
 use super::model::{LinearPlant, Signal, System};
 use nalgebra::DMatrix;
@@ -39,13 +40,15 @@ struct JsonLaw<'a> {
     axes: Vec<super::law::Transfer>,
     /// A state-space law's discrete system (its `axes` empty).
     #[serde(skip_serializing_if = "Option::is_none")]
-    system: Option<JsonLawSystem>,
+    system: Option<JsonMatrices>,
     /// The law's own poles outside the unit circle (summed over the axes of a per-axis law).
     unstable_poles: usize,
 }
 
+/// A system's matrices as rows under `A`, `B`, `C`, `D`: the law's system as it is, the
+/// plant's flattened into [`JsonSystem`] (one struct, so that both are written the same way).
 #[derive(Serialize)]
-struct JsonLawSystem {
+struct JsonMatrices {
     #[serde(rename = "A")]
     a: Vec<Vec<f64>>,
     #[serde(rename = "B")]
@@ -54,6 +57,12 @@ struct JsonLawSystem {
     c: Vec<Vec<f64>>,
     #[serde(rename = "D")]
     d: Vec<Vec<f64>>,
+}
+
+impl JsonMatrices {
+    fn of(a: &DMatrix<f64>, b: &DMatrix<f64>, c: &DMatrix<f64>, d: &DMatrix<f64>) -> Self {
+        Self { a: rows(a), b: rows(b), c: rows(c), d: rows(d) }
+    }
 }
 
 #[derive(Serialize)]
@@ -79,14 +88,8 @@ struct JsonSystem<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     delay_samples: Option<u32>,
     states: &'a [Signal],
-    #[serde(rename = "A")]
-    a: Vec<Vec<f64>>,
-    #[serde(rename = "B")]
-    b: Vec<Vec<f64>>,
-    #[serde(rename = "C")]
-    c: Vec<Vec<f64>>,
-    #[serde(rename = "D")]
-    d: Vec<Vec<f64>>,
+    #[serde(flatten)]
+    matrices: JsonMatrices,
 }
 
 #[derive(Serialize)]
@@ -127,19 +130,13 @@ pub fn json(e: &Export<'_>) -> Vec<u8> {
             dt: None,
             delay_samples: None,
             states: &e.plant.states,
-            a: rows(&s.a),
-            b: rows(&s.b),
-            c: rows(&s.c),
-            d: rows(&s.d),
+            matrices: JsonMatrices::of(&s.a, &s.b, &s.c, &s.d),
         },
         discrete: JsonSystem {
             dt: Some(e.period),
             delay_samples: Some(e.delay),
             states: e.discrete_states,
-            a: rows(&e.discrete.a),
-            b: rows(&e.discrete.b),
-            c: rows(&e.discrete.c),
-            d: rows(&e.discrete.d),
+            matrices: JsonMatrices::of(&e.discrete.a, &e.discrete.b, &e.discrete.c, &e.discrete.d),
         },
         law: e.law.map(|(name, law)| JsonLaw {
             name,
@@ -147,9 +144,7 @@ pub fn json(e: &Export<'_>) -> Vec<u8> {
             dt: law.period().map(|_| e.period),
             axes: law.transfers(),
             system: match law {
-                super::law::LinearLaw::StateSpace { system: l, .. } => {
-                    Some(JsonLawSystem { a: rows(&l.a), b: rows(&l.b), c: rows(&l.c), d: rows(&l.d) })
-                }
+                super::law::LinearLaw::StateSpace { system: l, .. } => Some(JsonMatrices::of(&l.a, &l.b, &l.c, &l.d)),
                 _ => None,
             },
             unstable_poles: law.unstable_poles(),
@@ -265,6 +260,96 @@ pub fn npz(e: &Export<'_>) -> anyhow::Result<Vec<u8>> {
         zip.write_all(&bytes)?;
     }
     Ok(zip.finish()?.into_inner())
+}
+
+/// The header's descriptive text (116 bytes, space-padded): fixed, so that the same model
+/// gives the same bytes (matrw writes the time of writing there).
+const MAT_TEXT: &str = "MATLAB 5.0 MAT-file, Platform: GLNXA64, Created by: plant linear";
+
+/// `linear.mat`: MATLAB's level 5 (uncompressed, as scipy's `savemat` writes by default), the
+/// same variables as [`npz`]: matrices as they are, numbers as 1 × 1, the names and units as
+/// n × 1 cell arrays of text (MATLAB's `InputName` form: `ss(A, B, C, D, 'InputName', inputs)`).
+///
+/// Through the `matrw` crate (pure Rust: CI has no C library for matio-rs), but not its
+/// `save_matfile_v7`: that writes to a path, not through the project's atomic writer, and drops
+/// every write error. Its serialisers are called into memory here instead, the bytes read back
+/// by its parser and every variable checked there with its size (the serialiser of one
+/// variable drops that variable's error as well).
+pub fn mat(e: &Export<'_>) -> anyhow::Result<Vec<u8>> {
+    use matrw::{CellArray, MatFile, MatVariable, MatlabType, NumericArray};
+    use matrw_binrw::BinWrite;
+    let matrix = |m: &DMatrix<f64>| -> anyhow::Result<MatVariable> {
+        // Column-major, as nalgebra holds it.
+        let array = NumericArray::new(vec![m.nrows(), m.ncols()], MatlabType::from(m.as_slice().to_vec()), None)?;
+        Ok(MatVariable::NumericArray(array))
+    };
+    let scalar = |v: f64| matrix(&DMatrix::from_element(1, 1, v));
+    let text = |items: Vec<&str>| -> anyhow::Result<MatVariable> {
+        let cells = items
+            .iter()
+            .map(|s| {
+                let chars = s.chars().count();
+                Ok(MatVariable::NumericArray(NumericArray::new(vec![1, chars], MatlabType::from(*s), None)?))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(MatVariable::CellArray(CellArray::new(vec![items.len(), 1], cells)?))
+    };
+    let names = |v: &[Signal]| text(v.iter().map(|s| s.name.as_str()).collect());
+    let units = |v: &[Signal]| text(v.iter().map(|s| s.unit.as_str()).collect());
+    let s = &e.plant.system;
+    let variables: Vec<(&str, MatVariable)> = vec![
+        ("A", matrix(&s.a)?),
+        ("B", matrix(&s.b)?),
+        ("C", matrix(&s.c)?),
+        ("D", matrix(&s.d)?),
+        ("Ad", matrix(&e.discrete.a)?),
+        ("Bd", matrix(&e.discrete.b)?),
+        ("Cd", matrix(&e.discrete.c)?),
+        ("Dd", matrix(&e.discrete.d)?),
+        ("dt", scalar(e.period)?),
+        ("delay_samples", scalar(f64::from(e.delay))?),
+        ("speed_hz", scalar(e.plant.speed_hz)?),
+        ("inputs", names(&e.plant.inputs)?),
+        ("input_units", units(&e.plant.inputs)?),
+        ("outputs", names(&e.plant.outputs)?),
+        ("output_units", units(&e.plant.outputs)?),
+        ("states", names(&e.plant.states)?),
+        ("state_units", units(&e.plant.states)?),
+        ("states_d", names(e.discrete_states)?),
+        ("state_units_d", units(e.discrete_states)?),
+        ("format", text(vec![FORMAT])?),
+    ];
+    let written: Vec<(String, Vec<usize>, Option<Vec<f64>>)> =
+        variables.iter().map(|(n, v)| (n.to_string(), v.dim(), v.to_vec::<f64>())).collect();
+    let mut file = MatFile::new();
+    for (name, v) in variables {
+        file.insert(name, v);
+    }
+    let header = matrw::parser::header::MatFileHeader::new(matrw::parser::header::MatFileVerFlag::V7);
+    let endian = matrw_binrw::Endian::Little;
+    let header = matrw::parser::header::MatFileHeader { matfile_endian: endian, ..header };
+    let mut out = std::io::Cursor::new(Vec::new());
+    header.write_options(&mut out, endian, ())?;
+    matrw::parser::v7::matfile7::MatFile7::from(file).write_options(&mut out, endian, ())?;
+    let mut bytes = out.into_inner();
+    anyhow::ensure!(bytes.len() >= 128 && MAT_TEXT.len() <= 116, "the .mat header was not written");
+    bytes[..116].copy_from_slice(format!("{MAT_TEXT:<116}").as_bytes());
+    let back = matrw::load_matfile_from_u8(&bytes).map_err(|e| anyhow::anyhow!("linear.mat reads back wrong: {e}"))?;
+    for (name, dim, values) in written {
+        let got = back.iter().find(|(n, _)| **n == name).map(|(_, v)| v);
+        let got_dim = got.map(|v| v.dim());
+        anyhow::ensure!(
+            got_dim.as_ref() == Some(&dim),
+            "linear.mat: `{name}` reads back as {got_dim:?}, written {dim:?}"
+        );
+        // The numbers equal (a matrix of whole numbers is stored as integers, as MATLAB's `save`
+        // does: a zero's sign is then not kept).
+        if let Some(values) = values {
+            let back = got.and_then(|v| v.to_vec::<f64>());
+            anyhow::ensure!(back.as_ref() == Some(&values), "linear.mat: `{name}` reads back with other values");
+        }
+    }
+    Ok(bytes)
 }
 
 #[cfg(test)]

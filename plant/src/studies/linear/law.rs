@@ -202,6 +202,30 @@ pub fn of(scene: &Scene) -> Option<LinearLaw> {
     Some(LinearLaw::Sampled { laws, period: c.period })
 }
 
+/// The closed loop's state matrix of a discrete plant (current command in, sensor volts out,
+/// its hold and delay states in) and a discrete law of every axis (volts in, command out), the
+/// law's output fed to the plant as it is (`i = C_k x_k + D_k v`, the sign in the law, as
+/// [`sensitivity`]'s `S = (I − P C)⁻¹`): the plant's states then the law's. `None` where the
+/// loop has no solution for its commands (`I − D_k D_p` singular) or the sizes disagree.
+pub fn closed_loop(plant: &System, law: &System) -> Option<DMatrix<f64>> {
+    let (n, nk, m) = (plant.a.nrows(), law.a.nrows(), plant.b.ncols());
+    if law.b.ncols() != plant.c.nrows() || law.c.nrows() != m {
+        return None;
+    }
+    // i = M (D_k C_p x + C_k x_k), M = (I − D_k D_p)⁻¹; v = C_p x + D_p i.
+    let inv = (DMatrix::<f64>::identity(m, m) - &law.d * &plant.d).try_inverse()?;
+    let i_x = &inv * &law.d * &plant.c;
+    let i_k = &inv * &law.c;
+    let v_x = &plant.c + &plant.d * &i_x;
+    let v_k = &plant.d * &i_k;
+    let mut a = DMatrix::zeros(n + nk, n + nk);
+    a.view_mut((0, 0), (n, n)).copy_from(&(&plant.a + &plant.b * &i_x));
+    a.view_mut((0, n), (n, nk)).copy_from(&(&plant.b * &i_k));
+    a.view_mut((n, 0), (nk, n)).copy_from(&(&law.b * &v_x));
+    a.view_mut((n, n), (nk, nk)).copy_from(&(&law.a + &law.b * &v_k));
+    Some(a)
+}
+
 /// `C (wI − A)⁻¹ B + D` at the complex frequency `w` (`s`, or `z` of a discrete system).
 pub fn response(sys: &System, w: C64) -> DMatrix<C64> {
     let n = sys.a.nrows();

@@ -2,8 +2,8 @@
 //! written for a control engineer's tools (python-control, MATLAB, numpy): from each axis'
 //! current command (A) to each axis' sensor signal (V), as a continuous state-space system
 //! ([`model`]) and as the discrete system the digital controller sees (zero-order hold at the
-//! controller's rate, its command delay as states: [`discrete`]); `linear.json` and
-//! `linear.npz` ([`files`]; docs/guide/linear.md). The law's linear form on it ([`law`]) gives
+//! controller's rate, its command delay as states: [`discrete`]); `linear.json`,
+//! `linear.npz` and `linear.mat` ([`files`]; docs/guide/linear.md). The law's linear form on it ([`law`]) gives
 //! the closed loop's sensitivity, the very one `plant assess`'s closed forms draw, and each
 //! axis' gain and phase margins ([`margins`]), written into `linear.json` beside the law.
 
@@ -122,9 +122,10 @@ pub fn command(req: &Request<'_>) -> anyhow::Result<Vec<PathBuf>> {
     };
     let json = files::json(&export);
     let npz = files::npz(&export).context("packing linear.npz")?;
+    let mat = files::mat(&export).context("packing linear.mat")?;
     let _claim = crate::claim::claim(&dir, true)?;
     let mut written = Vec::new();
-    for (name, bytes) in [("linear.json", json), ("linear.npz", npz)] {
+    for (name, bytes) in [("linear.json", json), ("linear.npz", npz), ("linear.mat", mat)] {
         let path = dir.join(name);
         crate::outfile::write(&path, &bytes).with_context(|| format!("writing {}", path.display()))?;
         written.push(path);

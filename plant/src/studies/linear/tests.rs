@@ -274,3 +274,25 @@ fn a_laws_unstable_poles_are_counted() {
     );
     assert_eq!(law::of(&ss).expect("linear form").unstable_poles(), 1);
 }
+
+/// The closed loop's state matrix of a one-state plant with a feedthrough and a one-state law,
+/// worked by hand: `v = 2x + 0.5 i`, `i = −0.3 x_k − 0.2 v` give `i = (−0.4 x − 0.3 x_k)/1.1`;
+/// `x⁺ = 1.1 x + i`, `x_k⁺ = 0.5 x_k + v = 0.5 x_k + 2 x + 0.5 i`. Sizes that disagree: `None`.
+#[test]
+fn a_state_space_law_closes_the_loop_as_worked_by_hand() {
+    let m = |r: usize, c: usize, v: &[f64]| DMatrix::from_row_slice(r, c, v);
+    let plant = super::model::System { a: m(1, 1, &[1.1]), b: m(1, 1, &[1.0]), c: m(1, 1, &[2.0]), d: m(1, 1, &[0.5]) };
+    let law_sys =
+        super::model::System { a: m(1, 1, &[0.5]), b: m(1, 1, &[1.0]), c: m(1, 1, &[-0.3]), d: m(1, 1, &[-0.2]) };
+    let a = law::closed_loop(&plant, &law_sys).expect("a loop");
+    let (ix, ik) = (-0.4 / 1.1, -0.3 / 1.1);
+    let want = m(2, 2, &[1.1 + ix, ik, 2.0 + 0.5 * ix, 0.5 + 0.5 * ik]);
+    assert!((&a - &want).abs().max() < 1e-15, "{a} against {want}");
+    let two_axes = super::model::System {
+        a: m(1, 1, &[0.5]),
+        b: m(1, 2, &[1.0, 0.0]),
+        c: m(2, 1, &[1.0, 0.0]),
+        d: DMatrix::zeros(2, 2),
+    };
+    assert!(law::closed_loop(&plant, &two_axes).is_none());
+}
