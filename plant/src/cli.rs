@@ -58,6 +58,11 @@ pub enum Command {
         /// PlotJuggler (the same as `--set output.mcap=true`).
         #[arg(long)]
         mcap: bool,
+        /// Serve the run live over the Foxglove WebSocket protocol on ADDR (default
+        /// 127.0.0.1:8765; port 0: the system's choice, printed), at `output.live_rate_hz`
+        /// (default 200 Hz of simulated time), for Foxglove or Lichtblick. Put it after the scene.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = plant::live::DEFAULT_ADDR)]
+        live: Option<String>,
     },
     /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
     /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.

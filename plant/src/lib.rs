@@ -41,6 +41,7 @@ pub mod input;
 pub mod interrupt;
 pub mod invalid;
 pub mod linear;
+pub mod live;
 pub mod machine;
 pub mod offload;
 pub mod outfile;

@@ -97,6 +97,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             from_state,
             robustness,
             mcap,
+            live,
         } => {
             if mcap {
                 set.push("output.mcap=true".into());
@@ -105,7 +106,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if let Some(n) = robustness {
                 set.push(format!("robustness.members={n}"));
             }
-            run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
+            run_scene(&scene, out, &set, quiet, controller.launch(run_id), states, live.as_deref())
         }
         Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
@@ -390,6 +391,7 @@ fn run_scene(
     quiet: bool,
     launch: Launch,
     states: States,
+    live: Option<&str>,
 ) -> anyhow::Result<()> {
     let scene = load_scene(path, set)?;
     load_checked(&scene)?;
@@ -408,6 +410,10 @@ fn run_scene(
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
+    let live = live.map(|addr| plant::live::start(addr, &scene)).transpose()?;
+    if let Some(server) = &live {
+        eprintln!("plant: live view at ws://{} (Foxglove WebSocket protocol)", server.addr());
+    }
     let mut hooks = CliHooks {
         stop: plant::interrupt::stop_flag(),
         duration: scene.duration,
@@ -420,7 +426,7 @@ fn run_scene(
         save_error: None,
         pace_said: false,
     };
-    let mut written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
+    let mut written = match plant::output::run_to_dir_live(&dir, &scene, &launch, &mut hooks, from.as_ref(), live) {
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
@@ -436,6 +442,12 @@ fn run_scene(
     }
     for chart in &written.skipped_charts {
         eprintln!("plant: {chart} not drawn: nothing to draw");
+    }
+    if let Some(s) = written.live {
+        eprintln!(
+            "plant: live view: {} client(s); {} frames made, {} not delivered (a client's queue full)",
+            s.clients, s.frames, s.dropped
+        );
     }
     eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
     if robustness > 0 && written.run.outcome != Outcome::Interrupted {

@@ -217,6 +217,8 @@ pub struct Scene {
     pub plots: bool,
     /// Record the run as `run.mcap` (`[output] mcap`, `plant run --mcap`).
     pub mcap: bool,
+    /// Rows per simulated second the live view sends (`[output] live_rate_hz`, `plant run --live`).
+    pub live_rate_hz: f64,
     /// Notes for the user: deprecated keys, a run with few controller ticks. The CLI prints
     /// them as `plant: warning: …`.
     pub warnings: Vec<String>,

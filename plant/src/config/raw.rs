@@ -739,6 +739,10 @@ pub struct RawOutput {
     /// Also record the run as `run.mcap` (issue 42); written into `scene.toml` only when set.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mcap: Option<bool> = None,
+    /// The live view's rate (`plant run --live`, issue 42): rows sent per simulated second;
+    /// written into `scene.toml` only when set.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub live_rate_hz: Option<f64> = None,
 }
 }
 

@@ -147,7 +147,7 @@ impl McapSink {
 }
 
 /// A ROS 2 type name for a schema: `plant.Rotor` → `plant_msgs/msg/Rotor`.
-fn ros2_name(schema: &str) -> String {
+pub fn ros2_name(schema: &str) -> String {
     match schema.split_once('.') {
         Some((package, name)) => format!("{package}_msgs/msg/{name}"),
         None => schema.to_string(),
