@@ -108,7 +108,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             run_scene(&scene, out, &set, quiet, controller.launch(run_id), states, live.as_deref())
         }
-        Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
+        Command::Soak { programme, out, set, quiet, resume, live } => {
+            soak_cmd(&programme, out, &set, quiet, resume, live.as_deref())
+        }
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
             let req = plant::compare::Request {
                 scene: &scene,
@@ -444,10 +446,7 @@ fn run_scene(
         eprintln!("plant: {chart} not drawn: nothing to draw");
     }
     if let Some(s) = written.live {
-        eprintln!(
-            "plant: live view: {} client(s); {} frames made, {} not delivered (a client's queue full)",
-            s.clients, s.frames, s.dropped
-        );
+        eprintln!("plant: {}", live_line(&s));
     }
     eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
     if robustness > 0 && written.run.outcome != Outcome::Interrupted {
@@ -519,11 +518,22 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
 }
 
 /// `plant soak`.
-fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resume: bool) -> anyhow::Result<()> {
+fn soak_cmd(
+    path: &Path,
+    out: Option<PathBuf>,
+    set: &[String],
+    quiet: bool,
+    resume: bool,
+    live: Option<&str>,
+) -> anyhow::Result<()> {
     let prog = plant::soak::programme::load(path, set)?;
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
     let _claim = plant::claim::claim(&dir, true)?;
+    let live = live.map(|addr| plant::live::start(addr, &prog.scene)).transpose()?;
+    if let Some(server) = &live {
+        eprintln!("plant soak: live view at ws://{} (Foxglove WebSocket protocol)", server.addr());
+    }
     let stop = plant::interrupt::stop_flag();
     let progress = match (quiet, std::io::stderr().is_terminal()) {
         (true, _) => plant::soak::Progress::Quiet,
@@ -538,7 +548,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
         dir.display(),
         if resume { ", resumed from its checkpoint" } else { "" }
     );
-    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress, resume };
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress, resume, live };
     let done = match plant::soak::run(&prog, path, opts) {
         Ok(d) => d,
         Err(plant::soak::SoakError::Setup(e)) => return Err(e.into()),
@@ -546,6 +556,9 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
         Err(plant::soak::SoakError::Resume(e)) => return Err(Ending::BadArgument(e.to_string()).into()),
     };
     let r = &done.report;
+    if let Some(s) = done.live {
+        eprintln!("plant soak: {}", live_line(&s));
+    }
     eprintln!("plant soak: {}", r.headline());
     let failed: Vec<_> = r.criteria.iter().filter(|v| !v.passed).collect();
     for v in &failed {
@@ -557,6 +570,14 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
     }
     eprintln!("plant soak: all {} criteria met; results in {}", r.criteria.len(), dir.display());
     Ok(())
+}
+
+/// What a live view served, for a run's last lines.
+fn live_line(s: &plant::live::Served) -> String {
+    format!(
+        "live view: {} client(s); {} frames made, {} not delivered (a client's queue full)",
+        s.clients, s.frames, s.dropped
+    )
 }
 
 /// `plant analyze`.

@@ -237,7 +237,7 @@ impl RunFolder {
             summary.error = run.outcome.error();
             write_json(&dir.join("summary.json"), &summary)?;
         }
-        let live = self.live.take().map(|l| l.finish(&summary));
+        let live = self.live.take().map(|l| l.finish(Some(&summary)));
         // The recording closes last: its failure (a full disk) loses none of the other outputs.
         self.mcap.take().map(|m| m.finish(&summary)).transpose()?;
         Ok(Written { summary, run, skipped_charts: skipped, live })

@@ -277,6 +277,43 @@ fn a_client_gets_the_advertised_topics_and_the_trace_rows_at_the_live_rate() {
     assert!(log_msgs.iter().any(|m| m == "run completed"), "{log_msgs:?}");
 }
 
+#[test]
+fn a_soak_serves_its_rows_live() {
+    common::controller_bin();
+    let dir = TempDir::new("live-soak");
+    let programme = common::workspace_root().join("config/soak/soak-short.toml");
+    let mut cmd = std::process::Command::new(common::plant_bin());
+    cmd.arg("soak").arg(&programme).arg("--out").arg(dir.join("soak")).args(["--quiet", "--live", "127.0.0.1:0"]);
+    let mut p = Proc::spawn(&mut cmd);
+    let addr = address(&mut p);
+    let mut viewer = Viewer::connect(&addr);
+    assert_eq!(viewer.info["metadata"]["scene"], "soak-short");
+    viewer.subscribe_all();
+    let (got, _) = viewer.read_all(LIMIT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(0), "{log}");
+    let (clients, _, _) = served(&log);
+    assert_eq!(clients, 1, "{log}");
+    let rotor = viewer.channels.values().find(|c| c.topic == "/plane_a/rotor").unwrap();
+    let n = fields(&rotor.schema).len();
+    let times: Vec<f64> = got["/plane_a/rotor"].iter().map(|(_, b)| doubles(b, n)[0]).collect();
+    assert!(times.len() >= 10, "{} messages", times.len());
+    // The soak's rows at 20 kHz, served at 200 Hz: every 100th row, in order.
+    for w in times.windows(2) {
+        assert!(w[1] > w[0], "times not increasing: {w:?}");
+    }
+    for t in &times {
+        let row = (t * 20000.0).round();
+        assert!((row / 20000.0 - t).abs() < 1e-12, "t = {t} s is not a 20 kHz row");
+        assert_eq!(row % 100.0, 0.0, "t = {t} s is not a 200 Hz row");
+    }
+    let events: Vec<String> = got["/events"]
+        .iter()
+        .map(|(_, b)| serde_json::from_slice::<Value>(b).unwrap()["message"].as_str().unwrap().to_string())
+        .collect();
+    assert!(events.iter().any(|m| m.starts_with("shock 2 of 2 starts")), "{events:?}");
+}
+
 /// The memory of a process now (KiB, `VmRSS`).
 fn rss_kib(pid: u32) -> Option<u64> {
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;

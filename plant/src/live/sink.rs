@@ -121,10 +121,13 @@ impl LiveSink {
         }
     }
 
-    /// Sends the run's end (its status, motion mode, a co-simulation's figures) and stops the
-    /// server: the clients get what was queued for them, then are closed.
-    pub fn finish(mut self, summary: &Summary) -> Served {
-        self.pending.extend(self.events.end(summary));
+    /// Sends the run's end (with a `plant run`'s summary: its status, motion mode, a
+    /// co-simulation's figures) and stops the server: the clients get what was queued for
+    /// them, then are closed.
+    pub fn finish(mut self, summary: Option<&Summary>) -> Served {
+        if let Some(summary) = summary {
+            self.pending.extend(self.events.end(summary));
+        }
         let mut frame = Frame { ns: nanoseconds(self.pending.first().map_or(0.0, |e| e.t_s)), messages: Vec::new() };
         let events = self.topics.len();
         self.push_events(&mut frame, events);

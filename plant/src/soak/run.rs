@@ -42,6 +42,8 @@ pub struct Options<'a> {
     pub progress: Progress,
     /// Continue the soak in `dir` from its checkpoint (`plant soak --resume`).
     pub resume: bool,
+    /// Serve the soak live (`plant soak --live`).
+    pub live: Option<crate::live::Server>,
 }
 
 /// Why a soak could not run or write its results.
@@ -163,7 +165,7 @@ impl Hooks for SoakHooks<'_> {
 
 /// Runs a programme: writes `scene.toml` first, `soak.csv`, `rss.csv` and
 /// `envelope.csv` as it goes, then `soak.json` and the plots.
-pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Finished, SoakError> {
+pub fn run(prog: &Programme, programme_file: &Path, mut opts: Options) -> Result<Finished, SoakError> {
     let started = Instant::now();
     let dir = opts.dir;
     std::fs::create_dir_all(dir)
@@ -177,6 +179,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
     let snapshots = checkpoints.queue.clone();
     let mut sink = new_sink(prog, saved.as_ref(), files.soak_csv, files.envelope_csv, checkpoints);
+    sink.live = opts.live.take().map(|s| crate::live::LiveSink::new(s, &prog.scene));
     let mut hooks = new_hooks(prog, &opts, started, files.rss_csv, files.rss, snapshots);
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
     // Offloaded in realtime only, as before `plant run` offloaded on a spare core: the soak's
@@ -200,6 +203,7 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         bar.finish_and_clear();
     }
     sink.finish();
+    let live = sink.live.take().map(|l| l.finish(None));
     if let Some(e) = sink.checkpoints.error.take() {
         hooks.note(&format!(
             "warning: a checkpoint could not be written ({e:#}): --resume continues from the last one written"
@@ -208,7 +212,9 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     if let Some(e) = sink.error.take().or(hooks.error.take()) {
         return Err(SoakError::Io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
     }
-    write_results(prog, programme_file, &opts, result, &sink, &mut hooks)
+    let mut finished = write_results(prog, programme_file, &opts, result, &sink, &mut hooks)?;
+    finished.live = live;
+    Ok(finished)
 }
 
 /// The soak's row files and the RSS samples so far.
@@ -301,6 +307,7 @@ fn new_sink<'a>(
         error: None,
         rows,
         checkpoints,
+        live: None,
     }
 }
 
@@ -422,7 +429,7 @@ fn write_results(
             _ => {}
         }
     }
-    Ok(Finished { outcome: result.outcome, report })
+    Ok(Finished { outcome: result.outcome, report, live: None })
 }
 
 /// Default output folder of a programme file: `runs/soak-<file stem>`.

@@ -29,6 +29,8 @@ pub struct SoakSink<'a> {
     pub(crate) rows: u64,
     /// Where the checkpoints go.
     pub(crate) checkpoints: Checkpoints,
+    /// The live view (`plant soak --live`).
+    pub(crate) live: Option<crate::live::LiveSink>,
 }
 
 /// The plant's snapshots at the shocks' starts, handed over by the loop's hooks, and the
@@ -144,6 +146,9 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn sample(&mut self, record: &Record) {
+        if let Some(l) = &mut self.live {
+            l.push(record);
+        }
         self.take_checkpoint();
         self.rows += 1;
         // Of a two-plane rotor: the larger radius and contact force of the planes, and clear
