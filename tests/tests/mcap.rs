@@ -66,6 +66,7 @@ with open(sys.argv[1], "rb") as f:
     reader = make_reader(f)
     for m in reader.iter_metadata():
         out["metadata"][m.name] = dict(m.metadata)
+    out["compressions"] = sorted({c.compression for c in reader.get_summary().chunk_indexes})
     for schema, channel, message in reader.iter_messages(log_time_order=False):
         if channel.topic == "/events":
             data = json.loads(message.data)
@@ -206,6 +207,8 @@ fn a_recording_holds_the_trace_bit_for_bit() {
     let topics = assert_holds_trace(&run, &rec);
     let want = ["/housing", "/plane_a/coils", "/plane_a/contact", "/plane_a/race", "/plane_a/rotor", "/rotor/spin"];
     assert_eq!(topics, want);
+    // Chunks, not compressed by default (the MCAP format's empty compression name).
+    assert_eq!(rec["compressions"], serde_json::json!([""]));
     // The scene as metadata: the run's own scene.toml.
     assert_eq!(rec["metadata"]["scene"]["scene.toml"].as_str().unwrap(), read_text(&run.join("scene.toml")));
     // The events: the shock's start at its row (10 ms), contact onsets, the status at the end.
@@ -287,6 +290,28 @@ fn a_link_at_run_mcap_is_replaced_not_followed() {
     assert_eq!(read_text(&victim), "untouched");
     let meta = std::fs::symlink_metadata(out.join("run.mcap")).unwrap();
     assert!(meta.file_type().is_file(), "run.mcap is a regular file");
+}
+
+#[test]
+fn lz4_chunks_hold_the_same_trace() {
+    let dir = TempDir::new("mcap-lz4");
+    let sets: Vec<&str> = SHORT.iter().copied().chain(["output.mcap_compression=\"lz4\""]).collect();
+    let run = record(&dir, &scene("paper-10g.toml"), &sets);
+    let rec = read_back(&run);
+    assert_eq!(rec["compressions"], serde_json::json!(["lz4"]));
+    assert_eq!(assert_holds_trace(&run, &rec).len(), 6);
+}
+
+#[test]
+fn a_bad_compression_exits_2_naming_the_key_and_the_value() {
+    let dir = TempDir::new("mcap-bad-compression");
+    let out = dir.join("run");
+    let mut cmd = common::plant_run(&scene("paper-10g.toml"), &out, &["output.mcap_compression=\"zip\""]);
+    let done = output_within(cmd.arg("--mcap"), LIMIT);
+    assert_exit(&done, 2);
+    let err = stderr(&done);
+    assert!(err.contains("mcap_compression") && err.contains("zip"), "{err}");
+    assert!(!out.join("run.mcap").exists() && !out.join("trace.csv").exists());
 }
 
 #[test]

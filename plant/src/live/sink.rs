@@ -131,7 +131,9 @@ impl LiveSink {
         let mut frame = Frame { ns: nanoseconds(self.pending.first().map_or(0.0, |e| e.t_s)), messages: Vec::new() };
         let events = self.topics.len();
         self.push_events(&mut frame, events);
-        self.server.hub().offer(frame);
+        if self.server.hub().has_clients() {
+            self.server.hub().offer(frame);
+        }
         self.server.stop()
     }
 }

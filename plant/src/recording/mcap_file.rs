@@ -1,6 +1,7 @@
 //! `run.mcap`: a run's rows as messages on the topics of [`super::topics`] (CDR, with ROS 2
 //! message definitions as schemas), its events as `foxglove.Log` on `/events`
-//! ([`super::events`]) and the scene as metadata, lz4-compressed chunks, for Foxglove, Lichtblick, PlotJuggler and the `mcap`
+//! ([`super::events`]) and the scene as metadata, in chunks (uncompressed, or lz4 with `[output]
+//! mcap_compression = "lz4"`), for Foxglove, Lichtblick, PlotJuggler and the `mcap`
 //! readers. A [`crate::run::Sink`], fed the same rows as `trace.csv`.
 //!
 //! The file is created new in the run's folder ([`crate::outfile::create`]: an entry at the
@@ -60,8 +61,14 @@ impl McapSink {
 
     fn open(path: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let file = crate::outfile::create(path)?;
+        // Not compressed by default: lz4 through the `mcap` writer (many small writes per
+        // message, each with the lz4 frame's checksum) was about half the recording's CPU time.
+        let compression = match scene.mcap_compression {
+            crate::config::McapCompression::None => None,
+            crate::config::McapCompression::Lz4 => Some(mcap::Compression::Lz4),
+        };
         let options = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Lz4))
+            .compression(compression)
             .profile("")
             .library(concat!("plant ", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::with_capacity(1 << 20, file))?;

@@ -318,6 +318,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         plots: raw.output.plots,
         mcap: raw.output.mcap.unwrap_or(false),
         live_rate_hz: live_rate(raw.output.live_rate_hz, output_rate)?,
+        mcap_compression: raw.output.mcap_compression.unwrap_or(super::McapCompression::None),
         warnings,
         source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
     };
