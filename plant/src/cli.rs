@@ -83,6 +83,10 @@ pub enum Command {
         /// the uninterrupted soak's.
         #[arg(long)]
         resume: bool,
+        /// Also record the soak as soak.mcap in the output folder, one file over all its shocks
+        /// (the same as `--set output.mcap=true`).
+        #[arg(long)]
+        mcap: bool,
         /// Serve the soak live over the Foxglove WebSocket protocol on ADDR, as `plant run
         /// --live` does. Put it after the programme.
         #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = plant::live::DEFAULT_ADDR)]

@@ -108,7 +108,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             run_scene(&scene, out, &set, quiet, controller.launch(run_id), states, live.as_deref())
         }
-        Command::Soak { programme, out, set, quiet, resume, live } => {
+        Command::Soak { programme, out, mut set, quiet, resume, mcap, live } => {
+            if mcap {
+                set.push("output.mcap=true".into());
+            }
             soak_cmd(&programme, out, &set, quiet, resume, live.as_deref())
         }
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {

@@ -239,7 +239,7 @@ impl RunFolder {
         }
         let live = self.live.take().map(|l| l.finish(Some(&summary)));
         // The recording closes last: its failure (a full disk) loses none of the other outputs.
-        self.mcap.take().map(|m| m.finish(&summary)).transpose()?;
+        self.mcap.take().map(|m| m.finish(Some(&summary))).transpose()?;
         Ok(Written { summary, run, skipped_charts: skipped, live })
     }
 }

@@ -54,8 +54,12 @@ impl McapSink {
     /// Creates `dir/run.mcap` for a run of `scene`: the topics' schemas and channels and the
     /// scene's metadata (`scene`: its name and the resolved scene file).
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
-        let path = dir.join(FILE);
-        let made = Self::open(&path, scene);
+        Self::create_at(&dir.join(FILE), scene)
+    }
+
+    /// [`McapSink::create`] at `path` (`soak.mcap` of a soak).
+    pub fn create_at(path: &Path, scene: &Scene) -> anyhow::Result<Self> {
+        let made = Self::open(path, scene);
         made.with_context(|| format!("creating {}", path.display()))
     }
 
@@ -128,19 +132,20 @@ impl McapSink {
         }
     }
 
-    /// Logs the run's end (its status, motion mode, a co-simulation's figures) and writes the
-    /// file's summary and footer. The first error of the recording, if any, naming the file.
-    pub fn finish(mut self, summary: &Summary) -> anyhow::Result<()> {
+    /// Logs the run's end (with a `plant run`'s summary: its status, motion mode, a
+    /// co-simulation's figures) and writes the file's summary and footer. The first error of
+    /// the recording, if any, naming the file.
+    pub fn finish(mut self, summary: Option<&Summary>) -> anyhow::Result<()> {
         let path = self.path.clone();
         self.close(summary).with_context(|| format!("writing {}", path.display()))
     }
 
-    fn close(&mut self, summary: &Summary) -> anyhow::Result<()> {
+    fn close(&mut self, summary: Option<&Summary>) -> anyhow::Result<()> {
         if let Some(e) = self.error.take() {
             return Err(e);
         }
         let Some(mut writer) = self.writer.take() else { return Ok(()) };
-        for event in self.events.end(summary) {
+        for event in summary.map(|s| self.events.end(s)).unwrap_or_default() {
             let ns = nanoseconds(event.t_s);
             write(&mut writer, self.events_channel, &mut self.sequence, ns, event.to_log_json(ns).as_bytes())?;
         }
