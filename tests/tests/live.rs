@@ -380,16 +380,21 @@ fn viewers_that_come_late_leave_or_misbehave_change_nothing_in_the_outputs() {
     leaving.subscribe_all();
     let _ = leaving.ws.read();
     drop(leaving);
-    // A client that sends garbage: told why (status, level 2), closed after too much of it.
+    // A client that sends garbage: told why (status, level 2), closed after too much of it
+    // (the 17th message that is not a request: plant/src/live/server.rs, MAX_BAD = 16). Exactly
+    // 17, so that the server reads all it was sent before it closes (more, unread, would make
+    // its close a reset that may lose the statuses before this client reads them).
     let mut garbage = Viewer::connect(&addr);
-    for _ in 0..40 {
-        if garbage.send_text("this is not JSON").is_err()
-            || garbage.ws.send(Message::Binary(vec![7u8; 16].into())).is_err()
-        {
-            break;
-        }
+    for i in 0..17 {
+        let sent = if i % 2 == 0 {
+            garbage.send_text("this is not JSON")
+        } else {
+            garbage.ws.send(Message::Binary(vec![7u8; 16].into()))
+        };
+        sent.expect("the server reads 17 bad messages before it closes");
     }
     let (_, statuses) = garbage.read_all(Duration::from_secs(60));
+    assert_eq!(statuses.iter().filter(|s| s["op"] == "status" && s["level"] == 2).count(), 17, "{statuses:?}");
     assert!(
         statuses.iter().any(|s| s["op"] == "status"
             && s["level"] == 2
