@@ -58,6 +58,11 @@ pub enum Command {
         /// PlotJuggler (the same as `--set output.mcap=true`).
         #[arg(long)]
         mcap: bool,
+        /// Serve the run live over the Foxglove WebSocket protocol on ADDR (default
+        /// 127.0.0.1:8765; port 0: the system's choice, printed), at `output.live_rate_hz`
+        /// (default 200 Hz of simulated time), for Foxglove or Lichtblick. Put it after the scene.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = plant::live::DEFAULT_ADDR)]
+        live: Option<String>,
     },
     /// Soak test: one long co-simulation through a programme of shocks; writes soak.csv (per
     /// shock), soak.json (overall, criteria), rss.csv, envelope.csv and plots.
@@ -78,6 +83,14 @@ pub enum Command {
         /// the uninterrupted soak's.
         #[arg(long)]
         resume: bool,
+        /// Also record the soak as soak.mcap in the output folder, one file over all its shocks
+        /// (the same as `--set output.mcap=true`).
+        #[arg(long)]
+        mcap: bool,
+        /// Serve the soak live over the Foxglove WebSocket protocol on ADDR, as `plant run
+        /// --live` does. Put it after the programme.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = plant::live::DEFAULT_ADDR)]
+        live: Option<String>,
     },
     /// Measurements of the testbed itself.
     Bench {

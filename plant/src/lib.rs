@@ -28,7 +28,7 @@ pub mod studies;
 pub mod util;
 
 // Every module at its old path (`plant::trace`, `plant::assess`, …).
-pub use outputs::{fmu_export, output, recording, status, summary};
+pub use outputs::{fmu_export, live, output, recording, status, summary};
 pub use results::{analysis, bounded, figures, plot, record, snapshot, trace};
 pub use run::{cosim, offload};
 pub use studies::{

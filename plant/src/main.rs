@@ -97,6 +97,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             from_state,
             robustness,
             mcap,
+            live,
         } => {
             if mcap {
                 set.push("output.mcap=true".into());
@@ -105,9 +106,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if let Some(n) = robustness {
                 set.push(format!("robustness.members={n}"));
             }
-            run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
+            run_scene(&scene, out, &set, quiet, controller.launch(run_id), states, live.as_deref())
         }
-        Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
+        Command::Soak { programme, out, mut set, quiet, resume, mcap, live } => {
+            if mcap {
+                set.push("output.mcap=true".into());
+            }
+            soak_cmd(&programme, out, &set, quiet, resume, live.as_deref())
+        }
         Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
             let req = plant::compare::Request {
                 scene: &scene,
@@ -390,6 +396,7 @@ fn run_scene(
     quiet: bool,
     launch: Launch,
     states: States,
+    live: Option<&str>,
 ) -> anyhow::Result<()> {
     let scene = load_scene(path, set)?;
     load_checked(&scene)?;
@@ -408,6 +415,10 @@ fn run_scene(
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&scene.name));
     let _claim = plant::claim::claim(&dir, true)?;
+    let live = live.map(|addr| plant::live::start(addr, &scene)).transpose()?;
+    if let Some(server) = &live {
+        eprintln!("plant: live view at ws://{} (Foxglove WebSocket protocol)", server.addr());
+    }
     let mut hooks = CliHooks {
         stop: plant::interrupt::stop_flag(),
         duration: scene.duration,
@@ -420,7 +431,7 @@ fn run_scene(
         save_error: None,
         pace_said: false,
     };
-    let mut written = match plant::output::run_to_dir_from(&dir, &scene, &launch, &mut hooks, from.as_ref()) {
+    let mut written = match plant::output::run_to_dir_live(&dir, &scene, &launch, &mut hooks, from.as_ref(), live) {
         Ok(w) => w,
         Err(plant::output::RunDirError::Setup(e)) => {
             // The scene loaded: the folder records why the run did not start.
@@ -436,6 +447,9 @@ fn run_scene(
     }
     for chart in &written.skipped_charts {
         eprintln!("plant: {chart} not drawn: nothing to draw");
+    }
+    if let Some(s) = written.live {
+        eprintln!("plant: {}", live_line(&s));
     }
     eprintln!("plant: {}; results in {}", written.summary.headline(), dir.display());
     if robustness > 0 && written.run.outcome != Outcome::Interrupted {
@@ -507,11 +521,22 @@ fn stopped(outcome: &Outcome, simulated_s: f64) -> anyhow::Result<()> {
 }
 
 /// `plant soak`.
-fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resume: bool) -> anyhow::Result<()> {
+fn soak_cmd(
+    path: &Path,
+    out: Option<PathBuf>,
+    set: &[String],
+    quiet: bool,
+    resume: bool,
+    live: Option<&str>,
+) -> anyhow::Result<()> {
     let prog = plant::soak::programme::load(path, set)?;
     load_checked(&prog.scene)?;
     let dir = out.unwrap_or_else(|| plant::soak::default_dir(path));
     let _claim = plant::claim::claim(&dir, true)?;
+    let live = live.map(|addr| plant::live::start(addr, &prog.scene)).transpose()?;
+    if let Some(server) = &live {
+        eprintln!("plant soak: live view at ws://{} (Foxglove WebSocket protocol)", server.addr());
+    }
     let stop = plant::interrupt::stop_flag();
     let progress = match (quiet, std::io::stderr().is_terminal()) {
         (true, _) => plant::soak::Progress::Quiet,
@@ -526,7 +551,7 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
         dir.display(),
         if resume { ", resumed from its checkpoint" } else { "" }
     );
-    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress, resume };
+    let opts = plant::soak::Options { dir: &dir, launch: Launch::default(), stop: &stop, progress, resume, live };
     let done = match plant::soak::run(&prog, path, opts) {
         Ok(d) => d,
         Err(plant::soak::SoakError::Setup(e)) => return Err(e.into()),
@@ -534,6 +559,9 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
         Err(plant::soak::SoakError::Resume(e)) => return Err(Ending::BadArgument(e.to_string()).into()),
     };
     let r = &done.report;
+    if let Some(s) = done.live {
+        eprintln!("plant soak: {}", live_line(&s));
+    }
     eprintln!("plant soak: {}", r.headline());
     let failed: Vec<_> = r.criteria.iter().filter(|v| !v.passed).collect();
     for v in &failed {
@@ -545,6 +573,14 @@ fn soak_cmd(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool, resu
     }
     eprintln!("plant soak: all {} criteria met; results in {}", r.criteria.len(), dir.display());
     Ok(())
+}
+
+/// What a live view served, for a run's last lines.
+fn live_line(s: &plant::live::Served) -> String {
+    format!(
+        "live view: {} client(s); {} frames made, {} not delivered (a client's queue full)",
+        s.clients, s.frames, s.dropped
+    )
 }
 
 /// `plant analyze`.

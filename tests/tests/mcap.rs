@@ -66,6 +66,7 @@ with open(sys.argv[1], "rb") as f:
     reader = make_reader(f)
     for m in reader.iter_metadata():
         out["metadata"][m.name] = dict(m.metadata)
+    out["compressions"] = sorted({c.compression for c in reader.get_summary().chunk_indexes})
     for schema, channel, message in reader.iter_messages(log_time_order=False):
         if channel.topic == "/events":
             data = json.loads(message.data)
@@ -90,9 +91,13 @@ print(json.dumps(out))
 
 /// The recording of `dir/run.mcap` as the Python reader sees it.
 fn read_back(dir: &Path) -> serde_json::Value {
+    read_file(&dir.join("run.mcap"))
+}
+
+/// The recording of `file` as the Python reader sees it.
+fn read_file(file: &Path) -> serde_json::Value {
     let python = mcap_venv().join("bin/python");
-    let out =
-        output_within(Command::new(python).arg("-c").arg(READER).arg(dir.join("run.mcap")), Duration::from_secs(300));
+    let out = output_within(Command::new(python).arg("-c").arg(READER).arg(file), Duration::from_secs(300));
     assert_exit(&out, 0);
     serde_json::from_slice(&out.stdout).expect("the reader's JSON")
 }
@@ -206,6 +211,8 @@ fn a_recording_holds_the_trace_bit_for_bit() {
     let topics = assert_holds_trace(&run, &rec);
     let want = ["/housing", "/plane_a/coils", "/plane_a/contact", "/plane_a/race", "/plane_a/rotor", "/rotor/spin"];
     assert_eq!(topics, want);
+    // Chunks, not compressed by default (the MCAP format's empty compression name).
+    assert_eq!(rec["compressions"], serde_json::json!([""]));
     // The scene as metadata: the run's own scene.toml.
     assert_eq!(rec["metadata"]["scene"]["scene.toml"].as_str().unwrap(), read_text(&run.join("scene.toml")));
     // The events: the shock's start at its row (10 ms), contact onsets, the status at the end.
@@ -287,6 +294,60 @@ fn a_link_at_run_mcap_is_replaced_not_followed() {
     assert_eq!(read_text(&victim), "untouched");
     let meta = std::fs::symlink_metadata(out.join("run.mcap")).unwrap();
     assert!(meta.file_type().is_file(), "run.mcap is a regular file");
+}
+
+#[test]
+fn a_soak_records_one_file_over_its_shocks() {
+    common::controller_bin();
+    let dir = TempDir::new("mcap-soak");
+    let out = dir.join("soak");
+    let programme = common::workspace_root().join("config/soak/soak-short.toml");
+    let mut cmd = Command::new(common::plant_bin());
+    cmd.arg("soak").arg(&programme).arg("--out").arg(&out).args(["--quiet", "--mcap"]);
+    assert_exit(&output_within(&mut cmd, LIMIT), 0);
+    let rec = read_file(&out.join("soak.mcap"));
+    assert_eq!(rec["headers_ok"], true);
+    assert_eq!(rec["log_times_ok"], true);
+    // soak-short: two shocks in 0.65 s simulated (the second's start, 0.45 s, plus its pulse
+    // and settle_s = 0.15 s), rows at 20 kHz from t = 0: one message per row on each topic.
+    let json = common::read_json(&out.join("soak.json"));
+    let simulated = common::num(&json, "simulated_s");
+    let rows = (simulated * 20000.0).round() as usize + 1;
+    let t: Vec<i64> = serde_json::from_value(rec["topics"]["/plane_a/rotor"]["fields"]["t_s"].clone()).unwrap();
+    assert_eq!(t.len(), rows, "one message per row over {simulated} s");
+    let t: Vec<f64> = t.iter().map(|b| f64::from_bits(*b as u64)).collect();
+    assert_eq!(t[0], 0.0);
+    assert!(t.windows(2).all(|w| w[1] > w[0]), "times increase");
+    let events: Vec<(u64, u64, String)> = serde_json::from_value(rec["events"].clone()).unwrap();
+    for (n, start_ns) in [(1, 20_000_000), (2, 450_000_000)] {
+        assert!(
+            events.iter().any(|(ns, _, m)| *ns == start_ns && m.starts_with(&format!("shock {n} of 2 starts"))),
+            "{events:?}"
+        );
+    }
+    assert_eq!(rec["metadata"]["scene"]["name"], "soak-short");
+}
+
+#[test]
+fn lz4_chunks_hold_the_same_trace() {
+    let dir = TempDir::new("mcap-lz4");
+    let sets: Vec<&str> = SHORT.iter().copied().chain(["output.mcap_compression=\"lz4\""]).collect();
+    let run = record(&dir, &scene("paper-10g.toml"), &sets);
+    let rec = read_back(&run);
+    assert_eq!(rec["compressions"], serde_json::json!(["lz4"]));
+    assert_eq!(assert_holds_trace(&run, &rec).len(), 6);
+}
+
+#[test]
+fn a_bad_compression_exits_2_naming_the_key_and_the_value() {
+    let dir = TempDir::new("mcap-bad-compression");
+    let out = dir.join("run");
+    let mut cmd = common::plant_run(&scene("paper-10g.toml"), &out, &["output.mcap_compression=\"zip\""]);
+    let done = output_within(cmd.arg("--mcap"), LIMIT);
+    assert_exit(&done, 2);
+    let err = stderr(&done);
+    assert!(err.contains("mcap_compression") && err.contains("zip"), "{err}");
+    assert!(!out.join("run.mcap").exists() && !out.join("trace.csv").exists());
 }
 
 #[test]

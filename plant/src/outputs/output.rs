@@ -77,6 +77,8 @@ pub struct Written {
     pub run: SinkRun,
     /// Charts not drawn because they had nothing to draw (a run stopped at its start).
     pub skipped_charts: Vec<&'static str>,
+    /// What the live view served (`plant run --live`).
+    pub live: Option<crate::live::Served>,
 }
 
 /// Creates `dir`, removes the files an earlier run left there that this run
@@ -145,6 +147,7 @@ pub struct RunFolder {
     recorder: Recorder,
     error: Option<std::io::Error>,
     mcap: Option<McapSink>,
+    live: Option<crate::live::LiveSink>,
 }
 
 impl RunFolder {
@@ -160,7 +163,13 @@ impl RunFolder {
         )
         .with_context(|| format!("creating {}", path.display()))?;
         let mcap = scene.mcap.then(|| McapSink::create(dir, scene)).transpose()?;
-        Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None, mcap })
+        Ok(Self { trace, recorder: Recorder::new(scene, scene.plots), error: None, mcap, live: None })
+    }
+
+    /// Also serves the rows live through `server` (`plant run --live`).
+    pub fn with_live(mut self, server: Option<crate::live::Server>, scene: &Scene) -> Self {
+        self.live = server.map(|s| crate::live::LiveSink::new(s, scene));
+        self
     }
 
     /// One sample (also for a trace already in memory).
@@ -173,6 +182,9 @@ impl RunFolder {
         self.recorder.push(r);
         if let Some(m) = &mut self.mcap {
             m.push(r);
+        }
+        if let Some(l) = &mut self.live {
+            l.push(r);
         }
     }
 
@@ -225,9 +237,10 @@ impl RunFolder {
             summary.error = run.outcome.error();
             write_json(&dir.join("summary.json"), &summary)?;
         }
+        let live = self.live.take().map(|l| l.finish(Some(&summary)));
         // The recording closes last: its failure (a full disk) loses none of the other outputs.
-        self.mcap.take().map(|m| m.finish(&summary)).transpose()?;
-        Ok(Written { summary, run, skipped_charts: skipped })
+        self.mcap.take().map(|m| m.finish(Some(&summary))).transpose()?;
+        Ok(Written { summary, run, skipped_charts: skipped, live })
     }
 }
 
@@ -285,8 +298,20 @@ pub fn run_to_dir_from(
     hooks: &mut dyn Hooks,
     from: Option<&crate::snapshot::Snapshot>,
 ) -> Result<Written, RunDirError> {
+    run_to_dir_live(dir, scene, launch, hooks, from, None)
+}
+
+/// [`run_to_dir_from`], the rows also served live through `live` (`plant run --live`).
+pub fn run_to_dir_live(
+    dir: &Path,
+    scene: &Scene,
+    launch: &Launch,
+    hooks: &mut dyn Hooks,
+    from: Option<&crate::snapshot::Snapshot>,
+    live: Option<crate::live::Server>,
+) -> Result<Written, RunDirError> {
     prepare(dir, scene).map_err(RunDirError::Output)?;
-    let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?;
+    let mut folder = RunFolder::create(dir, scene).map_err(RunDirError::Output)?.with_live(live, scene);
     let launch = Launch { log: Some(dir.join("controller.log")), ..launch.clone() };
     let run = run_into_offloaded(scene, &launch, hooks, &mut folder, from, When::SpareCore)?;
     // What an external controller ran differently from the scene goes into the record, so that

@@ -21,8 +21,8 @@ pub mod validate;
 
 pub use overrides::apply_override;
 pub use raw::{
-    ControlMode, DragChoice, Fallback, ForceLaw, Pacing, RaceWhenClearChoice, RawController, RawScene, RealtimeSetting,
-    ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
+    ControlMode, DragChoice, Fallback, ForceLaw, McapCompression, Pacing, RaceWhenClearChoice, RawController, RawScene,
+    RealtimeSetting, ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
 pub use rotor::{Rotor, RotorParams};
 pub use validate::{finite, non_negative, positive, range, validate};
@@ -218,6 +218,10 @@ pub struct Scene {
     pub plots: bool,
     /// Record the run as `run.mcap` (`[output] mcap`, `plant run --mcap`).
     pub mcap: bool,
+    /// Rows per simulated second the live view sends (`[output] live_rate_hz`, `plant run --live`).
+    pub live_rate_hz: f64,
+    /// The compression of `run.mcap`'s chunks (`[output] mcap_compression`).
+    pub mcap_compression: McapCompression,
     /// Notes for the user: deprecated keys, a run with few controller ticks. The CLI prints
     /// them as `plant: warning: …`.
     pub warnings: Vec<String>,

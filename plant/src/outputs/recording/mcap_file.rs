@@ -1,6 +1,7 @@
 //! `run.mcap`: a run's rows as messages on the topics of [`super::topics`] (CDR, with ROS 2
 //! message definitions as schemas), its events as `foxglove.Log` on `/events`
-//! ([`super::events`]) and the scene as metadata, lz4-compressed chunks, for Foxglove, Lichtblick, PlotJuggler and the `mcap`
+//! ([`super::events`]) and the scene as metadata, in chunks (uncompressed, or lz4 with `[output]
+//! mcap_compression = "lz4"`), for Foxglove, Lichtblick, PlotJuggler and the `mcap`
 //! readers. A [`crate::run::Sink`], fed the same rows as `trace.csv`.
 //!
 //! The file is created new in the run's folder ([`crate::outfile::create`]: an entry at the
@@ -53,15 +54,25 @@ impl McapSink {
     /// Creates `dir/run.mcap` for a run of `scene`: the topics' schemas and channels and the
     /// scene's metadata (`scene`: its name and the resolved scene file).
     pub fn create(dir: &Path, scene: &Scene) -> anyhow::Result<Self> {
-        let path = dir.join(FILE);
-        let made = Self::open(&path, scene);
+        Self::create_at(&dir.join(FILE), scene)
+    }
+
+    /// [`McapSink::create`] at `path` (`soak.mcap` of a soak).
+    pub fn create_at(path: &Path, scene: &Scene) -> anyhow::Result<Self> {
+        let made = Self::open(path, scene);
         made.with_context(|| format!("creating {}", path.display()))
     }
 
     fn open(path: &Path, scene: &Scene) -> anyhow::Result<Self> {
         let file = crate::outfile::create(path)?;
+        // Not compressed by default: lz4 through the `mcap` writer (many small writes per
+        // message, each with the lz4 frame's checksum) was about half the recording's CPU time.
+        let compression = match scene.mcap_compression {
+            crate::config::McapCompression::None => None,
+            crate::config::McapCompression::Lz4 => Some(mcap::Compression::Lz4),
+        };
         let options = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Lz4))
+            .compression(compression)
             .profile("")
             .library(concat!("plant ", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::with_capacity(1 << 20, file))?;
@@ -121,19 +132,20 @@ impl McapSink {
         }
     }
 
-    /// Logs the run's end (its status, motion mode, a co-simulation's figures) and writes the
-    /// file's summary and footer. The first error of the recording, if any, naming the file.
-    pub fn finish(mut self, summary: &Summary) -> anyhow::Result<()> {
+    /// Logs the run's end (with a `plant run`'s summary: its status, motion mode, a
+    /// co-simulation's figures) and writes the file's summary and footer. The first error of
+    /// the recording, if any, naming the file.
+    pub fn finish(mut self, summary: Option<&Summary>) -> anyhow::Result<()> {
         let path = self.path.clone();
         self.close(summary).with_context(|| format!("writing {}", path.display()))
     }
 
-    fn close(&mut self, summary: &Summary) -> anyhow::Result<()> {
+    fn close(&mut self, summary: Option<&Summary>) -> anyhow::Result<()> {
         if let Some(e) = self.error.take() {
             return Err(e);
         }
         let Some(mut writer) = self.writer.take() else { return Ok(()) };
-        for event in self.events.end(summary) {
+        for event in summary.map(|s| self.events.end(s)).unwrap_or_default() {
             let ns = nanoseconds(event.t_s);
             write(&mut writer, self.events_channel, &mut self.sequence, ns, event.to_log_json(ns).as_bytes())?;
         }
@@ -147,7 +159,7 @@ impl McapSink {
 }
 
 /// A ROS 2 type name for a schema: `plant.Rotor` → `plant_msgs/msg/Rotor`.
-fn ros2_name(schema: &str) -> String {
+pub fn ros2_name(schema: &str) -> String {
     match schema.split_once('.') {
         Some((package, name)) => format!("{package}_msgs/msg/{name}"),
         None => schema.to_string(),

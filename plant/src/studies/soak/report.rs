@@ -177,6 +177,8 @@ pub struct Finished {
     pub outcome: Outcome,
     /// What `soak.json` holds.
     pub report: Report,
+    /// What the live view served (`plant soak --live`).
+    pub live: Option<crate::live::Served>,
 }
 
 fn process_rss(samples: impl Iterator<Item = Option<u64>>) -> Option<ProcessRss> {

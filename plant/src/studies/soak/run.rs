@@ -9,6 +9,7 @@ use super::{monitor, rss, ENVELOPE_BIN_S, ENVELOPE_CSV_HEADER, RSS_CSV_HEADER, S
 use crate::cosim::Launch;
 use crate::hooks::Hooks;
 use crate::offload::{run_into_offloaded, When};
+use crate::recording::mcap_file::McapSink;
 use crate::row_file::RowFile;
 use crate::run::SetupError;
 use crate::snapshot::Snapshot;
@@ -42,6 +43,8 @@ pub struct Options<'a> {
     pub progress: Progress,
     /// Continue the soak in `dir` from its checkpoint (`plant soak --resume`).
     pub resume: bool,
+    /// Serve the soak live (`plant soak --live`).
+    pub live: Option<crate::live::Server>,
 }
 
 /// Why a soak could not run or write its results.
@@ -163,7 +166,7 @@ impl Hooks for SoakHooks<'_> {
 
 /// Runs a programme: writes `scene.toml` first, `soak.csv`, `rss.csv` and
 /// `envelope.csv` as it goes, then `soak.json` and the plots.
-pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Finished, SoakError> {
+pub fn run(prog: &Programme, programme_file: &Path, mut opts: Options) -> Result<Finished, SoakError> {
     let started = Instant::now();
     let dir = opts.dir;
     std::fs::create_dir_all(dir)
@@ -177,6 +180,8 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         Checkpoints { dir: dir.to_path_buf(), programme, queue: Arc::new(Mutex::new(VecDeque::new())), error: None };
     let snapshots = checkpoints.queue.clone();
     let mut sink = new_sink(prog, saved.as_ref(), files.soak_csv, files.envelope_csv, checkpoints);
+    sink.live = opts.live.take().map(|s| crate::live::LiveSink::new(s, &prog.scene));
+    sink.mcap = recording(dir, prog, opts.resume)?;
     let mut hooks = new_hooks(prog, &opts, started, files.rss_csv, files.rss, snapshots);
     let launch = Launch { log: Some(dir.join("controller.log")), ..opts.launch.clone() };
     // Offloaded in realtime only, as before `plant run` offloaded on a spare core: the soak's
@@ -200,6 +205,8 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
         bar.finish_and_clear();
     }
     sink.finish();
+    let live = sink.live.take().map(|l| l.finish(None));
+    let recorded = sink.mcap.take().map(|m| m.finish(None)).transpose();
     if let Some(e) = sink.checkpoints.error.take() {
         hooks.note(&format!(
             "warning: a checkpoint could not be written ({e:#}): --resume continues from the last one written"
@@ -208,8 +215,38 @@ pub fn run(prog: &Programme, programme_file: &Path, opts: Options) -> Result<Fin
     if let Some(e) = sink.error.take().or(hooks.error.take()) {
         return Err(SoakError::Io(anyhow::Error::new(e).context("writing soak.csv, envelope.csv or rss.csv")));
     }
-    write_results(prog, programme_file, &opts, result, &sink, &mut hooks)
+    let mut finished = write_results(prog, programme_file, &opts, result, &sink, &mut hooks)?;
+    finished.live = live;
+    // The recording's failure (a full disk) is said after every other output was written.
+    recorded.map_err(SoakError::Io)?;
+    Ok(finished)
 }
+
+/// The soak's recording, `soak.mcap` (`[output] mcap`, `plant soak --mcap`): one file over all
+/// its shocks. A resumed soak keeps the killed soak's file aside (`soak.1.mcap`, …) and records
+/// from its checkpoint on; a soak without a recording removes an earlier soak's file.
+fn recording(dir: &Path, prog: &Programme, resume: bool) -> Result<Option<McapSink>, SoakError> {
+    let io = SoakError::Io;
+    let path = dir.join(SOAK_MCAP);
+    if !prog.scene.mcap {
+        if !resume {
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(io(anyhow::Error::new(e).context(format!("removing {}", path.display()))))
+                }
+                _ => {}
+            }
+        }
+        return Ok(None);
+    }
+    if resume {
+        crate::outfile::keep_aside(&path).map_err(io)?;
+    }
+    McapSink::create_at(&path, &prog.scene).map(Some).map_err(io)
+}
+
+/// The soak's recording's file name.
+pub const SOAK_MCAP: &str = "soak.mcap";
 
 /// The soak's row files and the RSS samples so far.
 struct Files {
@@ -301,6 +338,8 @@ fn new_sink<'a>(
         error: None,
         rows,
         checkpoints,
+        live: None,
+        mcap: None,
     }
 }
 
@@ -422,7 +461,7 @@ fn write_results(
             _ => {}
         }
     }
-    Ok(Finished { outcome: result.outcome, report })
+    Ok(Finished { outcome: result.outcome, report, live: None })
 }
 
 /// Default output folder of a programme file: `runs/soak-<file stem>`.

@@ -29,6 +29,10 @@ pub struct SoakSink<'a> {
     pub(crate) rows: u64,
     /// Where the checkpoints go.
     pub(crate) checkpoints: Checkpoints,
+    /// The live view (`plant soak --live`).
+    pub(crate) live: Option<crate::live::LiveSink>,
+    /// The recording (`soak.mcap`, `plant soak --mcap`).
+    pub(crate) mcap: Option<crate::recording::mcap_file::McapSink>,
 }
 
 /// The plant's snapshots at the shocks' starts, handed over by the loop's hooks, and the
@@ -175,6 +179,12 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn sample(&mut self, record: &Record) {
+        if let Some(l) = &mut self.live {
+            l.push(record);
+        }
+        if let Some(m) = &mut self.mcap {
+            m.push(record);
+        }
         self.take_checkpoint();
         self.rows += 1;
         // Of a two-plane rotor: the larger radius and contact force of the planes, and clear

@@ -59,6 +59,21 @@ pub const MAX_RATE_HZ: f64 = 1e7;
 pub const MAX_TICKS: f64 = 1e9;
 /// Highest trace rate (Hz).
 pub const MAX_OUTPUT_RATE_HZ: f64 = 1e7;
+/// The live view's rate when `output.live_rate_hz` is not set (Hz): a screen's rate.
+pub const DEFAULT_LIVE_RATE_HZ: f64 = 200.0;
+
+/// `output.live_rate_hz`: > 0 and at most the output rate (the live view sends trace rows);
+/// unset, [`DEFAULT_LIVE_RATE_HZ`] or the output rate if that is lower.
+fn live_rate(key: Option<f64>, output_rate: f64) -> Result<f64, ConfigError> {
+    let Some(rate) = key else { return Ok(DEFAULT_LIVE_RATE_HZ.min(output_rate)) };
+    let rate = positive("output.live_rate_hz", rate, "Hz")?;
+    if rate > output_rate {
+        let why = format!("must be <= output.rate_hz = {output_rate} Hz: the live view sends trace rows");
+        return Err(range("output.live_rate_hz", rate, "Hz", &why));
+    }
+    Ok(rate)
+}
+
 /// Most trace rows in a run: `scene.duration_s × output.rate_hz` (1000 s at 10 kHz).
 pub const MAX_OUTPUT_ROWS: f64 = 1e7;
 /// Stiffest loop the controller may be designed for (N/m): a closed-loop natural frequency
@@ -303,6 +318,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         output_interval: 1.0 / output_rate,
         plots: raw.output.plots,
         mcap: raw.output.mcap.unwrap_or(false),
+        live_rate_hz: live_rate(raw.output.live_rate_hz, output_rate)?,
+        mcap_compression: raw.output.mcap_compression.unwrap_or(super::McapCompression::None),
         warnings,
         source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
     };
