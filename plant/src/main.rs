@@ -108,7 +108,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             run_scene(&scene, out, &set, quiet, controller.launch(run_id), states)
         }
         Command::Soak { programme, out, set, quiet, resume } => soak_cmd(&programme, out, &set, quiet, resume),
-        Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs } => {
+        Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs, robustness } => {
             let req = plant::compare::Request {
                 scene: &scene,
                 set: &set,
@@ -118,6 +118,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 maps,
                 laws: &laws,
                 realtime: realtime.then_some(runs),
+                robustness,
             };
             let written = plant::compare::command(&req, &mut |l| eprintln!("plant compare: {l}"), &mut |w| warn(w))?;
             eprintln!("plant compare: wrote {}", written.display());
