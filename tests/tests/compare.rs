@@ -240,7 +240,8 @@ fn compare_says_how_robust_each_run_and_each_difference_is() {
         serde_json::from_str(&std::fs::read_to_string(out.join("compare_robustness.json")).unwrap()).unwrap();
     assert_eq!(json["reference"], "pd");
     let runs = json["runs"].as_array().expect("runs");
-    for r in 0..2 {
+    assert_eq!(runs.len(), 2);
+    for (r, run) in runs.iter().enumerate() {
         assert_eq!(robust.text(r, "run"), laws.text(r, "law"));
         assert_eq!(robust.num(r, "members"), 2.0);
         assert!(robust.num(r, "same_mode") <= 2.0);
@@ -248,8 +249,8 @@ fn compare_says_how_robust_each_run_and_each_difference_is() {
         assert_eq!(robust.text(r, "run_mode"), laws.text(r, "post_shock_mode"));
         let force = laws.num(r, "max_contact_force_n");
         assert!(robust.num(r, "force_min_n") <= force && force <= robust.num(r, "force_max_n"), "{:?}", robust.rows[r]);
-        assert_eq!(runs[r]["robustness"]["members"], 2);
-        assert!(runs[r]["robustness"]["integration"]["setting"].is_string(), "the refined run: {}", runs[r]);
+        assert_eq!(run["robustness"]["members"], 2);
+        assert!(run["robustness"]["integration"]["setting"].is_string(), "the refined run: {run}");
     }
     for c in ["mode_vs_reference", "force_vs_reference", "radius_vs_reference"] {
         assert_eq!(robust.text(0, c), "same");

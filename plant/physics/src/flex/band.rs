@@ -1,5 +1,5 @@
 //! Band matrices: the finite-element rotor's global matrices stored by their band, with the
-//! products and factorisations the reduction needs on them (MODEL.md §13.5, "Large shafts").
+//! products and factorisations the reduction needs on them (MODEL.md §13.4, "Large shafts").
 //!
 //! Each shaft element couples the eight coordinates of its two nodes, so every global matrix
 //! has nonzeros only within [`HALF_BAND`] = 7 of its diagonal: `O(n)` storage instead of the

@@ -1,4 +1,4 @@
-//! The lowest modes of `K φ = λ M φ` for band matrices (MODEL.md §13.5, "Large shafts"):
+//! The lowest modes of `K φ = λ M φ` for band matrices (MODEL.md §13.4, "Large shafts"):
 //! subspace iteration with the shift-inverted operator and a Rayleigh–Ritz step each sweep
 //! (Bathe, *Finite Element Procedures*, §11.6), the count of wanted modes fixed beforehand by the
 //! Sturm count of `K − λ_c M` ([`Band::negative_eigenvalues`]), so that none below the cutoff
