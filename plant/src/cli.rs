@@ -128,6 +128,11 @@ pub enum Command {
         /// Realtime runs of `--realtime`.
         #[arg(long, default_value_t = 1, requires = "realtime")]
         runs: usize,
+        /// Give each compared run (rates or laws) its robustness answer with N perturbed copies,
+        /// as `plant run --robustness N`, and say whether each difference from the reference
+        /// run lies within the runs' spreads (compare_robustness.csv and .json).
+        #[arg(long, value_name = "N", conflicts_with = "realtime")]
+        robustness: Option<u32>,
     },
     /// The whirl modes of a two-plane or flexible scene's rotor on its continuous PD against spin
     /// speed (Campbell diagram, linearised; a flexible rotor's bending modes beside its

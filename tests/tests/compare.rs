@@ -209,3 +209,82 @@ fn compare_realtime_puts_realtime_runs_beside_their_lockstep_twin() {
     assert!(stderr(&o).contains("realtime 2:"), "{}", stderr(&o));
     assert!(out.join("realtime_radius.png").exists());
 }
+
+/// Issue 40 item 1: `plant compare --robustness N` gives each compared run the robustness
+/// answer of `plant run --robustness N` (its N perturbed members and its refined-integrator
+/// run) and says of each run's difference from the reference (the first law) whether it lies
+/// within the runs' spreads: compare_robustness.csv and .json. Checked against the law table
+/// written beside it: each run's own peak force lies in its spread, the reference is the same as
+/// itself, and each verdict on the force follows from the two runs' ranges in the JSON.
+/// Bad members are refused before anything runs, nothing written.
+#[test]
+fn compare_says_how_robust_each_run_and_each_difference_is() {
+    controller_bin();
+    let dir = TempDir::new("compare-robustness");
+    let out = dir.join("out");
+    let o = output_within(
+        Command::new(plant_bin())
+            .arg("compare")
+            .arg(scene("paper-10g.toml"))
+            .args(["--laws", "pd,pd_delay", "--robustness", "2", "--out"])
+            .arg(&out)
+            .args(["--set", "scene.duration_s=0.04", "--set", "shock[0].start_s=0.01"])
+            .args(["--set", "controller.max_miss_fraction=1", "--set", "controller.max_overrun_fraction=1"]),
+        LIMIT,
+    );
+    assert_exit(&o, 0);
+    let laws = Table::read(&out.join("laws.csv"));
+    let robust = Table::read(&out.join("compare_robustness.csv"));
+    assert_eq!(robust.rows.len(), 2);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("compare_robustness.json")).unwrap()).unwrap();
+    assert_eq!(json["reference"], "pd");
+    let runs = json["runs"].as_array().expect("runs");
+    assert_eq!(runs.len(), 2);
+    for (r, run) in runs.iter().enumerate() {
+        assert_eq!(robust.text(r, "run"), laws.text(r, "law"));
+        assert_eq!(robust.num(r, "members"), 2.0);
+        assert!(robust.num(r, "same_mode") <= 2.0);
+        assert!(["robust", "fragile", "unconverged"].contains(&robust.text(r, "verdict")), "{:?}", robust.rows[r]);
+        assert_eq!(robust.text(r, "run_mode"), laws.text(r, "post_shock_mode"));
+        let force = laws.num(r, "max_contact_force_n");
+        assert!(robust.num(r, "force_min_n") <= force && force <= robust.num(r, "force_max_n"), "{:?}", robust.rows[r]);
+        assert_eq!(run["robustness"]["members"], 2);
+        assert!(run["robustness"]["integration"]["setting"].is_string(), "the refined run: {run}");
+    }
+    for c in ["mode_vs_reference", "force_vs_reference", "radius_vs_reference"] {
+        assert_eq!(robust.text(0, c), "same");
+    }
+    let range = |r: usize| {
+        let i = &runs[r]["robustness"]["integration"]["max_contact_force_n"];
+        let refined = i.as_f64().unwrap_or(f64::NAN);
+        (robust.num(r, "force_min_n").min(refined), robust.num(r, "force_max_n").max(refined))
+    };
+    let ((lo_a, hi_a), (lo_b, hi_b)) = (range(0), range(1));
+    let expected = if laws.num(0, "max_contact_force_n") == laws.num(1, "max_contact_force_n") {
+        "same"
+    } else if lo_a <= hi_b && lo_b <= hi_a {
+        "within_spread"
+    } else {
+        "beyond_spread"
+    };
+    assert_eq!(robust.text(1, "force_vs_reference"), expected, "{:?} {:?}", (lo_a, hi_a), (lo_b, hi_b));
+
+    // Too many members: refused by the key, nothing written.
+    let bad = dir.join("bad");
+    let o = output_within(
+        Command::new(plant_bin())
+            .arg("compare")
+            .arg(scene("paper-10g.toml"))
+            .args(["--laws", "pd", "--robustness", "300", "--out"])
+            .arg(&bad),
+        LIMIT,
+    );
+    assert_exit(&o, 2);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("robustness.members = 300"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!bad.exists(), "a refused compare leaves no folder behind");
+}

@@ -88,11 +88,11 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
     refused("zeta", &flex, &["rotor.modal_damping=-0.1"], &["rotor.modal_damping = -0.1"]);
     // A shaft past the element bound, refused before any element is made: 20 000 elements
     // asked for 51 GB and aborted, 10^18 would not have been counted before allocating.
-    for (name, split) in [("split-big", "20000"), ("split-huge", "1000000000000000000")] {
+    for (name, split) in [("split-big", "20000"), ("split-over", "2001"), ("split-huge", "1000000000000000000")] {
         let row = format!(
             "rotor.shaft.element=[{{length_mm=460.0, outer_diameter_mm=40.0, material=\"steel\", split={split}}}]"
         );
-        refused(name, &flex, &[&row], &["rotor.shaft", &format!("the shaft has {split} elements, more than the 200")]);
+        refused(name, &flex, &[&row], &["rotor.shaft", &format!("the shaft has {split} elements, more than the 2000")]);
     }
     // A ROSS file that is not there, and both descriptions at once.
     refused("ross-missing", &flex, &["rotor.ross_file=\"nowhere.toml\""], &["rotor.ross_file = nowhere.toml"]);
@@ -103,6 +103,40 @@ fn bad_flexible_input_is_refused_at_load_naming_the_key() {
         &scene("two-plane-asymmetric-10g.toml"),
         &["rotor.amb_a_node=2"],
         &["rotor.amb_a_node = 2", "flexible"],
+    );
+}
+
+/// The largest shaft a scene may have, 2,000 elements (the band path: `flex::MAX_ELEMENTS`),
+/// loads and runs: the shipped scene's machine with its shaft as one 45 mm cylinder split 2,000
+/// times, its disks and AMBs at the same places (nodes × 125), cut to 5 ms; bounded in time
+/// (building it takes well under a second in release), never timed. Past the cutoff's modes
+/// the band path keeps at most `flex::BAND_MAX_MODES`: a cutoff of 1 MHz is refused by its key.
+#[test]
+fn the_largest_allowed_shaft_runs() {
+    let dir = TempDir::new("flexible-largest");
+    let shaft = [
+        "rotor.shaft.element=[{length_mm=460.0, outer_diameter_mm=45.0, material=\"steel\", split=2000}]",
+        "rotor.shaft.disk=[{node=0, mass_kg=1.5, diametral_inertia_kg_m2=0.6e-3, polar_inertia_kg_m2=1.2e-3}, \
+         {node=625, mass_kg=4.0, diametral_inertia_kg_m2=1.3e-3, polar_inertia_kg_m2=1.7e-3}, \
+         {node=750, mass_kg=4.0, diametral_inertia_kg_m2=1.3e-3, polar_inertia_kg_m2=1.7e-3}, \
+         {node=875, mass_kg=4.0, diametral_inertia_kg_m2=1.3e-3, polar_inertia_kg_m2=1.7e-3}, \
+         {node=2000, mass_kg=3.0, diametral_inertia_kg_m2=2.2e-3, polar_inertia_kg_m2=4.0e-3}]",
+        "rotor.amb_a_node=250",
+        "rotor.amb_b_node=1750",
+    ];
+    let out = dir.join("run");
+    let sets: Vec<&str> = TINY.iter().chain(&shaft).copied().collect();
+    let run = output_within(&mut plant_run(&scene("flexible-10g.toml"), &out, &sets), RUN);
+    assert_exit(&run, 0);
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["model"]["rotor"], "flexible");
+    assert_eq!(summary["status"], "completed", "{summary:#}");
+    let high: Vec<&str> = sets.iter().copied().chain(["rotor.cutoff_hz=1e6"]).collect();
+    refused(
+        "flexible-largest-cutoff",
+        &scene("flexible-10g.toml"),
+        &high,
+        &["rotor.cutoff_hz = 1000000 Hz", "lower the cutoff"],
     );
 }
 

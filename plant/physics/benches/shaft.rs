@@ -2,9 +2,11 @@
 //! (`cargo bench -p plant-physics --bench shaft`): a uniform steel shaft of 0.5 m, 40 mm, in
 //! `n` Timoshenko elements, AMBs and touchdown bearings at the nodes nearest 10 % and 90 % of
 //! its length, modes below 2 kHz with the static and gyroscopic corrections (as the shipped
-//! flexible scene reduces). The full matrices are dense (4 (n + 1) coordinates) and the modes
-//! come from a dense symmetric eigensolver: the cost grows as n³ (docs/results/flexible-rotor.md,
-//! "How big a shaft"), which is what bounds the element count (`flex::MAX_ELEMENTS`).
+//! flexible scene reduces). Up to `flex::DENSE_ELEMENTS` (200) the full matrices are dense
+//! (4 (n + 1) coordinates) and the modes come from a dense symmetric eigensolver: the cost grows
+//! as n³. Above it the matrices are bands and the modes come from subspace iteration: the cost
+//! grows as n, the cost per element the slope of the band sizes (docs/results/flexible-rotor.md,
+//! "How big a shaft"), up to `flex::MAX_ELEMENTS` (2,000).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use plant_physics::flex::reduce::{Reduced, Reduction};
@@ -29,7 +31,7 @@ fn shaft(n: usize) -> (Rotor, Reduction) {
 fn build(c: &mut Criterion) {
     let mut g = c.benchmark_group("shaft/reduce");
     g.sample_size(10);
-    for n in [16usize, 32, 64, 128, 256] {
+    for n in [16usize, 64, 128, 200, 250, 500, 1000, 2000] {
         let (rotor, spec) = shaft(n);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| Reduced::new(black_box(&rotor), black_box(&spec)).expect("reduces"))

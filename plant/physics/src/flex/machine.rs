@@ -201,7 +201,6 @@ impl Model {
         use two_plane::ix as rix;
         let red = &*params.reduced;
         let shaft = &*params.shaft;
-        let mass = shaft.matrices().mass;
         let n = shaft.dof();
         let field = |x: f64, y: f64, a: f64, b: f64| {
             let mut q = DVector::zeros(n);
@@ -213,9 +212,20 @@ impl Model {
             }
             q
         };
-        let project: DMatrix<f64> = red.basis.transpose() * &mass;
-        let eta = &project * field(rigid[rix::X], rigid[rix::Y], rigid[rix::SX], rigid[rix::SY]);
-        let rate = &project * field(rigid[rix::VX], rigid[rix::VY], rigid[rix::VSX], rigid[rix::VSY]);
+        let (position, velocity) = (
+            field(rigid[rix::X], rigid[rix::Y], rigid[rix::SX], rigid[rix::SY]),
+            field(rigid[rix::VX], rigid[rix::VY], rigid[rix::VSX], rigid[rix::VSY]),
+        );
+        // `Φᵀ M q`: with the dense mass matrix up to the dense limit (the shipped scenes' start
+        // as it was), by its band above it (no full-size square matrix).
+        let (eta, rate) = if super::dense_model(shaft) {
+            let project: DMatrix<f64> = red.basis.transpose() * shaft.matrices().mass;
+            (&project * position, &project * velocity)
+        } else {
+            let mass = shaft.band_matrices().mass;
+            let both = mass.mul(&DMatrix::from_columns(&[position, velocity]));
+            (red.basis.transpose() * both.column(0), red.basis.transpose() * both.column(1))
+        };
         let mut y = [0.0; N];
         let r = red.size();
         y[..r].copy_from_slice(eta.as_slice());

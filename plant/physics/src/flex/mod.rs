@@ -8,25 +8,45 @@
 //! [`machine`] is the rotor the plant steps (`rotor.model = "flexible"`): the reduced shaft
 //! with two AMBs, two sensors and two touchdown bearings at its nodes.
 
+pub mod band;
 pub mod initial;
 pub mod linear;
 pub mod machine;
 pub mod modes;
 pub mod reduce;
+mod reduce_band;
 pub mod ross;
 pub mod ross_amb;
 pub mod rotor;
 pub mod shaft;
+pub mod subspace;
 pub mod table;
 
 pub use modes::{Linear, Mode, Whirl};
 
-/// The most shaft elements a rotor may have (after splits). The model's full matrices are
-/// dense, `4 (n + 1)` coordinates square, and its modes come from a dense eigensolver, so
-/// building costs O(n³) time and O(n²) memory (`cargo bench -p plant-physics --bench shaft`;
+/// The most shaft elements a rotor may have (after splits). The model is assembled by its band
+/// and reduced by subspace iteration on the bands above [`DENSE_ELEMENTS`] ([`band`],
+/// [`subspace`]): building costs time and memory in proportion to the element count, a few
+/// seconds at this limit (`cargo bench -p plant-physics --bench shaft`;
 /// docs/results/flexible-rotor.md, "How big a shaft"). A slender rotor's lowest modes converge
-/// with a few elements per span; this bound leaves a wide margin over that.
-pub const MAX_ELEMENTS: usize = 200;
+/// with a few elements per span; this bound leaves a wide margin over that and keeps a ROSS
+/// file of 20,000 elements from being taken.
+pub const MAX_ELEMENTS: usize = 2000;
+
+/// Up to this many elements the model is built with dense matrices and nalgebra's dense
+/// eigensolver, as it always was, so that the shipped scenes' figures stay the same to the bit;
+/// above it, by the band path (the two agree to 1e-10 on the retained frequencies, tested).
+pub const DENSE_ELEMENTS: usize = 200;
+
+/// The most modes below the cutoff the band path computes (the plant's flexible state holds
+/// [`machine::MAX_MODES`] basis vectors in all): more is refused by their count, before the
+/// iteration, whose cost grows as the square of the modes sought.
+pub const BAND_MAX_MODES: usize = 100;
+
+/// Whether `rotor` is built by the dense path ([`DENSE_ELEMENTS`]).
+pub fn dense_model(rotor: &Rotor) -> bool {
+    rotor.elements.len() <= DENSE_ELEMENTS
+}
 pub use reduce::{Reduced, Reduction};
 pub use rotor::{Disk, LinearBearing, Rotor};
 pub use shaft::{Material, ShaftElement};
@@ -39,8 +59,8 @@ pub enum FlexError {
     NoElements,
     /// More shaft elements than the model builds in bounded time and memory.
     #[error(
-        "the shaft has {count} elements, more than the {limit} this model takes (its full matrices are dense: \
-         {limit} elements build in seconds, 20 000 would need 51 GB); merge elements or split them less"
+        "the shaft has {count} elements, more than the {limit} this model takes (building costs time in \
+         proportion to the element count: {limit} elements build in seconds); merge elements or split them less"
     )]
     TooManyElements {
         /// The element count (after splits).
@@ -120,6 +140,27 @@ pub enum FlexError {
     /// The static correction's stiffness is singular.
     #[error("the rotor's stiffness matrix is singular: no static correction")]
     SingularStiffness,
+    /// The cutoff keeps more modes of a large shaft than the band path computes.
+    #[error(
+        "cutoff_hz = {cutoff_hz} Hz keeps {count} modes of the shaft, more than the {limit} a shaft of more than \
+         {dense} elements is reduced to: lower the cutoff"
+    )]
+    TooManyModes {
+        /// The cutoff (Hz).
+        cutoff_hz: f64,
+        /// The modes below it (the Sturm count).
+        count: usize,
+        /// [`BAND_MAX_MODES`].
+        limit: usize,
+        /// [`DENSE_ELEMENTS`].
+        dense: usize,
+    },
+    /// The band eigensolver of a large shaft did not converge.
+    #[error("the shaft's modes did not converge in {sweeps} sweeps of subspace iteration")]
+    NoConvergence {
+        /// The sweeps made.
+        sweeps: usize,
+    },
     /// A ROSS file that cannot be read.
     #[error("{file}: {message}")]
     Ross {

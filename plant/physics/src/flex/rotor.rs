@@ -3,6 +3,7 @@
 //! `M q̈ + (C + Ω G) q̇ + K q = f` on four degrees of freedom per node, `[x, y, α, β]`
 //! (node `n`'s `x` is `q[4n]`).
 
+use super::band::{Band, HALF_BAND};
 use super::shaft::ShaftElement;
 use super::FlexError;
 use nalgebra::DMatrix;
@@ -206,6 +207,66 @@ impl Rotor {
     }
 }
 
+/// The global matrices by their band ([`super::band`]): what [`Rotor::matrices`] assembles,
+/// entry by entry in the same order, in `O(n)` storage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BandMatrices {
+    /// Mass M.
+    pub mass: Band,
+    /// Stiffness K (shaft and bearings).
+    pub stiffness: Band,
+    /// Damping C (proportional damping and bearings).
+    pub damping: Band,
+    /// Gyroscopic G (multiplied by the spin Ω).
+    pub gyroscopic: Band,
+}
+
+impl Rotor {
+    /// The global matrices as bands, assembled as [`Rotor::matrices`] assembles the dense ones.
+    pub fn band_matrices(&self) -> BandMatrices {
+        let n = self.dof();
+        let zero = || Band::zeros(n, HALF_BAND);
+        let (mut mass, mut stiffness, mut damping, mut gyroscopic) = (zero(), zero(), zero(), zero());
+        for (i, el) in self.elements.iter().enumerate() {
+            let at = DOF_PER_NODE * i;
+            let add = |target: &mut Band, m: super::shaft::Matrix8| {
+                for r in 0..8 {
+                    for c in 0..8 {
+                        target.add(at + r, at + c, m[(r, c)]);
+                    }
+                }
+            };
+            add(&mut mass, el.mass_matrix());
+            add(&mut stiffness, el.stiffness_matrix());
+            add(&mut damping, el.damping_matrix());
+            add(&mut gyroscopic, el.gyroscopic_matrix());
+        }
+        for d in &self.disks {
+            let at = DOF_PER_NODE * d.node;
+            mass.add(at, at, d.mass);
+            mass.add(at + 1, at + 1, d.mass);
+            mass.add(at + 2, at + 2, d.diametral_inertia);
+            mass.add(at + 3, at + 3, d.diametral_inertia);
+            gyroscopic.add(at + 2, at + 3, d.polar_inertia);
+            gyroscopic.add(at + 3, at + 2, -d.polar_inertia);
+        }
+        if self.alpha != 0.0 || self.beta != 0.0 {
+            damping = damping.plus(self.alpha, &mass).plus(self.beta, &stiffness);
+        }
+        for b in &self.bearings {
+            let at = DOF_PER_NODE * b.node;
+            for r in 0..2 {
+                for c in 0..2 {
+                    stiffness.add(at + r, at + c, b.stiffness[r][c]);
+                    damping.add(at + r, at + c, b.damping[r][c]);
+                    mass.add(at + r, at + c, b.mass[r][c]);
+                }
+            }
+        }
+        BandMatrices { mass, stiffness, damping, gyroscopic }
+    }
+}
+
 /// The rotor as a rigid body (from its mass and gyroscopic matrices, so the shaft's distributed
 /// mass and rotary inertia count as the finite elements have them).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -228,7 +289,24 @@ impl Rotor {
     pub fn rigid_body(&self) -> RigidBody {
         let mut without = self.clone();
         without.bearings.clear();
-        let m = without.matrices();
+        // `uᵀ M v` and `uᵀ G v`: from the dense matrices up to the dense limit (the shipped
+        // scenes' figures as they were), from the bands above it.
+        let (dense, band) = if super::dense_model(self) {
+            (Some(without.matrices()), None)
+        } else {
+            (None, Some(without.band_matrices()))
+        };
+        let form = |gyro: bool, u: &nalgebra::DVector<f64>, v: &nalgebra::DVector<f64>| -> f64 {
+            match (&dense, &band) {
+                (Some(m), _) => (u.transpose() * if gyro { &m.gyroscopic } else { &m.mass } * v)[0],
+                (_, Some(m)) => {
+                    let a = if gyro { &m.gyroscopic } else { &m.mass };
+                    let v = nalgebra::DMatrix::from_column_slice(v.len(), 1, v.as_slice());
+                    u.dot(&a.mul(&v).column(0))
+                }
+                _ => unreachable!("one of the two"),
+            }
+        };
         let z = self.node_positions();
         let n = self.dof();
         let vector = |f: &dyn Fn(usize, f64) -> [f64; 4]| {
@@ -242,16 +320,16 @@ impl Rotor {
             v
         };
         let rx = vector(&|_, _| [1.0, 0.0, 0.0, 0.0]);
-        let mass = (rx.transpose() * &m.mass * &rx)[0];
+        let mass = form(false, &rx, &rx);
         let tilt0 = vector(&|_, zk| [zk, 0.0, 0.0, 1.0]);
-        let centre = (rx.transpose() * &m.mass * &tilt0)[0] / mass;
+        let centre = form(false, &rx, &tilt0) / mass;
         let t_beta = vector(&|_, zk| [zk - centre, 0.0, 0.0, 1.0]);
         let t_alpha = vector(&|_, zk| [0.0, -(zk - centre), 1.0, 0.0]);
         RigidBody {
             mass,
             centre,
-            transverse_inertia: (t_beta.transpose() * &m.mass * &t_beta)[0],
-            polar_inertia: (t_alpha.transpose() * &m.gyroscopic * &t_beta)[0],
+            transverse_inertia: form(false, &t_beta, &t_beta),
+            polar_inertia: form(true, &t_alpha, &t_beta),
         }
     }
 }

@@ -267,8 +267,8 @@ mod tests {
         };
         assert_eq!(rotor(super::super::MAX_ELEMENTS).validate(), Ok(()));
         let e = rotor(super::super::MAX_ELEMENTS + 1).validate().unwrap_err();
-        assert_eq!(e, FlexError::TooManyElements { count: 201, limit: 200 });
-        assert!(e.to_string().contains("the shaft has 201 elements, more than the 200"), "{e}");
+        assert_eq!(e, FlexError::TooManyElements { count: 2001, limit: 2000 });
+        assert!(e.to_string().contains("the shaft has 2001 elements, more than the 2000"), "{e}");
     }
 
     const TABLE: &str = r#"

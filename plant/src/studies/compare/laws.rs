@@ -53,6 +53,7 @@ pub fn compare_laws(
     let mut rows = Vec::new();
     let mut runs: Vec<(String, RunResult)> = Vec::new();
     let mut probe = None;
+    let mut answers = Vec::new();
     let own = with(scene_path, &base, &[])?.controller.law;
     for law in laws {
         // The scene's `[controller.params]` belong to its own law; another law runs on its defaults.
@@ -85,6 +86,8 @@ pub fn compare_laws(
             row.whirl_hz
         ));
         rows.push(row);
+        let law_sets: Vec<String> = base.iter().cloned().chain(extra.iter().cloned()).collect();
+        answers.extend(robust::answer(scene_path, &law_sets, &scene, &s, law, log, stop)?);
         runs.push((law.clone(), r));
         probe = Some(scene);
     }
@@ -92,6 +95,7 @@ pub fn compare_laws(
         return Err(nothing_finished());
     }
     crate::table::write_with_header(&out.join("laws.csv"), LAWS_HEADER, &rows)?;
+    robust::write(out, &answers)?;
     if let Some(scene) = probe {
         law_plots(out, &runs, &scene)?;
     }

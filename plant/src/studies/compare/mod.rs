@@ -18,6 +18,7 @@
 pub mod laws;
 pub mod maps;
 pub mod realtime;
+pub mod robust;
 
 pub use laws::{compare_laws, LawRow, LAWS_HEADER};
 pub use maps::{stability_maps, MapPoint, MAP_HEADER};
@@ -203,6 +204,11 @@ pub fn compare(
     let Some(xi) = decay(&["controller.mode=\"continuous\"".into()])? else { return Err(nothing_finished()) };
     let mut rows = vec![row(0.0, ControlMode::Continuous, &reference, &continuous, xi)];
     log(&format!("continuous: damping ratio {:.4}", rows[0].damping_ratio));
+    // Each run's robustness answer, when asked for (`--robustness N`; robust.rs).
+    let mut answers = Vec::new();
+    let continuous_sets: Vec<String> = base.iter().cloned().chain(["controller.mode=\"continuous\"".into()]).collect();
+    let summary = Summary::new(&continuous, &reference);
+    answers.extend(robust::answer(scene_path, &continuous_sets, &continuous, &summary, "continuous", log, stop)?);
     let mut traces: Vec<(String, RunResult)> = vec![("continuous".into(), reference.clone())];
     let modes = if cosim { vec![ControlMode::Sampled, ControlMode::Lockstep] } else { vec![ControlMode::Sampled] };
     'rates: for &rate in rates {
@@ -228,12 +234,16 @@ pub fn compare(
                 rw.post_shock_mode
             ));
             rows.push(rw);
+            let sets: Vec<String> = base.iter().cloned().chain(extra.iter().cloned()).collect();
+            let label = format!("{name} {rate} Hz");
+            answers.extend(robust::answer(scene_path, &sets, &scene, &Summary::new(&scene, &r), &label, log, stop)?);
             if mode == ControlMode::Sampled {
                 traces.push((format!("sampled {} kHz", rate / 1e3), r));
             }
         }
     }
     crate::table::write_with_header(&out.join("compare.csv"), COMPARE_HEADER, &rows)?;
+    robust::write(out, &answers)?;
     plots(out, &traces, start, &continuous)?;
     let planned = 1 + rates.len() * modes.len();
     interrupted(stop, || format!("{} of {planned} configurations finished, written to compare.csv", rows.len()))?;
@@ -325,13 +335,22 @@ pub struct Request<'a> {
     pub laws: &'a [String],
     /// Realtime against lockstep instead of rates: this many realtime runs.
     pub realtime: Option<usize>,
+    /// Each compared run's robustness answer with this many perturbed members
+    /// (`compare_robustness.csv`; the same as `--set robustness.members=N`).
+    pub robustness: Option<u32>,
 }
 
 /// `plant compare`: the rate comparison (and maps), or the law comparison; `warn` gets the
 /// scene's own warnings once (deprecated keys), not once per compared run. Returns the table
 /// written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&str)) -> anyhow::Result<PathBuf> {
-    for w in &load_scene(req.scene, req.set)?.warnings {
+    let mut set = req.set.to_vec();
+    set.extend(req.robustness.map(|n| format!("robustness.members={n}")));
+    let req = &Request { set: &set, ..*req };
+    let probe = load_scene(req.scene, req.set)?;
+    // Bad members (out of range, or a realtime scene's) are refused before anything runs.
+    crate::robustness::members(&probe)?;
+    for w in &probe.warnings {
         warn(w);
     }
     let stem = req.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();

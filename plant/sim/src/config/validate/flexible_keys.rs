@@ -174,7 +174,9 @@ pub(in crate::config) fn flexible_params(
         modal_damping: zeta,
     };
     let reduced = flex::Reduced::new(&shaft, &spec).map_err(|e| match e {
-        flex::FlexError::CutoffBelowRigidModes { .. } => flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e),
+        flex::FlexError::CutoffBelowRigidModes { .. } | flex::FlexError::TooManyModes { .. } => {
+            flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e)
+        }
         // The free rotor's static correction is solved with the shift (2π f_c)²: a cutoff far
         // below the first bending mode leaves it too small to solve with. The cutoff is at fault.
         flex::FlexError::SingularStiffness => {
