@@ -62,6 +62,10 @@ pub struct ModelInfo {
     /// AMBs and what each plane took from it (`rotor.ross_ambs`); not written when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ross_ambs: Vec<plant_physics::flex::ross_amb::UsedAmb>,
+    /// Each plane's axis angle θ (degrees, `amb.axis_angle_deg`): the coil pairs' and sensors'
+    /// axes (u, v) the currents and the wire speak in; not written when every plane's is 0°.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub amb_axis_angle_deg: Vec<f64>,
 }
 
 impl ModelInfo {
@@ -91,6 +95,11 @@ impl ModelInfo {
             ross_ambs: match &scene.rotor {
                 crate::config::Rotor::Flexible(f) => f.file_ambs.clone(),
                 _ => Vec::new(),
+            },
+            amb_axis_angle_deg: if scene.rotor.bearings().any(|b| b.axes.turned()) {
+                scene.rotor.bearings().map(|b| b.axes.angle().to_degrees()).collect()
+            } else {
+                Vec::new()
             },
         }
     }

@@ -182,3 +182,75 @@ fn refusals_name_the_key() {
     let e = err(&["rotor.ross_ambs=\"some\""]);
     assert!(e.contains("ross_ambs") && e.contains("some"), "{e}");
 }
+
+/// Issue 38 item 2: ROSS's UFU rig (`rotor_example_amb_general_controllers`, the committed
+/// fixture `ufu_rig.toml`: two elements at nodes 12 and 43, `sensors_axis_rotation =
+/// 0.78539816`) read with its rotation (`rotor.ross_axes = "apply"`): each plane's axes are the
+/// file's 0.78539816 rad, the run's first line and `summary.json` say so; without the key, or
+/// with `"ignore"`, they stay at 0° and are said not applied. Applied with a sampled law and the
+/// gravity bias: refused (the law's bias is on its own y); the key without the file's AMBs, or
+/// beside the scene's own angle: refused by name.
+#[test]
+fn rosss_ufu_rig_is_read_with_its_axis_rotation() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("ross-ufu-axes-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::copy(fixture("ufu_rig.toml"), out.join("machine.toml")).unwrap();
+    let mut scene: toml::Table =
+        std::fs::read_to_string(root.join("../config/flexible-10g.toml")).unwrap().parse().unwrap();
+    let rotor = scene["rotor"].as_table_mut().unwrap();
+    rotor.remove("shaft");
+    rotor.insert("ross_file".into(), "machine.toml".into());
+    rotor.insert("amb_a_node".into(), 12.into());
+    rotor.insert("amb_b_node".into(), 43.into());
+    rotor.insert("radius_mm".into(), 17.3.into());
+    std::fs::write(out.join("scene.toml"), toml::to_string(&scene).unwrap()).unwrap();
+    let load = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load_scene(&out.join("scene.toml"), &sets)
+    };
+    let constants = "rotor.ross_ambs=\"constants\"";
+    let applied = load(&[constants, "rotor.ross_axes=\"apply\""]).unwrap();
+    #[allow(clippy::approx_constant)]
+    let file_angle = 0.78539816;
+    for i in 0..2 {
+        let got = applied.plane(i).axes.angle();
+        assert!((got - file_angle).abs() < 1e-15, "plane {i}: {got} rad");
+    }
+    let Rotor::Flexible(f) = &applied.rotor else { panic!("flexible") };
+    for u in &f.file_ambs {
+        assert_eq!(u.axis_rotation_deg_not_applied, None);
+        let deg = u.axis_rotation_deg.expect("applied");
+        assert!((deg - file_angle * 180.0 / std::f64::consts::PI).abs() < 1e-12, "{deg}");
+    }
+    let first = &applied.warnings[0];
+    assert!(
+        first.contains("their axes turned by 45.0°, 45.0° are the planes' (rotor.ross_axes = \"apply\""),
+        "{first}"
+    );
+    for sets in [&[constants][..], &[constants, "rotor.ross_axes=\"ignore\""]] {
+        let plain = load(sets).unwrap();
+        assert!(!plain.plane(0).axes.turned() && !plain.plane(1).axes.turned(), "{sets:?}");
+        assert!(plain.warnings[0].contains("turned by 45.0°, 45.0° are not applied"), "{:?}", plain.warnings);
+    }
+    // The file's PID in sampled mode: its bias is on its own y axis.
+    let sampled = ["rotor.ross_ambs=\"use\"", "controller.mode=\"sampled\"", "rotor.ross_axes=\"apply\""];
+    let e = load(&sampled).err().unwrap_or_else(|| panic!("the gravity bias")).to_string();
+    assert!(e.starts_with("rotor.ross_axes = \"apply\"") && e.contains("controller.gravity_bias = false"), "{e}");
+    let no_bias = load(&[&sampled[..], &["controller.gravity_bias=false"]].concat()).unwrap();
+    assert!(no_bias.plane(1).axes.turned());
+    let e = load(&[constants, "rotor.ross_axes=\"apply\"", "amb.axis_angle_deg=10"]).err().unwrap().to_string();
+    assert!(e.starts_with("amb.axis_angle_deg = 10 °") && e.contains("remove one"), "{e}");
+    for sets in [&["rotor.ross_ambs=\"refuse\"", "rotor.ross_axes=\"apply\""][..], &["rotor.ross_axes=\"ignore\""]] {
+        let e = load(sets).err().unwrap().to_string();
+        assert!(e.starts_with("rotor.ross_axes") && e.contains("does not make them its AMBs"), "{e}");
+    }
+    let e = load(&[constants, "rotor.ross_axes=\"sideways\""]).err().unwrap().to_string();
+    assert!(e.contains("ross_axes") && e.contains("sideways"), "{e}");
+    std::fs::remove_dir_all(&out).unwrap();
+    let e = load_scene(&root.join("../config/paper-10g.toml"), &["rotor.ross_axes=\"apply\"".to_string()])
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.starts_with("rotor.ross_axes = \"apply\"") && e.contains("rotor is rigid"), "{e}");
+}

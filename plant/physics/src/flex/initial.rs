@@ -17,7 +17,7 @@
 
 use super::machine::{ix, Model, Params, State};
 use crate::model::Control;
-use controller::{LoopConstants, PdDesign, PdGains};
+use controller::{PdDesign, PdGains};
 use nalgebra::{DMatrix, DVector};
 
 /// Newton steps at most (the linear force law needs one; the nonlinear one settles in a few).
@@ -33,12 +33,14 @@ const COLUMN_STEP: f64 = 1e-6;
 /// (a singular Jacobian, or a residual that does not fall).
 pub fn static_sag(params: &Params, design: &PdDesign, rest: &State) -> Option<Vec<f64>> {
     let r = params.reduced.size();
-    let gains = |c: &LoopConstants| PdGains::from_design(design, c).ok();
+    // Each plane's bias in its own axes (u, v) ([`crate::axes`]): the weight shared when turned.
+    let gains = |p: &crate::model::Params| {
+        PdGains::from_design(design, &p.loop_constants)
+            .ok()
+            .map(|g| PdGains { bias_a: p.axes.pair_to_plane(g.bias_a), ..g })
+    };
     let planes = &params.machine.planes;
-    let control = [
-        Control::Continuous(gains(&planes[0].params.loop_constants)?),
-        Control::Continuous(gains(&planes[1].params.loop_constants)?),
-    ];
+    let control = [Control::Continuous(gains(&planes[0].params)?), Control::Continuous(gains(&planes[1].params)?)];
     // No unbalance and a quiet housing: the static loads only (gravity, the bias currents).
     let mut still = params.clone();
     still.machine.rotor.eccentricity = 0.0;

@@ -219,11 +219,20 @@ pub(super) fn note(raw: &RawScene, used: &[UsedAmb]) -> Option<String> {
         })
         .collect();
     let from = if used.len() == 2 { "both planes'" } else { "that plane's" };
-    let axes = used.iter().map(|u| format!("{:.1}°", u.axis_rotation_deg_not_applied)).collect::<Vec<_>>().join(", ");
+    let list = |f: fn(&UsedAmb) -> Option<f64>| {
+        let all: Vec<String> = used.iter().filter_map(|u| f(u).map(|d| format!("{d:.1}°"))).collect();
+        (!all.is_empty()).then(|| all.join(", "))
+    };
+    let axes = match (list(|u| u.axis_rotation_deg_not_applied), list(|u| u.axis_rotation_deg)) {
+        (Some(not), _) => format!("their sensor axes turned by {not} are not applied (the plant's axes are at 0°)"),
+        (None, Some(applied)) => {
+            format!("their axes turned by {applied} are the planes' (rotor.ross_axes = \"apply\": amb.axis_angle_deg)")
+        }
+        (None, None) => String::new(),
+    };
     Some(format!(
         "rotor.ross_file = {file}: the file's MagneticBearingElements are the AMBs (rotor.ross_ambs): {}; they \
-         replace {from} [amb] constants; their sensor axes turned by {axes} are not applied (the plant's axes are at \
-         0°) (summary.json model.ross_ambs)",
+         replace {from} [amb] constants; {axes} (summary.json model.ross_ambs)",
         planes.join("; ")
     ))
 }
