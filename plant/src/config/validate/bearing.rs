@@ -183,7 +183,7 @@ pub(in crate::config) fn bearing(
     };
     if axes.turned() && ctl.gravity_bias && ctl.mode != ControlMode::Continuous {
         // The laws of the registry add the gravity bias on their own y axis (v), and the hello
-        // carries no angle to turn it with (docs/guide/wire-protocol.md): refused, not guessed.
+        // carries no angle to turn it with (docs/wire-protocol.md): refused, not guessed.
         return Err(range(
             &k.amb("axis_angle_deg"),
             amb.axis_angle_deg.unwrap_or_default(),
