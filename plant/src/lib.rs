@@ -48,6 +48,7 @@ pub mod output;
 pub mod plot;
 pub mod record;
 pub mod recording;
+pub mod rest_law;
 pub mod rng;
 pub mod robustness;
 pub mod row_file;

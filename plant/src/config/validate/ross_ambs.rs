@@ -124,7 +124,10 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
                 "\"continuous\"",
                 "",
                 "runs the plant's continuous PD, and rotor.ross_ambs = \"use\" makes the file's PID the law \
-                 (ross_pid, sampled as ROSS samples it): set controller.mode = \"sampled\" (or lockstep, \
+                 (ross_pid, sampled as ROSS samples it). It cannot run continuously: the continuous mode's law is \
+                 a PD evaluated inside the derivative on the sensor's reading and its rate, with no state of its \
+                 own, and ROSS's PID has two per axis (its integral, and its derivative's filter at n_f) that the \
+                 continuous model's state does not carry. Set controller.mode = \"sampled\" (or lockstep, \
                  realtime), or rotor.ross_ambs = \"constants\" for the continuous PD on the file's AMB constants",
             ));
         }
