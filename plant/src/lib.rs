@@ -17,7 +17,9 @@
 pub use plant_physics::{force, integrate, model, park};
 // The simulation's modules at their old paths (`plant::config`, `plant::Plant`, …): the
 // `plant-sim` crate's.
-pub use plant_sim::{config, digital, hardware, hooks, initial, invalid, machine, rng, sensor, stepper, Plant};
+pub use plant_sim::{
+    config, digital, hardware, hooks, initial, invalid, machine, rest_law, rng, sensor, stepper, Plant,
+};
 
 // The layers, each importing only from those below it (util < results < run < outputs <
 // studies; tests/tests/modules.rs fails on a cycle between them).

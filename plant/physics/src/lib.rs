@@ -6,11 +6,12 @@
 //! fixed-size state; [`integrate`] the hand-written integrators, which do not own the state;
 //! [`park`] the parked-race simplification; [`initial`] the levitated state a run starts from;
 //! [`stability`] the fixed-step integrators' stability estimate; [`amplifier`] one axis's amplifier
-//! and coil (the run loop appends its states to the model's). Scene files, runs and outputs are the `plant`
+//! and coil; [`axes`] a bearing plane's own axes, turned from the housing's (the run loop appends its states to the model's). Scene files, runs and outputs are the `plant`
 //! crate's; this crate builds and tests without them.
 #![warn(missing_docs)]
 
 pub mod amplifier;
+pub mod axes;
 pub mod flex;
 pub mod force;
 pub mod initial;

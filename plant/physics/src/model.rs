@@ -39,6 +39,7 @@
 //! The state stays a plain array that the integrators step; the kernels take
 //! [`nalgebra::Vector2`] views of its pairs, on the stack, without allocation.
 
+use crate::axes::Axes;
 use crate::force::lumped::LumpedSupport;
 use crate::force::rotor_race::RotorRaceForce;
 use crate::force::{amb::AmbLaw, balls::BallForce, balls::BallSet, drag::RaceDrag, rotor_race::RotorRace};
@@ -176,6 +177,10 @@ pub struct Params {
     pub loop_constants: LoopConstants,
     /// Amplifier current limit i_max (A).
     pub current_limit: f64,
+    /// The plane's own axes (u, v) of its coil pairs and sensors, turned from (x, y)
+    /// ([`crate::axes`]); the default: not turned. Not serialised at 0°.
+    #[serde(skip_serializing_if = "Axes::is_housings")]
+    pub axes: Axes,
 }
 
 impl Params {
@@ -225,8 +230,47 @@ impl Control {
     /// at `delta` (m) in the magnets' gap, at time `t`; the continuous laws read `sensor()`, the
     /// sensor's position and rate (m, m/s), only when they need it. One match for every rotor
     /// model (planar, two-plane, flexible).
+    ///
+    /// With the plane's axes turned ([`Params::axes`]) the currents are the coil pairs' of u and
+    /// v, the law reads `delta` and the sensor in (u, v), and the force it gives is turned back
+    /// to (x, y); not turned, the arithmetic is the one of before the axes could turn.
     #[inline]
     pub(crate) fn amb(
+        self,
+        t: f64,
+        p: &Params,
+        delta: Vector2<f64>,
+        sensor: impl FnOnce() -> (Vector2<f64>, Vector2<f64>),
+    ) -> ([f64; 2], Vector2<f64>) {
+        if p.axes.turned() {
+            return self.amb_turned(t, p, delta, sensor);
+        }
+        self.amb_plane(t, p, delta, sensor)
+    }
+
+    /// [`Control::amb`] with the plane's axes turned: the plane's own arithmetic in (u, v).
+    #[cold]
+    #[inline(never)]
+    fn amb_turned(
+        self,
+        t: f64,
+        p: &Params,
+        delta: Vector2<f64>,
+        sensor: impl FnOnce() -> (Vector2<f64>, Vector2<f64>),
+    ) -> ([f64; 2], Vector2<f64>) {
+        let axes = p.axes;
+        let turned = || {
+            let (x, v) = sensor();
+            (axes.to_plane(x), axes.to_plane(v))
+        };
+        let (current, force) = self.amb_plane(t, p, axes.to_plane(delta), turned);
+        (current, axes.to_housing(force))
+    }
+
+    /// [`Control::amb`] in the plane's own axes: `delta` and the sensor read along them, the
+    /// force along them.
+    #[inline(always)]
+    fn amb_plane(
         self,
         t: f64,
         p: &Params,

@@ -43,8 +43,8 @@ pub fn initial_state(scene: &Scene, params: &crate::model::Params) -> State {
 }
 
 /// The initial state of a flexible scene whose machine is `params`: at rest on its bearings
-/// (the shaft sagged under gravity, the bias currents and the levitation design's loop:
-/// [`plant_physics::flex::initial::static_sag`]), with the two-plane rotor's unbalance orbit
+/// (the shaft sagged under gravity, the bias currents and the levitation design's loop, or the
+/// run's law where it has a static gain: [`plant_physics::flex::initial::static_sag_with`]), with the two-plane rotor's unbalance orbit
 /// and the scene's `[initial]` offsets as a rigid motion of the shaft on top of it.
 pub fn flexible_initial_state(
     scene: &Scene,
@@ -74,7 +74,9 @@ pub fn flexible_initial_state(
     };
     // A shaft the levitation design cannot hold still has no equilibrium to start from: it
     // starts straight (the rigid start), and the run shows it move.
-    if let Some(sag) = plant_physics::flex::initial::static_sag(params, &design, &y) {
+    // Held by the run's law at rest where it has a static gain (crate::rest_law).
+    let kp = crate::rest_law::static_gains(scene);
+    if let Some(sag) = plant_physics::flex::initial::static_sag_with(params, &design, kp, &y) {
         for (k, s) in sag.iter().enumerate() {
             y[k] += s;
         }

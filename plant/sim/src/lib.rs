@@ -24,6 +24,7 @@ pub mod hooks;
 pub mod initial;
 pub mod invalid;
 pub mod machine;
+pub mod rest_law;
 pub mod rng;
 pub mod rows;
 pub mod run;

@@ -123,9 +123,16 @@ pub trait PlaneStates {
     fn visit(&self, visit: &mut dyn FnMut(usize, &crate::machine::PlaneState<'_>));
 }
 
-/// Continuous PD gains of each bearing plane's design (one for the planar model).
+/// Continuous PD gains of each bearing plane's design (one for the planar model), the gravity
+/// bias in the plane's own axes: `m g / k_i` along y, `(m g / k_i)(sin θ, cos θ)` along (u, v)
+/// on axes turned by θ (docs/MODEL.md §3.3), so that the coil pairs share the weight.
 pub fn plane_gains(scene: &Scene) -> Result<Vec<PdGains>, controller::LawError> {
-    scene.plane_designs().iter().map(|d| PdGains::from_design(&d.pd(), &d.constants)).collect()
+    let planes = scene.plane_designs();
+    let gains = planes.iter().map(|d| PdGains::from_design(&d.pd(), &d.constants));
+    gains
+        .enumerate()
+        .map(|(i, g)| g.map(|g| PdGains { bias_a: scene.plane(i).axes.pair_to_plane(g.bias_a), ..g }))
+        .collect()
 }
 
 /// Integrator settings for a scene's model of `N` state components, absolute tolerances `atol`.

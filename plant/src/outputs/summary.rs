@@ -62,6 +62,10 @@ pub struct ModelInfo {
     /// AMBs and what each plane took from it (`rotor.ross_ambs`); not written when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ross_ambs: Vec<plant_physics::flex::ross_amb::UsedAmb>,
+    /// Each plane's axis angle θ (degrees, `amb.axis_angle_deg`): the coil pairs' and sensors'
+    /// axes (u, v) the currents and the wire speak in; not written when every plane's is 0°.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub amb_axis_angle_deg: Vec<f64>,
 }
 
 impl ModelInfo {
@@ -86,6 +90,11 @@ impl ModelInfo {
             delay_samples: c.delay_samples,
             ross_bearings: scene.rotor.params().file_bearings().to_vec(),
             ross_ambs: scene.rotor.params().file_ambs().to_vec(),
+            amb_axis_angle_deg: if scene.rotor.bearings().any(|b| b.axes.turned()) {
+                scene.rotor.bearings().map(|b| b.axes.angle().to_degrees()).collect()
+            } else {
+                Vec::new()
+            },
         }
     }
 }

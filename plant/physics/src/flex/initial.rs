@@ -17,7 +17,7 @@
 
 use super::machine::{ix, Model, Params, State};
 use crate::model::Control;
-use controller::{LoopConstants, PdDesign, PdGains};
+use controller::{PdDesign, PdGains};
 use nalgebra::{DMatrix, DVector};
 
 /// Newton steps at most (the linear force law needs one; the nonlinear one settles in a few).
@@ -32,12 +32,32 @@ const COLUMN_STEP: f64 = 1e-6;
 /// rates are not read). `None` when the levitated shaft has no equilibrium the solve can find
 /// (a singular Jacobian, or a residual that does not fall).
 pub fn static_sag(params: &Params, design: &PdDesign, rest: &State) -> Option<Vec<f64>> {
+    static_sag_with(params, design, [None; 2], rest)
+}
+
+/// [`static_sag`] held at rest by each plane's law of static gain `static_kp` where given: the
+/// run's law at rest, `i = bias − A_a k₀ A_s d` with `k₀` its gain at zero frequency (V/V, as
+/// `PdGains::kp`) in place of the design's `k_p` (issue 38 item 3); the design's PD where `None`.
+/// The derivative gain plays no part at rest.
+pub fn static_sag_with(
+    params: &Params,
+    design: &PdDesign,
+    static_kp: [Option<f64>; 2],
+    rest: &State,
+) -> Option<Vec<f64>> {
     let r = params.reduced.size();
-    let gains = |c: &LoopConstants| PdGains::from_design(design, c).ok();
+    // Each plane's bias in its own axes (u, v) ([`crate::axes`]): the weight shared when turned.
+    let gains = |p: &crate::model::Params, kp: Option<f64>| {
+        PdGains::from_design(design, &p.loop_constants).ok().map(|g| PdGains {
+            bias_a: p.axes.pair_to_plane(g.bias_a),
+            kp: kp.unwrap_or(g.kp),
+            ..g
+        })
+    };
     let planes = &params.machine.planes;
     let control = [
-        Control::Continuous(gains(&planes[0].params.loop_constants)?),
-        Control::Continuous(gains(&planes[1].params.loop_constants)?),
+        Control::Continuous(gains(&planes[0].params, static_kp[0])?),
+        Control::Continuous(gains(&planes[1].params, static_kp[1])?),
     ];
     // No unbalance and a quiet housing: the static loads only (gravity, the bias currents).
     let mut still = params.clone();

@@ -146,9 +146,14 @@ pub struct UsedAmb {
     /// The PID made the plane's law (`rotor.ross_ambs = "use"`); none with `"constants"`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pid: Option<RossPid>,
-    /// `sensors_axis_rotation` (degrees): not applied, the plant's axes are at 0° (issue 38
-    /// item 2).
-    pub axis_rotation_deg_not_applied: f64,
+    /// `sensors_axis_rotation` (degrees) when it is not applied: the plant's axes are at 0°
+    /// (without `rotor.ross_axes = "apply"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_rotation_deg_not_applied: Option<f64>,
+    /// `sensors_axis_rotation` (degrees) when it turns the plane's axes
+    /// (`rotor.ross_axes = "apply"`: the plane's `amb.axis_angle_deg`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_rotation_deg: Option<f64>,
 }
 
 impl MagneticBearing {
@@ -171,7 +176,8 @@ impl MagneticBearing {
             sensor_gain_v_per_m: self.k_sense,
             nominal_gap_mm: self.g0 * 1e3,
             pid: with_pid.then(|| self.ross_pid()),
-            axis_rotation_deg_not_applied: self.axis_rotation.to_degrees(),
+            axis_rotation_deg_not_applied: Some(self.axis_rotation.to_degrees()),
+            axis_rotation_deg: None,
         }
     }
 }

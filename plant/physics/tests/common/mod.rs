@@ -56,6 +56,7 @@ pub fn study_params() -> Params {
         amb: AmbLaw::Linear { ki: 216.0, ks: 4.32e5 },
         loop_constants: LoopConstants::study(),
         current_limit: 2.0,
+        axes: Default::default(),
     }
 }
 

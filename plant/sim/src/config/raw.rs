@@ -144,6 +144,11 @@ pub struct RawRotor {
     /// constants each element stands for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ross_ambs: Option<plant_physics::flex::ross::RossAmbs> = None,
+    /// Flexible, with `ross_ambs`: what to do with each `MagneticBearingElement`'s
+    /// `sensors_axis_rotation`: `apply` (its plane's `amb.axis_angle_deg`) or `ignore` (the
+    /// plant's axes at 0°, as without the key).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ross_axes: Option<RossAxes> = None,
     /// Flexible: the node of AMB A (on the −z side of the centre of mass).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub amb_a_node: Option<usize> = None,
@@ -319,6 +324,13 @@ pub struct RawAmb {
     /// A unipolar amplifier's bridge: `one_quadrant`, `0..V_dc` (default); `two_quadrant`,
     /// `−V_dc..V_dc` while the current flows.
     pub unipolar_bridge: plant_physics::amplifier::Bridge = plant_physics::amplifier::Bridge::OneQuadrant,
+    /// The angle θ of the plane's coil pair and sensor axis u from x (degrees, in [−90, 90],
+    /// counter-clockwise; v is 90° further): 45 puts the magnet pairs at ±45° from the vertical,
+    /// sharing the weight (docs/MODEL.md §3.3). The sensor, the wire, the currents and the
+    /// controller speak in (u, v). Unset: 0, or with `rotor.ross_ambs` the ROSS file's
+    /// `sensors_axis_rotation` when `rotor.ross_axes = "apply"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_angle_deg: Option<f64> = None,
     /// Two-plane: plane A's own values of this table's keys (the others are shared).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub a: Option<toml::Table> = None,
@@ -512,6 +524,16 @@ pub enum ControlMode {
     Lockstep,
     /// The law runs in the controller process, paced by the wall clock.
     Realtime,
+}
+
+/// `rotor.ross_axes`: what the scene does with the ROSS file's AMB axis rotation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RossAxes {
+    /// Each element's `sensors_axis_rotation` turns its plane's axes (`amb.axis_angle_deg`).
+    Apply,
+    /// The plant's axes stay at 0° (the default).
+    Ignore,
 }
 
 scene_table! {

@@ -90,7 +90,7 @@ impl Machine<N> for Model {
     }
 
     fn sensed(&self, y: &State, i: usize) -> [f64; 2] {
-        self.node(y, self.params.nodes[i].sensor).0.into()
+        self.bearing(i).axes.pair_to_plane(self.node(y, self.params.nodes[i].sensor).0.into())
     }
 
     fn parked(&self, i: usize) -> bool {
@@ -172,11 +172,11 @@ impl Machine<N> for Model {
     }
 
     fn sensed_rate(&self, y: &State, i: usize) -> [f64; 2] {
-        self.node(y, self.params.nodes[i].sensor).1.into()
+        self.bearing(i).axes.pair_to_plane(self.node(y, self.params.nodes[i].sensor).1.into())
     }
 
     fn bearing_velocity(&self, y: &State, i: usize) -> [f64; 2] {
-        self.node(y, self.params.nodes[i].amb).1.into()
+        self.bearing(i).axes.pair_to_plane(self.node(y, self.params.nodes[i].amb).1.into())
     }
 
     fn plane_states(&self, t: f64, y: &State, visit: &mut dyn FnMut(usize, &PlaneState<'_>)) {

@@ -110,7 +110,9 @@ pub trait Machine<const N: usize>: System<N> {
     /// Sets plane `i`'s control for the coming macro step.
     fn set_control(&mut self, i: usize, control: Control);
 
-    /// The rotor's displacement at plane `i`'s sensor, relative to the housing (m), x then y.
+    /// The rotor's displacement at plane `i`'s sensor, relative to the housing (m), along the
+    /// plane's own axes (u, v): x then y unless the plane's axes are turned
+    /// ([`plant_physics::axes`]). What the sensor reads, the wire carries and the law sees.
     fn sensed(&self, y: &[f64; N], i: usize) -> [f64; 2];
 
     /// Whether plane `i`'s race is parked.
@@ -183,7 +185,8 @@ pub trait Machine<const N: usize>: System<N> {
         saturate(gains.current([d[0] * a_s, d[1] * a_s], [v[0] * a_s, v[1] * a_s]), p.current_limit)
     }
 
-    /// The rotor's velocity at plane `i`'s bearing, relative to the housing (m/s).
+    /// The rotor's velocity at plane `i`'s bearing, relative to the housing (m/s), along the
+    /// plane's own axes (its coils' motional voltages).
     fn bearing_velocity(&self, y: &[f64; N], i: usize) -> [f64; 2];
 
     /// Time spent with an amplifier at its voltage limit (s), for a model with amplifiers

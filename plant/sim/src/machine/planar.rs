@@ -43,7 +43,7 @@ impl Machine<N> for Model {
     }
 
     fn sensed(&self, y: &State, _i: usize) -> [f64; 2] {
-        [y[XR], y[YR]]
+        self.params.axes.pair_to_plane([y[XR], y[YR]])
     }
 
     fn parked(&self, _i: usize) -> bool {
@@ -92,11 +92,11 @@ impl Machine<N> for Model {
     }
 
     fn sensed_rate(&self, y: &State, _i: usize) -> [f64; 2] {
-        [y[VXR], y[VYR]]
+        self.params.axes.pair_to_plane([y[VXR], y[VYR]])
     }
 
     fn bearing_velocity(&self, y: &State, _i: usize) -> [f64; 2] {
-        [y[VXR], y[VYR]]
+        self.params.axes.pair_to_plane([y[VXR], y[VYR]])
     }
 
     fn plane_states(&self, t: f64, y: &State, visit: &mut dyn FnMut(usize, &PlaneState<'_>)) {

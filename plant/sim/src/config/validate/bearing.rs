@@ -174,6 +174,26 @@ pub(in crate::config) fn bearing(
         air_gap_m: gap,
     };
     let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    let axes = match amb.axis_angle_deg {
+        None => Default::default(),
+        Some(deg) if deg.is_finite() && (-90.0..=90.0).contains(&deg) => {
+            plant_physics::axes::Axes::new(deg.to_radians())
+        }
+        Some(deg) => return Err(range(&k.amb("axis_angle_deg"), deg, "°", "must be an angle in [-90, 90] degrees")),
+    };
+    if axes.turned() && ctl.gravity_bias && ctl.mode != ControlMode::Continuous {
+        // The laws of the registry add the gravity bias on their own y axis (v), and the hello
+        // carries no angle to turn it with (docs/wire-protocol.md): refused, not guessed.
+        return Err(range(
+            &k.amb("axis_angle_deg"),
+            amb.axis_angle_deg.unwrap_or_default(),
+            "°",
+            "turns the plane's axes, and with controller.gravity_bias = true a sampled or co-simulated law adds \
+             the weight's current on its own y axis (v), which is then not vertical (the wire carries no angle): \
+             set controller.gravity_bias = false and let an integral carry the weight (law pid, ross_pid), or \
+             controller.mode = \"continuous\" (the plant's PD shares the bias between u and v)",
+        ));
+    }
     Ok(Params {
         gravity: share.gravity,
         rotor_mass: share.mass,
@@ -194,5 +214,6 @@ pub(in crate::config) fn bearing(
         amb: amb_law,
         loop_constants,
         current_limit,
+        axes,
     })
 }

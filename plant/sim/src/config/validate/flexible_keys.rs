@@ -27,6 +27,9 @@ pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), Conf
     if let Some(b) = r.ross_ambs {
         return Err(range("rotor.ross_ambs", super::ross_ambs::name(b), "", WHY));
     }
+    if let Some(a) = r.ross_axes {
+        return Err(range("rotor.ross_axes", super::ross_axes::name(a), "", WHY));
+    }
     let nodes = [
         ("rotor.amb_a_node", r.amb_a_node),
         ("rotor.amb_b_node", r.amb_b_node),

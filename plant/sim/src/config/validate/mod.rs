@@ -41,6 +41,7 @@ mod controller_keys;
 pub(super) mod flexible_keys;
 mod hardware_keys;
 mod ross_ambs;
+mod ross_axes;
 mod rotor_of;
 pub(super) mod two_plane_keys;
 
@@ -128,7 +129,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     resolve_command(&mut raw.controller, base_dir)?;
     let fmu = super::fmu::resolve(&mut raw.controller, base_dir)?;
     // A ROSS file's AMB elements as the planes' AMBs (rotor.ross_ambs): written into the scene.
-    let file_ambs = ross_ambs::apply(&mut raw, base_dir)?;
+    let mut file_ambs = ross_ambs::apply(&mut raw, base_dir)?;
+    ross_axes::apply(&mut raw, &mut file_ambs)?;
     let (r, ctl, int) = (&raw.rotor, &raw.controller, &raw.integrator);
     let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
     let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;

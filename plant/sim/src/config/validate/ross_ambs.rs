@@ -124,7 +124,10 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
                 "\"continuous\"",
                 "",
                 "runs the plant's continuous PD, and rotor.ross_ambs = \"use\" makes the file's PID the law \
-                 (ross_pid, sampled as ROSS samples it): set controller.mode = \"sampled\" (or lockstep, \
+                 (ross_pid, sampled as ROSS samples it). It cannot run continuously: the continuous mode's law is \
+                 a PD evaluated inside the derivative on the sensor's reading and its rate, with no state of its \
+                 own, and ROSS's PID has two per axis (its integral, and its derivative's filter at n_f) that the \
+                 continuous model's state does not carry. Set controller.mode = \"sampled\" (or lockstep, \
                  realtime), or rotor.ross_ambs = \"constants\" for the continuous PD on the file's AMB constants",
             ));
         }
@@ -219,11 +222,20 @@ pub(super) fn note(raw: &RawScene, used: &[UsedAmb]) -> Option<String> {
         })
         .collect();
     let from = if used.len() == 2 { "both planes'" } else { "that plane's" };
-    let axes = used.iter().map(|u| format!("{:.1}°", u.axis_rotation_deg_not_applied)).collect::<Vec<_>>().join(", ");
+    let list = |f: fn(&UsedAmb) -> Option<f64>| {
+        let all: Vec<String> = used.iter().filter_map(|u| f(u).map(|d| format!("{d:.1}°"))).collect();
+        (!all.is_empty()).then(|| all.join(", "))
+    };
+    let axes = match (list(|u| u.axis_rotation_deg_not_applied), list(|u| u.axis_rotation_deg)) {
+        (Some(not), _) => format!("their sensor axes turned by {not} are not applied (the plant's axes are at 0°)"),
+        (None, Some(applied)) => {
+            format!("their axes turned by {applied} are the planes' (rotor.ross_axes = \"apply\": amb.axis_angle_deg)")
+        }
+        (None, None) => String::new(),
+    };
     Some(format!(
         "rotor.ross_file = {file}: the file's MagneticBearingElements are the AMBs (rotor.ross_ambs): {}; they \
-         replace {from} [amb] constants; their sensor axes turned by {axes} are not applied (the plant's axes are at \
-         0°) (summary.json model.ross_ambs)",
+         replace {from} [amb] constants; {axes} (summary.json model.ross_ambs)",
         planes.join("; ")
     ))
 }
