@@ -205,13 +205,13 @@ recovery_p90_s,worst_contact_force_n,verified,numerically_sensitive,sensitive,st
     assert_eq!(plant::ensemble::merge::ENSEMBLE_COLUMNS.join(","), ensemble);
 }
 
-/// No header constant in `plant/src` is a string literal (`…_HEADER: &str = "…"`) or a
+/// No header constant in `plant/src` or `plant/sim/src` is a string literal (`…_HEADER: &str = "…"`) or a
 /// literal list of names (`…_COLUMNS: [&str; n] = [`): each is derived from its row type
 /// (`table_row!`, `text_row!`, or the trace's typed rows).
 #[test]
 fn no_header_constant_is_a_hand_written_list() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = vec![src];
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = vec![root.join("src"), root.join("sim/src")];
     let mut literal = Vec::new();
     while let Some(path) = files.pop() {
         if path.is_dir() {

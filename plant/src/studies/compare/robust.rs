@@ -47,6 +47,7 @@ impl Versus {
     }
 }
 
+crate::table::table_row! {
 /// One compared run's robustness: a row of `compare_robustness.csv`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RobustRow {
@@ -77,10 +78,10 @@ pub struct RobustRow {
     /// The largest radius against the reference run's.
     pub radius_vs_reference: &'static str,
 }
+}
 
-/// Header of `compare_robustness.csv`.
-pub const ROBUST_HEADER: &str = "run,verdict,run_mode,same_mode,members,force_min_n,force_max_n,radius_min_m,\
-                                 radius_max_m,refined_mode,mode_vs_reference,force_vs_reference,radius_vs_reference";
+/// Header of `compare_robustness.csv`: [`RobustRow`]'s fields.
+pub const ROBUST_HEADER: &str = RobustRow::HEADER;
 
 /// The range a run's answer spans for one figure: its spread, widened to the refined run's.
 fn range(spread: &Spread, refined: Option<f64>) -> Option<(f64, f64)> {
