@@ -159,16 +159,7 @@ fn dense_parts(rotor: &Rotor, spec: &Reduction) -> Result<Parts, FlexError> {
     let mut basis = phi.columns(0, kept).into_owned();
 
     let n = rotor.dof();
-    let mut loads: Vec<DVector<f64>> = Vec::new();
-    if spec.static_correction {
-        for &node in &spec.force_nodes {
-            for axis in 0..2 {
-                let mut e = DVector::zeros(n);
-                e[DOF_PER_NODE * node + axis] = 1.0;
-                loads.push(e);
-            }
-        }
-    }
+    let mut loads = if spec.static_correction { unit_loads(n, &spec.force_nodes) } else { Vec::new() };
     if spec.gyroscopic_correction {
         for k in 0..kept {
             let g = &m.gyroscopic * phi.column(k);
@@ -188,34 +179,14 @@ fn dense_parts(rotor: &Rotor, spec: &Reduction) -> Result<Parts, FlexError> {
             let coef = (p.transpose() * &f) / (w2k + sigma);
             psi -= p * coef;
         }
-        // M-orthonormalise the corrections among themselves (dropping dependent ones) and
-        // diagonalise K on them (Rayleigh–Ritz).
-        let gram = psi.transpose() * &m.mass * &psi;
-        let gram = (&gram + gram.transpose()) * 0.5;
-        let ge = gram.symmetric_eigen();
-        let top = ge.eigenvalues.iter().copied().fold(0.0, f64::max);
-        let cols: Vec<DVector<f64>> = (0..ge.eigenvalues.len())
-            .filter(|&i| ge.eigenvalues[i] > 1e-10 * top)
-            .map(|i| &psi * ge.eigenvectors.column(i) / ge.eigenvalues[i].sqrt())
-            .collect();
-        if !cols.is_empty() {
-            let q = DMatrix::from_columns(&cols);
-            let kq = q.transpose() * &m.stiffness * &q;
-            let kq = (&kq + kq.transpose()) * 0.5;
-            let ke = kq.symmetric_eigen();
-            let mut order: Vec<usize> = (0..ke.eigenvalues.len()).collect();
-            order.sort_by(|&a, &b| ke.eigenvalues[a].total_cmp(&ke.eigenvalues[b]));
-            let extra = q * DMatrix::from_columns(
-                &order.iter().map(|&i| ke.eigenvectors.column(i).into_owned()).collect::<Vec<_>>(),
-            );
-            let mut all: Vec<DVector<f64>> = basis.column_iter().map(|c| c.into_owned()).collect();
-            all.extend(extra.column_iter().map(|c| c.into_owned()));
-            basis = DMatrix::from_columns(&all);
-            for &i in &order {
-                omega_sq.push(ke.eigenvalues[i].max(0.0));
-                kinds.push(Kind::Correction);
-            }
-        }
+        append_corrections(
+            &mut basis,
+            &mut omega_sq,
+            &mut kinds,
+            &psi,
+            |x| x.transpose() * &m.mass * x,
+            |x| x.transpose() * &m.stiffness * x,
+        );
     }
     let r = basis.ncols();
     let mut damping = basis.transpose() * &m.damping * &basis;
@@ -226,6 +197,60 @@ fn dense_parts(rotor: &Rotor, spec: &Reduction) -> Result<Parts, FlexError> {
     let rigid = |axis: usize| DVector::from_fn(rotor.dof(), |i, _| if i % DOF_PER_NODE == axis { 1.0 } else { 0.0 });
     let frame = [basis.transpose() * (&m.mass * rigid(0)), basis.transpose() * (&m.mass * rigid(1))];
     Ok(Parts { basis, omega_sq, kinds, damping, gyroscopic, frame })
+}
+
+/// The unit loads on the two axes of each node in `nodes` (the static correction's right-hand
+/// sides), on a shaft of `n` degrees of freedom.
+pub(super) fn unit_loads(n: usize, nodes: &[usize]) -> Vec<DVector<f64>> {
+    let mut loads = Vec::with_capacity(2 * nodes.len());
+    for &node in nodes {
+        for axis in 0..2 {
+            let mut e = DVector::zeros(n);
+            e[DOF_PER_NODE * node + axis] = 1.0;
+            loads.push(e);
+        }
+    }
+    loads
+}
+
+/// Appends the corrections `psi` to `basis`: M-orthonormalised among themselves (dropping
+/// dependent ones), K diagonalised on them (Rayleigh–Ritz), each with its `ω²` and kind.
+/// `mass` and `stiffness` give `Xᵀ A X` of a block `X`: the dense path's products or the band
+/// path's, each with its own arithmetic.
+pub(super) fn append_corrections(
+    basis: &mut DMatrix<f64>,
+    omega_sq: &mut Vec<f64>,
+    kinds: &mut Vec<Kind>,
+    psi: &DMatrix<f64>,
+    mass: impl Fn(&DMatrix<f64>) -> DMatrix<f64>,
+    stiffness: impl Fn(&DMatrix<f64>) -> DMatrix<f64>,
+) {
+    let gram = mass(psi);
+    let gram = (&gram + gram.transpose()) * 0.5;
+    let ge = gram.symmetric_eigen();
+    let top = ge.eigenvalues.iter().copied().fold(0.0, f64::max);
+    let cols: Vec<DVector<f64>> = (0..ge.eigenvalues.len())
+        .filter(|&i| ge.eigenvalues[i] > 1e-10 * top)
+        .map(|i| psi * ge.eigenvectors.column(i) / ge.eigenvalues[i].sqrt())
+        .collect();
+    if cols.is_empty() {
+        return;
+    }
+    let q = DMatrix::from_columns(&cols);
+    let kq = stiffness(&q);
+    let kq = (&kq + kq.transpose()) * 0.5;
+    let ke = kq.symmetric_eigen();
+    let mut order: Vec<usize> = (0..ke.eigenvalues.len()).collect();
+    order.sort_by(|&a, &b| ke.eigenvalues[a].total_cmp(&ke.eigenvalues[b]));
+    let extra =
+        q * DMatrix::from_columns(&order.iter().map(|&i| ke.eigenvectors.column(i).into_owned()).collect::<Vec<_>>());
+    let mut all: Vec<DVector<f64>> = basis.column_iter().map(|c| c.into_owned()).collect();
+    all.extend(extra.column_iter().map(|c| c.into_owned()));
+    *basis = DMatrix::from_columns(&all);
+    for &i in &order {
+        omega_sq.push(ke.eigenvalues[i].max(0.0));
+        kinds.push(Kind::Correction);
+    }
 }
 
 /// Rows `k .. k + L` of each column of `m` (column-major, `r` rows), as arrays.

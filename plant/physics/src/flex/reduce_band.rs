@@ -12,7 +12,7 @@
 //! retained frequencies).
 
 use super::band::Band;
-use super::reduce::{Kind, Parts, Reduction, RIGID_MODES};
+use super::reduce::{append_corrections, unit_loads, Kind, Parts, Reduction, RIGID_MODES};
 use super::rotor::{Rotor, DOF_PER_NODE};
 use super::FlexError;
 use nalgebra::{DMatrix, DVector};
@@ -66,16 +66,7 @@ pub(crate) fn parts(rotor: &Rotor, spec: &Reduction) -> Result<Parts, FlexError>
     let modes = phi.columns(0, kept).into_owned();
     let mut basis = modes.clone();
 
-    let mut loads: Vec<DVector<f64>> = Vec::new();
-    if spec.static_correction {
-        for &node in &spec.force_nodes {
-            for axis in 0..2 {
-                let mut e = DVector::zeros(n);
-                e[DOF_PER_NODE * node + axis] = 1.0;
-                loads.push(e);
-            }
-        }
-    }
+    let mut loads = if spec.static_correction { unit_loads(n, &spec.force_nodes) } else { Vec::new() };
     if spec.gyroscopic_correction {
         let g = m.gyroscopic.mul(&modes);
         for k in 0..kept {
@@ -99,32 +90,14 @@ pub(crate) fn parts(rotor: &Rotor, spec: &Reduction) -> Result<Parts, FlexError>
             coef.row_mut(k).unscale_mut(w2k + sigma);
         }
         psi -= &modes * coef;
-        let gram = m.mass.project(&psi, &psi);
-        let gram = (&gram + gram.transpose()) * 0.5;
-        let ge = gram.symmetric_eigen();
-        let top = ge.eigenvalues.iter().copied().fold(0.0, f64::max);
-        let cols: Vec<DVector<f64>> = (0..ge.eigenvalues.len())
-            .filter(|&i| ge.eigenvalues[i] > 1e-10 * top)
-            .map(|i| &psi * ge.eigenvectors.column(i) / ge.eigenvalues[i].sqrt())
-            .collect();
-        if !cols.is_empty() {
-            let q = DMatrix::from_columns(&cols);
-            let kq = m.stiffness.project(&q, &q);
-            let kq = (&kq + kq.transpose()) * 0.5;
-            let ke = kq.symmetric_eigen();
-            let mut order: Vec<usize> = (0..ke.eigenvalues.len()).collect();
-            order.sort_by(|&a, &b| ke.eigenvalues[a].total_cmp(&ke.eigenvalues[b]));
-            let extra = q * DMatrix::from_columns(
-                &order.iter().map(|&i| ke.eigenvectors.column(i).into_owned()).collect::<Vec<_>>(),
-            );
-            let mut all: Vec<DVector<f64>> = basis.column_iter().map(|c| c.into_owned()).collect();
-            all.extend(extra.column_iter().map(|c| c.into_owned()));
-            basis = DMatrix::from_columns(&all);
-            for &i in &order {
-                omega_sq.push(ke.eigenvalues[i].max(0.0));
-                kinds.push(Kind::Correction);
-            }
-        }
+        append_corrections(
+            &mut basis,
+            &mut omega_sq,
+            &mut kinds,
+            &psi,
+            |x| m.mass.project(x, x),
+            |x| m.stiffness.project(x, x),
+        );
     }
     let r = basis.ncols();
     let mut damping = m.damping.project(&basis, &basis);
