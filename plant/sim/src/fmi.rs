@@ -17,8 +17,8 @@ use crate::config::{load_scene, Scene};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-/// The most a file the scene reads may hold when its bytes go into the GUID (bytes): as the
-/// CLI's tables (`plant::input::MAX_TABLE_BYTES`).
+/// The most a file the scene reads may hold (bytes), when its bytes go into the GUID and when
+/// `plant fmu` packs it into the FMU.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
 /// The FMI version of the FMU.

@@ -46,7 +46,7 @@ pub fn package(scene: &Scene, library: &Path, out: &Path, fmi: Fmi) -> anyhow::R
     // the scene names it there.
     let mut extra = Vec::new();
     for (keys, file) in files_read(&raw) {
-        let bytes = crate::input::read_bytes(Path::new(&file), crate::input::MAX_TABLE_BYTES)
+        let bytes = crate::input::read_bytes(Path::new(&file), MAX_FILE_BYTES)
             .with_context(|| format!("{} {file}", keys.join(".")))?;
         let name = match keys[0].as_str() {
             "shock" => format!("shock-{}.csv", keys[1]),

@@ -355,13 +355,14 @@ fn sensitivity_part(
     let closed_form_planes = if scene.planes() > 1 { closed.into_iter().flatten().collect() } else { Vec::new() };
     // A `state_space` law's closed form on any rotor (from the matrices `plant linear` writes),
     // else the coupled one of a rotor that gives its whole open loop.
-    let mut closed_form_axes = if state_space_form::applies(scene) {
+    let state_space = state_space_form::applies(scene);
+    let mut closed_form_axes = if state_space {
         state_space_form::closed_form_axes(scene, &a.sensitivity, &speeds)
     } else {
         coupled::closed_form_axes(scene, &a.sensitivity, &speeds)
     }
     .unwrap_or_default();
-    if state_space_form::applies(scene) {
+    if state_space {
         state_space_form::compare(&mut closed_form_axes, &axes, scene);
     } else {
         coupled::compare(&mut closed_form_axes, &axes, scene);
