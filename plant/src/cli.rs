@@ -303,6 +303,11 @@ pub enum BenchCommand {
         /// charts instead of running the peer; they keep their own timings.
         #[arg(long, conflicts_with = "peer")]
         peer_rows: Option<PathBuf>,
+        /// Draw the charts of an earlier `accuracy.csv` (e.g. docs/charts/accuracy.csv, with the
+        /// `stability.csv` beside it) again, keeping its timings: only the untimed references and
+        /// the failure runs run.
+        #[arg(long, conflicts_with_all = ["peer", "peer_rows", "quick"])]
+        redraw: Option<PathBuf>,
     },
     /// Error and speed of each model simplification (lumped race support, fixed balls, speed
     /// held, linear bearing) against the most detailed model, on the same three scenes; then the
@@ -318,6 +323,10 @@ pub enum BenchCommand {
         /// Timed runs per variant (1 to 1000); the minimum counts.
         #[arg(long, default_value_t = 5, value_parser = repeats())]
         repeats: usize,
+        /// Draw the charts of an earlier `models.csv` (e.g. docs/charts/models.csv) again; nothing
+        /// runs.
+        #[arg(long)]
+        redraw: Option<PathBuf>,
     },
     /// The plant's execution time per tick, alone (the law in process, no IPC), on the realtime
     /// fixed-step setting and on the scene's own integrator: integration p50/p99/p99.9/max over

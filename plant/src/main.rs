@@ -169,7 +169,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             BenchCommand::Ipc { samples, warmup, pin_cores, spin_us, controller, run_id } => {
                 bench_ipc(samples, warmup, pin_cores, spin_us, controller, run_id)
             }
-            BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows } => {
+            BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows, redraw } => {
                 let req = plant::bench::accuracy::Request {
                     out: out.as_deref(),
                     config: &config,
@@ -177,10 +177,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     quick,
                     peer_python: peer.then_some(peer_python.as_path()),
                     peer_rows: peer_rows.as_deref(),
+                    redraw: redraw.as_deref(),
                 };
                 bench_wrote(plant::bench::accuracy::command(&req, &mut bench_log)?)
             }
-            BenchCommand::Models { out, config, repeats } => {
+            BenchCommand::Models { out, redraw: Some(csv), .. } => {
+                bench_wrote([plant::bench::models::redraw(out.as_deref(), &csv)?])
+            }
+            BenchCommand::Models { out, config, repeats, redraw: None } => {
                 bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
             }
             BenchCommand::Tick { scene, set, repeats, out, sched } => {

@@ -116,6 +116,46 @@ fn bench_counts_are_bounded() {
     }
 }
 
+/// Issue 41 item 5: the bench charts are drawn again from the committed rows with today's
+/// charts (`--redraw`), nothing timed: `models --redraw` writes one chart per bench scene from
+/// docs/charts/models.csv; rows that are not the bench's, or an `accuracy.csv` without its
+/// `stability.csv`, are refused naming the flag (exit 2) and write no chart.
+#[test]
+fn bench_charts_are_drawn_again_from_their_rows() {
+    let dir = TempDir::new("bench-redraw");
+    let rows = common::workspace_root().join("docs/charts/models.csv");
+    let out = dir.join("models");
+    let run = output_within(
+        Command::new(plant_bin()).args(["bench", "models", "--redraw"]).arg(&rows).arg("--out").arg(&out),
+        QUICK,
+    );
+    assert_exit(&run, 0);
+    for scene in ["levitation", "impact", "rub"] {
+        let png = out.join(format!("models_{scene}.png"));
+        assert!(std::fs::metadata(&png).map(|m| m.len() > 10_000).unwrap_or(false), "{}", png.display());
+    }
+    let garbage = dir.join("bad/models.csv");
+    std::fs::create_dir_all(garbage.parent().unwrap()).unwrap();
+    std::fs::write(&garbage, "scene,variant\nrub\n").unwrap();
+    let csv = dir.join("bad/accuracy.csv");
+    std::fs::copy(common::workspace_root().join("docs/charts/accuracy.csv"), &csv).unwrap();
+    for (verb, file) in [("models", &garbage), ("accuracy", &csv)] {
+        let out = dir.join(&format!("refused-{verb}"));
+        let run = output_within(
+            Command::new(plant_bin()).args(["bench", verb, "--redraw"]).arg(file).arg("--out").arg(&out),
+            QUICK,
+        );
+        assert_exit(&run, 2);
+        let err = stderr(&run);
+        assert!(err.contains("--redraw"), "{verb}: {err}");
+        assert!(
+            !out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(),
+            "{verb} wrote into {}",
+            out.display()
+        );
+    }
+}
+
 /// Issue 22: `plant bench host` measures every tick it was asked for, once sleeping and once
 /// spinning, into `host.csv`; a rate, a duration or a priority out of range is refused naming
 /// the flag and the value (exit 2), before anything is written.

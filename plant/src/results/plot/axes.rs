@@ -1,6 +1,7 @@
 //! Axis ranges (padding, log decades, equal scales) and tick labels.
 
 use super::MAX_TICKS;
+use plotters::coord::combinators::{BindKeyPoints, IntoLogRange, LogCoord, WithKeyPoints};
 
 /// Smallest and largest finite value, if any.
 pub(crate) fn finite_bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
@@ -122,6 +123,43 @@ pub(crate) fn linear_ticks(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
             format!("{:.*}", digits, v)
         }
     }
+}
+
+/// A log axis over `[lo, hi]` with its own key points ([`log_key_points`]).
+pub(crate) fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
+    let (bold, light) = log_key_points(lo, hi);
+    LogCoord::from((lo..hi).log_scale()).with_key_points(bold).with_light_points(light)
+}
+
+/// The labelled and the grid values of a log axis over `[lo, hi]`. Written here rather than
+/// taken from plotters, whose log key points start at the lowest power of ten in the range
+/// (data below it sit beside an unlabelled stretch) and label no value between powers once the
+/// range spans more than a decade: up to 1.2 decades every 1…9 × 10ᵏ is labelled, up to 3
+/// decades 1, 2, 5 × 10ᵏ, up to 12 the powers of ten, beyond that every n-th power (at most 12
+/// labels); the grid has every 1…9 × 10ᵏ up to 12 decades, the labelled values beyond.
+pub(crate) fn log_key_points(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let decades = (hi / lo).log10();
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let inside = |v: f64| v >= lo * (1.0 - 1e-9) && v <= hi * (1.0 + 1e-9);
+    let all: [f64; 9] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+    let values = |mantissas: &[f64], every: i32| -> Vec<f64> {
+        (k0..=k1)
+            .filter(|k| k.rem_euclid(every) == 0)
+            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| inside(*v))
+            .collect()
+    };
+    let bold = if decades <= 1.2 {
+        values(&all, 1)
+    } else if decades <= 3.0 {
+        values(&[1.0, 2.0, 5.0], 1)
+    } else if decades <= 12.0 {
+        values(&[1.0], 1)
+    } else {
+        values(&[1.0], (decades / 12.0).ceil() as i32)
+    };
+    let light = if decades <= 12.0 { values(&all, 1) } else { bold.clone() };
+    (bold, light)
 }
 
 /// Tick label formatter for a log axis: plain numbers between 10⁻³ and

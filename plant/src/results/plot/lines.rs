@@ -88,7 +88,7 @@ pub fn lines(
 
         let x_fmt = linear_ticks(x_range.0, x_range.1);
         if log {
-            let y_coord: LogCoord<f64> = (y_range.0..y_range.1).log_scale().into();
+            let y_coord = super::axes::log_axis(y_range.0, y_range.1);
             let mut chart = builder(&area).build_cartesian_2d(x_range.0..x_range.1, y_coord).map_err(draw_err(path))?;
             draw_mesh(&mut chart, x_label, y_label, &x_fmt, &log_ticks, path)?;
             draw_pieces(&mut chart, &pieces, path)?;

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::axes::{finite_bounds, log_padded, log_ticks};
+use super::axes::{finite_bounds, log_axis, log_padded, log_ticks};
 use super::legend::{legend_strip, Mark, Shape};
 use super::*;
 
@@ -50,8 +50,7 @@ pub fn loglog(
             )
             .collect();
         let area = legend_strip(&area, &entries, path)?;
-        let x_coord: LogCoord<f64> = (xr.0..xr.1).log_scale().into();
-        let y_coord: LogCoord<f64> = (yr.0..yr.1).log_scale().into();
+        let (x_coord, y_coord) = (log_axis(xr.0, xr.1), log_axis(yr.0, yr.1));
         let mut chart = builder(&area).build_cartesian_2d(x_coord, y_coord).map_err(draw_err(path))?;
         draw_mesh(&mut chart, x_label, y_label, &log_ticks, &log_ticks, path)?;
         for (i, s) in series.iter().enumerate() {

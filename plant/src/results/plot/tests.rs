@@ -295,6 +295,25 @@ fn constant_series_gets_a_nonzero_range() {
 }
 
 #[test]
+fn a_log_axis_labels_values_below_its_lowest_power_of_ten() {
+    // 0.015 … 1.8: plotters' own key points label 0.1 and 1 only, leaving the data under 0.1
+    // beside an unlabelled stretch; ours label 1, 2, 5 × 10ᵏ over two decades.
+    let (bold, light) = log_key_points(0.015, 1.8);
+    let want = [0.02, 0.05, 0.1, 0.2, 0.5, 1.0];
+    assert_eq!(bold.len(), want.len(), "{bold:?}");
+    for (b, w) in bold.iter().zip(want) {
+        assert!((b / w - 1.0).abs() < 1e-12, "{bold:?}");
+    }
+    assert!(light.len() > bold.len() && light.iter().all(|v| (0.015..=1.8).contains(v)));
+    // Within one decade every 1…9 × 10ᵏ is labelled; over nine decades every power; over
+    // forty decades at most thirteen powers.
+    assert_eq!(log_key_points(0.15, 0.95).0.len(), 8);
+    assert_eq!(log_key_points(3e-8, 50.0).0.len(), 9);
+    let (wide, _) = log_key_points(1e-20, 1e20);
+    assert!(wide.len() >= 2 && wide.len() <= 13, "{wide:?}");
+}
+
+#[test]
 fn tick_labels_are_short() {
     let f = linear_ticks(0.0, 1.5);
     assert_eq!(f(&0.2), "0.2");

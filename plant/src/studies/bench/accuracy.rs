@@ -292,8 +292,9 @@ fn failure_plot(out: &Path, b: &BenchScene, method: Method, substeps: u32, refer
     let um = |t: &Trace| t.radius().iter().map(|r| r * 1e6).collect::<Vec<f64>>();
     let (tr, rr, tf, rf) = (ms(reference), um(reference), ms(&r.trace), um(&r.trace));
     let label = format!(
-        "{} with {substeps} substeps (h = {:.2e} s)",
+        "{} with {substeps} substep{} (h = {:.2e} s)",
         method_name(method),
+        if substeps == 1 { "" } else { "s" },
         s.controller.period / substeps as f64
     );
     plot::lines(
@@ -358,6 +359,40 @@ pub fn charts(out: &Path, rows: &[AccuracyRow], floors: &[(String, (f64, f64))])
     Ok(written)
 }
 
+/// `plant bench accuracy --redraw CSV`: the charts of an earlier run drawn again from its rows
+/// (`accuracy.csv` and the `stability.csv` beside it), with today's `plot/`. Its timings are
+/// kept: only the references (for the floors in the titles) and the runs just beyond each
+/// stability limit (for the failure charts) run again, and neither is timed, so the pictures
+/// show the earlier run's figures and not this host's load.
+fn redraw(config: &Path, csv: &Path, dir: &Path, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {
+    let bad = |flag: &str, e: anyhow::Error| crate::exit::BadArgument(format!("{flag}: {e:#}"));
+    let rows = rows::read_accuracy(csv).map_err(|e| bad("--redraw", e))?;
+    let stability_csv = csv.with_file_name("stability.csv");
+    let stability: Vec<StabilityRow> =
+        crate::table::read(&stability_csv).map_err(|e| bad("--redraw (its stability.csv)", e))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let (mut floors, mut written) = (Vec::new(), Vec::new());
+    for b in super::scenes(config)? {
+        log(&format!("{}: reference (DOP853 rtol 1e-13, checked with DP5 rtol 1e-11)", b.name));
+        let reference = reference(&b)?;
+        floors.push((b.name.to_string(), reference.floor));
+        for s in stability.iter().filter(|s| s.scene == b.name) {
+            let Some(method) = [Method::ExplicitEuler, Method::SymplecticEuler, Method::Rk4]
+                .into_iter()
+                .find(|m| method_name(*m) == s.method)
+            else {
+                continue;
+            };
+            if let Some(n) = s.substeps.filter(|n| *n > 1) {
+                failure_plot(dir, &b, method, n / 2, &reference.trace)?;
+                written.push(dir.join(format!("failure_{}_{}.png", b.name, s.method)));
+            }
+        }
+    }
+    written.extend(charts(dir, &rows, &floors)?);
+    Ok(written)
+}
+
 /// What `plant bench accuracy` was asked to do.
 pub struct Request<'a> {
     /// Output folder (default `runs/bench-accuracy`).
@@ -372,12 +407,18 @@ pub struct Request<'a> {
     pub peer_python: Option<&'a Path>,
     /// An earlier `accuracy.csv` whose peer rows join the charts.
     pub peer_rows: Option<&'a Path>,
+    /// An earlier `accuracy.csv` (with its `stability.csv` beside it) to draw the charts from,
+    /// instead of timing the runs again.
+    pub redraw: Option<&'a Path>,
 }
 
 /// `plant bench accuracy`: runs the bench, joins any earlier peer rows, draws the charts;
 /// returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {
     let dir = crate::output::out_dir(req.out, "bench-accuracy");
+    if let Some(csv) = req.redraw {
+        return redraw(req.config, csv, &dir, log);
+    }
     let peer = req.peer_python.map(|python| Peer {
         script: req.config.join("..").join("bench").join("peer").join("run_peer.py"),
         python: python.to_path_buf(),

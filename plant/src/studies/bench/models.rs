@@ -159,6 +159,12 @@ pub fn models(
     rows.extend(summary_rows);
     crate::table::write_with_header(&out.join("models_flexible.csv"), rows::MACHINE_HEADER, &machine_rows)?;
     crate::table::write_with_header(&out.join("models.csv"), rows::MODELS_HEADER, &rows)?;
+    charts(out, &rows)?;
+    Ok(rows)
+}
+
+/// Draws `models_<scene>.png` for the three bench scenes from the rows.
+fn charts(out: &Path, rows: &[ModelRow]) -> anyhow::Result<()> {
     for scene in ["levitation", "impact", "rub"] {
         let here: Vec<&ModelRow> = rows
             .iter()
@@ -179,7 +185,7 @@ pub fn models(
             &groups,
         )?;
     }
-    Ok(rows)
+    Ok(())
 }
 
 /// The rows of [`TWO_PLANE_VARIANTS`] on one bench scene: each against the planar study model
@@ -380,4 +386,15 @@ pub fn command(
     let dir = crate::output::out_dir(out, "bench-models");
     models(config, &dir, repeats, log)?;
     Ok(dir.join("models.csv"))
+}
+
+/// `plant bench models --redraw CSV`: the charts of an earlier `models.csv` drawn again with
+/// today's `plot/`, nothing run; returns the folder written.
+pub fn redraw(out: Option<&Path>, csv: &Path) -> anyhow::Result<PathBuf> {
+    let rows: Vec<ModelRow> =
+        crate::table::read(csv).map_err(|e| crate::exit::BadArgument(format!("--redraw: {e:#}")))?;
+    let dir = crate::output::out_dir(out, "bench-models");
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    charts(&dir, &rows)?;
+    Ok(dir)
 }
