@@ -89,3 +89,25 @@ fn without_the_key_the_ladder_runs_no_copies_and_says_nothing_of_them() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("perturbed copies"), "{stderr}");
 }
+
+/// `plant assess --robustness N` asks the same as the key (and overrides it): the small
+/// assessment's two members get one copy each, and the report says so.
+#[test]
+fn the_flag_asks_for_the_ladders_robustness_as_the_key_does() {
+    let dir = TempDir::new("ladder-flag");
+    let out = dir.join("out");
+    let o = output_within(
+        Command::new(plant_bin())
+            .arg("assess")
+            .arg(small_assessment(&dir))
+            .args(["--robustness", "1", "--out"])
+            .arg(&out),
+        LIMIT,
+    );
+    assert_exit(&o, 0);
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["ladder_settings"]["robustness"], 1);
+    let r = &report["controllers"][0]["ladder"]["result"]["robustness"];
+    assert_eq!((r["copies"].as_u64(), r["rungs"][0]["members"].as_u64()), (Some(1), Some(2)), "{r:#}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("robustness (1 perturbed copies per member)"));
+}

@@ -31,6 +31,7 @@ fn flags() -> Vec<(Vec<String>, &'static str, &'static str, Vec<&'static str>)> 
             with(COUNTS, &["257"]),
         ),
         (v(&["run", &paper]), "--save-state-at", "is not a time in the run: a number in s", vec!["", "abc"]),
+        (v(&["assess", &paper]), "--robustness", "is not a number of perturbed runs", with(COUNTS, &["257"])),
         (v(&["compare", &paper]), "--robustness", "is not a number of perturbed runs", with(COUNTS, &["257"])),
         (
             v(&["compare", &paper, "--realtime"]),
