@@ -109,5 +109,5 @@ fn the_flag_asks_for_the_ladders_robustness_as_the_key_does() {
     assert_eq!(report["ladder_settings"]["robustness"], 1);
     let r = &report["controllers"][0]["ladder"]["result"]["robustness"];
     assert_eq!((r["copies"].as_u64(), r["rungs"][0]["members"].as_u64()), (Some(1), Some(2)), "{r:#}");
-    assert!(String::from_utf8_lossy(&o.stderr).contains("robustness (1 perturbed copies per member)"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("robustness (1 perturbed copy per member)"));
 }

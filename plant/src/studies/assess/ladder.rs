@@ -336,7 +336,9 @@ impl LadderRobustness {
                 g(safe_up_to_g)
             )
         };
-        format!("robustness ({} perturbed copies per member): {fragile}; {survives}", self.copies)
+        let copies =
+            if self.copies == 1 { "1 perturbed copy".to_string() } else { format!("{} perturbed copies", self.copies) };
+        format!("robustness ({copies} per member): {fragile}; {survives}")
     }
 }
 
