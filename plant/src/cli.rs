@@ -4,9 +4,27 @@ use clap::{Parser, Subcommand};
 use plant::cosim::{ControllerProcess, Launch};
 use std::path::PathBuf;
 
+use plant::argument::{count, number};
+
 /// `--repeats` of the benches: 1 to 1000 (0 used to run once silently).
-fn repeats() -> clap::builder::RangedU64ValueParser<usize> {
-    clap::builder::RangedU64ValueParser::new().range(1..=1000)
+fn repeats() -> impl Fn(&str) -> Result<usize, String> + Clone + Send + Sync + 'static {
+    count("a number of timed runs", 1, 1000)
+}
+
+/// `--robustness N` of `run` and `compare`: 0 to the most perturbed members a run may ask for.
+fn robustness() -> impl Fn(&str) -> Result<u32, String> + Clone + Send + Sync + 'static {
+    count("a number of perturbed runs", 0, plant::robustness::MAX_MEMBERS as u64)
+}
+
+/// A time of `--save-state-at` (s): any number, so that the run's own check says where the run
+/// is (NaN and times outside it are refused there, naming the run's span).
+fn time_in_run(s: &str) -> Result<f64, String> {
+    s.trim().parse().map_err(|_| format!("`{s}` is not a time in the run: a number in s (e.g. 0.5 or 0.5,1.0)"))
+}
+
+/// A core number of the pinning flags.
+fn core() -> impl Fn(&str) -> Result<usize, String> + Clone + Send + Sync + 'static {
+    count("a core number", 0, 1023)
 }
 
 #[derive(Parser)]
@@ -42,7 +60,8 @@ pub enum Command {
         /// Save the plant's whole state at these times (s, ascending, within the run), each at
         /// the end of the first controller tick at or after it, as `state-T.json` in the output
         /// folder: `--from-state` continues from one.
-        #[arg(long, value_delimiter = ',', value_name = "T[,T...]")]
+        #[arg(long, value_delimiter = ',', value_name = "T[,T...]",
+              value_parser = time_in_run)]
         save_state_at: Vec<f64>,
         /// Start from a state saved with `--save-state-at` (of a scene with the same rotor,
         /// hardware, integrator and rates; the controller, its law and gains, and the shock
@@ -52,7 +71,7 @@ pub enum Command {
         /// Also run N perturbed copies (the unbalance's angle by ±k·1e-9 rad, the rotor's start by
         /// ±k pm), in parallel, and say how robust the outcome is (summary.json `robustness`; the
         /// same as `--set robustness.members=N`).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", value_parser = robustness())]
         robustness: Option<u32>,
         /// Also record the run as run.mcap in the output folder, for Foxglove, Lichtblick and
         /// PlotJuggler (the same as `--set output.mcap=true`).
@@ -126,12 +145,12 @@ pub enum Command {
         #[arg(long, conflicts_with_all = ["maps", "laws", "no_cosim"])]
         realtime: bool,
         /// Realtime runs of `--realtime`.
-        #[arg(long, default_value_t = 1, requires = "realtime")]
+        #[arg(long, default_value_t = 1, requires = "realtime", value_parser = count::<usize>("a number of realtime runs", 1, 1000))]
         runs: usize,
         /// Give each compared run (rates or laws) its robustness answer with N perturbed copies,
         /// as `plant run --robustness N`, and say whether each difference from the reference
         /// run lies within the runs' spreads (compare_robustness.csv and .json).
-        #[arg(long, value_name = "N", conflicts_with = "realtime")]
+        #[arg(long, value_name = "N", conflicts_with = "realtime", value_parser = robustness())]
         robustness: Option<u32>,
     },
     /// The whirl modes of a two-plane or flexible scene's rotor on its continuous PD against spin
@@ -148,10 +167,10 @@ pub enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Highest spin speed of the diagram (Hz).
-        #[arg(long, default_value_t = 500.0)]
+        #[arg(long, default_value_t = 500.0, value_parser = number("a spin speed", "Hz", 0.0, 1e5))]
         max_speed_hz: f64,
         /// Speeds of the diagram, from 0 to the highest (2 to 10000).
-        #[arg(long, default_value_t = 51, value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(2..=10_000))]
+        #[arg(long, default_value_t = 51, value_parser = count::<usize>("a number of speeds", 2, 10_000))]
         points: usize,
         /// Spin speeds of the free decays (Hz), comma-separated; empty (`""`): none.
         #[arg(long, default_value = "0,250,500", value_parser = parse_speeds)]
@@ -165,7 +184,7 @@ pub enum Command {
         /// Scene file (TOML).
         scene: PathBuf,
         /// Spin speed to linearise at (Hz); default: the scene's rotor.speed_hz.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true, value_parser = number("a spin speed", "Hz", 0.0, 1e5))]
         speed_hz: Option<f64>,
         /// Output folder (default: runs/linear-<scene name>).
         #[arg(long)]
@@ -188,7 +207,7 @@ pub enum Command {
         set: Vec<String>,
         /// The FMI version: 2 (FMI 2.0 co-simulation) or 3 (FMI 3.0 co-simulation, with
         /// fixedInternalStepSize the controller tick).
-        #[arg(long, default_value_t = 2, value_parser = clap::builder::RangedU64ValueParser::<u8>::new().range(2..=3))]
+        #[arg(long, default_value_t = 2, value_parser = count::<u8>("an FMI version", 2, 3))]
         fmi: u8,
         /// The FMU's binary (default: libplant_fmu.so next to this executable, which
         /// `cargo build -p plant-fmu` puts there).
@@ -241,11 +260,11 @@ impl ControllerArg {
 #[derive(clap::Args, Clone, Copy)]
 pub struct BenchScheduling {
     /// Pin the bench's thread to this core.
-    #[arg(long)]
+    #[arg(long, value_parser = core())]
     pub pin_core: Option<usize>,
     /// `SCHED_FIFO` at this priority (1 to 99) with memory locked (`bench host`: and every
     /// core's idle latency held at 0); 0: the normal scheduler.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = count::<u32>("a realtime priority (0: off)", 0, 99))]
     pub realtime_priority: u32,
 }
 
@@ -259,16 +278,16 @@ pub enum BenchCommand {
     /// controller binary); prints p50/p99/p99.9/max. Build with `--release` for figures.
     Ipc {
         /// Recorded round trips (1 to 1e7).
-        #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+        #[arg(long, default_value_t = 200_000, value_parser = count::<u64>("a number of round trips", 1, 10_000_000))]
         samples: u64,
-        /// Unrecorded round trips first.
-        #[arg(long, default_value_t = 20_000)]
+        /// Unrecorded round trips first (0 to 1e7).
+        #[arg(long, default_value_t = 20_000, value_parser = count::<u64>("a number of round trips", 0, 10_000_000))]
         warmup: u64,
         /// Pin plant and controller to these cores, e.g. `--pin-cores 0,1`.
-        #[arg(long, value_delimiter = ',')]
+        #[arg(long, value_delimiter = ',', value_parser = core())]
         pin_cores: Option<Vec<usize>>,
-        /// Busy-poll budget before blocking (µs).
-        #[arg(long, default_value_t = 200.0)]
+        /// Busy-poll budget before blocking (µs, 0 to 1e6).
+        #[arg(long, default_value_t = 200.0, value_parser = number("a busy-poll budget", "µs", 0.0, 1e6))]
         spin_us: f64,
         /// `spawn` (default) or `external`.
         #[arg(long, value_enum, default_value_t = ControllerArg::Spawn)]
@@ -339,8 +358,8 @@ pub enum BenchCommand {
         /// Override a scene key, e.g. `--set controller.rate_hz=10000`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// Runs per setting.
-        #[arg(long, default_value_t = 3)]
+        /// Runs per setting (1 to 1000).
+        #[arg(long, default_value_t = 3, value_parser = repeats())]
         repeats: usize,
         /// Output folder (default: runs/bench-tick).
         #[arg(long)]
@@ -355,10 +374,10 @@ pub enum BenchCommand {
     /// `--release`, and give the run's `--pin-core` and `--realtime-priority`.
     Host {
         /// Ticks per second (a realtime scene's `controller.rate_hz`), 1 to 1e6.
-        #[arg(long, default_value_t = 20_000.0)]
+        #[arg(long, default_value_t = 20_000.0, value_parser = number("a tick rate", "Hz", 1.0, 1e6))]
         rate_hz: f64,
         /// Seconds per loop (0.001 to 3600).
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, default_value_t = 10.0, value_parser = number("a loop's duration", "s", 1e-3, 3600.0))]
         seconds: f64,
         /// Output folder (default: runs/bench-host).
         #[arg(long)]
@@ -389,10 +408,6 @@ fn parse_speeds(text: &str) -> Result<Vec<f64>, String> {
     if text.trim().is_empty() {
         return Ok(Vec::new());
     }
-    text.split(',')
-        .map(|v| {
-            let v = v.trim();
-            v.parse::<f64>().map_err(|_| format!("`{v}` is not a speed in Hz (e.g. 0,250,500, or \"\" for none)"))
-        })
-        .collect()
+    let speed = number("a spin speed", "Hz", 0.0, 1e5);
+    text.split(',').map(|v| speed(v).map_err(|e| format!("{e} (e.g. 0,250,500, or \"\" for none)"))).collect()
 }

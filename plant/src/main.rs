@@ -314,7 +314,8 @@ impl States {
         };
         let start = from.as_ref().map_or(0.0, |s| s.t_s);
         for (i, &t) in self.save_at.iter().enumerate() {
-            let bad = |why: String| Ending::BadArgument(format!("--save-state-at {t} s: {why}"));
+            let bad =
+                |why: String| Ending::BadArgument(format!("--save-state-at {} s: {why}", plant::argument::shown(t)));
             if !(t.is_finite() && t > start && t <= scene.duration) {
                 return Err(bad(format!(
                     "outside the run (after {start} s, up to scene.duration_s = {} s)",

@@ -446,7 +446,8 @@ fn a_run_says_how_robust_its_outcome_is() {
     // Bad input: nothing written.
     let bad = dir.join("bad");
     for (extra, says) in [
-        (&["--robustness", "300"][..], "robustness.members = 300: must be 0 (none) to 256"),
+        (&["--robustness", "300"][..], "`300` is not a number of perturbed runs: a whole number from 0 to 256"),
+        (&["--set", "robustness.members=300"][..], "robustness.members = 300: must be 0 (none) to 256"),
         (
             &["--robustness", "2", "--set", "controller.mode=\"realtime\""][..],
             "ask for the robustness of the same scene in lockstep",

@@ -515,16 +515,58 @@ pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigErro
     };
     let mut raw = parse(value.clone(), path.display().to_string())?;
     if !overrides.is_empty() {
+        let file = value.clone();
         for arg in overrides {
             apply_override(&mut value, arg)?;
         }
-        raw = parse(value, format!("--set {}", overrides.join(" --set ")))?;
+        raw = parse(value, format!("--set {}", overrides.join(" --set ")))
+            .map_err(|e| blame_override(&file, overrides, e))?;
     }
     if raw.scene.name.is_empty() {
         raw.scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     validate(raw, base_dir)
+}
+
+/// The overrides' parse error `e` blamed on the one `--set` that brings it (the first whose
+/// prefix of the overrides fails with the same message) instead of on all of them, and said in
+/// words where serde names a Rust type ("expected f64": a number). An error that only the
+/// overrides together bring keeps naming them all.
+fn blame_override(file: &toml::Table, overrides: &[String], e: ConfigError) -> ConfigError {
+    let ConfigError::Parse { path, message } = e else { return e };
+    // serde's type names are Rust's; the scene's readers know numbers, whole numbers, booleans.
+    let words = |m: &str| {
+        // serde prints a float as all its digits (1e300: 301 of them); back to exponent form.
+        let m: String = m
+            .split('`')
+            .enumerate()
+            .map(|(i, part)| match part.parse::<f64>() {
+                Ok(v) if i % 2 == 1 && part.len() > 16 => format!("{v:e}"),
+                _ => part.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join("`");
+        m.replace("expected f64", "expected a number")
+            .replace("invalid type: unit variant, expected string only", "expected one of the key's names, in quotes")
+            .replace("wanted exactly 1 element, found 0 elements", "expected one of the key's names, in quotes")
+            .replace("expected u32", "expected a whole number ≥ 0")
+            .replace("expected u64", "expected a whole number ≥ 0")
+            .replace("expected usize", "expected a whole number ≥ 0")
+            .replace("expected i64", "expected a whole number")
+            .replace("expected u8", "expected a whole number from 0 to 255")
+    };
+    let mut value = file.clone();
+    for arg in overrides {
+        if apply_override(&mut value, arg).is_err() {
+            break;
+        }
+        let failed = toml::Value::Table(value.clone()).try_into::<RawScene>().err().map(|e| e.to_string());
+        if failed.as_deref() == Some(message.as_str()) {
+            return ConfigError::Parse { path: format!("--set {arg}"), message: words(&message) };
+        }
+    }
+    ConfigError::Parse { path, message: words(&message) }
 }
 
 /// `table`'s values as `(prefix.key, value)` pairs, sub-tables flattened, in key order.

@@ -29,7 +29,7 @@ use crate::ensemble::member::{close_to_decision, figures, member_overrides, veri
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
 use crate::ensemble::tally::{tally, Tally};
-use crate::grid::Point;
+use crate::grid::{Mode, Point};
 use crate::hooks::Hooks;
 use crate::run::{run_into, Outcome, RunResult, Sink};
 use crate::trace::{Record, Trace};
@@ -59,6 +59,15 @@ pub struct Settings {
     /// End a member's run once its outcome is decided (module doc); `false`: every member runs
     /// to the scene's end.
     pub end_when_decided: bool,
+    /// Perturbed copies of every counted member (`ladder.robustness`, 0: none, the default):
+    /// [`LadderRobustness`]. Left out of `report.json` at 0, so that a report without it is
+    /// the same as before.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub robustness: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl Default for Settings {
@@ -72,6 +81,7 @@ impl Default for Settings {
             min_p: 0.9,
             duty_g: 10.0,
             end_when_decided: true,
+            robustness: 0,
         }
     }
 }
@@ -227,6 +237,221 @@ pub struct LadderResult {
     pub simulated_s: f64,
     /// True when interrupted before every rung was decided.
     pub interrupted: bool,
+    /// How robust the members' outcomes are (`ladder.robustness` > 0, the ladder complete).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robustness: Option<LadderRobustness>,
+}
+
+/// A counted member some of whose perturbed copies ended in another motion mode.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FragileMember {
+    /// The member's index in its rung.
+    pub member: usize,
+    /// Its rotor angle at the shock's arrival (deg), if drawn.
+    pub angle_deg: Option<f64>,
+    /// The mode it was counted with.
+    pub mode: &'static str,
+    /// Its copies' modes, copy 1 first.
+    pub copies: Vec<&'static str>,
+    /// Recovered in some runs (the member or a copy) and not in others: the rung's count
+    /// depends on the branch.
+    pub flips_recovery: bool,
+}
+
+/// One rung's robustness: its counted members' copies.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RungRobustness {
+    /// Peak of the first shock (G).
+    pub peak_g: f64,
+    /// Counted members.
+    pub members: usize,
+    /// Members with a copy in another mode.
+    pub fragile: usize,
+    /// Members recovered in the member's run and in every copy, and the Wilson 95 % lower
+    /// bound with that count: the rung's worst case under the perturbation.
+    pub recovered_worst: usize,
+    /// Its lower bound.
+    pub p_lo_worst: f64,
+    /// Members recovered in the member's run or in any copy, and its lower bound: the best case.
+    pub recovered_best: usize,
+    /// Its lower bound.
+    pub p_lo_best: f64,
+    /// The fragile members.
+    pub fragile_members: Vec<FragileMember>,
+}
+
+/// The ladder's robustness answer (`ladder.robustness = N`): every counted member repeated `N`
+/// times with the perturbations `plant run --robustness` uses ([`crate::robustness::perturbation`]:
+/// the unbalance's angle by ±k·10⁻⁹ rad, the rotor's start by ±k pm), at the setting it was
+/// counted on (a verified member at the reference setting). A member is fragile when a copy ends
+/// in another mode; the highest safe shock survives when the worst case (every member that
+/// recovers in some runs but not in others counted as not recovered) gives the same rung.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LadderRobustness {
+    /// Perturbed copies per member.
+    pub copies: usize,
+    /// The perturbation, in words.
+    pub perturbation: String,
+    /// Fragile members over all rungs.
+    pub fragile_members: usize,
+    /// Members whose recovery flips among their runs, over all rungs.
+    pub flipping_members: usize,
+    /// The highest safe shock in the worst case (G).
+    pub safe_up_to_g_worst: Option<f64>,
+    /// In the best case (every flipping member counted as recovered) (G).
+    pub safe_up_to_g_best: Option<f64>,
+    /// The ladder's highest safe shock equals the worst case's.
+    pub safe_survives: bool,
+    /// Per rung.
+    pub rungs: Vec<RungRobustness>,
+}
+
+impl LadderRobustness {
+    /// The answer in words, for the verdict line and the report.
+    pub fn words(&self, safe_up_to_g: Option<f64>) -> String {
+        let g = |x: Option<f64>| x.map_or("none".to_string(), |g| format!("{g} G"));
+        let members: usize = self.rungs.iter().map(|r| r.members).sum();
+        let fragile = if self.fragile_members == 0 {
+            format!("no member of {members} fragile")
+        } else {
+            let at: Vec<String> = self
+                .rungs
+                .iter()
+                .filter(|r| r.fragile > 0)
+                .map(|r| format!("{} of {} at {} G", r.fragile, r.members, r.peak_g))
+                .collect();
+            format!(
+                "FRAGILE members: {} ({} of them recovering in some runs and not in others)",
+                at.join(", "),
+                self.flipping_members
+            )
+        };
+        let survives = if self.safe_survives {
+            format!("the highest safe shock ({}) survives", g(safe_up_to_g))
+        } else {
+            format!(
+                "the highest safe shock does NOT survive: {} in the worst case, {} in the best (the ladder: {})",
+                g(self.safe_up_to_g_worst),
+                g(self.safe_up_to_g_best),
+                g(safe_up_to_g)
+            )
+        };
+        let copies =
+            if self.copies == 1 { "1 perturbed copy".to_string() } else { format!("{} perturbed copies", self.copies) };
+        format!("robustness ({copies} per member): {fragile}; {survives}")
+    }
+}
+
+/// The answer as an HTML paragraph with a table of the fragile members, for the report's ladder
+/// section (the text escaped: it holds only numbers and mode names, but the page is HTML).
+pub fn robustness_html(r: &LadderRobustness, safe_up_to_g: Option<f64>) -> String {
+    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let class = if r.fragile_members == 0 && r.safe_survives { "ok" } else { "bad" };
+    let mut h = format!(
+        "<p class=\"{class}\">{}. Perturbation: {}; each copy at its member's counted setting.</p>\n",
+        esc(&r.words(safe_up_to_g)),
+        esc(&r.perturbation)
+    );
+    if r.fragile_members > 0 {
+        h.push_str(
+            "<table><tr><th>peak (G)</th><th>member</th><th>angle (deg)</th><th>counted as</th><th>its copies</th>\
+             <th>recovered worst / best, lower bound</th></tr>\n",
+        );
+        for rung in r.rungs.iter().filter(|x| x.fragile > 0) {
+            for m in &rung.fragile_members {
+                h.push_str(&format!(
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}–{} of {}, [{:.2}, {:.2}]</td></tr>\n",
+                    rung.peak_g,
+                    m.member,
+                    m.angle_deg.map_or("–".into(), |a| format!("{a:.3}")),
+                    m.mode,
+                    m.copies.join(", "),
+                    rung.recovered_worst,
+                    rung.recovered_best,
+                    rung.members,
+                    rung.p_lo_worst,
+                    rung.p_lo_best
+                ));
+            }
+        }
+        h.push_str("</table>\n");
+    }
+    h
+}
+
+/// One counted member's outcome and its copies' (for [`judge`]).
+pub struct MemberCopies {
+    /// The member's index in its rung.
+    pub member: usize,
+    /// Its rotor angle (deg).
+    pub angle_deg: Option<f64>,
+    /// The mode it was counted with.
+    pub mode: Mode,
+    /// Its copies' modes.
+    pub copies: Vec<Mode>,
+}
+
+/// The highest peak up to which every rung is complete and its lower bound reaches `min_p`.
+fn safe_up_to(peaks: &[f64], complete: &[bool], p_lo: &[f64], min_p: f64) -> Option<f64> {
+    peaks.iter().zip(complete).zip(p_lo).take_while(|((_, c), p)| **c && **p >= min_p).last().map(|((g, _), _)| *g)
+}
+
+/// The ladder's robustness from each rung's members and their copies (pure): `rungs[i]` holds
+/// rung `i`'s counted members; `complete[i]` whether the rung was decided; `safe_up_to_g` the
+/// ladder's own answer.
+pub fn judge(
+    peaks_g: &[f64],
+    complete: &[bool],
+    rungs: &[Vec<MemberCopies>],
+    min_p: f64,
+    copies: usize,
+    safe_up_to_g: Option<f64>,
+) -> LadderRobustness {
+    let mut out = Vec::new();
+    for (peak_g, members) in peaks_g.iter().zip(rungs) {
+        let recovered = |m: &Mode| *m == Mode::Recovered;
+        let worst = members.iter().filter(|m| recovered(&m.mode) && m.copies.iter().all(recovered)).count();
+        let best = members.iter().filter(|m| recovered(&m.mode) || m.copies.iter().any(recovered)).count();
+        let fragile_members: Vec<FragileMember> = members
+            .iter()
+            .filter(|m| m.copies.iter().any(|c| *c != m.mode))
+            .map(|m| FragileMember {
+                member: m.member,
+                angle_deg: m.angle_deg,
+                mode: m.mode.name(),
+                copies: m.copies.iter().map(|c| c.name()).collect(),
+                flips_recovery: m.copies.iter().any(|c| recovered(c) != recovered(&m.mode)),
+            })
+            .collect();
+        out.push(RungRobustness {
+            peak_g: *peak_g,
+            members: members.len(),
+            fragile: fragile_members.len(),
+            recovered_worst: worst,
+            p_lo_worst: wilson(worst, members.len())[0],
+            recovered_best: best,
+            p_lo_best: wilson(best, members.len())[0],
+            fragile_members,
+        });
+    }
+    let lo = |f: fn(&RungRobustness) -> f64| out.iter().map(f).collect::<Vec<_>>();
+    let safe_up_to_g_worst = safe_up_to(peaks_g, complete, &lo(|r| r.p_lo_worst), min_p);
+    let safe_up_to_g_best = safe_up_to(peaks_g, complete, &lo(|r| r.p_lo_best), min_p);
+    LadderRobustness {
+        copies,
+        perturbation: format!(
+            "the unbalance's angle by ±k·{:e} rad and the rotor's initial x by ±k·{:e} m, k = 1 … {}",
+            crate::robustness::ANGLE_STEP_RAD,
+            crate::robustness::POSITION_STEP_M,
+            copies.div_ceil(2)
+        ),
+        fragile_members: out.iter().map(|r| r.fragile).sum(),
+        flipping_members: out.iter().flat_map(|r| &r.fragile_members).filter(|m| m.flips_recovery).count(),
+        safe_up_to_g_worst,
+        safe_up_to_g_best,
+        safe_survives: safe_up_to_g_worst == safe_up_to_g,
+        rungs: out,
+    }
 }
 
 /// A member's controller process was lost (or missed its realtime budget): the ladder stops
@@ -249,6 +474,9 @@ struct Counted {
     decided: bool,
     /// Simulated time of the member's runs (s).
     simulated_s: f64,
+    /// The overrides of the counted run (the reference setting's for a verified member): its
+    /// perturbed copies start from them.
+    sets: Vec<String>,
 }
 
 /// Revolutions per block of the orbit's envelope in [`Decision`].
@@ -392,6 +620,46 @@ pub fn rung_overrides(scene: &Scene, g: f64) -> anyhow::Result<Vec<String>> {
         .collect())
 }
 
+/// The figures of a member's run, a decided one's steady window taken as the full run's.
+fn figures_of(scene: &Scene, result: &RunResult, decision: &Option<Decision>) -> crate::ensemble::member::Figures {
+    let (mut f, _) = figures(scene, result);
+    if let Some(d) = decision.as_ref().filter(|d| d.decided.get()) {
+        f.steady_window_start_s = d.full_window_start(scene);
+    }
+    f
+}
+
+/// One run of a member's scene with its duty and decision; `None` when interrupted.
+fn run_scene(
+    scene: &Scene,
+    bearing: Bearing,
+    end_when_decided: bool,
+    stop: &AtomicBool,
+) -> anyhow::Result<Option<(RunResult, Duty, Option<Decision>)>> {
+    let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
+    // A start: each plane's duty takes its own bearing's ball count at its first sample.
+    let balls = scene.plane(0).balls.count();
+    let decision = Decision::new(scene, end_when_decided);
+    let mut hooks = MemberHooks { stop, decision: decision.as_ref() };
+    let mut duty_sink = DutySink::new(&mut trace, bearing, balls);
+    let mut sink = Watch { inner: &mut duty_sink, decision: decision.as_ref() };
+    let run = run_into(scene, &crate::cosim::Launch::default(), &mut hooks, &mut sink)?;
+    let duty = duty_sink.finish();
+    match &run.outcome {
+        Outcome::Interrupted => return Ok(None),
+        // Ctrl-C in a terminal stops the controller process too: interrupted, not lost.
+        _ if stop.load(Ordering::Relaxed) && run.outcome != Outcome::Completed => return Ok(None),
+        // A member whose controller was lost says nothing of the controller's recovery: it
+        // must not be counted (as a run that did not complete, it would count as diverged).
+        Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => {
+            return Err(ControllerLost(why.clone()).into());
+        }
+        Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),
+        Outcome::Completed | Outcome::Diverged(_) => {}
+    }
+    Ok(Some((RunResult { trace, run }, duty, decision)))
+}
+
 /// Runs a member with its duty; `None` when interrupted.
 fn run_counted(
     point: &Point,
@@ -401,39 +669,8 @@ fn run_counted(
     end_when_decided: bool,
     stop: &AtomicBool,
 ) -> anyhow::Result<Option<Counted>> {
-    // The figures of a run, a decided one's steady window taken as the full run's.
-    let figures_of = |scene: &Scene, result: &RunResult, decision: &Option<Decision>| {
-        let (mut f, _) = figures(scene, result);
-        if let Some(d) = decision.as_ref().filter(|d| d.decided.get()) {
-            f.steady_window_start_s = d.full_window_start(scene);
-        }
-        f
-    };
-    let run = |scene: &Scene| -> anyhow::Result<Option<(RunResult, Duty, Option<Decision>)>> {
-        let mut trace = Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
-        // A start: each plane's duty takes its own bearing's ball count at its first sample.
-        let balls = scene.plane(0).balls.count();
-        let decision = Decision::new(scene, end_when_decided);
-        let mut hooks = MemberHooks { stop, decision: decision.as_ref() };
-        let mut duty_sink = DutySink::new(&mut trace, bearing, balls);
-        let mut sink = Watch { inner: &mut duty_sink, decision: decision.as_ref() };
-        let run = run_into(scene, &crate::cosim::Launch::default(), &mut hooks, &mut sink)?;
-        let duty = duty_sink.finish();
-        match &run.outcome {
-            Outcome::Interrupted => return Ok(None),
-            // Ctrl-C in a terminal stops the controller process too: interrupted, not lost.
-            _ if stop.load(Ordering::Relaxed) && run.outcome != Outcome::Completed => return Ok(None),
-            // A member whose controller was lost says nothing of the controller's recovery: it
-            // must not be counted (as a run that did not complete, it would count as diverged).
-            Outcome::PeerLost(why) | Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => {
-                return Err(ControllerLost(why.clone()).into());
-            }
-            Outcome::InvalidCommands(why) => return Err(NotControlling(why.clone()).into()),
-            Outcome::Completed | Outcome::Diverged(_) => {}
-        }
-        Ok(Some((RunResult { trace, run }, duty, decision)))
-    };
-    let (sets, draw, drawn) = member_overrides(point, spec, j);
+    let run = |scene: &Scene| run_scene(scene, bearing, end_when_decided, stop);
+    let (mut sets, draw, drawn) = member_overrides(point, spec, j);
     let scene = load_scene(point.path, &sets)?;
     let Some((result, mut duty, decision)) = run(&scene)? else { return Ok(None) };
     let first = figures_of(&scene, &result, &decision);
@@ -442,7 +679,7 @@ fn run_counted(
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
-        let mut sets = point.sets.to_vec();
+        sets = point.sets.to_vec();
         sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
         sets.extend(drawn.iter().cloned());
         let reference = load_scene(point.path, &sets)?;
@@ -465,7 +702,26 @@ fn run_counted(
         duty,
         decided,
         simulated_s,
+        sets,
     }))
+}
+
+/// Copy `k` (1 …) of a counted member: its counted run perturbed as `plant run --robustness`
+/// perturbs a run; its mode and simulated time, `None` when interrupted.
+fn run_copy(
+    path: &Path,
+    member: &Counted,
+    k: usize,
+    bearing: Bearing,
+    end_when_decided: bool,
+    stop: &AtomicBool,
+) -> anyhow::Result<Option<(Mode, f64)>> {
+    let scene = load_scene(path, &member.sets)?;
+    let mut sets = member.sets.clone();
+    sets.extend(crate::robustness::perturbation(&scene, k)?);
+    let scene = load_scene(path, &sets)?;
+    let Some((result, _, decision)) = run_scene(&scene, bearing, end_when_decided, stop)? else { return Ok(None) };
+    Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.simulated)))
 }
 
 /// Runs the ladder for the controller whose scene is `path` with `sets`. A member that fails
@@ -577,9 +833,56 @@ pub fn ladder(
     }
     let safe_up_to_g =
         rungs.iter().take_while(|r| r.complete && r.tally.p_lo >= settings.min_p).last().map(|r| r.peak_g);
+    let mut simulated_s: f64 = counted.iter().flatten().map(|m| m.simulated_s).sum();
+    let mut robustness = None;
+    if settings.robustness > 0 && failed.is_none() && !interrupted {
+        let copies = settings.robustness;
+        let work: Vec<(usize, usize, usize)> = counted
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| (0..c.len()).flat_map(move |m| (1..=copies).map(move |k| (i, m, k))))
+            .collect();
+        log(&format!("ladder robustness: {} perturbed copies of {} members", work.len(), work.len() / copies));
+        let done: Vec<anyhow::Result<Option<(Mode, f64)>>> = super::jobs_for(&base, || {
+            work.par_iter().map(|&(i, m, k)| run_copy(path, &counted[i][m], k, bearing, end_early, stop)).collect()
+        });
+        let mut modes: Vec<Vec<Vec<Mode>>> = counted.iter().map(|c| c.iter().map(|_| Vec::new()).collect()).collect();
+        for (&(i, m, _), r) in work.iter().zip(done) {
+            match r {
+                Ok(Some((mode, t))) => {
+                    modes[i][m].push(mode);
+                    simulated_s += t;
+                }
+                Ok(None) => interrupted = true,
+                Err(e) => {
+                    failed.get_or_insert(e);
+                }
+            }
+        }
+        if failed.is_none() && !interrupted && !stop.load(Ordering::Relaxed) {
+            let members: Vec<Vec<MemberCopies>> = counted
+                .iter()
+                .zip(modes)
+                .map(|(c, modes)| {
+                    c.iter()
+                        .zip(modes)
+                        .map(|(m, copies)| MemberCopies {
+                            member: m.result.member,
+                            angle_deg: m.result.angle_deg,
+                            mode: m.result.counted().mode,
+                            copies,
+                        })
+                        .collect()
+                })
+                .collect();
+            let complete: Vec<bool> = rungs.iter().map(|r| r.complete).collect();
+            robustness = Some(judge(&settings.peaks_g, &complete, &members, settings.min_p, copies, safe_up_to_g));
+        } else {
+            interrupted = interrupted || failed.is_none();
+        }
+    }
     let verified = rungs.iter().map(|r| r.verified).sum();
     let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();
-    let simulated_s = counted.iter().flatten().map(|m| m.simulated_s).sum();
     let result = LadderResult {
         rungs,
         safe_up_to_g,
@@ -589,6 +892,7 @@ pub fn ladder(
         ended_when_decided,
         simulated_s,
         interrupted,
+        robustness,
     };
     Ok((result, failed))
 }
@@ -613,6 +917,65 @@ mod tests {
         assert_eq!(s(35).unreachable(), None);
         assert!(s(34).unreachable().is_some());
         assert!((16.0 / (16.0 + z2) - wilson(16, 16)[0]).abs() < 1e-12);
+    }
+
+    /// The ladder's robustness from its members' copies: a member with a copy in another mode is
+    /// fragile; one whose recovery flips lowers the rung's worst case, and the highest safe
+    /// shock survives only when the worst case gives the same rung. 35 of 35 recovered gives the
+    /// Wilson lower bound 35 / (35 + z²) = 0.9013 ≥ 0.9; 34 of 35 gives
+    /// (p + z²/2n − z √(p(1−p)/n + z²/4n²)) / (1 + z²/n) = 0.8545 (p = 34/35) < 0.9.
+    #[test]
+    fn the_ladder_says_which_members_are_fragile_and_whether_its_safe_shock_survives() {
+        let z: f64 = 1.959_963_984_540_054;
+        let (n, p) = (35.0, 34.0 / 35.0);
+        let lower_34 =
+            (p + z * z / (2.0 * n) - z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt()) / (1.0 + z * z / n);
+        assert!((lower_34 - 0.8545).abs() < 5e-4, "{lower_34}");
+        let member = |j, mode, copies: &[Mode]| MemberCopies {
+            member: j,
+            angle_deg: Some(j as f64),
+            mode,
+            copies: copies.to_vec(),
+        };
+        let all = |copies: &[Mode]| (0..35).map(|j| member(j, Mode::Recovered, copies)).collect::<Vec<_>>();
+        let steady = [Mode::Recovered, Mode::Recovered];
+        // 3 G: every member and copy recovered. 10 G: member 7 rebounds in its second copy, and
+        // member 9 ends in dry whirl where its copies rebound (fragile, but not recovered in any
+        // run, so the rung's counts do not move).
+        let mut ten = all(&steady);
+        ten[7].copies = vec![Mode::Recovered, Mode::Rebound];
+        ten.push(member(35, Mode::DryWhirl, &[Mode::Rebound, Mode::DryWhirl]));
+        let rungs = vec![all(&steady), ten];
+        let complete = [true, true];
+        // The ladder's own answer with 35 of 35 and 35 of 36 recovered at 10 G: the test gives it
+        // as the counted modes say (10 G's 35 of 36: lower bound below 0.9, so 3 G).
+        let r = judge(&[3.0, 10.0], &complete, &rungs, 0.9, 2, Some(3.0));
+        assert_eq!((r.fragile_members, r.flipping_members), (2, 1));
+        assert_eq!(r.rungs[0].fragile, 0);
+        assert_eq!((r.rungs[1].fragile, r.rungs[1].recovered_worst, r.rungs[1].recovered_best), (2, 34, 35));
+        let flip = &r.rungs[1].fragile_members[0];
+        assert_eq!(
+            (flip.member, flip.mode, flip.copies.clone(), flip.flips_recovery),
+            (7, "recovered", vec!["recovered", "rebound"], true)
+        );
+        assert!(!r.rungs[1].fragile_members[1].flips_recovery);
+        assert!((r.rungs[0].p_lo_worst - 35.0 / (35.0 + z * z)).abs() < 1e-12);
+        assert_eq!(r.safe_up_to_g_worst, Some(3.0));
+        assert!(r.safe_survives, "3 G in the worst case as in the ladder");
+        // Without member 35 the 10 G rung is 35 of 35: safe up to 10 G in the ladder, but member
+        // 7's flip leaves 34 of 35 in the worst case: the safe shock does not survive.
+        let mut rungs = rungs;
+        rungs[1].pop();
+        let r = judge(&[3.0, 10.0], &complete, &rungs, 0.9, 2, Some(10.0));
+        assert!((r.rungs[1].p_lo_worst - lower_34).abs() < 1e-9, "{}", r.rungs[1].p_lo_worst);
+        assert_eq!((r.safe_up_to_g_worst, r.safe_up_to_g_best, r.safe_survives), (Some(3.0), Some(10.0), false));
+        let words = r.words(Some(10.0));
+        assert!(words.contains("FRAGILE members: 1 of 35 at 10 G"), "{words}");
+        assert!(words.contains("does NOT survive: 3 G in the worst case, 10 G in the best"), "{words}");
+        // An incomplete rung is safe in no case.
+        let r = judge(&[3.0, 10.0], &[false, true], &rungs, 0.9, 2, None);
+        assert_eq!((r.safe_up_to_g_worst, r.safe_up_to_g_best, r.safe_survives), (None, None, true));
+        assert!(r.words(None).contains("the highest safe shock (none) survives"));
     }
 
     /// A member ended once decided is graded as its full run: on the 10 G scene with a

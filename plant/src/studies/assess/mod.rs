@@ -65,6 +65,11 @@ pub struct AssessArgs {
     /// No progress lines.
     #[arg(long)]
     pub quiet: bool,
+    /// Repeat every counted member of the ladder N times with `plant run --robustness`'s
+    /// perturbations and say which are fragile and whether the highest safe shock survives (the
+    /// same as `[ladder] robustness = N`, which it overrides).
+    #[arg(long, value_name = "N", value_parser = crate::argument::count::<usize>("a number of perturbed runs", 0, crate::robustness::MAX_MEMBERS as u64))]
+    pub robustness: Option<usize>,
 }
 
 /// The axes a scene's loop has, by name: x then y (the planar model), x_A, y_A, x_B, y_B (the
@@ -623,6 +628,7 @@ fn mark_not_measured(report: &mut ControllerReport, parts: &[Part]) {
 pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> {
     let started = Instant::now();
     let mut a = spec::load(&args.file, &args.set, &args.laws)?;
+    a.ladder.robustness = args.robustness.unwrap_or(a.ladder.robustness);
     // A warning is said even with --quiet: it changes how the report reads.
     for w in &a.warnings {
         eprintln!("plant assess: warning: {w}");

@@ -98,6 +98,7 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
             status => format!("ladder {status}, on the members run so far: "),
         };
         parts.push(format!("{so_far}{}", safe_words(l, min_p)));
+        parts.extend(l.robustness.as_ref().map(|x| x.words(l.safe_up_to_g)));
         if let Some(rung) = l.rungs.iter().find(|x| (x.peak_g - duty_g).abs() < 1e-9) {
             let d = &rung.duty;
             parts.push(format!(

@@ -151,6 +151,7 @@ struct RawLadder {
     min_p: Option<f64>,
     duty_g: Option<f64>,
     end_when_decided: Option<bool>,
+    robustness: Option<i64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -411,6 +412,7 @@ fn ladder_settings(l: &RawLadder, parts: &[Part]) -> Result<ladder::Settings, Co
         min_p: number("ladder.min_p", l.min_p, dl.min_p, "", 0.0, 1.0)?,
         duty_g: number("ladder.duty_g", l.duty_g, default_duty.unwrap_or(dl.duty_g), "G", 0.0, 1e3)?,
         end_when_decided: l.end_when_decided.unwrap_or(dl.end_when_decided),
+        robustness: count("ladder.robustness", l.robustness, 0, 0, crate::robustness::MAX_MEMBERS as i64)?,
     };
     // The verdict's duty is that of a rung: a `duty_g` on none would leave it out silently.
     if parts.contains(&Part::Ladder) && !ladder.peaks_g.iter().any(|g| (g - ladder.duty_g).abs() < 1e-9) {

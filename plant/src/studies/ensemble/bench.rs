@@ -25,7 +25,7 @@ pub struct BenchArgs {
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Members run each way.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = crate::argument::count::<usize>("a number of members", 1, 10_000))]
     pub members: usize,
     /// Output folder (default: runs/bench-ensemble).
     #[arg(long)]

@@ -31,7 +31,7 @@ pub struct RunArgs {
     /// Ensembles: run only round R (batch R of every point not decided by its batches
     /// 0 … R−1); the earlier rounds must be complete (else exit 7). A sweep of single runs
     /// has round 0 only.
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", value_parser = crate::argument::count::<usize>("a round", 0, 10_000))]
     pub round: Option<usize>,
     /// Only merge: write the tables and charts from the units present; exits 7 listing what
     /// is missing or corrupt.

@@ -67,6 +67,9 @@ pub(super) fn section(h: &mut String, dir: &Path, r: &Report, charts: &[(String,
             }
         }
         let _ = writeln!(h, "</table>");
+        h.push_str(
+            &l.robustness.as_ref().map_or(String::new(), |x| crate::assess::ladder::robustness_html(x, l.safe_up_to_g)),
+        );
     }
     for (name, alt) in charts {
         h.push_str(&image(dir, name, alt)?);
