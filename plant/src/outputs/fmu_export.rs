@@ -108,9 +108,7 @@ mod tests {
     /// edited file in `resources/` makes another GUID.
     #[test]
     fn an_fmu_with_files_is_the_same_model_wherever_it_is_unpacked() {
-        let dir = std::env::temp_dir().join(format!("plant-fmu-files-test-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::util::scratch("fmu-files-test");
         let csv: String = std::iter::once("t_s,accel_m_s2\n".to_string())
             .chain((0..50).map(|i| format!("{},{}\n", i as f64 * 1e-4, (i as f64 * 0.1).sin() * 50.0)))
             .collect();

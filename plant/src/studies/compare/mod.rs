@@ -169,6 +169,13 @@ fn nothing_finished() -> anyhow::Error {
     Ending::Interrupted("before the first run finished; nothing was written".into()).into()
 }
 
+/// The output folder `out` made, and the overrides every run of a form starts from: the
+/// command's `sets`, no plots (the form draws its own).
+fn prepare(out: &Path, sets: &[String]) -> anyhow::Result<Vec<String>> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    Ok(sets.iter().cloned().chain(["output.plots=false".to_string()]).collect())
+}
+
 /// Runs the comparison and writes `compare.csv` and the plots into `out`.
 pub fn compare(
     scene_path: &Path,
@@ -179,8 +186,7 @@ pub fn compare(
     log: &mut dyn FnMut(&str),
     stop: &AtomicBool,
 ) -> anyhow::Result<Vec<RateRow>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let base = prepare(out, sets)?;
     let continuous = with(scene_path, &base, &["controller.mode=\"continuous\"".into()])?;
     let start = continuous.first_shock_start();
     // All traces on the same grid: the output rate of the scene.
