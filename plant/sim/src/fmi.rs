@@ -297,21 +297,21 @@ fn parameters(table: &toml::Table, planes: usize, variables: &mut Vec<Variable>)
         });
     };
     for k in ROTOR_KEYS {
-        if let Some(v) = number_at(&table, &["rotor", k.field]) {
+        if let Some(v) = number_at(table, &["rotor", k.field]) {
             param(format!("rotor.{}", k.field), v, k, "rotor: ");
         }
     }
     for (section, kinds) in [("touchdown", TOUCHDOWN_KEYS), ("contact", CONTACT_KEYS)] {
         for k in kinds {
             if planes == 1 {
-                if let Some(v) = number_at(&table, &[section, k.field]) {
+                if let Some(v) = number_at(table, &[section, k.field]) {
                     param(format!("{section}.{}", k.field), v, k, "");
                 }
                 continue;
             }
             for plane in ["a", "b"] {
-                let own = number_at(&table, &[section, plane, k.field]);
-                if let Some(v) = own.or_else(|| number_at(&table, &[section, k.field])) {
+                let own = number_at(table, &[section, plane, k.field]);
+                if let Some(v) = own.or_else(|| number_at(table, &[section, k.field])) {
                     param(format!("{section}.{plane}.{}", k.field), v, k, &format!("bearing {plane}: "));
                 }
             }

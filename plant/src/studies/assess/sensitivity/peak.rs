@@ -35,25 +35,6 @@ pub fn peak_of(points: &[Point]) -> Option<Peak> {
     Some(at(xv.exp(), yv.max(y1), spacing))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_parabola_finds_a_peak_between_points() {
-        let f0 = 50.0;
-        let pts: Vec<Point> = [49.0, 50.3, 51.6]
-            .iter()
-            .map(|f: &f64| {
-                let db = 30.0 - 400.0 * (f / f0).ln().powi(2);
-                Point { f_hz: *f, s: [0.0; 2], s_db: db, t_db: db, amplitude_v: 0.0, windows: 2, settled: true }
-            })
-            .collect();
-        let p = peak_of(&pts).expect("peak");
-        assert!((p.f_hz / f0 - 1.0).abs() < 1e-9 && (p.s_db - 30.0).abs() < 1e-9, "{p:?}");
-    }
-}
-
 impl Measure<'_> {
     /// Adds a frequency near the largest `|S|` until its neighbours are within the resolution:
     /// the vertex of the parabola through it and its neighbours (in ln f, dB) while that lies
@@ -106,5 +87,24 @@ impl Measure<'_> {
             }
         }
         self.refined += self.queue.len();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_parabola_finds_a_peak_between_points() {
+        let f0 = 50.0;
+        let pts: Vec<Point> = [49.0, 50.3, 51.6]
+            .iter()
+            .map(|f: &f64| {
+                let db = 30.0 - 400.0 * (f / f0).ln().powi(2);
+                Point { f_hz: *f, s: [0.0; 2], s_db: db, t_db: db, amplitude_v: 0.0, windows: 2, settled: true }
+            })
+            .collect();
+        let p = peak_of(&pts).expect("peak");
+        assert!((p.f_hz / f0 - 1.0).abs() < 1e-9 && (p.s_db - 30.0).abs() < 1e-9, "{p:?}");
     }
 }

@@ -67,27 +67,6 @@ pub fn decay(samples: &[(f64, f64)], speed_hz: f64) -> (f64, f64) {
     (-sxy / sxx, f_d)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_decay_of_a_damped_sine_with_an_unbalance_line() {
-        let (sigma, f) = (2.95, 47.0);
-        let s: Vec<(f64, f64)> = (0..20_000)
-            .map(|k| {
-                let t = k as f64 * 5e-5;
-                (t, 1.0 + (-sigma * t).exp() * (TAU * f * t).cos() + 0.05 * (TAU * 500.0 * t + 0.3).sin())
-            })
-            .collect();
-        let (got, fd) = decay(&s, 500.0);
-        assert!((got / sigma - 1.0).abs() < 0.05, "σ = {got}");
-        assert!((fd / f - 1.0).abs() < 0.02, "f = {fd}");
-        let grow: Vec<(f64, f64)> = s.iter().map(|(t, _)| (*t, (0.5 * t).exp() * (TAU * f * t).sin())).collect();
-        assert!(decay(&grow, 0.0).0 < 0.0);
-    }
-}
-
 impl Measure<'_> {
     /// The probe ends at `t`: the loop is stable or not, and the excitation starts (the
     /// multisine where it applies, else the stepped sine).
@@ -115,5 +94,26 @@ impl Measure<'_> {
         } else {
             self.next_step(t);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_decay_of_a_damped_sine_with_an_unbalance_line() {
+        let (sigma, f) = (2.95, 47.0);
+        let s: Vec<(f64, f64)> = (0..20_000)
+            .map(|k| {
+                let t = k as f64 * 5e-5;
+                (t, 1.0 + (-sigma * t).exp() * (TAU * f * t).cos() + 0.05 * (TAU * 500.0 * t + 0.3).sin())
+            })
+            .collect();
+        let (got, fd) = decay(&s, 500.0);
+        assert!((got / sigma - 1.0).abs() < 0.05, "σ = {got}");
+        assert!((fd / f - 1.0).abs() < 0.02, "f = {fd}");
+        let grow: Vec<(f64, f64)> = s.iter().map(|(t, _)| (*t, (0.5 * t).exp() * (TAU * f * t).sin())).collect();
+        assert!(decay(&grow, 0.0).0 < 0.0);
     }
 }
