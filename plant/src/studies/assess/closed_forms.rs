@@ -41,7 +41,7 @@ pub fn closed_form_of_plane(scene: &Scene, plane: usize) -> Option<(closed_form:
     Some((pd, axis))
 }
 
-pub(super) fn closed_form_peak(
+fn closed_form_peak(
     plant: &closed_form::AxisPlant,
     pd: &closed_form::PdLoop,
     settings: &sensitivity::Settings,
