@@ -162,52 +162,57 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             eprintln!("plant assess: report in {}", dir.join("report.html").display());
             Ok(())
         }
-        Command::Bench { what } => match what {
-            BenchCommand::Ensemble(args) => {
-                plant::ensemble::bench::bench(&args, &mut |l| eprintln!("plant bench: {l}")).map(|_| ())
-            }
-            BenchCommand::Ipc { samples, warmup, pin_cores, spin_us, controller, run_id } => {
-                bench_ipc(samples, warmup, pin_cores, spin_us, controller, run_id)
-            }
-            BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows, redraw } => {
-                let req = plant::bench::accuracy::Request {
-                    out: out.as_deref(),
-                    config: &config,
-                    repeats,
-                    quick,
-                    peer_python: peer.then_some(peer_python.as_path()),
-                    peer_rows: peer_rows.as_deref(),
-                    redraw: redraw.as_deref(),
-                };
-                bench_wrote(plant::bench::accuracy::command(&req, &mut bench_log)?)
-            }
-            BenchCommand::Models { out, redraw: Some(csv), .. } => {
-                bench_wrote([plant::bench::models::redraw(out.as_deref(), &csv)?])
-            }
-            BenchCommand::Models { out, config, repeats, redraw: None } => {
-                bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
-            }
-            BenchCommand::Tick { scene, set, repeats, out, sched } => {
-                let req = plant::bench::tick::Request {
-                    scene: &scene,
-                    set: &set,
-                    repeats,
-                    out: out.as_deref(),
-                    pin_core: sched.pin_core,
-                    realtime_priority: sched.realtime_priority,
-                };
-                bench_wrote([plant::bench::tick::command(&req, &mut bench_log)?])
-            }
-            BenchCommand::Host { rate_hz, seconds, out, sched } => {
-                let (pin_core, realtime_priority) = (sched.pin_core, sched.realtime_priority);
-                let req =
-                    plant::bench::host::Request { rate_hz, seconds, out: out.as_deref(), pin_core, realtime_priority };
-                bench_wrote([plant::bench::host::command(&req, &mut bench_log)?])
-            }
-            BenchCommand::Engineering { out, config, repeats } => {
-                bench_wrote([plant::bench::engineering::command(out.as_deref(), &config, repeats, &mut bench_log)?])
-            }
-        },
+        Command::Bench { what } => bench_cmd(what),
+    }
+}
+
+/// Runs one `plant bench` command.
+fn bench_cmd(what: BenchCommand) -> anyhow::Result<()> {
+    match what {
+        BenchCommand::Ensemble(args) => {
+            plant::ensemble::bench::bench(&args, &mut |l| eprintln!("plant bench: {l}")).map(|_| ())
+        }
+        BenchCommand::Ipc { samples, warmup, pin_cores, spin_us, controller, run_id } => {
+            bench_ipc(samples, warmup, pin_cores, spin_us, controller, run_id)
+        }
+        BenchCommand::Accuracy { out, config, repeats, quick, peer, peer_python, peer_rows, redraw } => {
+            let req = plant::bench::accuracy::Request {
+                out: out.as_deref(),
+                config: &config,
+                repeats,
+                quick,
+                peer_python: peer.then_some(peer_python.as_path()),
+                peer_rows: peer_rows.as_deref(),
+                redraw: redraw.as_deref(),
+            };
+            bench_wrote(plant::bench::accuracy::command(&req, &mut bench_log)?)
+        }
+        BenchCommand::Models { out, redraw: Some(csv), .. } => {
+            bench_wrote([plant::bench::models::redraw(out.as_deref(), &csv)?])
+        }
+        BenchCommand::Models { out, config, repeats, redraw: None } => {
+            bench_wrote([plant::bench::models::command(out.as_deref(), &config, repeats, &mut bench_log)?])
+        }
+        BenchCommand::Tick { scene, set, repeats, out, sched } => {
+            let req = plant::bench::tick::Request {
+                scene: &scene,
+                set: &set,
+                repeats,
+                out: out.as_deref(),
+                pin_core: sched.pin_core,
+                realtime_priority: sched.realtime_priority,
+            };
+            bench_wrote([plant::bench::tick::command(&req, &mut bench_log)?])
+        }
+        BenchCommand::Host { rate_hz, seconds, out, sched } => {
+            let (pin_core, realtime_priority) = (sched.pin_core, sched.realtime_priority);
+            let req =
+                plant::bench::host::Request { rate_hz, seconds, out: out.as_deref(), pin_core, realtime_priority };
+            bench_wrote([plant::bench::host::command(&req, &mut bench_log)?])
+        }
+        BenchCommand::Engineering { out, config, repeats } => {
+            bench_wrote([plant::bench::engineering::command(out.as_deref(), &config, repeats, &mut bench_log)?])
+        }
     }
 }
 

@@ -200,6 +200,134 @@ fn number_at(table: &toml::Table, path: &[&str]) -> Option<f64> {
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
 }
 
+/// The FMU's inputs (each axis' current command, starting at its bias `bias` A) and outputs,
+/// in their value references' order, for a rotor of `planes` bearing planes.
+fn signals(planes: usize, bias: &[f64]) -> Vec<Variable> {
+    let mut variables = Vec::new();
+    let axis_name = ["x", "y"];
+    for axis in 0..2 * planes {
+        let (plane, xy) = (PLANES[axis / 2], axis_name[axis % 2]);
+        variables.push(Variable {
+            name: format!("current_{xy}_{plane}"),
+            role: Role::Input(axis),
+            unit: Some("A"),
+            description: format!(
+                "coil current command of bearing {plane}, {xy} axis (as the wire carries it; held over the \
+                 step, saturated at controller.current_limit_a)"
+            ),
+            start: Some(bias[axis]),
+            min: None,
+            max: None,
+        });
+    }
+    let out = |name: String, o: Output, unit: &'static str, description: String| Variable {
+        name,
+        role: Role::Output(o),
+        unit: Some(unit),
+        description,
+        start: None,
+        min: None,
+        max: None,
+    };
+    for axis in 0..2 * planes {
+        let (plane, xy) = (PLANES[axis / 2], axis_name[axis % 2]);
+        variables.push(out(
+            format!("sensor_{xy}_{plane}"),
+            Output::Sensor(axis),
+            "V",
+            format!("sensor signal of bearing {plane}, {xy} axis, as the controller reads it"),
+        ));
+    }
+    variables.push(out("speed".into(), Output::Speed, "rad/s", "keyphasor: rotor spin speed".into()));
+    variables.push(out(
+        "angle".into(),
+        Output::Angle,
+        "rad",
+        "keyphasor: rotor angle in [0, 2 pi), 0 when the unbalance points along +x".into(),
+    ));
+    for (i, plane) in PLANES.iter().enumerate().take(planes) {
+        variables.push(out(
+            format!("rotor_x_{plane}"),
+            Output::RotorX(i),
+            "m",
+            format!("rotor x at bearing {plane} relative to the housing"),
+        ));
+        variables.push(out(
+            format!("rotor_y_{plane}"),
+            Output::RotorY(i),
+            "m",
+            format!("rotor y at bearing {plane} relative to the housing"),
+        ));
+        variables.push(out(
+            format!("radius_{plane}"),
+            Output::Radius(i),
+            "m",
+            format!("rotor radius at bearing {plane} relative to the housing"),
+        ));
+        variables.push(out(
+            format!("contact_force_{plane}"),
+            Output::ContactForce(i),
+            "N",
+            format!("rotor - race normal force at bearing {plane}"),
+        ));
+        variables.push(out(
+            format!("race_speed_{plane}"),
+            Output::RaceSpeed(i),
+            "rad/s",
+            format!("spin speed of touchdown bearing {plane}'s race"),
+        ));
+    }
+    variables.push(out("housing_x".into(), Output::HousingX, "m", "housing displacement, x".into()));
+    variables.push(out("housing_y".into(), Output::HousingY, "m", "housing displacement, y".into()));
+    variables
+}
+
+/// The scene's numeric keys of [`Kind`]s in its resolved TOML `table`, appended to `variables`
+/// as parameters (per plane on a rotor of two `planes`).
+fn parameters(table: &toml::Table, planes: usize, variables: &mut Vec<Variable>) {
+    let mut param = |key: String, start: f64, k: &Kind, context: &str| {
+        variables.push(Variable {
+            name: key.clone(),
+            role: Role::Parameter(key),
+            unit: k.unit,
+            description: format!("{context}{} (scene key)", k.what),
+            start: Some(start),
+            min: Some(k.min.min(start)),
+            max: Some(k.max.max(start)),
+        });
+    };
+    for k in ROTOR_KEYS {
+        if let Some(v) = number_at(table, &["rotor", k.field]) {
+            param(format!("rotor.{}", k.field), v, k, "rotor: ");
+        }
+    }
+    for (section, kinds) in [("touchdown", TOUCHDOWN_KEYS), ("contact", CONTACT_KEYS)] {
+        for k in kinds {
+            if planes == 1 {
+                if let Some(v) = number_at(table, &[section, k.field]) {
+                    param(format!("{section}.{}", k.field), v, k, "");
+                }
+                continue;
+            }
+            for plane in ["a", "b"] {
+                let own = number_at(table, &[section, plane, k.field]);
+                if let Some(v) = own.or_else(|| number_at(table, &[section, k.field])) {
+                    param(format!("{section}.{plane}.{}", k.field), v, k, &format!("bearing {plane}: "));
+                }
+            }
+        }
+    }
+    let shocks = table.get("shock").and_then(|s| s.as_array()).cloned().unwrap_or_default();
+    for (i, shock) in shocks.iter().enumerate() {
+        let Some(t) = shock.as_table() else { continue };
+        for k in SHOCK_KEYS {
+            if let Some(v) = number_at(t, &[k.field]) {
+                param(format!("shock[{i}].{}", k.field), v, k, &format!("shock {i}: "));
+            }
+        }
+    }
+}
+
 /// The plane words of a parameter key and the letters of the outputs.
 const PLANES: [&str; 2] = ["A", "B"];
 
@@ -207,127 +335,11 @@ impl Model {
     /// The FMU of `scene` (its parameters those of [`Kind`]s the scene has).
     pub fn of(scene: &Scene) -> Result<Self, String> {
         let planes = scene.planes();
-        let mut variables = Vec::new();
         let bias = crate::run::bias_of(scene, &crate::run::plane_gains(scene).map_err(|e| e.to_string())?);
-        let axis_name = ["x", "y"];
-        for axis in 0..2 * planes {
-            let (plane, xy) = (PLANES[axis / 2], axis_name[axis % 2]);
-            variables.push(Variable {
-                name: format!("current_{xy}_{plane}"),
-                role: Role::Input(axis),
-                unit: Some("A"),
-                description: format!(
-                    "coil current command of bearing {plane}, {xy} axis (as the wire carries it; held over the \
-                     step, saturated at controller.current_limit_a)"
-                ),
-                start: Some(bias[axis]),
-                min: None,
-                max: None,
-            });
-        }
-        let out = |name: String, o: Output, unit: &'static str, description: String| Variable {
-            name,
-            role: Role::Output(o),
-            unit: Some(unit),
-            description,
-            start: None,
-            min: None,
-            max: None,
-        };
-        for axis in 0..2 * planes {
-            let (plane, xy) = (PLANES[axis / 2], axis_name[axis % 2]);
-            variables.push(out(
-                format!("sensor_{xy}_{plane}"),
-                Output::Sensor(axis),
-                "V",
-                format!("sensor signal of bearing {plane}, {xy} axis, as the controller reads it"),
-            ));
-        }
-        variables.push(out("speed".into(), Output::Speed, "rad/s", "keyphasor: rotor spin speed".into()));
-        variables.push(out(
-            "angle".into(),
-            Output::Angle,
-            "rad",
-            "keyphasor: rotor angle in [0, 2 pi), 0 when the unbalance points along +x".into(),
-        ));
-        for (i, plane) in PLANES.iter().enumerate().take(planes) {
-            variables.push(out(
-                format!("rotor_x_{plane}"),
-                Output::RotorX(i),
-                "m",
-                format!("rotor x at bearing {plane} relative to the housing"),
-            ));
-            variables.push(out(
-                format!("rotor_y_{plane}"),
-                Output::RotorY(i),
-                "m",
-                format!("rotor y at bearing {plane} relative to the housing"),
-            ));
-            variables.push(out(
-                format!("radius_{plane}"),
-                Output::Radius(i),
-                "m",
-                format!("rotor radius at bearing {plane} relative to the housing"),
-            ));
-            variables.push(out(
-                format!("contact_force_{plane}"),
-                Output::ContactForce(i),
-                "N",
-                format!("rotor - race normal force at bearing {plane}"),
-            ));
-            variables.push(out(
-                format!("race_speed_{plane}"),
-                Output::RaceSpeed(i),
-                "rad/s",
-                format!("spin speed of touchdown bearing {plane}'s race"),
-            ));
-        }
-        variables.push(out("housing_x".into(), Output::HousingX, "m", "housing displacement, x".into()));
-        variables.push(out("housing_y".into(), Output::HousingY, "m", "housing displacement, y".into()));
-
+        let mut variables = signals(planes, &bias);
         let text = scene.to_toml().map_err(|e| e.to_string())?;
         let table: toml::Table = toml::from_str(&text).map_err(|e| e.to_string())?;
-        let mut param = |key: String, start: f64, k: &Kind, context: &str| {
-            variables.push(Variable {
-                name: key.clone(),
-                role: Role::Parameter(key),
-                unit: k.unit,
-                description: format!("{context}{} (scene key)", k.what),
-                start: Some(start),
-                min: Some(k.min.min(start)),
-                max: Some(k.max.max(start)),
-            });
-        };
-        for k in ROTOR_KEYS {
-            if let Some(v) = number_at(&table, &["rotor", k.field]) {
-                param(format!("rotor.{}", k.field), v, k, "rotor: ");
-            }
-        }
-        for (section, kinds) in [("touchdown", TOUCHDOWN_KEYS), ("contact", CONTACT_KEYS)] {
-            for k in kinds {
-                if planes == 1 {
-                    if let Some(v) = number_at(&table, &[section, k.field]) {
-                        param(format!("{section}.{}", k.field), v, k, "");
-                    }
-                    continue;
-                }
-                for plane in ["a", "b"] {
-                    let own = number_at(&table, &[section, plane, k.field]);
-                    if let Some(v) = own.or_else(|| number_at(&table, &[section, k.field])) {
-                        param(format!("{section}.{plane}.{}", k.field), v, k, &format!("bearing {plane}: "));
-                    }
-                }
-            }
-        }
-        let shocks = table.get("shock").and_then(|s| s.as_array()).cloned().unwrap_or_default();
-        for (i, shock) in shocks.iter().enumerate() {
-            let Some(t) = shock.as_table() else { continue };
-            for k in SHOCK_KEYS {
-                if let Some(v) = number_at(t, &[k.field]) {
-                    param(format!("shock[{i}].{}", k.field), v, k, &format!("shock {i}: "));
-                }
-            }
-        }
+        parameters(&table, planes, &mut variables);
         let identifier = identifier_of(&scene.name);
         let mut model = Model {
             name: scene.name.clone(),

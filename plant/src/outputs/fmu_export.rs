@@ -102,15 +102,25 @@ mod tests {
     use super::*;
     use crate::config::load_scene;
 
+    /// The files `names` of the FMU `fmu`'s `resources/` unpacked into the folder `into`.
+    fn unpack(fmu: &Path, names: &[&str], into: &Path) -> std::path::PathBuf {
+        std::fs::create_dir_all(into).unwrap();
+        let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu).unwrap()).unwrap();
+        for name in names {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut zip.by_name(&format!("resources/{name}")).unwrap(), &mut bytes).unwrap();
+            std::fs::write(into.join(name), bytes).unwrap();
+        }
+        into.to_path_buf()
+    }
+
     /// An FMU whose scene reads files (a recorded shock, a ROSS machine) carries them in
     /// `resources/`, and the scene unpacked anywhere makes the GUID written into it (it once
     /// held the staging folder's paths, and every such FMU was refused at instantiation); an
     /// edited file in `resources/` makes another GUID.
     #[test]
     fn an_fmu_with_files_is_the_same_model_wherever_it_is_unpacked() {
-        let dir = std::env::temp_dir().join(format!("plant-fmu-files-test-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::util::scratch("fmu-files-test");
         let csv: String = std::iter::once("t_s,accel_m_s2\n".to_string())
             .chain((0..50).map(|i| format!("{},{}\n", i as f64 * 1e-4, (i as f64 * 0.1).sin() * 50.0)))
             .collect();
@@ -129,14 +139,7 @@ mod tests {
         let library = dir.join("lib.so");
         std::fs::write(&library, b"not a library: package only copies it").unwrap();
         let model = package(&scene, &library, &dir.join("x.fmu"), Fmi::V2).unwrap();
-        let unpacked = dir.join("unpacked");
-        std::fs::create_dir_all(&unpacked).unwrap();
-        let mut zip = zip::ZipArchive::new(std::fs::File::open(dir.join("x.fmu")).unwrap()).unwrap();
-        for name in ["resources/scene.toml", "resources/shock-0.csv"] {
-            let mut bytes = Vec::new();
-            std::io::Read::read_to_end(&mut zip.by_name(name).unwrap(), &mut bytes).unwrap();
-            std::fs::write(unpacked.join(name.trim_start_matches("resources/")), bytes).unwrap();
-        }
+        let unpacked = unpack(&dir.join("x.fmu"), &["scene.toml", "shock-0.csv"], &dir.join("unpacked"));
         let back = Model::of(&load_fmu_scene(&unpacked, &[]).unwrap()).unwrap();
         assert_eq!(back.guid, model.guid);
         std::fs::write(unpacked.join("shock-0.csv"), csv.replace(",0\n", ",1\n")).unwrap();
@@ -155,14 +158,7 @@ mod tests {
         std::fs::write(dir.join("flex.toml"), toml::to_string(&table).unwrap()).unwrap();
         let model =
             package(&load_scene(&dir.join("flex.toml"), &[]).unwrap(), &library, &dir.join("f.fmu"), Fmi::V2).unwrap();
-        let flex = dir.join("flex");
-        std::fs::create_dir_all(&flex).unwrap();
-        let mut zip = zip::ZipArchive::new(std::fs::File::open(dir.join("f.fmu")).unwrap()).unwrap();
-        for name in ["resources/scene.toml", "resources/rotor-ross.toml"] {
-            let mut bytes = Vec::new();
-            std::io::Read::read_to_end(&mut zip.by_name(name).unwrap(), &mut bytes).unwrap();
-            std::fs::write(flex.join(name.trim_start_matches("resources/")), bytes).unwrap();
-        }
+        let flex = unpack(&dir.join("f.fmu"), &["scene.toml", "rotor-ross.toml"], &dir.join("flex"));
         std::fs::remove_file(dir.join("m.toml")).unwrap();
         let back = Model::of(&load_fmu_scene(&flex, &[]).unwrap()).unwrap();
         assert_eq!(back.guid, model.guid);

@@ -377,6 +377,11 @@ pub fn write_charts(
         draw(file, plot::orbit(&dir.join(file), &title(&what), &ox, &oy, gap(i)))?;
     }
 
+    // A chart against time (ms), its y axis `y_label`.
+    let mut time_chart = |file: &'static str, what: &str, y_label: &str, series: &[Series]| {
+        draw(file, plot::lines(&dir.join(file), &title(what), "time (ms)", y_label, series, Scale::Linear))
+    };
+
     let radius: Vec<(Vec<f64>, Vec<f64>)> = charts.iter().map(|c| c.radius_um.points()).collect();
     let gap_lines: Vec<Vec<f64>> = radius.iter().enumerate().map(|(i, (ms, _))| vec![gap(i) * 1e6; ms.len()]).collect();
     let labels: Vec<(String, String)> =
@@ -395,32 +400,12 @@ pub fn write_charts(
             });
         }
     }
-    draw(
-        "radius.png",
-        plot::lines(
-            &dir.join("radius.png"),
-            &title("rotor radius"),
-            "time (ms)",
-            "radius (µm)",
-            &series,
-            Scale::Linear,
-        ),
-    )?;
+    time_chart("radius.png", "rotor radius", "radius (µm)", &series)?;
 
     let rpm: Vec<(Vec<f64>, Vec<f64>)> = charts.iter().map(|c| c.race_rpm.points()).collect();
     let labels: Vec<String> = (0..charts.len()).map(|i| label("race speed", i)).collect();
     let series: Vec<Series> = rpm.iter().zip(&labels).map(|((x, y), l)| Series { label: l, x, y }).collect();
-    draw(
-        "race_speed.png",
-        plot::lines(
-            &dir.join("race_speed.png"),
-            &title("inner race speed"),
-            "time (ms)",
-            "speed (rpm)",
-            &series,
-            Scale::Linear,
-        ),
-    )?;
+    time_chart("race_speed.png", "inner race speed", "speed (rpm)", &series)?;
 
     let currents: Vec<[(Vec<f64>, Vec<f64>); 2]> =
         charts.iter().map(|c| [c.current_a[0].points(), c.current_a[1].points()]).collect();
@@ -432,17 +417,7 @@ pub fn write_charts(
             [Series { label: &l[0], x: &c[0].0, y: &c[0].1 }, Series { label: &l[1], x: &c[1].0, y: &c[1].1 }]
         })
         .collect();
-    draw(
-        "currents.png",
-        plot::lines(
-            &dir.join("currents.png"),
-            &title("coil currents"),
-            "time (ms)",
-            "current (A)",
-            &series,
-            Scale::Linear,
-        ),
-    )?;
+    time_chart("currents.png", "coil currents", "current (A)", &series)?;
 
     let forces: Vec<[(Vec<f64>, Vec<f64>); 2]> =
         charts.iter().map(|c| [c.force_n[0].points(), c.force_n[1].points()]).collect();
@@ -454,30 +429,15 @@ pub fn write_charts(
             series.push(Series { label: &l[k], x: &f[k].0, y: &f[k].1 });
         }
     }
-    draw(
-        "contact_force.png",
-        plot::lines(
-            &dir.join("contact_force.png"),
-            &title("rotor – race contact force"),
-            "time (ms)",
-            "force (N)",
-            &series,
-            Scale::Linear,
-        ),
-    )?;
+    time_chart("contact_force.png", "rotor – race contact force", "force (N)", &series)?;
 
     if let Some(tilt) = tilt {
         let (ms, urad) = tilt.points();
-        draw(
+        time_chart(
             "tilt.png",
-            plot::lines(
-                &dir.join("tilt.png"),
-                &title("tilt of the rotor axis |(a, b)|"),
-                "time (ms)",
-                "tilt (µrad)",
-                &[Series { label: "tilt angle", x: &ms, y: &urad }],
-                Scale::Linear,
-            ),
+            "tilt of the rotor axis |(a, b)|",
+            "tilt (µrad)",
+            &[Series { label: "tilt angle", x: &ms, y: &urad }],
         )?;
     }
     Ok(skipped)

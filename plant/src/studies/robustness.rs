@@ -221,23 +221,9 @@ pub fn judge(own: &Figures, members: &[Figures], refined: Option<(Figures, Strin
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::classify::SteadyClass;
-    use crate::status::Status;
 
     fn run(mode: Mode, force: f64, recovery_s: Option<f64>) -> Figures {
-        Figures {
-            status: Status::Completed,
-            mode,
-            steady_class: SteadyClass::Periodic,
-            period_k: Some(1),
-            recovery_s,
-            contact_fraction: 0.0,
-            whirl_hz: 0.0,
-            max_radius_m: force * 1e-8,
-            max_contact_force_n: force,
-            steady_window_start_s: 1.1,
-            wall_time_s: 0.0,
-        }
+        Figures::fixture(mode, recovery_s, 0.0, force)
     }
 
     /// One member in another mode makes the run fragile; the spreads cover the run and its

@@ -14,3 +14,13 @@ pub mod interrupt;
 pub mod outfile;
 pub mod row_file;
 pub mod table;
+
+/// A fresh folder for a test: `plant-<name>-<process id>` in the system's temporary folder,
+/// emptied and created.
+#[cfg(test)]
+pub(crate) fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("plant-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

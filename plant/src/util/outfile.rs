@@ -137,10 +137,7 @@ pub(crate) mod tests {
     use std::path::PathBuf;
 
     fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("plant-outfile-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+        crate::util::scratch(&format!("outfile-{name}"))
     }
 
     /// Every way of writing replaces a symbolic or hard link at its name and leaves what it

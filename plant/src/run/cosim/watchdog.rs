@@ -150,15 +150,21 @@ mod tests {
         std::process::Command::new("sleep").arg("30").spawn().unwrap()
     }
 
+    /// `child` watched every 5 ms against a stall of `stall`: the shared state and the watcher.
+    fn watched(child: &std::process::Child, stall: Duration) -> (Arc<Shared>, std::thread::JoinHandle<()>) {
+        let s = Arc::new(Shared::default());
+        s.pid.store(child.id(), Ordering::Relaxed);
+        let t = {
+            let s = s.clone();
+            std::thread::spawn(move || watch(&s, Duration::from_millis(5), stall))
+        };
+        (s, t)
+    }
+
     #[test]
     fn a_plant_that_stops_ticking_has_its_controller_demoted_and_one_that_ticks_does_not() {
         let mut c = busy();
-        let s = Arc::new(Shared::default());
-        s.pid.store(c.id(), Ordering::Relaxed);
-        let t = {
-            let s = s.clone();
-            std::thread::spawn(move || watch(&s, Duration::from_millis(5), Duration::from_millis(40)))
-        };
+        let (s, t) = watched(&c, Duration::from_millis(40));
         // Ticking for 200 ms (longer than the stall): nobody is demoted.
         let start = Instant::now();
         while start.elapsed() < Duration::from_millis(200) {
@@ -182,12 +188,7 @@ mod tests {
     #[test]
     fn a_controller_that_is_not_running_is_not_demoted() {
         let mut c = waiting();
-        let s = Arc::new(Shared::default());
-        s.pid.store(c.id(), Ordering::Relaxed);
-        let t = {
-            let s = s.clone();
-            std::thread::spawn(move || watch(&s, Duration::from_millis(5), Duration::from_millis(20)))
-        };
+        let (s, t) = watched(&c, Duration::from_millis(20));
         std::thread::sleep(Duration::from_millis(200));
         s.stop.store(true, Ordering::Relaxed);
         t.join().unwrap();

@@ -11,6 +11,7 @@
 use super::sensitivity::{self, Settings};
 use crate::config::Scene;
 use crate::linear::law::LinearLaw;
+use nalgebra::{Complex, DMatrix};
 use plant_physics::flex::linear::{AxisLaw, OpenLoop, PlanePd, Response, SampledLoop};
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -73,7 +74,27 @@ fn law_of(scene: &Scene) -> Option<Law> {
 pub fn closed_form_axes(scene: &Scene, settings: &Settings, speeds_hz: &[f64]) -> Option<Vec<AxisClosedForm>> {
     let open = scene.rotor.open_loop()?;
     let law = law_of(scene)?;
-    let names = super::axis_names(scene);
+    every_axis(&super::axis_names(scene), speeds_hz, settings, |speed_hz| {
+        let (response, largest_pole, stable, f_hi) = loop_at(&open, &law, speed_hz * TAU, settings);
+        let law = &law;
+        let s_at = move |f: f64| match law {
+            Law::Continuous(pd) => response.sensitivity_continuous(pd, f),
+            Law::Sampled(lp) => response.sensitivity(lp, f),
+        };
+        Some((stable, largest_pole, f_hi, s_at))
+    })
+}
+
+/// The closed forms of every axis (`names`) at each distinct speed of `speeds_hz` (Hz), from
+/// `at(speed_hz)`: the loop's stability, its largest pole, the band's top (Hz) and its `S` (all
+/// axes) at a frequency (Hz); `S` once per frequency of the grid, every axis from it. `None`
+/// where `at` has no loop at a speed.
+pub(super) fn every_axis<S: Fn(f64) -> DMatrix<Complex<f64>>>(
+    names: &[&str],
+    speeds_hz: &[f64],
+    settings: &Settings,
+    mut at: impl FnMut(f64) -> Option<(bool, f64, f64, S)>,
+) -> Option<Vec<AxisClosedForm>> {
     let mut out = Vec::new();
     let mut seen: Vec<f64> = Vec::new();
     for &speed_hz in speeds_hz {
@@ -81,12 +102,7 @@ pub fn closed_form_axes(scene: &Scene, settings: &Settings, speeds_hz: &[f64]) -
             continue;
         }
         seen.push(speed_hz);
-        let (response, largest_pole, stable, f_hi) = loop_at(&open, &law, speed_hz * TAU, settings);
-        let s_at = |f: f64| match &law {
-            Law::Continuous(pd) => response.sensitivity_continuous(pd, f),
-            Law::Sampled(lp) => response.sensitivity(lp, f),
-        };
-        // `S` once per frequency of the grid, every axis from it.
+        let (stable, largest_pole, f_hi, s_at) = at(speed_hz)?;
         let grid: Vec<f64> =
             if stable { sensitivity::log_grid(settings.f_min_hz, f_hi, GRID).into() } else { Vec::new() };
         let matrices: Vec<_> = grid.iter().map(|f| s_at(*f)).collect();

@@ -9,8 +9,14 @@
 //! A controller is the scene with `--set` overrides (a law by name with its
 //! `[controller.params]`, or a controller process by `controller.command`): the plant treats it
 //! as a black box through the same run loop every other command uses.
+//!
+//! By job: [`spec`] reads what to assess; `measure` runs one measurement (a quiet run, one axis'
+//! sensitivity, how a run failed); `parts` runs and judges each part of one controller;
+//! `closed_forms` says which closed form a scene's loop has; [`report`] writes the sections.
+//! This file holds the command: load and check everything, assess each controller, write.
 
 pub mod closed_form;
+mod closed_forms;
 pub mod coupled;
 pub mod duty;
 mod failure;
@@ -20,7 +26,9 @@ pub mod ladder;
 mod linear_check;
 pub mod loop_charts;
 pub mod margins;
+mod measure;
 mod outcome;
+mod parts;
 mod paths;
 pub mod rainflow;
 pub mod report;
@@ -29,21 +37,20 @@ pub mod spec;
 mod state_space_form;
 pub mod vibration;
 
+pub use closed_forms::{closed_form_of, closed_form_of_plane};
+pub use measure::{jobs_for, measure_axis, COSIM_JOBS};
 pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
+pub use parts::UNSTABLE_ZONE;
+use parts::{bearing, ladder_part, sensitivity_part, vibration_part};
 use paths::roots;
 pub use paths::{relative_text, relative_to, shown, shown_relative};
 
 use crate::config::{load_scene, ConfigError, ControlMode, Scene};
 use crate::cosim::Launch;
-use crate::ensemble::member::setting_overrides;
-use crate::ensemble::spec::MemberSetting;
-use crate::run::{run_into, Outcome};
+use crate::run::run_into;
 use anyhow::Context;
-use rayon::prelude::*;
 use spec::{Assessment, ControllerSpec, Part};
-use std::cell::Cell;
 use std::path::{Path, PathBuf};
-use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -81,24 +88,6 @@ pub fn axis_names(scene: &Scene) -> Vec<&'static str> {
     }
 }
 
-/// Each bearing plane's air gap (m).
-fn plane_gaps(scene: &Scene) -> Vec<f64> {
-    scene.rotor.bearings().map(|p| p.contact.gap).collect()
-}
-
-/// Each bearing plane's sensor gain (V/m).
-fn plane_sensor_gains(scene: &Scene) -> Vec<f64> {
-    scene.rotor.bearings().map(|p| p.loop_constants.sensor_gain_v_per_m).collect()
-}
-
-/// The initial offsets that put the rotor `offset_um` (µm) off on axis `axis` at its sensor:
-/// the planar model's x or y; on the two-plane rotor, a translation and a slope that move the
-/// axis' own plane's sensor by `offset_um` and leave the other plane's sensor where it was (both
-/// modes, translation and tilt, start to move).
-fn initial_offsets(scene: &Scene, axis: usize, offset_um: f64) -> Vec<String> {
-    scene.rotor.sensor_offset(axis, offset_um)
-}
-
 /// The override put before a lockstep controller's own (so that its `set` still decides):
 /// plant and controller block for each other's frame instead of busy-polling first. An
 /// assessment runs [`COSIM_JOBS`] lockstep runs at once, more processes than cores, where a
@@ -110,341 +99,6 @@ fn initial_offsets(scene: &Scene, axis: usize, offset_um: f64) -> Vec<String> {
 /// blocking waits had been slower in a loaded debug build: `cosim::session::check_silence`).
 pub const LOCKSTEP_WAIT: &str = "controller.spin_us=0.0";
 
-/// Overrides of a measurement run without shocks: the shocks moved past `duration`, the fast
-/// setting, the output at `output_hz`, no plots.
-fn quiet_run_overrides(scene: &Scene, duration: f64, output_hz: f64, substeps: u32) -> Vec<String> {
-    let mut s: Vec<String> = setting_overrides(scene, MemberSetting::Fast);
-    s.retain(|o| !o.starts_with("integrator.substeps"));
-    s.push(format!("integrator.substeps={substeps}"));
-    s.extend((0..scene.shock_count()).map(|i| format!("shock[{i}].start_s={:?}", duration + 10.0)));
-    s.push(format!("scene.duration_s={duration:?}"));
-    s.push(format!("output.rate_hz={output_hz:?}"));
-    s.push("output.plots=false".into());
-    s
-}
-
-fn run_failure(outcome: &Outcome, stop: &AtomicBool) -> Option<(Failure, String)> {
-    match outcome {
-        Outcome::Completed => None,
-        // Ctrl-C in a terminal also reaches a controller process of the same process group,
-        // which then stops: the run was interrupted, not its controller lost.
-        _ if stop.load(Ordering::Relaxed) => Some((Failure::Interrupted, "interrupted".into())),
-        Outcome::Interrupted => None,
-        Outcome::Diverged(e) => Some((Failure::Diverged, e.to_string())),
-        Outcome::PeerLost(why) => Some((Failure::PeerLost, why.clone())),
-        Outcome::MissBudget(why) | Outcome::OverrunBudget(why) => Some((Failure::PeerLost, why.clone())),
-        Outcome::InvalidCommands(why) => Some((Failure::InvalidCommands, why.clone())),
-    }
-}
-
-/// Runs of a co-simulated controller (lockstep, realtime) at once: each run is two processes
-/// that mostly wait for each other, so more runs than cores fill the gaps. Measured on the shared
-/// 2-core machine at a load average of 13 (10 000 lockstep ticks of `pd_notch` per run): 4 600
-/// ticks a second in all with 2 runs at once, 8 600 with 4, 10 400 with 8, and with 16 the
-/// plant's liveness checks of late replies piled up (p99 round trip 0.4 s, 50 times slower).
-pub const COSIM_JOBS: usize = 4;
-
-/// `f` on a pool of [`COSIM_JOBS`] threads when `scene`'s controller is a process of its own in
-/// lockstep, on rayon's global pool (one thread per core) otherwise (a realtime run needs its
-/// core: more runs at once would only miss their deadlines).
-pub fn jobs_for<R: Send>(scene: &Scene, f: impl FnOnce() -> R + Send) -> R {
-    if scene.controller.mode != ControlMode::Lockstep {
-        return f();
-    }
-    match rayon::ThreadPoolBuilder::new().num_threads(COSIM_JOBS).build() {
-        Ok(pool) => pool.install(f),
-        Err(_) => f(),
-    }
-}
-
-/// Measures the sensitivity of axis `axis` at rotor speed `speed_hz` (0: standstill).
-pub fn measure_axis(
-    scene: &Scene,
-    axis: usize,
-    speed_hz: f64,
-    settings: &sensitivity::Settings,
-    stop: &AtomicBool,
-) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
-    measure_axis_or_abandon(scene, axis, speed_hz, settings, stop, None)
-}
-
-/// [`measure_axis`], stopping early (`MeasureError::Abandoned`) once `abandon` is set.
-fn measure_axis_or_abandon(
-    scene: &Scene,
-    axis: usize,
-    speed_hz: f64,
-    settings: &sensitivity::Settings,
-    stop: &AtomicBool,
-    abandon: Option<&AtomicBool>,
-) -> Result<sensitivity::AxisResult, sensitivity::MeasureError> {
-    use sensitivity::MeasureError;
-    let continuous = scene.controller.mode == ControlMode::Continuous;
-    let period = scene.controller.period;
-    // The continuous PD reads the sine inside the derivative: steps of at most 1/20 of its period.
-    let substeps = if continuous { ((20.0 * settings.f_max_hz * period).ceil() as u32).max(1) } else { 1 };
-    let cap = sensitivity::RUN_CAP_S;
-    let mut sets = quiet_run_overrides(scene, cap, 1000.0, substeps);
-    sets.push(format!("rotor.speed_hz={speed_hz:?}"));
-    sets.extend(initial_offsets(scene, axis, settings.probe_um));
-    let run_scene = scene.reload(&sets).map_err(|e| MeasureError::Run { kind: Failure::Other, why: e.to_string() })?;
-    let touched = Rc::new(Cell::new(None));
-    let names = axis_names(scene);
-    let mut m = sensitivity::Measure::new(
-        settings.clone(),
-        axis,
-        names.get(axis).copied().unwrap_or("?"),
-        period,
-        !continuous,
-        plane_sensor_gains(scene)[axis / 2],
-        plane_gaps(scene)[axis / 2],
-        speed_hz,
-        stop,
-        touched.clone(),
-    );
-    if let Some(flag) = abandon {
-        m = m.abandon_on(flag);
-    }
-    let mut watch = sensitivity::ContactWatch { touched, gaps: plane_gaps(scene) };
-    let run = run_into(&run_scene, &Launch::default(), &mut m, &mut watch);
-    // Stopped by another axis' failure (while running or still connecting), not by Ctrl-C.
-    let abandoned = || abandon.is_some_and(|a| a.load(Ordering::Relaxed)) && !stop.load(Ordering::Relaxed);
-    let run = match run {
-        Ok(run) => run,
-        Err(crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted)) if abandoned() => {
-            return Err(MeasureError::Abandoned)
-        }
-        Err(e) => return Err(MeasureError::Run { kind: setup_failure(&e, stop), why: e.to_string() }),
-    };
-    if run.outcome == Outcome::Interrupted && abandoned() {
-        return Err(MeasureError::Abandoned);
-    }
-    if let Some((kind, why)) = run_failure(&run.outcome, stop) {
-        return Err(MeasureError::Run { kind, why });
-    }
-    m.result(run.simulated)
-}
-
-fn setup_failure(e: &crate::run::SetupError, stop: &AtomicBool) -> Failure {
-    if stop.load(Ordering::Relaxed) {
-        return Failure::Interrupted;
-    }
-    match e {
-        crate::run::SetupError::Cosim(crate::cosim::CosimError::Interrupted) => Failure::Interrupted,
-        crate::run::SetupError::Cosim(_) => Failure::PeerLost,
-        _ => Failure::Other,
-    }
-}
-
-fn measure_kind(e: &sensitivity::MeasureError) -> Failure {
-    match e {
-        sensitivity::MeasureError::Touched { .. }
-        | sensitivity::MeasureError::TouchedMulti { .. }
-        | sensitivity::MeasureError::Level { .. } => Failure::NotGradable,
-        sensitivity::MeasureError::Run { kind, .. } => *kind,
-        sensitivity::MeasureError::Abandoned => Failure::Other,
-    }
-}
-
-/// The closed form of the scene's law, where it has one (plane A's, [`closed_form_of_plane`]).
-pub fn closed_form_of(scene: &Scene) -> Option<closed_form::PdLoop> {
-    closed_form_of_plane(scene, 0).map(|(pd, _)| pd)
-}
-
-/// The closed form of bearing plane `plane`'s loop, where the law has one, with the axis it
-/// closes around: the planar model's axis; on the two-plane rotor, the plane's load share as a
-/// planar rotor, with the plane's design. That is the two-plane loop only where the rotor's
-/// modes decouple into the plane's own (the cylindrical mode of a symmetric machine); the
-/// conical mode has another modal mass, and the measured sensitivity of an axis mixes both.
-pub fn closed_form_of_plane(scene: &Scene, plane: usize) -> Option<(closed_form::PdLoop, closed_form::AxisPlant)> {
-    let params = scene.rotor.bearings().nth(plane)?;
-    if !matches!(params.amb, crate::force::amb::AmbLaw::Linear { .. }) {
-        return None;
-    }
-    let design = scene.plane_designs().into_iter().nth(plane)?;
-    let axis = closed_form::AxisPlant::of(&design.constants);
-    let c = &scene.controller;
-    // A sampled law runs in the plant whatever `controller.command` says; co-simulated, the
-    // built-in controller runs the registry's law, a command is a black box.
-    let registry = c.mode == ControlMode::Sampled || c.cosim.command.is_none();
-    let pd = if c.mode == ControlMode::Continuous {
-        let g = controller::PdGains::from_design(&design.pd(), &design.constants).ok()?;
-        closed_form::PdLoop::Continuous { kp: g.kp, kd: g.kd }
-    } else if registry {
-        // The law says whether it is a PD around levitation ([`controller::ControlLaw::linear_pd`]).
-        let g = controller::build_law(&c.law, &design, &c.params).ok()?.linear_pd()?;
-        closed_form::PdLoop::Sampled { kp: g.kp, kd: g.kd, period: c.period, delay: c.delay_samples }
-    } else {
-        return None;
-    };
-    Some((pd, axis))
-}
-
-fn closed_form_peak(
-    plant: &closed_form::AxisPlant,
-    pd: &closed_form::PdLoop,
-    settings: &sensitivity::Settings,
-) -> ClosedFormPeak {
-    let stable = closed_form::stable(plant, pd);
-    let f_hi = match pd {
-        closed_form::PdLoop::Sampled { period, .. } => settings.f_max_hz.min(0.45 / period),
-        _ => settings.f_max_hz,
-    };
-    let curve: Vec<(f64, f64)> = sensitivity::log_grid(settings.f_min_hz, f_hi, 400)
-        .into_iter()
-        .map(|f| (f, 20.0 * closed_form::sensitivity(plant, pd, f).norm().log10()))
-        .collect();
-    if !stable {
-        return ClosedFormPeak { stable, f_hz: None, s_abs: None, s_db: None, zone: "unstable".into(), curve };
-    }
-    let (f, s) = closed_form::peak(plant, pd, settings.f_min_hz, f_hi);
-    ClosedFormPeak {
-        stable,
-        f_hz: Some(f),
-        s_abs: Some(s),
-        s_db: Some(20.0 * s.log10()),
-        zone: sensitivity::zone(s).into(),
-        curve,
-    }
-}
-
-/// A sensitivity part that failed or was interrupted: how, why, and the part with the axes
-/// measured before it (none: `None`).
-type PartialSensitivity = (Failure, String, Option<Box<SensitivityPart>>);
-
-/// The sensitivity part of one controller: every axis at each speed, in parallel.
-fn sensitivity_part(
-    scene: &Scene,
-    a: &Assessment,
-    stop: &AtomicBool,
-    log: &(dyn Fn(&str) + Sync),
-) -> Result<SensitivityPart, PartialSensitivity> {
-    let speed = scene.rotor.speed() / std::f64::consts::TAU;
-    let speeds: Vec<f64> = a.speeds.iter().map(|s| if *s == spec::Speed::Rated { speed } else { 0.0 }).collect();
-    let jobs: Vec<(usize, f64)> =
-        speeds.iter().flat_map(|s| (0..axis_names(scene).len()).map(move |k| (k, *s))).collect();
-    // One axis failing fails the part: the others stop there instead of running on for nothing.
-    let abandon = AtomicBool::new(false);
-    let results: Vec<_> = jobs_for(scene, || {
-        jobs.par_iter()
-            .map(|&(k, s)| {
-                let r = measure_axis_or_abandon(scene, k, s, &a.sensitivity, stop, Some(&abandon));
-                match &r {
-                    Ok(x) => {
-                        let peak = x
-                            .peak
-                            .as_ref()
-                            .map_or(String::new(), |p| format!(", {:.2} dB at {:.2} Hz", p.s_db, p.f_hz));
-                        log(&format!("  axis {} at {:.0} Hz: zone {}{peak}", x.axis, x.speed_hz, x.zone));
-                    }
-                    Err(_) => abandon.store(true, Ordering::Relaxed),
-                }
-                r
-            })
-            .collect()
-    });
-    let mut axes = Vec::new();
-    let mut errors = Vec::new();
-    for r in results {
-        match r {
-            Ok(x) => axes.push(x),
-            Err(sensitivity::MeasureError::Abandoned) => {}
-            Err(e) => errors.push((measure_kind(&e), e.to_string())),
-        }
-    }
-    let simulated_s = axes.iter().map(|x| x.simulated_s).sum();
-    let planes = plane_gaps(scene).len();
-    let closed: Vec<Option<ClosedFormPeak>> = (0..planes)
-        .map(|i| closed_form_of_plane(scene, i).map(|(pd, axis)| closed_form_peak(&axis, &pd, &a.sensitivity)))
-        .collect();
-    let closed_form = closed.first().cloned().flatten();
-    let closed_form_planes = if scene.planes() > 1 { closed.into_iter().flatten().collect() } else { Vec::new() };
-    // A `state_space` law's closed form on any rotor (from the matrices `plant linear` writes),
-    // else the coupled one of a rotor that gives its whole open loop.
-    let state_space = state_space_form::applies(scene);
-    let mut closed_form_axes = if state_space {
-        state_space_form::closed_form_axes(scene, &a.sensitivity, &speeds)
-    } else {
-        coupled::closed_form_axes(scene, &a.sensitivity, &speeds)
-    }
-    .unwrap_or_default();
-    if state_space {
-        state_space_form::compare(&mut closed_form_axes, &axes, scene);
-    } else {
-        coupled::compare(&mut closed_form_axes, &axes, scene);
-    }
-    for f in &closed_form_axes {
-        let peak = f.s_db.map_or(String::new(), |d| format!(", {d:.2} dB at {:.2} Hz", f.f_hz.unwrap_or(f64::NAN)));
-        let diff = f.measured_difference_db.map_or(String::new(), |d| format!("; measured within {d:.2} dB"));
-        log(&format!("  closed form {} at {:.0} Hz: zone {}{peak}{diff}", f.axis, f.speed_hz, f.zone));
-    }
-    let margins = margins::of(scene, &axes);
-    let part = SensitivityPart {
-        axes,
-        closed_form,
-        closed_form_planes,
-        closed_form_axes,
-        margins,
-        simulated_s,
-        settings: a.sensitivity.clone(),
-    };
-    if let Some(worst) = errors.iter().max_by_key(|e| e.0.rank()) {
-        // The axes often fail alike (one controller command, one interruption): each reason once.
-        let mut reasons: Vec<&str> = Vec::new();
-        for (_, why) in &errors {
-            if !reasons.contains(&why.as_str()) {
-                reasons.push(why);
-            }
-        }
-        let mut why = reasons.join("; ");
-        // The axes measured before the failure are kept, and said to be all there is.
-        let kept = (!part.axes.is_empty()).then(|| Box::new(part));
-        if let Some(p) = &kept {
-            let names: Vec<String> = p.axes.iter().map(|x| format!("{} at {:.0} Hz", x.axis, x.speed_hz)).collect();
-            why.push_str(&format!(
-                "; measured before it: {} of {} axes ({})",
-                names.len(),
-                jobs.len(),
-                names.join(", ")
-            ));
-        }
-        return Err((worst.0, why, kept));
-    }
-    Ok(part)
-}
-
-/// The vibration zone of a loop the sensitivity part measured unstable: not graded.
-pub const UNSTABLE_ZONE: &str = "not graded (unstable loop)";
-
-/// The vibration part: the levitated rotor at its speed without shock.
-fn vibration_part(
-    scene: &Scene,
-    decay_per_s: Option<f64>,
-    stop: &AtomicBool,
-) -> Result<vibration::Vibration, (Failure, String)> {
-    let speed_hz = scene.rotor.speed() / std::f64::consts::TAU;
-    let settle = decay_per_s.filter(|s| *s > 0.0).map_or(1.0, |s| (1000f64.ln() / s).clamp(0.1, 5.0));
-    let window = if speed_hz > 0.0 { (50.0 / speed_hz).max(0.2) } else { 0.2 };
-    let sets = quiet_run_overrides(scene, settle + window, scene.controller.rate_hz.min(20_000.0), 1);
-    let run_scene = scene.reload(&sets).map_err(|e| (Failure::Other, e.to_string()))?;
-    let mut sink = vibration::VibrationSink::new(settle, plane_gaps(scene));
-    let run = run_into(&run_scene, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut sink)
-        .map_err(|e| (setup_failure(&e, stop), e.to_string()))?;
-    if let Some(t) = sink.touched {
-        return Err((
-            Failure::NotGradable,
-            format!("not levitated: without a shock the rotor touches the touchdown bearing at t = {t:.4} s"),
-        ));
-    }
-    if let Some(f) = run_failure(&run.outcome, stop) {
-        return Err(f);
-    }
-    if run.outcome == Outcome::Interrupted {
-        return Err((Failure::Interrupted, "interrupted".into()));
-    }
-    // The report's one current limit is plane A's.
-    Ok(sink.figures(scene.plane(0).current_limit, speed_hz, settle, window))
-}
-
 /// A co-simulated controller started once, for one tick, before anything is measured: a
 /// command that cannot run, a controller that refuses the run or speaks another protocol is
 /// found here, with the exit code `plant run` gives it (bad input: 2), instead of failing every
@@ -455,19 +109,6 @@ fn controller_starts(scene: &Scene, stop: &AtomicBool) -> anyhow::Result<()> {
     let mut trace = crate::trace::Trace::with_capacity(4);
     run_into(&one_tick, &Launch::default(), &mut crate::hooks::Cancel(stop), &mut trace)?;
     Ok(())
-}
-
-/// The bearing of a scene with the assessment's materials.
-fn bearing(scene: &Scene, a: &Assessment) -> anyhow::Result<duty::Bearing> {
-    let raw = scene.resolved()?;
-    let t = &raw.touchdown;
-    Ok(duty::Bearing::new(
-        a.materials,
-        t.ball_diameter_mm * 1e-3,
-        t.pitch_diameter_mm * 1e-3,
-        t.width_mm * 1e-3,
-        a.capacity_fraction,
-    ))
 }
 
 /// Assesses one controller.
@@ -544,60 +185,6 @@ fn assess_controller(
     report.verdict = report::verdict(&report, a.ladder.duty_g, a.ladder.min_p);
     report.wall_s = started.elapsed().as_secs_f64();
     Ok(report)
-}
-
-/// The shock ladder of one controller: none where the rotor was not levitated before the
-/// shock; a member may end once decided only where the probe measured the loop stable.
-fn ladder_part(
-    a: &Assessment,
-    c: &ControllerSpec,
-    scene: &Scene,
-    levitated: bool,
-    decay_at_speed: Option<f64>,
-    stop: &AtomicBool,
-    log: &(dyn Fn(&str) + Sync),
-) -> anyhow::Result<PartOutcome<ladder::LadderResult>> {
-    let interrupted = || stop.load(Ordering::Relaxed);
-    if !levitated {
-        let why = "not levitated before the shock (see the vibration part): no ladder".to_string();
-        return Ok(PartOutcome::failed(Failure::NotGradable, why, 0.0));
-    }
-    log(&format!("{}: shock ladder", c.label));
-    let t = Instant::now();
-    let b = bearing(scene, a)?;
-    let stable = decay_at_speed.is_some_and(|s| s > 0.0);
-    let kind = |e: &anyhow::Error| {
-        if interrupted() {
-            Failure::Interrupted
-        } else if e.chain().any(|c| c.is::<ladder::NotControlling>()) {
-            Failure::InvalidCommands
-        } else if e.chain().any(|c| c.is::<crate::run::SetupError>() || c.is::<ladder::ControllerLost>()) {
-            Failure::PeerLost
-        } else {
-            Failure::Other
-        }
-    };
-    Ok(match ladder::ladder(&a.scene, &c.sets, &a.ladder, b, stable, stop, log) {
-        Ok((l, Some(e))) => {
-            let kind = kind(&e);
-            PartOutcome {
-                status: if kind == Failure::Interrupted { "interrupted" } else { "failed" },
-                why: Some(format!("{e:#}; the rungs marked incomplete were not decided")),
-                failure: Some(kind),
-                result: Some(l),
-                wall_s: t.elapsed().as_secs_f64(),
-            }
-        }
-        Ok((l, None)) if l.interrupted => PartOutcome {
-            status: "interrupted",
-            why: Some("interrupted: the rungs marked incomplete were not decided".into()),
-            failure: Some(Failure::Interrupted),
-            result: Some(l),
-            wall_s: t.elapsed().as_secs_f64(),
-        },
-        Ok((l, None)) => PartOutcome::measured(l, t.elapsed().as_secs_f64()),
-        Err(e) => PartOutcome::failed(kind(&e), format!("{e:#}"), t.elapsed().as_secs_f64()),
-    })
 }
 
 /// An interrupted assessment: each part asked for and not reached says so.

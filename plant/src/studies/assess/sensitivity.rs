@@ -44,24 +44,28 @@
 //! points around it in (log f, dB). For a resonance of damping ratio ζ the
 //! half-power width is `2ζ f`: at 0.2 % spacing the nearest point of a peak with ζ = 0.004 is
 //! within 0.1 % of it, 0.3 dB below it, and the parabola's vertex closer.
+//!
+//! By job: this file holds the settings, the results and the measurement's state machine (the
+//! run loop's hooks); `probe` the free decay, `multisine` and `stepped` the two excitations,
+//! `peak` the refinement around the peak and the peak itself.
 
-mod decay;
 mod multisine;
 mod peak;
+mod probe;
+mod stepped;
 
-pub use decay::decay;
 pub use peak::peak_of;
+pub use probe::decay;
 
-use multisine::{Multi, MULTI_WINDOWS};
+use multisine::Multi;
+use stepped::Step;
 
 use crate::hooks::{Excitation, Hooks};
 use crate::model::SensorSine;
 use crate::run::Sink;
-use nalgebra::{Complex, SMatrix, SVector};
 use serde::Serialize;
 use std::cell::Cell;
 use std::collections::VecDeque;
-use std::f64::consts::TAU;
 use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -282,41 +286,6 @@ enum Phase {
     Done,
 }
 
-/// One tone of the multisine.
-struct Tone {
-    f_hz: f64,
-    omega: f64,
-    phase: f64,
-    /// Σ cos θ·v, Σ sin θ·v over the window.
-    rv: [f64; 2],
-    /// Σ cos²θ, Σ sin²θ.
-    d: [f64; 2],
-    /// Σ cos θ·[cos Ωt, sin Ωt], Σ sin θ·[cos Ωt, sin Ωt] (at speed).
-    b: [[f64; 2]; 2],
-    estimates: Vec<Complex<f64>>,
-    /// The estimate once two consecutive windows agreed.
-    settled: Option<Complex<f64>>,
-}
-
-/// One frequency being measured.
-struct Step {
-    f_hz: f64,
-    omega: f64,
-    amplitude: f64,
-    /// θ at the step's start and that start's time.
-    theta0: f64,
-    t0: f64,
-    /// Ticks left to settle, then ticks of the current window.
-    settle_left: u64,
-    window_ticks: u64,
-    in_window: u64,
-    /// The normal equations of the fit on `[1, cos θ, sin θ, cos Ωt, sin Ωt]` (the last two
-    /// zero at standstill), fixed-size: no allocation per tick.
-    normal: SMatrix<f64, 5, 5>,
-    rhs: SVector<f64, 5>,
-    estimates: Vec<Complex<f64>>,
-}
-
 /// The measurement as run-loop hooks: drives the excitation and reads the axis' sensor.
 pub struct Measure<'a> {
     settings: Settings,
@@ -453,279 +422,6 @@ impl<'a> Measure<'a> {
         })
     }
 
-    fn finish_probe(&mut self, t: f64) {
-        let (sigma, f_d) = decay(&self.probe, self.speed_hz);
-        self.sigma = sigma;
-        self.probe_hz = f_d;
-        if sigma.is_nan() || sigma <= 0.0 {
-            self.stable = Some(false);
-            self.note = Some(format!(
-                "the free decay from {:.1} µm does not decay: its envelope grows at {:.3} 1/s (about {:.1} Hz)",
-                self.settings.probe_um, -sigma, f_d
-            ));
-            self.phase = Phase::Done;
-            return;
-        }
-        self.stable = Some(true);
-        self.t_now = t;
-        let multi = self.discrete && self.settings.auto_level && self.settings.excitation == Signal::Multisine;
-        if multi && self.queue.len() >= 2 {
-            let tones: Vec<f64> = self.queue.drain(..).collect();
-            let a = self.settings.excitation_um.min(self.settings.response_um) * 1e-6 * self.sensor_gain
-                / (tones.len() as f64).sqrt();
-            self.start_multi(tones, a, t);
-        } else {
-            self.next_step(t);
-        }
-    }
-
-    /// Starts the multisine of `tones` (Hz, ascending), each of amplitude `amplitude` (V), at
-    /// `t`: the window holds `min_cycles` periods of the lowest tone (at speed also 4 periods of
-    /// each tone's distance from the rotation), and each tone moves to the nearest free bin of
-    /// that window (a whole number of periods in it).
-    fn start_multi(&mut self, tones: Vec<f64>, amplitude: f64, t: f64) {
-        let s = &self.settings;
-        let lowest = tones[0];
-        let mut window = s.min_cycles / lowest;
-        if self.speed_hz > 0.0 {
-            for f in &tones {
-                window = window.max(4.0 / (f - self.speed_hz).abs());
-            }
-        }
-        let ticks = (window / self.period).ceil().max(8.0) as u64;
-        let bin = 1.0 / (ticks as f64 * self.period);
-        let mut bins: Vec<u64> = Vec::with_capacity(tones.len());
-        for f in &tones {
-            let k = ((f / bin).round() as u64).max(1).max(bins.last().map_or(1, |b| b + 1));
-            let f_k = k as f64 * bin;
-            if 2 * k < ticks && !near_rotation(f_k, self.speed_hz) && f_k <= self.f_max {
-                bins.push(k);
-            }
-        }
-        let n = bins.len();
-        let tones: Vec<Tone> = bins
-            .iter()
-            .enumerate()
-            .map(|(j, k)| Tone {
-                f_hz: *k as f64 * bin,
-                omega: TAU * *k as f64 * bin,
-                // Schroeder's phases: a low crest factor.
-                phase: -std::f64::consts::PI * (j * (j + 1)) as f64 / n as f64,
-                rv: [0.0; 2],
-                d: [0.0; 2],
-                b: [[0.0; 2]; 2],
-                estimates: Vec::with_capacity(MULTI_WINDOWS as usize),
-                settled: None,
-            })
-            .collect();
-        let settle = self.settle_time(lowest);
-        self.phase = Phase::Multi(Box::new(Multi {
-            tones,
-            amplitude,
-            t0: t,
-            settle_left: (settle / self.period).ceil() as u64,
-            window_ticks: ticks,
-            in_window: 0,
-            windows: 0,
-            n: 0.0,
-            sv: 0.0,
-            su: [0.0; 2],
-            uv: [0.0; 2],
-            uu: [0.0; 3],
-            e_now: 0.0,
-            e_at: f64::NAN,
-        }));
-    }
-
-    /// One tick of the multisine.
-    fn tick_multi(&mut self, t: f64, u: f64) -> Option<Excitation> {
-        let limit_v = self.settings.limit * self.gap * self.sensor_gain;
-        let tolerance = self.settings.tolerance;
-        let at_speed = self.speed_hz > 0.0;
-        let Phase::Multi(m) = &mut self.phase else { return None };
-        let e = m.value(t);
-        if u.abs() > limit_v && t >= self.grace_until {
-            // Too strong a response: a quarter of the level, twice at most; then the stepped
-            // sine, frequency by frequency, with its own levels.
-            let floor = self.settings.excitation_um.min(self.settings.response_um) * 1e-6 * self.sensor_gain / 20.0;
-            let tones: Vec<f64> = m.tones.iter().map(|k| k.f_hz).collect();
-            let a = m.amplitude / 4.0;
-            self.grace_until = t + (self.settle_time(tones[0]) * 0.5).min(2.0);
-            if a >= floor / (tones.len() as f64).sqrt() {
-                self.start_multi(tones, a, t);
-                return self.sine();
-            }
-            self.queue.extend(tones);
-            self.theta_now = 0.0;
-            self.next_step(t);
-            return self.sine();
-        }
-        if m.settle_left > 0 {
-            m.settle_left -= 1;
-            return self.sine();
-        }
-        let rot = if at_speed {
-            let (sn, cs) = (TAU * self.speed_hz * t).sin_cos();
-            [cs, sn]
-        } else {
-            [0.0; 2]
-        };
-        m.add(t, u + e, rot);
-        if m.in_window < m.window_ticks {
-            return self.sine();
-        }
-        let fit = m.fit(at_speed);
-        m.clear();
-        m.windows += 1;
-        for (k, s_est) in m.tones.iter_mut().zip(fit) {
-            if k.settled.is_some() {
-                continue;
-            }
-            k.estimates.push(s_est);
-            let n = k.estimates.len();
-            if n >= 2 && (k.estimates[n - 1] - k.estimates[n - 2]).norm() <= tolerance * s_est.norm() {
-                k.settled = Some(s_est);
-            }
-        }
-        if m.tones.iter().all(|k| k.settled.is_some()) || m.windows >= MULTI_WINDOWS {
-            let amplitude = m.amplitude;
-            let tones = std::mem::take(&mut m.tones);
-            for k in tones {
-                match k.settled {
-                    Some(s_est) => {
-                        let tt = s_est - 1.0;
-                        self.points.push(Point {
-                            f_hz: k.f_hz,
-                            s: [s_est.re, s_est.im],
-                            s_db: 20.0 * s_est.norm().log10(),
-                            t_db: 20.0 * tt.norm().log10(),
-                            amplitude_v: amplitude,
-                            windows: k.estimates.len() as u32,
-                            settled: true,
-                        });
-                    }
-                    // Not settled in the multisine's windows: measured again on its own.
-                    None => self.queue.push_back(k.f_hz),
-                }
-            }
-            self.theta_now = 0.0;
-            self.next_step(t);
-        }
-        self.sine()
-    }
-
-    /// The amplitude (V) for frequency `f` from the points measured so far.
-    fn level(&self, f: f64) -> f64 {
-        let max = self.settings.excitation_um * 1e-6 * self.sensor_gain;
-        if !self.settings.auto_level {
-            return max;
-        }
-        let near =
-            self.points.iter().min_by(|a, b| (a.f_hz.ln() - f.ln()).abs().total_cmp(&(b.f_hz.ln() - f.ln()).abs()));
-        let t = near.map_or(1.0, |p| 10f64.powf(p.t_db / 20.0)).max(1.0);
-        max.min(self.settings.response_um * 1e-6 * self.sensor_gain / t)
-    }
-
-    fn next_step(&mut self, t: f64) {
-        if self.queue.is_empty() && self.coarse_left {
-            self.coarse_left = false;
-        }
-        if self.queue.is_empty() {
-            self.refine();
-        }
-        match self.queue.pop_front() {
-            Some(f) => {
-                let a = self.level(f);
-                self.start(f, a, t);
-            }
-            None => self.phase = Phase::Done,
-        }
-    }
-
-    /// The settling time at frequency `f_hz` (s).
-    fn settle_time(&self, f_hz: f64) -> f64 {
-        let s = &self.settings;
-        (s.settle.recip().ln() / self.sigma).clamp(2.0 / f_hz, s.max_settle_s.max(2.0 / f_hz))
-    }
-
-    fn start(&mut self, f_hz: f64, amplitude: f64, t: f64) {
-        let omega = TAU * f_hz;
-        let s = &self.settings;
-        let settle = self.settle_time(f_hz);
-        let mut window = s.min_cycles / f_hz;
-        if self.speed_hz > 0.0 {
-            window = window.max(4.0 / (f_hz - self.speed_hz).abs());
-        }
-        // A whole number of excitation periods, and whole ticks.
-        let window = (window * f_hz).ceil() / f_hz;
-        self.phase = Phase::Step(Box::new(Step {
-            f_hz,
-            omega,
-            amplitude,
-            theta0: self.theta_now,
-            t0: t,
-            settle_left: (settle / self.period).ceil() as u64,
-            window_ticks: ((window / self.period).round() as u64).max(4),
-            in_window: 0,
-            normal: SMatrix::zeros(),
-            rhs: SVector::zeros(),
-            estimates: Vec::with_capacity(6),
-        }));
-    }
-
-    /// Adds a frequency near the largest `|S|` until its neighbours are within the resolution:
-    /// the vertex of the parabola through it and its neighbours (in ln f, dB) while that lies
-    /// half a resolution or more from it, then the points one resolution either side of it. At
-    /// an end of the grid, the interval beside it is halved.
-    fn refine(&mut self) {
-        let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz.ln(), p.s_db)).collect();
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let Some(i) = (0..pts.len()).max_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1)) else { return };
-        let res = self.settings.resolution;
-        // Points added around one peak, at most: a guard, the rule ends long before.
-        if self.refined >= 64 {
-            return;
-        }
-        let add = |x: f64, me: &mut Self| {
-            let f = x.exp();
-            let clear = pts.iter().all(|p| (p.0 - x).abs() > 0.25 * res);
-            let ok = clear && !near_rotation(f, me.speed_hz) && f <= me.f_max;
-            if ok {
-                me.queue.push_back(f);
-            }
-            ok
-        };
-        if i == 0 || i + 1 == pts.len() {
-            let j = if i == 0 { 1 } else { i - 1 };
-            if let Some(n) = pts.get(j) {
-                if (n.0 - pts[i].0).abs() > res {
-                    add(0.5 * (n.0 + pts[i].0), self);
-                }
-            }
-            self.refined += self.queue.len();
-            return;
-        }
-        let ((x0, y0), (x1, y1), (x2, y2)) = (pts[i - 1], pts[i], pts[i + 1]);
-        let (left, right) = (x1 - x0, x2 - x1);
-        if left <= res * (1.0 + 1e-9) && right <= res * (1.0 + 1e-9) {
-            return;
-        }
-        let d0 = (y1 - y0) / left;
-        let d1 = (y2 - y1) / right;
-        let curv = (d1 - d0) / (x2 - x0);
-        let vertex = (curv < 0.0).then(|| (0.5 * (x0 + x1) - d0 / (2.0 * curv)).clamp(x0, x2));
-        let at_vertex = vertex.is_some_and(|xv| (xv - x1).abs() >= 0.5 * res && add(xv, self));
-        if !at_vertex {
-            if left > res * (1.0 + 1e-9) {
-                add(x1 - res.min(0.5 * left), self);
-            }
-            if right > res * (1.0 + 1e-9) {
-                add(x1 + res.min(0.5 * right), self);
-            }
-        }
-        self.refined += self.queue.len();
-    }
-
     fn tick(&mut self, t: f64, u: f64) -> Option<Excitation> {
         self.t_now = t;
         if let Phase::Probe = self.phase {
@@ -743,77 +439,7 @@ impl<'a> Measure<'a> {
         if let Phase::Multi(_) = self.phase {
             return self.tick_multi(t, u);
         }
-        let speed = self.speed_hz;
-        let limit_v = self.settings.limit * self.gap * self.sensor_gain;
-        let tolerance = self.settings.tolerance;
-        let Phase::Step(step) = &mut self.phase else { return None };
-        let theta = step.theta0 + step.omega * (t - step.t0);
-        self.theta_now = theta;
-        self.t_now = t;
-        let e = step.amplitude * theta.sin();
-        if u.abs() > limit_v && t >= self.grace_until {
-            // Too strong a response: a quarter of the level, and this frequency again.
-            let (f, a, was) = (step.f_hz, step.amplitude / 4.0, step.amplitude);
-            let floor = 1e-6 * self.settings.excitation_um * 1e-6 * self.sensor_gain;
-            if !self.settings.auto_level || a < floor {
-                self.error = Some(MeasureError::Level {
-                    axis: self.axis_name.clone(),
-                    f_hz: f,
-                    limit_um: limit_v / self.sensor_gain * 1e6,
-                    amplitude_um: was / self.sensor_gain * 1e6,
-                });
-                self.phase = Phase::Done;
-                return None;
-            }
-            self.start(f, a, t);
-            // The response decays at σ: judge it again once it has had time to come down.
-            self.grace_until = t + (self.settle_time(f) * 0.5).min(2.0);
-            return self.sine();
-        }
-        let mut done = None;
-        if step.settle_left > 0 {
-            step.settle_left -= 1;
-        } else {
-            let (w_sin, w_cos) = if speed > 0.0 { (TAU * speed * t).sin_cos() } else { (0.0, 0.0) };
-            let phi = SVector::<f64, 5>::new(1.0, theta.cos(), theta.sin(), w_cos, w_sin);
-            step.normal += phi * phi.transpose();
-            step.rhs += phi * (u + e);
-            step.in_window += 1;
-            if step.in_window >= step.window_ticks {
-                let mut normal = step.normal;
-                if speed <= 0.0 {
-                    normal[(3, 3)] = 1.0;
-                    normal[(4, 4)] = 1.0;
-                }
-                let fit = normal.lu().solve(&step.rhs);
-                let v = fit.map_or(Complex::new(f64::NAN, f64::NAN), |c| Complex::new(c[1], -c[2]));
-                let s_est = v / Complex::new(0.0, -step.amplitude);
-                step.estimates.push(s_est);
-                step.normal.fill(0.0);
-                step.rhs.fill(0.0);
-                step.in_window = 0;
-                let n = step.estimates.len();
-                let agreed =
-                    n >= 2 && (step.estimates[n - 1] - step.estimates[n - 2]).norm() <= tolerance * s_est.norm();
-                if agreed || n >= 6 {
-                    let tt = s_est - 1.0;
-                    done = Some(Point {
-                        f_hz: step.f_hz,
-                        s: [s_est.re, s_est.im],
-                        s_db: 20.0 * s_est.norm().log10(),
-                        t_db: 20.0 * tt.norm().log10(),
-                        amplitude_v: step.amplitude,
-                        windows: n as u32,
-                        settled: agreed,
-                    });
-                }
-            }
-        }
-        if let Some(point) = done {
-            self.points.push(point);
-            self.next_step(t);
-        }
-        self.sine()
+        self.tick_step(t, u)
     }
 
     /// The sine in force now, on the axis' plane (axes 0, 1: plane A's x, y; 2, 3: plane B's).

@@ -454,8 +454,7 @@ mod tests {
     /// two-plane machine with plane B's gap cut to 50 µm, 80 µm is refused (plane A's is 150).
     #[test]
     fn the_excitation_is_bounded_by_the_smallest_gap() {
-        let dir = std::env::temp_dir().join(format!("plant-assess-spec-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::util::scratch("assess-spec");
         let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
         let file = dir.join("a.toml");
         let write = |gap_b: f64| {

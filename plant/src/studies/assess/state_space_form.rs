@@ -5,7 +5,7 @@
 //! diagonal on a log grid ([`crate::linear::law::sensitivity`]), stability from the closed
 //! loop's poles (their largest modulus, [`crate::linear::law::closed_loop`]), the peaks refined.
 
-use super::coupled::{axis_form, AxisClosedForm, GRID};
+use super::coupled::{every_axis, AxisClosedForm};
 use super::sensitivity::{self, Settings};
 use crate::config::Scene;
 use crate::linear::law::{self, LinearLaw};
@@ -26,32 +26,15 @@ fn loop_at(scene: &Scene, speed_hz: f64) -> Option<(LinearLaw, crate::linear::Bu
 /// Every axis' closed form at each speed of `speeds_hz` (Hz); `None` where the law has no
 /// linear form or the plant no linear model.
 pub fn closed_form_axes(scene: &Scene, settings: &Settings, speeds_hz: &[f64]) -> Option<Vec<AxisClosedForm>> {
-    let names = super::axis_names(scene);
-    let mut out = Vec::new();
-    let mut seen: Vec<f64> = Vec::new();
-    for &speed_hz in speeds_hz {
-        if seen.contains(&speed_hz) {
-            continue;
-        }
-        seen.push(speed_hz);
+    every_axis(&super::axis_names(scene), speeds_hz, settings, |speed_hz| {
         let (law, built) = loop_at(scene, speed_hz)?;
         let LinearLaw::StateSpace { system, period } = &law else { return None };
-        let (plant_c, plant_d) = (&built.plant.system, &built.discrete.0);
-        let a = law::closed_loop(plant_d, system)?;
+        let a = law::closed_loop(&built.discrete.0, system)?;
         let largest_pole = a.complex_eigenvalues().iter().map(|p| p.norm()).fold(0.0, f64::max);
-        let stable = largest_pole < 1.0;
         let f_hi = settings.f_max_hz.min(0.45 / period);
-        let s_at = |f: f64| law::sensitivity(&law, plant_c, plant_d, f);
-        let grid: Vec<f64> =
-            if stable { sensitivity::log_grid(settings.f_min_hz, f_hi, GRID).into() } else { Vec::new() };
-        let matrices: Vec<_> = grid.iter().map(|f| s_at(*f)).collect();
-        for (k, name) in names.iter().enumerate() {
-            let s_kk = |f: f64| s_at(f)[(k, k)].norm();
-            let values: Vec<f64> = matrices.iter().map(|m| m[(k, k)].norm()).collect();
-            out.push(axis_form(name, speed_hz, stable, largest_pole, &grid, &values, &s_kk));
-        }
-    }
-    Some(out)
+        let s_at = move |f: f64| law::sensitivity(&law, &built.plant.system, &built.discrete.0, f);
+        Some((largest_pole < 1.0, largest_pole, f_hi, s_at))
+    })
 }
 
 /// Fills each closed form's `measured_difference_db` from the measured axes.

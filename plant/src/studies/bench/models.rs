@@ -120,34 +120,14 @@ pub fn models(
         let full_trace = accurate(&full)?.trace;
         // The scene's own integrator for the cost.
         let full_cost = measure(&full, repeats)?.best_wall / full.duration;
-        rows.push(ModelRow {
-            scene: b.name.into(),
-            variant: "full".into(),
-            err_rms: 0.0,
-            err_max: 0.0,
-            wall_s_per_sim_s: full_cost,
-            speedup: 1.0,
-        });
+        rows.push(reference_row(b.name, "full", full_cost));
         for v in VARIANTS {
             let mut sets: Vec<&str> = FULL.to_vec();
             sets.extend_from_slice(v.sets);
             let scene = overridden(&b, &sets)?;
-            let (rms, max) = window_error(&accurate(&scene)?.trace, &full_trace, t0, t1, gap);
+            let error = window_error(&accurate(&scene)?.trace, &full_trace, t0, t1, gap);
             let cost = measure(&scene, repeats)?.best_wall / scene.duration;
-            log(&format!(
-                "{}: {}: error rms {rms:.2e} max {max:.2e}, speed-up {:.2}",
-                b.name,
-                v.name,
-                full_cost / cost
-            ));
-            rows.push(ModelRow {
-                scene: b.name.into(),
-                variant: v.name.into(),
-                err_rms: rms,
-                err_max: max,
-                wall_s_per_sim_s: cost,
-                speedup: full_cost / cost,
-            });
+            rows.push(variant_row(b.name, v.name, error, cost, full_cost, log));
         }
     }
     for b in super::scenes(config_dir)? {
@@ -188,6 +168,40 @@ fn charts(out: &Path, rows: &[ModelRow]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The row of a reference model (no error against itself, speed-up 1) of wall `cost` s per
+/// simulated second.
+fn reference_row(scene: &str, variant: &str, cost: f64) -> ModelRow {
+    ModelRow {
+        scene: scene.into(),
+        variant: variant.into(),
+        err_rms: 0.0,
+        err_max: 0.0,
+        wall_s_per_sim_s: cost,
+        speedup: 1.0,
+    }
+}
+
+/// The row of a variant with its error `(rms, max)` against the reference, of wall `cost` s per
+/// simulated second against the reference's `reference_cost`; said in the log.
+fn variant_row(
+    scene: &str,
+    variant: &str,
+    (rms, max): (f64, f64),
+    cost: f64,
+    reference_cost: f64,
+    log: &mut dyn FnMut(&str),
+) -> ModelRow {
+    log(&format!("{scene}: {variant}: error rms {rms:.2e} max {max:.2e}, speed-up {:.2}", reference_cost / cost));
+    ModelRow {
+        scene: scene.into(),
+        variant: variant.into(),
+        err_rms: rms,
+        err_max: max,
+        wall_s_per_sim_s: cost,
+        speedup: reference_cost / cost,
+    }
+}
+
 /// The rows of [`TWO_PLANE_VARIANTS`] on one bench scene: each against the planar study model
 /// (`planar study model`, speed-up 1), both run accurately for the error; the error is the
 /// larger of the two planes'.
@@ -197,32 +211,17 @@ fn second_plane(b: &BenchScene, repeats: usize, log: &mut dyn FnMut(&str)) -> an
     let planar = overridden(b, STUDY)?;
     let reference = accurate(&planar)?.trace;
     let planar_cost = measure(&planar, repeats)?.best_wall / planar.duration;
-    let mut rows = vec![ModelRow {
-        scene: b.name.into(),
-        variant: "planar study model".into(),
-        err_rms: 0.0,
-        err_max: 0.0,
-        wall_s_per_sim_s: planar_cost,
-        speedup: 1.0,
-    }];
+    let mut rows = vec![reference_row(b.name, "planar study model", planar_cost)];
     for v in TWO_PLANE_VARIANTS {
         let sets: Vec<&str> = STUDY.iter().chain(SYMMETRIC_TWO_PLANE).chain(v.sets).copied().collect();
         let scene = overridden(b, &sets)?;
         let trace = accurate(&scene)?.trace;
-        let (rms, max) = (0..2).fold((0.0f64, 0.0f64), |(rms, max), i| {
+        let error = (0..2).fold((0.0f64, 0.0f64), |(rms, max), i| {
             let (r, m) = window_error(&trace.plane(i), &reference, t0, t1, gap);
             (rms.max(r), max.max(m))
         });
         let cost = measure(&scene, repeats)?.best_wall / scene.duration;
-        log(&format!("{}: {}: error rms {rms:.2e} max {max:.2e}, speed-up {:.2}", b.name, v.name, planar_cost / cost));
-        rows.push(ModelRow {
-            scene: b.name.into(),
-            variant: v.name.into(),
-            err_rms: rms,
-            err_max: max,
-            wall_s_per_sim_s: cost,
-            speedup: planar_cost / cost,
-        });
+        rows.push(variant_row(b.name, v.name, error, cost, planar_cost, log));
     }
     Ok(rows)
 }

@@ -48,8 +48,7 @@ pub fn compare_laws(
     log: &mut dyn FnMut(&str),
     stop: &AtomicBool,
 ) -> anyhow::Result<Vec<LawRow>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let base = prepare(out, sets)?;
     let mut rows = Vec::new();
     let mut runs: Vec<(String, RunResult)> = Vec::new();
     let mut probe = None;

@@ -37,8 +37,7 @@ pub fn stability_maps(
     log: &mut dyn FnMut(&str),
     stop: &AtomicBool,
 ) -> anyhow::Result<Vec<MapPoint>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
+    let base = prepare(out, sets)?;
     let probe = with(scene_path, &base, &[])?;
     let shocks = probe.shock_count();
     let mut points = Vec::new();

@@ -238,26 +238,12 @@ pub fn write(out: &Path, runs: &[Answered]) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::classify::SteadyClass;
     use crate::ensemble::member::Figures;
     use crate::grid::Mode;
     use crate::robustness::judge;
-    use crate::status::Status;
 
     fn run(mode: Mode, force: f64) -> Figures {
-        Figures {
-            status: Status::Completed,
-            mode,
-            steady_class: SteadyClass::Periodic,
-            period_k: Some(1),
-            recovery_s: if mode == Mode::Recovered { Some(0.1) } else { None },
-            contact_fraction: 0.0,
-            whirl_hz: 0.0,
-            max_radius_m: force * 1e-8,
-            max_contact_force_n: force,
-            steady_window_start_s: 1.1,
-            wall_time_s: 0.0,
-        }
+        Figures::fixture(mode, if mode == Mode::Recovered { Some(0.1) } else { None }, 0.0, force)
     }
 
     fn answered(name: &str, own: Figures, members: &[Figures], refined: Option<Figures>) -> Answered {

@@ -124,6 +124,27 @@ impl Figures {
     }
 }
 
+#[cfg(test)]
+impl Figures {
+    /// A completed, periodic (k = 1) member in `mode` for the tests: its recovery time, contact
+    /// fraction and peak contact force (N) as given, its largest radius `force` × 1e-8 m.
+    pub(crate) fn fixture(mode: Mode, recovery_s: Option<f64>, contact_fraction: f64, force: f64) -> Self {
+        Figures {
+            status: Status::Completed,
+            mode,
+            steady_class: SteadyClass::Periodic,
+            period_k: Some(1),
+            recovery_s,
+            contact_fraction,
+            whirl_hz: 0.0,
+            max_radius_m: force * 1e-8,
+            max_contact_force_n: force,
+            steady_window_start_s: 1.1,
+            wall_time_s: 0.0,
+        }
+    }
+}
+
 /// `--set` overrides of the members' setting for a point's scene (empty for `scene`).
 pub fn setting_overrides(scene: &Scene, setting: MemberSetting) -> Vec<String> {
     match setting {
@@ -276,19 +297,7 @@ mod tests {
     use super::*;
 
     fn figures(mode: Mode, recovery_s: Option<f64>, contact_fraction: f64) -> Figures {
-        Figures {
-            status: Status::Completed,
-            mode,
-            steady_class: SteadyClass::Periodic,
-            period_k: Some(1),
-            recovery_s,
-            contact_fraction,
-            whirl_hz: 0.0,
-            max_radius_m: 0.0,
-            max_contact_force_n: 0.0,
-            steady_window_start_s: 1.1,
-            wall_time_s: 0.0,
-        }
+        Figures::fixture(mode, recovery_s, contact_fraction, 0.0)
     }
 
     #[test]

@@ -127,9 +127,9 @@ pub fn sweep_thresholds(grid: &Grid, stats: &[PointStats]) -> Vec<Threshold> {
     };
     order.sort_by(|a, b| x_of(*a).total_cmp(&x_of(*b)));
     let x: Vec<f64> = order.iter().map(|&i| x_of(i)).collect();
-    let p: Vec<f64> = order.iter().map(|&i| stats[i].p_recovered).collect();
-    let lo: Vec<f64> = order.iter().map(|&i| stats[i].p_lo).collect();
-    let hi: Vec<f64> = order.iter().map(|&i| stats[i].p_hi).collect();
+    let p: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_recovered).collect();
+    let lo: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_lo).collect();
+    let hi: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_hi).collect();
     let back = |v: f64| if log { 10f64.powf(v) } else { v };
     thresholds(&x, &p, &lo, &hi)
         .into_iter()
@@ -171,7 +171,7 @@ pub fn write_ensemble(
         thresholds,
         sensitive_share: sensitive.len() as f64 / stats.len().max(1) as f64,
         numerically_sensitive_points: sensitive,
-        members_run: stats.iter().map(|s| s.members).sum(),
+        members_run: stats.iter().map(|s| s.tally.members).sum(),
         members_verified: stats.iter().map(|s| s.verified).sum(),
     };
     let json_name = if grid.kind == Kind::Ensemble { "ensemble.json" } else { "sweep.json" };
@@ -290,16 +290,16 @@ fn write_points(
         }
         row.extend(
             EnsembleFields {
-                members: s.members.to_string(),
-                recovered: s.recovered.to_string(),
-                dry_whirl: s.dry_whirl.to_string(),
-                rebound: s.rebound.to_string(),
-                diverged: s.diverged.to_string(),
-                p_recovered: e(s.p_recovered),
-                p_lo: e(s.p_lo),
-                p_hi: e(s.p_hi),
-                recovery_median_s: opt(s.recovery_median_s),
-                recovery_p90_s: opt(s.recovery_p90_s),
+                members: s.tally.members.to_string(),
+                recovered: s.tally.recovered.to_string(),
+                dry_whirl: s.tally.dry_whirl.to_string(),
+                rebound: s.tally.rebound.to_string(),
+                diverged: s.tally.diverged.to_string(),
+                p_recovered: e(s.tally.p_recovered),
+                p_lo: e(s.tally.p_lo),
+                p_hi: e(s.tally.p_hi),
+                recovery_median_s: opt(s.tally.recovery_median_s),
+                recovery_p90_s: opt(s.tally.recovery_p90_s),
                 worst_contact_force_n: e(s.worst_contact_force_n),
                 verified: s.verified.to_string(),
                 numerically_sensitive: s.numerically_sensitive.to_string(),

@@ -13,7 +13,7 @@ use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
-use crate::ensemble::tally::tally;
+use crate::ensemble::tally::{tally, Tally};
 use crate::grid::{Mode, Progress};
 use crate::status::Status;
 use serde::Serialize;
@@ -61,26 +61,9 @@ pub fn progress(spec: &EnsembleSpec, present: &BTreeMap<usize, bool>) -> Progres
 pub struct PointStats {
     /// Point index.
     pub index: usize,
-    /// Members counted.
-    pub members: usize,
-    /// Members recovered.
-    pub recovered: usize,
-    /// Members in dry whirl.
-    pub dry_whirl: usize,
-    /// Members rebounding.
-    pub rebound: usize,
-    /// Members whose run diverged (also at the reference setting).
-    pub diverged: usize,
-    /// Recovered share.
-    pub p_recovered: f64,
-    /// Wilson 95 % interval, lower end.
-    pub p_lo: f64,
-    /// Wilson 95 % interval, upper end.
-    pub p_hi: f64,
-    /// Median recovery time of the recovered members (s).
-    pub recovery_median_s: Option<f64>,
-    /// 90th percentile of the recovery times of the recovered members (s).
-    pub recovery_p90_s: Option<f64>,
+    /// The counted members' modes and recovery statistics.
+    #[serde(flatten)]
+    pub tally: Tally,
     /// Largest peak contact force of all members (N).
     pub worst_contact_force_n: f64,
     /// Members re-run at the reference setting.
@@ -137,16 +120,7 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedB
     let max = |f: fn(&MemberResult) -> f64| members.iter().map(|m| f(m)).filter(|v| v.is_finite()).fold(0.0, f64::max);
     PointStats {
         index,
-        members: t.members,
-        recovered: t.recovered,
-        dry_whirl: t.dry_whirl,
-        rebound: t.rebound,
-        diverged: t.diverged,
-        p_recovered: t.p_recovered,
-        p_lo: t.p_lo,
-        p_hi: t.p_hi,
-        recovery_median_s: t.recovery_median_s,
-        recovery_p90_s: t.recovery_p90_s,
+        tally: t,
         worst_contact_force_n: max(|m| m.counted().max_contact_force_n),
         verified,
         numerically_sensitive,

@@ -29,7 +29,9 @@
 //! rotor does not see and is left out too.
 
 use crate::config::{Rotor, Scene};
+use crate::sensor::LowPass;
 use nalgebra::DMatrix;
+use plant_physics::amplifier::Amplifier;
 use serde::Serialize;
 use std::f64::consts::{SQRT_2, TAU};
 
@@ -144,7 +146,7 @@ pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearErr
         return Err(LinearError::Speed(speed_hz));
     }
     let omega = TAU * speed_hz;
-    let mech = mechanics(&scene.rotor, omega);
+    let mut mech = mechanics(&scene.rotor, omega);
     let names = axis_names(&scene.rotor);
     let m = names.len();
     let plane_of = |k: usize| k / 2;
@@ -165,134 +167,38 @@ pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearErr
     // A unipolar drive about its bias, both magnets conducting and neither amplifier limited:
     // the differential current `(i₊ − i₋)/2` obeys the bipolar coil's equation with each
     // magnet's share of the back-EMF, `k_b/2` (MODEL.md §12.3; tests/tests/unipolar.rs runs it).
-    let amp = |k: usize| {
-        hw.amplifiers[plane_of(k)].map(|mut a| {
-            if hw.unipolar[plane_of(k)].is_some() {
-                a.back_emf *= 0.5;
-            }
-            a
+    let amps: Vec<Option<Amplifier>> = (0..m)
+        .map(|k| {
+            hw.amplifiers[plane_of(k)].map(|mut a| {
+                if hw.unipolar[plane_of(k)].is_some() {
+                    a.back_emf *= 0.5;
+                }
+                a
+            })
         })
-    };
-    let amplified: Vec<usize> = (0..m).filter(|&k| amp(k).is_some()).collect();
+        .collect();
+    let amplified: Vec<usize> = (0..m).filter(|&k| amps[k].is_some()).collect();
     let filter = hw.front_end.low_pass;
     let filter_states = match filter {
         None => 0,
-        Some(crate::sensor::LowPass::First { .. }) => 1,
-        Some(crate::sensor::LowPass::Second { .. }) => 2,
+        Some(LowPass::First { .. }) => 1,
+        Some(LowPass::Second { .. }) => 2,
     };
     let nm = mech.a.nrows();
-    let (i0, q0, z0) = (nm, nm + amplified.len(), nm + 2 * amplified.len());
-    let n = z0 + filter_states * m;
+    let n = nm + 2 * amplified.len() + filter_states * m;
     let mut a = DMatrix::zeros(n, n);
     let mut b = DMatrix::zeros(n, m);
     let mut c = DMatrix::zeros(m, n);
-    let mut states = mech.states;
+    let mut states = std::mem::take(&mut mech.states);
     a.view_mut((0, 0), (nm, nm)).copy_from(&mech.a);
-    // The current each axis' bearing sees: the coil's, or the command itself.
-    for k in 0..m {
-        match amplified.iter().position(|&j| j == k) {
-            None => {
-                for r in 0..nm {
-                    b[(r, k)] += mech.b[(r, k)];
-                }
-            }
-            Some(slot) => {
-                let (ci, cq) = (i0 + slot, q0 + slot);
-                for r in 0..nm {
-                    a[(r, ci)] += mech.b[(r, k)];
-                }
-                let p = amp(k).expect("amplified axis");
-                let l = p.inductance;
-                // L i̇ = K_p (r − i) + q − R i − k_b v_a;  q̇ = K_I (r − i).
-                a[(ci, ci)] = -(p.kp + p.resistance) / l;
-                a[(ci, cq)] = 1.0 / l;
-                b[(ci, k)] = p.kp / l;
-                let half = nm / 2;
-                for col in 0..half {
-                    // v_a: the actuator's displacement row on the rates.
-                    a[(ci, half + col)] -= p.back_emf / l * mech.actuator[(k, col)];
-                }
-                a[(cq, ci)] = -p.ki;
-                b[(cq, k)] = p.ki;
-            }
-        }
+    couple_coils(&mut a, &mut b, &mech, &amps, &amplified);
+    if let Some(part) = coil_signals(&mut states, &names, &amps, &amplified, hw.is_unipolar()) {
+        parts.push(part);
     }
-    for &k in &amplified {
-        states.push(Signal::new(format!("i_{}", names[k]), "A", format!("coil current of axis {}", names[k])));
-    }
-    for &k in &amplified {
-        states.push(Signal::new(
-            format!("q_{}", names[k]),
-            "V",
-            format!("integral of the current loop's PI, axis {}", names[k]),
-        ));
-    }
-    if !amplified.is_empty() {
-        let p = amp(amplified[0]).expect("amplified axis");
-        let unipolar = if hw.is_unipolar() {
-            " (unipolar: the differential current about the bias, each magnet's k_b/2)"
-        } else {
-            ""
-        };
-        parts.push(format!(
-            "amplifier and coil of {} axes{unipolar}: PI current loop (bandwidth {:.6} Hz), coil L = {} H, R = {} ohm, \
-             back-EMF k_b = {} V s/m; its voltage limit left out",
-            amplified.len(),
-            p.bandwidth / TAU,
-            p.inductance,
-            p.resistance,
-            p.back_emf
-        ));
-    }
-    let gain = |k: usize| scene.plane(plane_of(k)).loop_constants.sensor_gain_v_per_m;
-    match filter {
-        None => {
-            for k in 0..m {
-                for col in 0..nm {
-                    c[(k, col)] = gain(k) * mech.sensor[(k, col)];
-                }
-            }
-        }
-        Some(lp) => {
-            let w = lp.corner();
-            for k in 0..m {
-                let z = z0 + k;
-                c[(k, z)] = gain(k);
-                match lp {
-                    crate::sensor::LowPass::First { .. } => {
-                        a[(z, z)] = -w;
-                        for col in 0..nm {
-                            a[(z, col)] += w * mech.sensor[(k, col)];
-                        }
-                    }
-                    crate::sensor::LowPass::Second { .. } => {
-                        let zr = z0 + m + k;
-                        a[(z, zr)] = 1.0;
-                        a[(zr, z)] = -w * w;
-                        a[(zr, zr)] = -SQRT_2 * w;
-                        for col in 0..nm {
-                            a[(zr, col)] += w * w * mech.sensor[(k, col)];
-                        }
-                    }
-                }
-            }
-            for name in &names {
-                states.push(Signal::new(format!("z_{name}"), "m", format!("sensor filter output, axis {name}")));
-            }
-            if filter_states == 2 {
-                for name in &names {
-                    states.push(Signal::new(
-                        format!("zdot_{name}"),
-                        "m/s",
-                        format!("sensor filter output's rate, axis {name}"),
-                    ));
-                }
-            }
-            parts.push(format!(
-                "sensor low-pass of order {filter_states}, corner {:.6} Hz; the range, noise, ADC and runout left out",
-                w / TAU
-            ));
-        }
+    let gains: Vec<f64> = (0..m).map(|k| scene.plane(plane_of(k)).loop_constants.sensor_gain_v_per_m).collect();
+    let z0 = nm + 2 * amplified.len();
+    if let Some(part) = sense(&mut a, &mut c, &mut states, &mech, filter, &gains, &names, z0) {
+        parts.push(part);
     }
     let inputs = names
         .iter()
@@ -318,6 +224,145 @@ pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearErr
         outputs,
         parts,
     })
+}
+
+/// The current each axis' bearing sees: the coil's (its PI current loop's two states, current
+/// from `nm` and integral after them, in the order of `amplified`), or the command itself.
+fn couple_coils(
+    a: &mut DMatrix<f64>,
+    b: &mut DMatrix<f64>,
+    mech: &Mechanics,
+    amps: &[Option<Amplifier>],
+    amplified: &[usize],
+) {
+    let nm = mech.a.nrows();
+    let (i0, q0) = (nm, nm + amplified.len());
+    for (k, amp) in amps.iter().enumerate() {
+        match amplified.iter().position(|&j| j == k) {
+            None => {
+                for r in 0..nm {
+                    b[(r, k)] += mech.b[(r, k)];
+                }
+            }
+            Some(slot) => {
+                let (ci, cq) = (i0 + slot, q0 + slot);
+                for r in 0..nm {
+                    a[(r, ci)] += mech.b[(r, k)];
+                }
+                let p = amp.expect("amplified axis");
+                let l = p.inductance;
+                // L i̇ = K_p (r − i) + q − R i − k_b v_a;  q̇ = K_I (r − i).
+                a[(ci, ci)] = -(p.kp + p.resistance) / l;
+                a[(ci, cq)] = 1.0 / l;
+                b[(ci, k)] = p.kp / l;
+                let half = nm / 2;
+                for col in 0..half {
+                    // v_a: the actuator's displacement row on the rates.
+                    a[(ci, half + col)] -= p.back_emf / l * mech.actuator[(k, col)];
+                }
+                a[(cq, ci)] = -p.ki;
+                b[(cq, k)] = p.ki;
+            }
+        }
+    }
+}
+
+/// The coils' states appended to `states`, and the model's part they make (none without one).
+fn coil_signals(
+    states: &mut Vec<Signal>,
+    names: &[&str],
+    amps: &[Option<Amplifier>],
+    amplified: &[usize],
+    unipolar: bool,
+) -> Option<String> {
+    for &k in amplified {
+        states.push(Signal::new(format!("i_{}", names[k]), "A", format!("coil current of axis {}", names[k])));
+    }
+    for &k in amplified {
+        states.push(Signal::new(
+            format!("q_{}", names[k]),
+            "V",
+            format!("integral of the current loop's PI, axis {}", names[k]),
+        ));
+    }
+    let p = amps[*amplified.first()?].expect("amplified axis");
+    let unipolar =
+        if unipolar { " (unipolar: the differential current about the bias, each magnet's k_b/2)" } else { "" };
+    Some(format!(
+        "amplifier and coil of {} axes{unipolar}: PI current loop (bandwidth {:.6} Hz), coil L = {} H, R = {} ohm, \
+         back-EMF k_b = {} V s/m; its voltage limit left out",
+        amplified.len(),
+        p.bandwidth / TAU,
+        p.inductance,
+        p.resistance,
+        p.back_emf
+    ))
+}
+
+/// What each axis' sensor reads (`gains` V/m): the displacement, or the low-pass's output from
+/// state `z0` on (its states appended to `states`); the model's part the filter makes.
+#[allow(clippy::too_many_arguments)] // the assembly's parts, each a different one
+fn sense(
+    a: &mut DMatrix<f64>,
+    c: &mut DMatrix<f64>,
+    states: &mut Vec<Signal>,
+    mech: &Mechanics,
+    filter: Option<LowPass>,
+    gains: &[f64],
+    names: &[&str],
+    z0: usize,
+) -> Option<String> {
+    let (m, nm) = (names.len(), mech.a.nrows());
+    let Some(lp) = filter else {
+        for k in 0..m {
+            for col in 0..nm {
+                c[(k, col)] = gains[k] * mech.sensor[(k, col)];
+            }
+        }
+        return None;
+    };
+    let w = lp.corner();
+    for k in 0..m {
+        let z = z0 + k;
+        c[(k, z)] = gains[k];
+        match lp {
+            LowPass::First { .. } => {
+                a[(z, z)] = -w;
+                for col in 0..nm {
+                    a[(z, col)] += w * mech.sensor[(k, col)];
+                }
+            }
+            LowPass::Second { .. } => {
+                let zr = z0 + m + k;
+                a[(z, zr)] = 1.0;
+                a[(zr, z)] = -w * w;
+                a[(zr, zr)] = -SQRT_2 * w;
+                for col in 0..nm {
+                    a[(zr, col)] += w * w * mech.sensor[(k, col)];
+                }
+            }
+        }
+    }
+    for name in names {
+        states.push(Signal::new(format!("z_{name}"), "m", format!("sensor filter output, axis {name}")));
+    }
+    let order = match lp {
+        LowPass::First { .. } => 1,
+        LowPass::Second { .. } => {
+            for name in names {
+                states.push(Signal::new(
+                    format!("zdot_{name}"),
+                    "m/s",
+                    format!("sensor filter output's rate, axis {name}"),
+                ));
+            }
+            2
+        }
+    };
+    Some(format!(
+        "sensor low-pass of order {order}, corner {:.6} Hz; the range, noise, ADC and runout left out",
+        w / TAU
+    ))
 }
 
 /// The rotor's mechanics at spin speed `omega` (rad/s).

@@ -479,8 +479,7 @@ mod tests {
     /// gap for the whole rotor).
     #[test]
     fn each_plane_is_clear_within_its_own_gap() {
-        let dir = std::env::temp_dir().join(format!("plant-soak-gaps-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::util::scratch("soak-gaps");
         let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/two-plane-asymmetric-10g.toml");
         let file = dir.join("p.toml");
         std::fs::write(

@@ -256,8 +256,7 @@ mod tests {
 
     #[test]
     fn a_row_file_holds_its_header_at_once_and_whole_rows_only() {
-        let dir = std::env::temp_dir().join(format!("plant-rowfile-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::util::scratch("rowfile");
         let path = dir.join("x.csv");
         let mut f = RowFile::create(&path, &["a", "b"]).unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "a,b\n");

@@ -1,6 +1,7 @@
-//! Peak finding: the peak of `|S|` between the measured frequencies.
+//! Peak finding: frequencies added around the largest `|S|` until the resolution is reached,
+//! and the peak of `|S|` between the measured frequencies.
 
-use super::{Peak, Point};
+use super::{near_rotation, Measure, Peak, Point};
 
 /// The peak of `|S|` over the points (sorted by frequency): the vertex of the parabola through
 /// the largest and its neighbours in (ln f, dB), or the largest point itself at an end.
@@ -32,6 +33,61 @@ pub fn peak_of(points: &[Point]) -> Option<Peak> {
     let xv = xv.clamp(x0, x2);
     let yv = y0 + d0 * (xv - x0) + curv * (xv - x0) * (xv - x1);
     Some(at(xv.exp(), yv.max(y1), spacing))
+}
+
+impl Measure<'_> {
+    /// Adds a frequency near the largest `|S|` until its neighbours are within the resolution:
+    /// the vertex of the parabola through it and its neighbours (in ln f, dB) while that lies
+    /// half a resolution or more from it, then the points one resolution either side of it. At
+    /// an end of the grid, the interval beside it is halved.
+    pub(super) fn refine(&mut self) {
+        let mut pts: Vec<(f64, f64)> = self.points.iter().map(|p| (p.f_hz.ln(), p.s_db)).collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let Some(i) = (0..pts.len()).max_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1)) else { return };
+        let res = self.settings.resolution;
+        // Points added around one peak, at most: a guard, the rule ends long before.
+        if self.refined >= 64 {
+            return;
+        }
+        let add = |x: f64, me: &mut Self| {
+            let f = x.exp();
+            let clear = pts.iter().all(|p| (p.0 - x).abs() > 0.25 * res);
+            let ok = clear && !near_rotation(f, me.speed_hz) && f <= me.f_max;
+            if ok {
+                me.queue.push_back(f);
+            }
+            ok
+        };
+        if i == 0 || i + 1 == pts.len() {
+            let j = if i == 0 { 1 } else { i - 1 };
+            if let Some(n) = pts.get(j) {
+                if (n.0 - pts[i].0).abs() > res {
+                    add(0.5 * (n.0 + pts[i].0), self);
+                }
+            }
+            self.refined += self.queue.len();
+            return;
+        }
+        let ((x0, y0), (x1, y1), (x2, y2)) = (pts[i - 1], pts[i], pts[i + 1]);
+        let (left, right) = (x1 - x0, x2 - x1);
+        if left <= res * (1.0 + 1e-9) && right <= res * (1.0 + 1e-9) {
+            return;
+        }
+        let d0 = (y1 - y0) / left;
+        let d1 = (y2 - y1) / right;
+        let curv = (d1 - d0) / (x2 - x0);
+        let vertex = (curv < 0.0).then(|| (0.5 * (x0 + x1) - d0 / (2.0 * curv)).clamp(x0, x2));
+        let at_vertex = vertex.is_some_and(|xv| (xv - x1).abs() >= 0.5 * res && add(xv, self));
+        if !at_vertex {
+            if left > res * (1.0 + 1e-9) {
+                add(x1 - res.min(0.5 * left), self);
+            }
+            if right > res * (1.0 + 1e-9) {
+                add(x1 + res.min(0.5 * right), self);
+            }
+        }
+        self.refined += self.queue.len();
+    }
 }
 
 #[cfg(test)]

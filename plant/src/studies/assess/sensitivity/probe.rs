@@ -1,5 +1,7 @@
-//! The probe's reading: the decay rate and dominant frequency of a free response.
+//! The probe: the loop left to decay freely from an offset, its decay rate and dominant
+//! frequency read from the free response, and whether the loop is stable.
 
+use super::{Measure, Phase, Signal};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
@@ -63,6 +65,36 @@ pub fn decay(samples: &[(f64, f64)], speed_hz: f64) -> (f64, f64) {
     let (sxy, sxx) =
         used.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + (x - mx) * (y.ln() - my), b + (x - mx).powi(2)));
     (-sxy / sxx, f_d)
+}
+
+impl Measure<'_> {
+    /// The probe ends at `t`: the loop is stable or not, and the excitation starts (the
+    /// multisine where it applies, else the stepped sine).
+    pub(super) fn finish_probe(&mut self, t: f64) {
+        let (sigma, f_d) = decay(&self.probe, self.speed_hz);
+        self.sigma = sigma;
+        self.probe_hz = f_d;
+        if sigma.is_nan() || sigma <= 0.0 {
+            self.stable = Some(false);
+            self.note = Some(format!(
+                "the free decay from {:.1} µm does not decay: its envelope grows at {:.3} 1/s (about {:.1} Hz)",
+                self.settings.probe_um, -sigma, f_d
+            ));
+            self.phase = Phase::Done;
+            return;
+        }
+        self.stable = Some(true);
+        self.t_now = t;
+        let multi = self.discrete && self.settings.auto_level && self.settings.excitation == Signal::Multisine;
+        if multi && self.queue.len() >= 2 {
+            let tones: Vec<f64> = self.queue.drain(..).collect();
+            let a = self.settings.excitation_um.min(self.settings.response_um) * 1e-6 * self.sensor_gain
+                / (tones.len() as f64).sqrt();
+            self.start_multi(tones, a, t);
+        } else {
+            self.next_step(t);
+        }
+    }
 }
 
 #[cfg(test)]
