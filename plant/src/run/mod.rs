@@ -10,6 +10,7 @@
 //! rate (dense output inside macro steps).
 
 pub mod cosim;
+pub mod jobs;
 pub mod offload;
 
 pub use plant_sim::run::{bias_of, plane_gains, settings_with, Outcome, PlaneStates, RunError, Sink, TickCost};

@@ -149,7 +149,7 @@ pub fn assess(
         }
         false => None,
     };
-    let results: Vec<anyhow::Result<Option<Figures>>> = crate::assess::jobs_for(scene, || {
+    let results: Vec<anyhow::Result<Option<Figures>>> = crate::run::jobs::jobs_for(scene, || {
         scenes
             .par_iter()
             .map(|s| {

@@ -37,8 +37,9 @@ pub mod spec;
 mod state_space_form;
 pub mod vibration;
 
+pub use crate::run::jobs::{jobs_for, COSIM_JOBS};
 pub use closed_forms::{closed_form_of, closed_form_of_plane};
-pub use measure::{jobs_for, measure_axis, COSIM_JOBS};
+pub use measure::measure_axis;
 pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
 pub use parts::UNSTABLE_ZONE;
 use parts::{bearing, ladder_part, sensitivity_part, vibration_part};

@@ -4,13 +4,14 @@
 
 use super::closed_forms::closed_forms;
 use super::measure::{
-    jobs_for, measure_axis_or_abandon, measure_kind, plane_gaps, quiet_run_overrides, run_failure, setup_failure,
+    measure_axis_or_abandon, measure_kind, plane_gaps, quiet_run_overrides, run_failure, setup_failure,
 };
 use super::spec::{self, Assessment, ControllerSpec};
 use super::{axis_names, duty, ladder, margins, sensitivity, vibration};
 use super::{Failure, PartOutcome, SensitivityPart};
 use crate::config::Scene;
 use crate::cosim::Launch;
+use crate::run::jobs::jobs_for;
 use crate::run::{run_into, Outcome};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
