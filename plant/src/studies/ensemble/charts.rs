@@ -65,7 +65,7 @@ fn band_panel(
 ) -> anyhow::Result<()> {
     // The title, then the legend in a strip above the plot, never over the band or the curve.
     let area = match caption {
-        Some(c) => &area.titled(c, (FONT, 26)).map_err(draw_err(path))?,
+        Some(c) => &plot::titled_root(area, path, c)?,
         None => area,
     };
     let grey = RGBColor(0x60, 0x60, 0x60);
@@ -176,9 +176,7 @@ pub fn sweep_charts(
         let yr = range(groups.iter().flat_map(|g| g.2.iter().map(|p| p.1)));
         plot::draw_png(&path, (1200, 1000), |root| -> anyhow::Result<()> {
             root.fill(&WHITE).map_err(draw_err(&path))?;
-            let root = root
-                .titled(&format!("{scene}: bifurcation diagram, {c}(nT) against {key}"), (FONT, 26))
-                .map_err(draw_err(&path))?;
+            let root = plot::titled_root(root, &path, &format!("{scene}: bifurcation diagram, {c}(nT) against {key}"))?;
             let (upper, lower) = root.split_vertically(560);
             // The modes' legend in a strip above the upper panel, never over the points.
             let entries: Vec<(String, plot::Mark)> = groups
@@ -239,7 +237,7 @@ fn probability_map(
     plot::draw_png(path, (1200, 800), |root| -> anyhow::Result<()> {
         root.fill(&WHITE).map_err(draw_err(path))?;
         let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
-        let root = root.titled(&title, (FONT, 26)).map_err(draw_err(path))?;
+        let root = plot::titled_root(root, path, &title)?;
         let crossed: Vec<(f64, f64)> =
             stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
         // The crosses' legend in a strip above the map, never over its cells.
