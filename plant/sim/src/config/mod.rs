@@ -382,7 +382,7 @@ impl Scene {
                 *file = absolute(file);
             }
         }
-        if let Some(file) = &mut raw.rotor.ross_file {
+        if let Some(file) = raw.rotor.flexible_mut().and_then(|r| r.ross_file.as_mut()) {
             *file = absolute(Path::new(file)).display().to_string();
         }
         toml::to_string(&raw)
@@ -456,10 +456,7 @@ impl Scene {
     }
 
     fn revalidate(&self, table: toml::Table, blame: &str, base_dir: &Path) -> Result<Scene, ConfigError> {
-        let raw = toml::Value::Table(table)
-            .try_into::<RawScene>()
-            .map_err(|e| ConfigError::Parse { path: blame.to_string(), message: e.to_string() })?;
-        validate(raw, base_dir)
+        validate(parse_raw(table, blame)?, base_dir)
     }
 }
 
@@ -508,23 +505,32 @@ pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigErro
     let mut value: toml::Table = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     // The file alone first, so that its own mistakes are blamed on it, then with the overrides.
-    let parse = |table: toml::Table, blame: String| {
-        toml::Value::Table(table)
-            .try_into::<RawScene>()
-            .map_err(|e| ConfigError::Parse { path: blame, message: e.to_string() })
-    };
-    let mut raw = parse(value.clone(), path.display().to_string())?;
+    let mut raw = parse_raw(value.clone(), &path.display().to_string())?;
     if !overrides.is_empty() {
         for arg in overrides {
             apply_override(&mut value, arg)?;
         }
-        raw = parse(value, format!("--set {}", overrides.join(" --set ")))?;
+        raw = parse_raw(value, &format!("--set {}", overrides.join(" --set ")))?;
     }
     if raw.scene.name.is_empty() {
         raw.scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     validate(raw, base_dir)
+}
+
+/// A scene's table (the file with its overrides) read into the file format, `blame` naming
+/// where it came from in a parse error. A `[rotor]` key of another model than the scene's, which
+/// the model's key struct refuses, is refused naming the key, its value and both models
+/// ([`raw::RawRotor::foreign_key`]).
+pub(crate) fn parse_raw(table: toml::Table, blame: &str) -> Result<RawScene, ConfigError> {
+    let rotor = table.get("rotor").and_then(toml::Value::as_table).cloned();
+    toml::Value::Table(table).try_into::<RawScene>().map_err(|e| {
+        rotor
+            .as_ref()
+            .and_then(raw::RawRotor::foreign_key)
+            .unwrap_or_else(|| ConfigError::Parse { path: blame.to_string(), message: e.to_string() })
+    })
 }
 
 /// `table`'s values as `(prefix.key, value)` pairs, sub-tables flattened, in key order.

@@ -1,53 +1,15 @@
 //! `rotor.model = "flexible"`: the shaft (a table in the scene or a ROSS file), its nodes for the
-//! AMBs, sensors and touchdown bearings, the reduction; the flexible keys refused in a rigid
-//! scene and the rigid rotor's geometry keys refused in a flexible one.
+//! AMBs, sensors and touchdown bearings, the reduction. (Other models' `[rotor]` keys are refused
+//! by the flexible model's key struct, and its own by theirs.)
 
 use super::*;
 use crate::config::models::flexible::{CUTOFF_HZ, MODAL_DAMPING};
+use crate::config::models::{FlexibleKeys, TwoPlaneKeys};
 use plant_physics::flex::{self, machine, Reduction};
 use std::sync::Arc;
 
 /// Reduced coordinates the flexible state has room for.
 const MAX_BASIS: usize = machine::MAX_MODES;
-
-/// The flexible rotor's keys given in a rigid scene, refused by name.
-pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
-    let r = &raw.rotor;
-    const WHY: &str = "is a key of the flexible rotor and this scene's rotor is rigid: set rotor.model = \
-                       \"flexible\" or remove the key";
-    if r.shaft.is_some() {
-        return Err(range("rotor.shaft", "a table", "", WHY));
-    }
-    if let Some(f) = &r.ross_file {
-        return Err(range("rotor.ross_file", f, "", WHY));
-    }
-    if let Some(b) = r.ross_bearings {
-        return Err(range("rotor.ross_bearings", at_ambs_name(b), "", WHY));
-    }
-    if let Some(b) = r.ross_ambs {
-        return Err(range("rotor.ross_ambs", super::ross_ambs::name(b), "", WHY));
-    }
-    if let Some(a) = r.ross_axes {
-        return Err(range("rotor.ross_axes", super::ross_axes::name(a), "", WHY));
-    }
-    let nodes = [
-        ("rotor.amb_a_node", r.amb_a_node),
-        ("rotor.amb_b_node", r.amb_b_node),
-        ("rotor.sensor_a_node", r.sensor_a_node),
-        ("rotor.sensor_b_node", r.sensor_b_node),
-        ("rotor.touchdown_a_node", r.touchdown_a_node),
-        ("rotor.touchdown_b_node", r.touchdown_b_node),
-    ];
-    if let Some((key, n)) = nodes.iter().find_map(|(k, v)| v.map(|v| (*k, v))) {
-        return Err(range(key, n, "", WHY));
-    }
-    for (key, value, unit) in [("rotor.cutoff_hz", r.cutoff_hz, "Hz"), ("rotor.modal_damping", r.modal_damping, "")] {
-        if let Some(v) = value {
-            return Err(range(key, v, unit, WHY));
-        }
-    }
-    Ok(())
-}
 
 fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
     ConfigError::Range { key: key.to_string(), value: value.to_string(), unit: String::new(), why: e.to_string() }
@@ -56,16 +18,10 @@ fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
 /// The flexible machine of a scene, validated.
 pub(in crate::config) fn flexible_params(
     raw: &RawScene,
+    r: &FlexibleKeys,
     whole: &Share,
     base_dir: &Path,
 ) -> Result<machine::Params, ConfigError> {
-    let r = &raw.rotor;
-    const RIGID: &str = "is a key of the rigid two-plane rotor: a flexible rotor's geometry and inertia come from \
-                         its shaft (rotor.shaft or rotor.ross_file) and its nodes (rotor.amb_a_node, …)";
-    let rigid_keys = super::two_plane_keys::rigid_geometry_keys(raw);
-    if let Some((key, value, unit)) = rigid_keys.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
-        return Err(range(key, value, unit, RIGID));
-    }
     let (shaft, file) = match (&r.shaft, &r.ross_file) {
         (Some(_), Some(f)) => {
             return Err(range("rotor.ross_file", f, "", "a flexible rotor has either rotor.shaft or rotor.ross_file"))
@@ -215,17 +171,18 @@ pub(in crate::config) fn flexible_params(
     // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
     // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
     let mm = |n: usize| Some(z[n] * 1e3);
-    let mut as_rigid = raw.clone();
-    let rr = &mut as_rigid.rotor;
-    rr.transverse_inertia_kg_m2 = Some(body.transverse_inertia);
-    rr.bearing_a_mm = mm(amb[0]);
-    rr.bearing_b_mm = mm(amb[1]);
-    rr.sensor_a_mm = mm(sensor[0]);
-    rr.sensor_b_mm = mm(sensor[1]);
-    rr.end_a_mm = Some(z[0] * 1e3);
-    rr.end_b_mm = Some(z[nodes - 1] * 1e3);
+    let as_rigid = TwoPlaneKeys {
+        transverse_inertia_kg_m2: Some(body.transverse_inertia),
+        bearing_a_mm: mm(amb[0]),
+        bearing_b_mm: mm(amb[1]),
+        sensor_a_mm: mm(sensor[0]),
+        sensor_b_mm: mm(sensor[1]),
+        end_a_mm: Some(z[0] * 1e3),
+        end_b_mm: Some(z[nodes - 1] * 1e3),
+        ..TwoPlaneKeys::default()
+    };
     let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
-    let machine = super::two_plane_keys::two_plane_params(&as_rigid, &share)?;
+    let machine = super::two_plane_keys::two_plane_params(raw, &as_rigid, &share)?;
     let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
     // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
     // forms its terms at each evaluation, as before; the result is the same to the bit).
@@ -267,7 +224,7 @@ pub(in crate::config) fn file_bearings_note(raw: &RawScene, params: &machine::Pa
     if kept.is_empty() {
         return None;
     }
-    let file = raw.rotor.ross_file.as_deref().unwrap_or("the ROSS file");
+    let file = raw.rotor.flexible().and_then(|r| r.ross_file.as_deref()).unwrap_or("the ROSS file");
     Some(format!(
         "rotor.ross_file = {file}: the file's bearings act on the shaft besides the scene's AMBs: {} \
          (summary.json model.ross_bearings)",

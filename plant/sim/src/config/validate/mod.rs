@@ -33,8 +33,8 @@ use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
 use std::path::Path;
 
-// The rotor models' keys, each built by the model's arm of `rotor_of::rotor_from_raw`
-// (config/rotor.rs) with the bearing planes of `bearing`.
+// The rotor models' keys, each built by its model's key struct (`config/models/`,
+// `ModelKeys::build`) with the bearing planes of `bearing`.
 pub(super) mod bearing;
 mod checks;
 mod controller_keys;
@@ -42,7 +42,6 @@ pub(super) mod flexible_keys;
 mod hardware_keys;
 mod ross_ambs;
 mod ross_axes;
-mod rotor_of;
 pub(super) mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
@@ -106,9 +105,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     for arg in &overrides {
         super::apply_override(&mut table, arg)?;
     }
-    let fixed = toml::Value::Table(table)
-        .try_into::<RawScene>()
-        .map_err(|e| ConfigError::Parse { path: "the realtime setting".into(), message: e.to_string() })?;
+    let fixed = super::parse_raw(table, "the realtime setting")?;
     let mut fixed = validate_as_written(fixed, base_dir)?;
     // The first pass's warnings (deprecated keys are moved by it and not seen again).
     fixed.warnings = scene.warnings;
@@ -152,8 +149,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     };
     let whole =
         Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
-    // The rotor model, built from the scene by its own arm of `rotor_of::rotor_from_raw`.
-    let mut rotor = rotor_of::rotor_from_raw(&raw, &whole, base_dir)?;
+    // The rotor model, built from the scene by its own key struct.
+    let mut rotor = raw.rotor.model.build(&raw, &whole, base_dir)?;
     // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
     // AMBs: the run's first line says so.
     if let Rotor::Flexible(f) = &mut rotor {
@@ -305,7 +302,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
     let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
     // The resolved scene states the rotor model's defaults.
-    rotor.record_defaults(&mut raw);
+    rotor.record_defaults(&mut raw.rotor);
     let scene = Scene {
         name: raw.scene.name.clone(),
         description: raw.scene.description.clone(),
