@@ -22,7 +22,78 @@ pub(in crate::config) fn flexible_params(
     whole: &Share,
     base_dir: &Path,
 ) -> Result<machine::Params, ConfigError> {
-    let (shaft, file) = match (&r.shaft, &r.ross_file) {
+    let (shaft, file) = shaft_of(r, base_dir)?;
+    shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
+    let nodes = shaft.node_count();
+    let (amb, sensor, touchdown) = nodes_of(r, nodes)?;
+    let body = shaft.rigid_body();
+    let z: Vec<f64> = shaft.node_positions().iter().map(|p| p - body.centre).collect();
+    const SIDES: &str = "AMB A lies on the −z side of the rotor's centre of mass and AMB B on the +z side: the \
+                         centre of mass is between the AMBs";
+    if z[amb[0]] >= 0.0 {
+        return Err(range(
+            "rotor.amb_a_node",
+            amb[0],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[0]] * 1e3),
+        ));
+    }
+    if z[amb[1]] <= 0.0 {
+        return Err(range(
+            "rotor.amb_b_node",
+            amb[1],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
+        ));
+    }
+    let (shaft, file_bearings) = match file {
+        None => (shaft, Vec::new()),
+        Some((name, read)) => {
+            let (rotor, used) = read
+                .bearings_with_ambs(amb, r.ross_bearings)
+                .map_err(|why| range("rotor.ross_bearings", "none", "", &format!("rotor.ross_file = {name}: {why}")))?;
+            rotor.validate().map_err(|e| flex_error("rotor.ross_file", name, e))?;
+            (rotor, used)
+        }
+    };
+    let reduced = reduce(r, &shaft, amb, touchdown)?;
+    // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
+    // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
+    let mm = |n: usize| Some(z[n] * 1e3);
+    let as_rigid = TwoPlaneKeys {
+        transverse_inertia_kg_m2: Some(body.transverse_inertia),
+        bearing_a_mm: mm(amb[0]),
+        bearing_b_mm: mm(amb[1]),
+        sensor_a_mm: mm(sensor[0]),
+        sensor_b_mm: mm(sensor[1]),
+        end_a_mm: Some(z[0] * 1e3),
+        end_b_mm: Some(z[nodes - 1] * 1e3),
+        ..TwoPlaneKeys::default()
+    };
+    let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
+    let machine = super::two_plane_keys::two_plane_params(raw, &as_rigid, &share)?;
+    let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
+    // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
+    // forms its terms at each evaluation, as before; the result is the same to the bit).
+    let reduced = reduced.hold_speed(machine.rotor.speed);
+    Ok(machine::Params {
+        machine,
+        nodes,
+        reduced: Arc::new(reduced),
+        shaft: Arc::new(shaft),
+        z,
+        file_bearings,
+        file_ambs: Vec::new(),
+    })
+}
+
+/// A ROSS file's name as the scene gives it, and the file as read.
+type FileRead<'a> = (&'a str, flex::ross::RossFile);
+
+/// The shaft of a flexible rotor: `rotor.shaft`'s table, or `rotor.ross_file`'s rotor with the
+/// file as read (its bearings are placed once the AMB nodes are known).
+fn shaft_of<'a>(r: &'a FlexibleKeys, base_dir: &Path) -> Result<(flex::Rotor, Option<FileRead<'a>>), ConfigError> {
+    Ok(match (&r.shaft, &r.ross_file) {
         (Some(_), Some(f)) => {
             return Err(range("rotor.ross_file", f, "", "a flexible rotor has either rotor.shaft or rotor.ross_file"))
         }
@@ -67,11 +138,17 @@ pub(in crate::config) fn flexible_params(
                 _ => flex::ross::parse_file,
             };
             let read = parse(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?;
-            (read.rotor.clone(), Some((file, read)))
+            (read.rotor.clone(), Some((file.as_str(), read)))
         }
-    };
-    shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
-    let nodes = shaft.node_count();
+    })
+}
+
+/// A node on each plane, A's and B's.
+type PlaneNodes = [usize; 2];
+
+/// The nodes of each plane's AMB, sensor and touchdown bearing (the sensor's and the touchdown
+/// bearing's the AMB's unless given), each on a shaft of `nodes` nodes.
+fn nodes_of(r: &FlexibleKeys, nodes: usize) -> Result<(PlaneNodes, PlaneNodes, PlaneNodes), ConfigError> {
     let node = |key: &str, value: Option<usize>, default: Option<usize>| -> Result<usize, ConfigError> {
         let Some(n) = value.or(default) else {
             return Err(range(key, "none", "", "a flexible rotor needs the node of each AMB"));
@@ -90,36 +167,18 @@ pub(in crate::config) fn flexible_params(
         node("rotor.touchdown_a_node", r.touchdown_a_node, Some(amb[0]))?,
         node("rotor.touchdown_b_node", r.touchdown_b_node, Some(amb[1]))?,
     ];
-    let body = shaft.rigid_body();
-    let z: Vec<f64> = shaft.node_positions().iter().map(|p| p - body.centre).collect();
-    const SIDES: &str = "AMB A lies on the −z side of the rotor's centre of mass and AMB B on the +z side: the \
-                         centre of mass is between the AMBs";
-    if z[amb[0]] >= 0.0 {
-        return Err(range(
-            "rotor.amb_a_node",
-            amb[0],
-            "",
-            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[0]] * 1e3),
-        ));
-    }
-    if z[amb[1]] <= 0.0 {
-        return Err(range(
-            "rotor.amb_b_node",
-            amb[1],
-            "",
-            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
-        ));
-    }
-    let (shaft, file_bearings) = match file {
-        None => (shaft, Vec::new()),
-        Some((name, read)) => {
-            let (rotor, used) = read
-                .bearings_with_ambs(amb, r.ross_bearings)
-                .map_err(|why| range("rotor.ross_bearings", "none", "", &format!("rotor.ross_file = {name}: {why}")))?;
-            rotor.validate().map_err(|e| flex_error("rotor.ross_file", name, e))?;
-            (rotor, used)
-        }
-    };
+    Ok((amb, sensor, touchdown))
+}
+
+/// The shaft reduced to its modes below `rotor.cutoff_hz` with the static correction at the
+/// force nodes (the AMBs' and the touchdown bearings'), `rotor.modal_damping` on every bending
+/// mode; within the room the flexible state has.
+fn reduce(
+    r: &FlexibleKeys,
+    shaft: &flex::Rotor,
+    amb: PlaneNodes,
+    touchdown: PlaneNodes,
+) -> Result<flex::Reduced, ConfigError> {
     let cutoff = positive("rotor.cutoff_hz", r.cutoff_hz.unwrap_or(CUTOFF_HZ), "Hz")?;
     let zeta = non_negative("rotor.modal_damping", r.modal_damping.unwrap_or(MODAL_DAMPING), "")?;
     if zeta >= 1.0 {
@@ -132,14 +191,14 @@ pub(in crate::config) fn flexible_params(
         gyroscopic_correction: false,
         modal_damping: zeta,
     };
-    let reduced = flex::Reduced::new(&shaft, &spec).map_err(|e| match e {
+    let reduced = flex::Reduced::new(shaft, &spec).map_err(|e| match e {
         flex::FlexError::CutoffBelowRigidModes { .. } | flex::FlexError::TooManyModes { .. } => {
             flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e)
         }
         // The free rotor's static correction is solved with the shift (2π f_c)²: a cutoff far
         // below the first bending mode leaves it too small to solve with. The cutoff is at fault.
         flex::FlexError::SingularStiffness => {
-            let first = flex::reduce::undamped_frequencies_hz(&shaft)
+            let first = flex::reduce::undamped_frequencies_hz(shaft)
                 .ok()
                 .and_then(|f| f.get(flex::reduce::RIGID_MODES).copied());
             let first = first.map_or(String::new(), |f| format!(" (the shaft's first bending mode is at {f:.1} Hz)"));
@@ -168,34 +227,7 @@ pub(in crate::config) fn flexible_params(
             ),
         ));
     }
-    // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
-    // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
-    let mm = |n: usize| Some(z[n] * 1e3);
-    let as_rigid = TwoPlaneKeys {
-        transverse_inertia_kg_m2: Some(body.transverse_inertia),
-        bearing_a_mm: mm(amb[0]),
-        bearing_b_mm: mm(amb[1]),
-        sensor_a_mm: mm(sensor[0]),
-        sensor_b_mm: mm(sensor[1]),
-        end_a_mm: Some(z[0] * 1e3),
-        end_b_mm: Some(z[nodes - 1] * 1e3),
-        ..TwoPlaneKeys::default()
-    };
-    let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
-    let machine = super::two_plane_keys::two_plane_params(raw, &as_rigid, &share)?;
-    let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
-    // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
-    // forms its terms at each evaluation, as before; the result is the same to the bit).
-    let reduced = reduced.hold_speed(machine.rotor.speed);
-    Ok(machine::Params {
-        machine,
-        nodes,
-        reduced: Arc::new(reduced),
-        shaft: Arc::new(shaft),
-        z,
-        file_bearings,
-        file_ambs: Vec::new(),
-    })
+    Ok(reduced)
 }
 
 /// `rotor.ross_bearings`'s value as the scene writes it.
