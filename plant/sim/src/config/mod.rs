@@ -17,6 +17,9 @@ pub mod models;
 pub mod overrides;
 pub mod raw;
 pub mod rotor;
+#[cfg(test)]
+mod rotor_tests;
+mod scene_table;
 pub mod validate;
 
 pub use overrides::apply_override;

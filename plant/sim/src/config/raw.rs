@@ -11,46 +11,7 @@ use crate::model::Cage;
 use serde::{Deserialize, Serialize};
 use shock_table::ShockSpec;
 
-/// Declares one table of the scene file, each key once: its doc, its field and type, and its
-/// default (the study's value). Gives the struct (every key optional in the file, unknown keys
-/// refused), its `Default`, the default in each field's doc, and `KEYS`, the keys in
-/// declaration order (the guide's key table, `docs/guide/scenes.md`, is checked against them
-/// and the defaults by `tests/tests/docs.rs`).
-macro_rules! scene_table {
-    (
-        $(#[$sattr:meta])*
-        pub struct $name:ident {
-            $(
-                $(#[$attr:meta])*
-                pub $field:ident : $ty:ty = $default:expr
-            ),* $(,)?
-        }
-    ) => {
-        $(#[$sattr])*
-        #[derive(Clone, Debug, Serialize, Deserialize)]
-        #[serde(default, deny_unknown_fields)]
-        pub struct $name {
-            $(
-                $(#[$attr])*
-                #[doc = ""]
-                #[doc = concat!("Default: `", stringify!($default), "`.")]
-                pub $field: $ty,
-            )*
-        }
-
-        impl Default for $name {
-            fn default() -> Self {
-                Self { $($field: $default),* }
-            }
-        }
-
-        impl $name {
-            /// The keys of this table as the scene file spells them, in declaration order.
-            pub const KEYS: &'static [&'static str] = &[$(stringify!($field)),*];
-        }
-    };
-}
-pub(crate) use scene_table;
+use super::scene_table::scene_table;
 
 scene_table! {
 /// `[scene]`: name and span of the run.
@@ -66,38 +27,9 @@ pub struct RawMeta {
 }
 }
 
-scene_table! {
-/// `[rotor]`'s keys that every model reads (the `model` key and each model's own keys are the
-/// model's key struct's, `config/models/<model>.rs`; [`RawRotor`] is the whole table).
-///
-/// The planar model has one bearing plane, the study's: `mass_kg` and `polar_inertia_kg_m2` are
-/// the share one bearing carries; the two-plane rotor is the whole rotor on two bearings with its
-/// tilt: they are the whole rotor's (the study's symmetric machine has 23 kg and
-/// 11.62e-3 kg·m², docs/MODEL.md §10.1).
-pub struct RotorShared {
-    /// m_r (kg); two-plane: the whole rotor's mass M.
-    pub mass_kg: f64 = 11.5,
-    /// e (µm): the centre of mass's offset from the geometric axis (static unbalance).
-    pub eccentricity_um: f64 = 2.0,
-    /// J_r (kg·m²); two-plane: the whole rotor's I_p.
-    pub polar_inertia_kg_m2: f64 = 5.81e-3,
-    /// r_r (mm).
-    pub radius_mm: f64 = 19.85,
-    /// Rated speed (Hz).
-    pub speed_hz: f64 = 500.0,
-    /// Angle of the unbalance at t = 0 (deg).
-    pub unbalance_phase_deg: f64 = 0.0,
-    /// `held` or `free`.
-    pub spin: SpinChoice = SpinChoice::Held,
-    /// Speed-loop gain for `free` spin (N·m·s/rad); two-plane: on the whole rotor.
-    pub drive_gain_n_m_s: f64 = 0.05,
-    /// Drive torque limit for `free` spin (N·m); two-plane: on the whole rotor.
-    pub drive_torque_limit_n_m: f64 = 2.0,
-}
-}
-
-/// `[rotor]` as a whole, and the rotor models' names and key structs.
-pub use super::models::{RawRotor, RotorKeys, RotorModel};
+/// `[rotor]` as a whole, the keys every model reads and the rotor models' names and key structs
+/// (`config/models/`).
+pub use super::models::{RawRotor, RossAxes, RotorKeys, RotorModel, RotorShared, SpinChoice};
 
 scene_table! {
 /// `[touchdown]`: the touchdown bearing.
@@ -258,16 +190,6 @@ pub enum McapCompression {
     None,
     /// lz4: about half the size, for about twice the recording's CPU time.
     Lz4,
-}
-
-/// `rotor.spin`: how the rotor's speed is driven.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SpinChoice {
-    /// The drive holds the speed exactly.
-    Held,
-    /// A speed loop with a gain and a torque limit drives it.
-    Free,
 }
 
 /// `touchdown.support`: how the race is supported.
@@ -434,16 +356,6 @@ pub enum ControlMode {
     Lockstep,
     /// The law runs in the controller process, paced by the wall clock.
     Realtime,
-}
-
-/// `rotor.ross_axes`: what the scene does with the ROSS file's AMB axis rotation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RossAxes {
-    /// Each element's `sensors_axis_rotation` turns its plane's axes (`amb.axis_angle_deg`).
-    Apply,
-    /// The plant's axes stay at 0° (the default).
-    Ignore,
 }
 
 scene_table! {

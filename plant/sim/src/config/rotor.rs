@@ -7,9 +7,8 @@
 //! by the model itself through [`crate::machine::Machine`].
 //! docs/ARCHITECTURE.md ("Adding a rotor model") lists what a new model touches.
 
-use super::models::RawRotor;
+use super::models::{RawRotor, RotorModel};
 pub use super::models::{Rotor, RotorParams};
-use super::RotorModel;
 use crate::model::Params;
 
 impl Rotor {

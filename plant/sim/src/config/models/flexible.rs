@@ -1,11 +1,8 @@
 //! The flexible shaft on two bearing planes (`rotor.model = "flexible"`): its `[rotor]` keys and
 //! their defaults, and what the model says of itself.
 
-use super::{ModelKeys, RawRotor, RotorKeys, RotorParams};
-use crate::config::raw::{scene_table, RawScene, RossAxes};
-use crate::config::validate::bearing::Share;
-use crate::config::validate::flexible_keys::flexible_params;
-use crate::config::{ConfigError, RotorModel};
+use super::{RawRotor, RotorKeys, RotorModel, RotorParams};
+use crate::config::scene_table::scene_table;
 use crate::machine::{mid_span_weight, FailureState, FlexibleLinear, Linearised, Machine};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
@@ -14,12 +11,21 @@ use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Cutoff when none is given (Hz).
 pub(in crate::config) const CUTOFF_HZ: f64 = 2000.0;
 /// Modal damping ratio when none is given.
 pub(in crate::config) const MODAL_DAMPING: f64 = 0.005;
+
+/// `rotor.ross_axes`: what the scene does with the ROSS file's AMB axis rotation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RossAxes {
+    /// Each element's `sensors_axis_rotation` turns its plane's axes (`amb.axis_angle_deg`).
+    Apply,
+    /// The plant's axes stay at 0° (the default).
+    Ignore,
+}
 
 scene_table! {
 /// `[rotor]`'s own keys of the flexible rotor, each `None` unless given. Its mass, inertias and
@@ -91,14 +97,6 @@ impl RawRotor {
             RotorKeys::Flexible(keys) => Some(keys),
             _ => None,
         }
-    }
-}
-
-impl ModelKeys for FlexibleKeys {
-    type Params = flexible::Params;
-
-    fn build(&self, raw: &RawScene, whole: &Share, base_dir: &Path) -> Result<flexible::Params, ConfigError> {
-        flexible_params(raw, self, whole, base_dir)
     }
 }
 

@@ -13,12 +13,11 @@ mod table;
 pub(in crate::config) mod two_plane;
 
 pub use flexible::FlexibleKeys;
+pub use flexible::RossAxes;
 pub use planar::PlanarKeys;
-pub use table::RawRotor;
+pub use table::{RawRotor, RotorShared, SpinChoice};
 pub use two_plane::TwoPlaneKeys;
 
-use super::raw::RawScene;
-use super::validate::bearing::Share;
 use super::ConfigError;
 use crate::machine::{FailureState, Linearised};
 use crate::model::Params;
@@ -28,14 +27,13 @@ use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane as rigid;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Declares the rotor models, each once: its doc, its variant, `rotor.model`'s name for it, the
 /// model in words and what a rotor of it is (for messages), its key struct (`[rotor]`'s own
 /// keys, in its file) and its validated parameters. Gives [`RotorModel`] (the names), [`RotorKeys`]
 /// (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's validated
 /// rotor) and the one dispatch of each on the model; the compiler points a new model to what it
-/// must give (its key struct's [`ModelKeys`], its parameters' [`RotorParams`]).
+/// must give (its key struct's [`Build`], its parameters' [`RotorParams`]).
 macro_rules! rotor_models {
     ($(
         $(#[$doc:meta])*
@@ -98,14 +96,13 @@ macro_rules! rotor_models {
                 Ok(match model { $(RotorModel::$variant => RotorKeys::$variant(table.try_into()?),)+ })
             }
 
-            /// The model's parameters built from its keys and the scene ([`ModelKeys::build`]).
-            pub(in crate::config) fn build(
-                &self,
-                raw: &RawScene,
-                whole: &Share,
-                base_dir: &Path,
-            ) -> Result<Rotor, ConfigError> {
-                Ok(match self { $(RotorKeys::$variant(k) => Rotor::$variant(k.build(raw, whole, base_dir)?),)+ })
+            /// The model's parameters built from its keys with what the scene's validation gives
+            /// (`ctx`, [`Build`]).
+            pub fn build<Ctx>(&self, ctx: &Ctx) -> Result<Rotor, ConfigError>
+            where
+                $($keys: Build<Ctx, Params = $params>,)+
+            {
+                Ok(match self { $(RotorKeys::$variant(k) => Rotor::$variant(k.build(ctx)?),)+ })
             }
         }
 
@@ -155,15 +152,17 @@ impl Default for RotorKeys {
     }
 }
 
-/// A model's key struct: the model's parameters built from its keys.
-pub(in crate::config) trait ModelKeys {
+/// A model's key struct built into the model's parameters with `Ctx`, what the scene's
+/// validation gives it (`config::validate`'s context: the scene as written, the shared keys
+/// validated, the scene's folder). Implemented beside the validation (`config/validate/`), which
+/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
+/// imports neither.
+pub trait Build<Ctx> {
     /// The model's validated parameters.
-    type Params: RotorParams;
+    type Params;
 
-    /// The model's parameters from its own keys and the scene `raw` (its bearing planes from
-    /// `[touchdown]`, `[contact]`, `[amb]`, the shared `[rotor]` keys as `whole`), each error
-    /// naming the key, value and unit. `base_dir` resolves the model's files.
-    fn build(&self, raw: &RawScene, whole: &Share, base_dir: &Path) -> Result<Self::Params, ConfigError>;
+    /// The model's parameters, each error naming the key, value and unit.
+    fn build(&self, ctx: &Ctx) -> Result<Self::Params, ConfigError>;
 }
 
 /// A rotor model's parameters, as the scene and the rest of the plant ask of them.

@@ -2,30 +2,15 @@
 //! `[rotor]` keys of its own: its bearing is the shared tables' (`[touchdown]`, `[contact]`,
 //! `[amb]`), its rotor the shared `[rotor]` keys.
 
-use super::{ModelKeys, RotorParams};
-use crate::config::raw::{scene_table, RawScene};
-use crate::config::validate::bearing::{bearing, Keys, Share};
-use crate::config::validate::two_plane_keys::refuse_plane_tables;
-use crate::config::{ConfigError, RotorModel};
+use super::{RotorModel, RotorParams};
+use crate::config::scene_table::scene_table;
 use crate::machine::{FailureState, Machine};
 use crate::model::{Model, Params, N};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 scene_table! {
 /// `[rotor]`'s own keys of the planar model: none (a key of another model is refused).
 pub struct PlanarKeys {}
-}
-
-impl ModelKeys for PlanarKeys {
-    type Params = Params;
-
-    /// The one bearing plane, from the shared tables; a two-plane rotor's per-plane tables and
-    /// initial slopes are refused by name (each would be ignored otherwise).
-    fn build(&self, raw: &RawScene, whole: &Share, _base_dir: &Path) -> Result<Params, ConfigError> {
-        refuse_plane_tables(raw)?;
-        bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &Keys { plane: None }, whole)
-    }
 }
 
 impl RotorParams for Params {

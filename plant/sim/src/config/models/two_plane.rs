@@ -1,16 +1,12 @@
 //! The rigid rotor on two bearing planes (`rotor.model = "two_plane"`): its `[rotor]` keys and
 //! their defaults, and what the model says of itself.
 
-use super::{ModelKeys, RawRotor, RotorKeys, RotorParams};
-use crate::config::raw::{scene_table, RawScene};
-use crate::config::validate::bearing::Share;
-use crate::config::validate::two_plane_keys::two_plane_params;
-use crate::config::{ConfigError, RotorModel};
+use super::{RawRotor, RotorKeys, RotorModel, RotorParams};
+use crate::config::scene_table::scene_table;
 use crate::machine::{FailureState, Linearised, Machine};
 use crate::model::Params;
 use plant_physics::two_plane::{self, Model, N};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// `transverse_inertia_kg_m2` when none is given (kg·m²).
 pub(in crate::config) const TRANSVERSE_INERTIA_KG_M2: f64 = 0.414;
@@ -58,14 +54,6 @@ pub struct TwoPlaneKeys {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_b_mm: Option<f64> = None,
 }
-}
-
-impl ModelKeys for TwoPlaneKeys {
-    type Params = two_plane::Params;
-
-    fn build(&self, raw: &RawScene, whole: &Share, _base_dir: &Path) -> Result<two_plane::Params, ConfigError> {
-        two_plane_params(raw, self, whole)
-    }
 }
 
 impl RotorParams for two_plane::Params {

@@ -15,6 +15,18 @@ pub(in crate::config) struct Share {
     pub(super) spin: Spin,
 }
 
+/// The planar model: its one bearing plane from the shared tables; a two-plane rotor's per-plane
+/// tables and initial slopes are refused by name (each would be ignored otherwise).
+impl crate::config::models::Build<Context<'_>> for crate::config::models::PlanarKeys {
+    type Params = Params;
+
+    fn build(&self, ctx: &Context) -> Result<Params, ConfigError> {
+        let raw = ctx.raw;
+        super::two_plane_keys::refuse_plane_tables(raw)?;
+        bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &Keys { plane: None }, ctx.whole)
+    }
+}
+
 /// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`
 /// where plane B's table sets it.
 pub(in crate::config) struct Keys<'a> {

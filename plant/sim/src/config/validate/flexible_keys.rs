@@ -11,6 +11,14 @@ use std::sync::Arc;
 /// Reduced coordinates the flexible state has room for.
 const MAX_BASIS: usize = machine::MAX_MODES;
 
+impl crate::config::models::Build<Context<'_>> for FlexibleKeys {
+    type Params = machine::Params;
+
+    fn build(&self, ctx: &Context) -> Result<machine::Params, ConfigError> {
+        flexible_params(ctx.raw, self, ctx.whole, ctx.base_dir)
+    }
+}
+
 fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
     ConfigError::Range { key: key.to_string(), value: value.to_string(), unit: String::new(), why: e.to_string() }
 }

@@ -49,6 +49,19 @@ pub use checks::{finite, non_negative, positive, range};
 use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
 use hardware_keys::hardware;
 
+/// What a rotor model's key struct is built with ([`crate::config::models::Build`], implemented
+/// beside each model's validation: `bearing.rs` the planar, `two_plane_keys.rs`,
+/// `flexible_keys.rs`): the scene as written (its bearing planes' tables), the shared `[rotor]`
+/// keys validated, the scene's folder (the model's files).
+pub(in crate::config) struct Context<'a> {
+    /// The scene as written.
+    pub(in crate::config) raw: &'a RawScene,
+    /// The shared `[rotor]` keys, validated.
+    pub(in crate::config) whole: &'a Share,
+    /// The scene's folder.
+    pub(in crate::config) base_dir: &'a Path,
+}
+
 /// Longest simulated time (s): about 11.6 days.
 pub const MAX_DURATION_S: f64 = 1e6;
 /// Lowest controller rate (Hz): one tick per 1000 s.
@@ -131,7 +144,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     let (gravity, duration) = span(&raw)?;
     let (whole, unbalance_phase) = whole_rotor(&raw.rotor, gravity)?;
     // The rotor model, built from the scene by its own key struct.
-    let mut rotor = raw.rotor.model.build(&raw, &whole, base_dir)?;
+    let mut rotor = raw.rotor.model.build(&Context { raw: &raw, whole: &whole, base_dir })?;
     // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
     // AMBs: the run's first line says so.
     if let Rotor::Flexible(f) = &mut rotor {

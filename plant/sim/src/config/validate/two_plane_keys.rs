@@ -6,6 +6,14 @@ use crate::config::models::two_plane::{BEARING_A_MM, BEARING_B_MM, END_A_MM, END
 use crate::config::models::TwoPlaneKeys;
 use plant_physics::two_plane;
 
+impl crate::config::models::Build<Context<'_>> for TwoPlaneKeys {
+    type Params = two_plane::Params;
+
+    fn build(&self, ctx: &Context) -> Result<two_plane::Params, ConfigError> {
+        two_plane_params(ctx.raw, self, ctx.whole)
+    }
+}
+
 /// A two-plane rotor's per-plane tables (`[touchdown.a]`, …) and initial slopes given in a planar
 /// scene, refused by name: each would be silently ignored otherwise. (Its `[rotor]` keys are
 /// refused by the planar model's key struct.)
