@@ -25,13 +25,25 @@ fn every_models_key_struct_refuses_every_other_models_keys() {
                 let format = toml::Value::Table(table.clone()).try_into::<RawScene>();
                 let format = format.expect_err(key).to_string();
                 let e = parse_raw(table, "test").expect_err(key).to_string();
+                // The unit the key's name ends with.
+                let unit = match key.rsplit('_').next() {
+                    Some("mm") => " mm",
+                    Some("hz") => " Hz",
+                    Some("urad") => " µrad",
+                    Some("deg") => " deg",
+                    Some("m2") => " kg·m²",
+                    _ => "",
+                };
                 for message in [&e, &format] {
-                    assert!(message.contains(&format!("rotor.{key} = 1: is a key of {}", owner.what())), "{message}");
+                    assert!(
+                        message.contains(&format!("rotor.{key} = 1{unit}: is a key of {}", owner.what())),
+                        "{message}"
+                    );
                     assert!(message.contains(&format!("(rotor.model = \"{}\")", owner.name())), "{message}");
                     assert!(message.contains(&format!("this scene's rotor is {}", held.is())), "{message}");
                     assert!(message.contains(&format!("(rotor.model = \"{}\")", held.name())), "{message}");
                 }
-                assert!(e.starts_with(&format!("rotor.{key} = 1: ")), "{e}");
+                assert!(e.starts_with(&format!("rotor.{key} = 1{unit}: ")), "{e}");
                 pairs += 1;
             }
         }

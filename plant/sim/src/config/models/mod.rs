@@ -135,7 +135,7 @@ rotor_models! {
     /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
     TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes": TwoPlaneKeys => rigid::Params;
     /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
-    Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia its shaft's":
+    Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
         FlexibleKeys => flexible_machine::Params;
 }
 

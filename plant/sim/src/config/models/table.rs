@@ -116,14 +116,14 @@ impl RawRotor {
         let ours = Self::keys_of(held);
         rotor.iter().filter(|(k, _)| !ours.contains(&k.as_str())).find_map(|(key, value)| {
             let owner = RotorModel::ALL.iter().find(|m| m.own_keys().contains(&key.as_str()))?;
-            let value = match value {
-                toml::Value::Table(_) => "a table".to_string(),
-                v => v.to_string(),
+            let (value, unit) = match value {
+                toml::Value::Table(_) => ("a table".to_string(), String::new()),
+                v => (v.to_string(), unit_of(key).map_or(String::new(), |u| format!(" {u}"))),
             };
             Some(ConfigError::Range {
                 key: format!("rotor.{key}"),
                 value,
-                unit: String::new(),
+                unit,
                 why: format!(
                     "is a key of {} (rotor.model = \"{}\") and this scene's rotor is {} (rotor.model = \"{}\"): set \
                      rotor.model = \"{}\" or remove the key",
@@ -136,6 +136,24 @@ impl RawRotor {
             })
         })
     }
+}
+
+/// The unit a `[rotor]` key's name ends with (the scene format writes units in the key names), as
+/// a message writes it; `None` for a key without one (a node, a ratio, a choice). Read from the
+/// name because the key structs' fields carry no unit of their own.
+fn unit_of(key: &str) -> Option<&'static str> {
+    const SUFFIXES: [(&str, &str); 9] = [
+        ("_kg_m2", "kg·m²"),
+        ("_kg", "kg"),
+        ("_mm", "mm"),
+        ("_um", "µm"),
+        ("_urad", "µrad"),
+        ("_deg", "deg"),
+        ("_hz", "Hz"),
+        ("_n_m_s", "N·m·s/rad"),
+        ("_n_m", "N·m"),
+    ];
+    SUFFIXES.iter().find(|(suffix, _)| key.ends_with(suffix)).map(|(_, unit)| *unit)
 }
 
 /// The file's order: `model`, the shared keys, the model's own (those it has).
