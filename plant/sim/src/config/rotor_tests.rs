@@ -81,7 +81,8 @@ fn every_shipped_scene_loads_and_writes_back_its_rotor_keys() {
     assert!(scenes.len() >= 14, "{scenes:?}");
     for path in scenes {
         let scene = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let file: toml::Table = toml::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let file: toml::Table =
+            toml::from_str(&shock_table::input::read_text(&path, shock_table::input::MAX_TOML_BYTES).unwrap()).unwrap();
         let written = file.get("rotor").and_then(toml::Value::as_table).cloned().unwrap_or_default();
         let model = written.get("model").and_then(toml::Value::as_str).unwrap_or("planar");
         assert_eq!(scene.rotor.model().name(), model, "{}", path.display());
