@@ -53,7 +53,7 @@ pub fn two_plane_model() -> (plant_physics::two_plane::Model, plant::config::Sce
         .expect("shock")],
         ..Default::default()
     };
-    raw.rotor.model = plant::config::RotorModel::TwoPlane;
+    raw.rotor.model = plant::config::RotorModel::TwoPlane.default_keys();
     raw.rotor.mass_kg = 23.0;
     raw.rotor.polar_inertia_kg_m2 = 11.62e-3;
     let scene = validate(raw, Path::new(".")).expect("scene");

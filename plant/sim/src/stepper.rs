@@ -650,6 +650,13 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
     /// believed). A state this plant wrote passes; the seal is checked before
     /// ([`crate::run::check_start`]).
     fn check_fields(&self, s: &Snapshot) -> Result<(), SnapshotError> {
+        self.check_counters(s)?;
+        self.check_integrator(s)?;
+        self.check_positions(s)
+    }
+
+    /// The times and the counters of `s` ([`Self::check_fields`]).
+    fn check_counters(&self, s: &Snapshot) -> Result<(), SnapshotError> {
         // Times: within the run, on the tick grid (checked above), and the output rows' clock
         // where this plant's would be at that time.
         // (Whether the state is before the scene's end is the caller's question: `plant run`
@@ -712,6 +719,11 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
                 format!("at most tick × planes = {} × {planes} (a macro step parks each race once at most)", s.tick),
             ));
         }
+        Ok(())
+    }
+
+    /// The integrator's fields of `s` ([`Self::check_fields`]).
+    fn check_integrator(&self, s: &Snapshot) -> Result<(), SnapshotError> {
         // The integrator: substeps of this scene, a step-size memory within the method's bounds.
         let settings = self.integrator.settings();
         if s.substeps != self.substeps && (self.contact_substeps == 0 || s.substeps != self.contact_substeps) {
@@ -764,6 +776,11 @@ impl<const N: usize, M: Machine<N>> Stepper<N, M> {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The bodies' positions and the parked races of `s` ([`Self::check_fields`]).
+    fn check_positions(&self, s: &Snapshot) -> Result<(), SnapshotError> {
         // Positions: each body within its clearance and the deepest penetration the contact
         // model is meant for (one gap, or the radius guard if smaller; real contacts are microns
         // deep) — a rotor 0.3 mm deep in a 0.15 mm gap was taken.

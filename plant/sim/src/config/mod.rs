@@ -17,6 +17,9 @@ pub mod models;
 pub mod overrides;
 pub mod raw;
 pub mod rotor;
+#[cfg(test)]
+mod rotor_tests;
+mod scene_table;
 pub mod validate;
 
 pub use overrides::apply_override;
@@ -382,7 +385,7 @@ impl Scene {
                 *file = absolute(file);
             }
         }
-        if let Some(file) = &mut raw.rotor.ross_file {
+        if let Some(file) = raw.rotor.flexible_mut().and_then(|r| r.ross_file.as_mut()) {
             *file = absolute(Path::new(file)).display().to_string();
         }
         toml::to_string(&raw)
@@ -456,10 +459,7 @@ impl Scene {
     }
 
     fn revalidate(&self, table: toml::Table, blame: &str, base_dir: &Path) -> Result<Scene, ConfigError> {
-        let raw = toml::Value::Table(table)
-            .try_into::<RawScene>()
-            .map_err(|e| ConfigError::Parse { path: blame.to_string(), message: e.to_string() })?;
-        validate(raw, base_dir)
+        validate(parse_raw(table, blame)?, base_dir)
     }
 }
 
@@ -508,18 +508,13 @@ pub fn load_scene(path: &Path, overrides: &[String]) -> Result<Scene, ConfigErro
     let mut value: toml::Table = toml::from_str(&text)
         .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
     // The file alone first, so that its own mistakes are blamed on it, then with the overrides.
-    let parse = |table: toml::Table, blame: String| {
-        toml::Value::Table(table)
-            .try_into::<RawScene>()
-            .map_err(|e| ConfigError::Parse { path: blame, message: e.to_string() })
-    };
-    let mut raw = parse(value.clone(), path.display().to_string())?;
+    let mut raw = parse_raw(value.clone(), &path.display().to_string())?;
     if !overrides.is_empty() {
         let file = value.clone();
         for arg in overrides {
             apply_override(&mut value, arg)?;
         }
-        raw = parse(value, format!("--set {}", overrides.join(" --set ")))
+        raw = parse_raw(value, &format!("--set {}", overrides.join(" --set ")))
             .map_err(|e| blame_override(&file, overrides, e))?;
     }
     if raw.scene.name.is_empty() {
@@ -561,12 +556,29 @@ fn blame_override(file: &toml::Table, overrides: &[String], e: ConfigError) -> C
         if apply_override(&mut value, arg).is_err() {
             break;
         }
-        let failed = toml::Value::Table(value.clone()).try_into::<RawScene>().err().map(|e| e.to_string());
+        let failed = match parse_raw(value.clone(), "") {
+            Err(ConfigError::Parse { message, .. }) => Some(message),
+            _ => None,
+        };
         if failed.as_deref() == Some(message.as_str()) {
             return ConfigError::Parse { path: format!("--set {arg}"), message: words(&message) };
         }
     }
     ConfigError::Parse { path, message: words(&message) }
+}
+
+/// A scene's table (the file with its overrides) read into the file format, `blame` naming
+/// where it came from in a parse error. A `[rotor]` key of another model than the scene's, which
+/// the model's key struct refuses, is refused naming the key, its value and both models
+/// ([`raw::RawRotor::foreign_key`]).
+pub(crate) fn parse_raw(table: toml::Table, blame: &str) -> Result<RawScene, ConfigError> {
+    let rotor = table.get("rotor").and_then(toml::Value::as_table).cloned();
+    toml::Value::Table(table).try_into::<RawScene>().map_err(|e| {
+        rotor
+            .as_ref()
+            .and_then(raw::RawRotor::foreign_key)
+            .unwrap_or_else(|| ConfigError::Parse { path: blame.to_string(), message: e.to_string() })
+    })
 }
 
 /// `table`'s values as `(prefix.key, value)` pairs, sub-tables flattened, in key order.

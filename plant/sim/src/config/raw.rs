@@ -11,45 +11,7 @@ use crate::model::Cage;
 use serde::{Deserialize, Serialize};
 use shock_table::ShockSpec;
 
-/// Declares one table of the scene file, each key once: its doc, its field and type, and its
-/// default (the study's value). Gives the struct (every key optional in the file, unknown keys
-/// refused), its `Default`, the default in each field's doc, and `KEYS`, the keys in
-/// declaration order (the guide's key table, `docs/guide/scenes.md`, is checked against them
-/// and the defaults by `tests/tests/docs.rs`).
-macro_rules! scene_table {
-    (
-        $(#[$sattr:meta])*
-        pub struct $name:ident {
-            $(
-                $(#[$attr:meta])*
-                pub $field:ident : $ty:ty = $default:expr
-            ),* $(,)?
-        }
-    ) => {
-        $(#[$sattr])*
-        #[derive(Clone, Debug, Serialize, Deserialize)]
-        #[serde(default, deny_unknown_fields)]
-        pub struct $name {
-            $(
-                $(#[$attr])*
-                #[doc = ""]
-                #[doc = concat!("Default: `", stringify!($default), "`.")]
-                pub $field: $ty,
-            )*
-        }
-
-        impl Default for $name {
-            fn default() -> Self {
-                Self { $($field: $default),* }
-            }
-        }
-
-        impl $name {
-            /// The keys of this table as the scene file spells them, in declaration order.
-            pub const KEYS: &'static [&'static str] = &[$(stringify!($field)),*];
-        }
-    };
-}
+use super::scene_table::scene_table;
 
 scene_table! {
 /// `[scene]`: name and span of the run.
@@ -65,129 +27,9 @@ pub struct RawMeta {
 }
 }
 
-scene_table! {
-/// `[rotor]`.
-///
-/// `model` chooses the planar model (one bearing plane, the study's: `mass_kg` and
-/// `polar_inertia_kg_m2` are the share one bearing carries) or the two-plane rotor (the whole
-/// rotor on two bearings with its tilt: they are the whole rotor's; the study's symmetric
-/// machine has 23 kg and 11.62e-3 kg·m², docs/MODEL.md §10.1). The keys after `drive_*` are the
-/// two-plane rotor's, `None` unless given, and refused in a planar scene.
-pub struct RawRotor {
-    /// `planar`, `two_plane` or `flexible`.
-    pub model: RotorModel = RotorModel::Planar,
-    /// m_r (kg); two-plane: the whole rotor's mass M.
-    pub mass_kg: f64 = 11.5,
-    /// e (µm): the centre of mass's offset from the geometric axis (static unbalance).
-    pub eccentricity_um: f64 = 2.0,
-    /// J_r (kg·m²); two-plane: the whole rotor's I_p.
-    pub polar_inertia_kg_m2: f64 = 5.81e-3,
-    /// r_r (mm).
-    pub radius_mm: f64 = 19.85,
-    /// Rated speed (Hz).
-    pub speed_hz: f64 = 500.0,
-    /// Angle of the unbalance at t = 0 (deg).
-    pub unbalance_phase_deg: f64 = 0.0,
-    /// `held` or `free`.
-    pub spin: SpinChoice = SpinChoice::Held,
-    /// Speed-loop gain for `free` spin (N·m·s/rad); two-plane: on the whole rotor.
-    pub drive_gain_n_m_s: f64 = 0.05,
-    /// Drive torque limit for `free` spin (N·m); two-plane: on the whole rotor.
-    pub drive_torque_limit_n_m: f64 = 2.0,
-    /// Two-plane: transverse moment of inertia I_t about the centre of mass (kg·m²); none: 0.414.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub transverse_inertia_kg_m2: Option<f64> = None,
-    /// Two-plane: couple unbalance, the tilt χ of the principal axis of inertia from the
-    /// geometric axis (µrad); none: 0.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub couple_unbalance_urad: Option<f64> = None,
-    /// Two-plane: the rotor-fixed direction of that tilt, from the static unbalance's (deg);
-    /// none: 0.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub couple_unbalance_phase_deg: Option<f64> = None,
-    /// Two-plane: axial position of bearing A (AMB and touchdown bearing) from the centre of
-    /// mass (mm), < 0; none: −180.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub bearing_a_mm: Option<f64> = None,
-    /// Two-plane: axial position of bearing B (mm), > 0; none: 180.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub bearing_b_mm: Option<f64> = None,
-    /// Two-plane: axial position of plane A's displacement sensor (mm); none: `bearing_a_mm`
-    /// (collocated).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sensor_a_mm: Option<f64> = None,
-    /// Two-plane: axial position of plane B's displacement sensor (mm); none: `bearing_b_mm`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sensor_b_mm: Option<f64> = None,
-    /// Two-plane: axial position of the rotor's end on plane A's side (mm); none: −230.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub end_a_mm: Option<f64> = None,
-    /// Two-plane: axial position of the rotor's end on plane B's side (mm); none: 230.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub end_b_mm: Option<f64> = None,
-    /// Flexible: the shaft as a table of elements, materials and disks (`[rotor.shaft]`,
-    /// `plant_physics::flex::table`); this or `ross_file`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub shaft: Option<plant_physics::flex::table::ShaftTable> = None,
-    /// Flexible: a rotor saved by ROSS's `Rotor.save()` (path from the scene's folder); this or
-    /// `shaft`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ross_file: Option<String> = None,
-    /// Flexible, with `ross_file`: what to do with the file's plain bearings at the AMB nodes
-    /// (the engineer's model of the AMBs): `ignore` (the scene's AMBs replace them) or
-    /// `parallel` (kept as springs beside the AMBs); none: such a file is refused.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ross_bearings: Option<plant_physics::flex::ross::AtAmbs> = None,
-    /// Flexible, with `ross_file`: what to do with the file's `MagneticBearingElement`s:
-    /// `use` (each its plane's AMB, its PID the law `ross_pid`), `constants` (each its plane's
-    /// AMB, the scene's `[controller]` the law) or `refuse`; none: such a file is refused with the
-    /// constants each element stands for.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ross_ambs: Option<plant_physics::flex::ross::RossAmbs> = None,
-    /// Flexible, with `ross_ambs`: what to do with each `MagneticBearingElement`'s
-    /// `sensors_axis_rotation`: `apply` (its plane's `amb.axis_angle_deg`) or `ignore` (the
-    /// plant's axes at 0°, as without the key).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ross_axes: Option<RossAxes> = None,
-    /// Flexible: the node of AMB A (on the −z side of the centre of mass).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub amb_a_node: Option<usize> = None,
-    /// Flexible: the node of AMB B (on the +z side of the centre of mass).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub amb_b_node: Option<usize> = None,
-    /// Flexible: the node of plane A's displacement sensor; none: `amb_a_node` (collocated).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sensor_a_node: Option<usize> = None,
-    /// Flexible: the node of plane B's displacement sensor; none: `amb_b_node`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sensor_b_node: Option<usize> = None,
-    /// Flexible: the node of touchdown bearing A; none: `amb_a_node`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub touchdown_a_node: Option<usize> = None,
-    /// Flexible: the node of touchdown bearing B; none: `amb_b_node`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub touchdown_b_node: Option<usize> = None,
-    /// Flexible: keep the shaft's modes below this frequency (Hz); none: 2000.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cutoff_hz: Option<f64> = None,
-    /// Flexible: modal damping ratio ζ of every bending mode; none: 0.005.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub modal_damping: Option<f64> = None,
-}
-}
-
-/// `rotor.model`: the rotor model.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RotorModel {
-    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
-    #[default]
-    Planar,
-    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
-    TwoPlane,
-    /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
-    Flexible,
-}
+/// `[rotor]` as a whole, the keys every model reads and the rotor models' names and key structs
+/// (`config/models/`).
+pub use super::models::{RawRotor, RossAxes, RotorKeys, RotorModel, RotorShared, SpinChoice};
 
 scene_table! {
 /// `[touchdown]`: the touchdown bearing.
@@ -348,16 +190,6 @@ pub enum McapCompression {
     None,
     /// lz4: about half the size, for about twice the recording's CPU time.
     Lz4,
-}
-
-/// `rotor.spin`: how the rotor's speed is driven.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SpinChoice {
-    /// The drive holds the speed exactly.
-    Held,
-    /// A speed loop with a gain and a torque limit drives it.
-    Free,
 }
 
 /// `touchdown.support`: how the race is supported.
@@ -524,16 +356,6 @@ pub enum ControlMode {
     Lockstep,
     /// The law runs in the controller process, paced by the wall clock.
     Realtime,
-}
-
-/// `rotor.ross_axes`: what the scene does with the ROSS file's AMB axis rotation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RossAxes {
-    /// Each element's `sensors_axis_rotation` turns its plane's axes (`amb.axis_angle_deg`).
-    Apply,
-    /// The plant's axes stay at 0° (the default).
-    Ignore,
 }
 
 scene_table! {
@@ -859,7 +681,7 @@ impl RawScene {
     pub fn tables() -> [(&'static str, &'static [&'static str]); 11] {
         [
             ("scene", RawMeta::KEYS),
-            ("rotor", RawRotor::KEYS),
+            ("rotor", RawRotor::keys()),
             ("touchdown", RawTouchdown::KEYS),
             ("housing", RawHousing::KEYS),
             ("contact", RawContact::KEYS),

@@ -7,50 +7,15 @@
 //! by the model itself through [`crate::machine::Machine`].
 //! docs/ARCHITECTURE.md ("Adding a rotor model") lists what a new model touches.
 
-pub use super::models::RotorParams;
-use super::raw::RawScene;
-use super::RotorModel;
+use super::models::{RawRotor, RotorModel};
+pub use super::models::{Rotor, RotorParams};
 use crate::model::Params;
-use plant_physics::flex::machine as flexible;
-use plant_physics::two_plane;
-
-/// The rotor of a scene, validated (SI).
-#[derive(Clone, Debug)]
-// One value per scene, built once and read by reference: its size does not matter.
-#[allow(clippy::large_enum_variant)]
-pub enum Rotor {
-    /// One bearing plane (the study's model, `rotor.model = "planar"`): its parameters.
-    Planar(Params),
-    /// The whole rigid rotor on two bearing planes, A and B (`rotor.model = "two_plane"`).
-    TwoPlane(two_plane::Params),
-    /// A flexible shaft on two bearing planes, A and B (`rotor.model = "flexible"`).
-    Flexible(flexible::Params),
-}
 
 impl Rotor {
-    /// The model's parameters, as the rest of the plant asks of them: the one dispatch on the
-    /// model ([`RotorParams`], one implementation per model in `config/models/`).
-    pub fn params(&self) -> &dyn RotorParams {
-        match self {
-            Rotor::Planar(p) => p,
-            Rotor::TwoPlane(p) => p,
-            Rotor::Flexible(p) => p,
-        }
-    }
-
-    /// The same, mutable.
-    pub fn params_mut(&mut self) -> &mut dyn RotorParams {
-        match self {
-            Rotor::Planar(p) => p,
-            Rotor::TwoPlane(p) => p,
-            Rotor::Flexible(p) => p,
-        }
-    }
-
-    /// Writes the model's defaults into the raw scene it was built from (as the user would have
+    /// Writes the model's defaults into the `[rotor]` table it was built from (as the user would have
     /// written them, in the file's units), so that the resolved `scene.toml` states them.
-    pub(super) fn record_defaults(&self, raw: &mut RawScene) {
-        self.params().record_defaults(raw);
+    pub(super) fn record_defaults(&self, rotor: &mut RawRotor) {
+        self.params().record_defaults(rotor);
     }
 
     /// The model's name as `rotor.model` writes it.
@@ -174,16 +139,5 @@ impl Rotor {
     /// in `assess::closed_form`.
     pub fn open_loop(&self) -> Option<plant_physics::flex::linear::OpenLoop> {
         self.params().open_loop()
-    }
-}
-
-impl RotorModel {
-    /// The name `rotor.model` gives it.
-    pub fn name(self) -> &'static str {
-        match self {
-            RotorModel::Planar => "planar",
-            RotorModel::TwoPlane => "two_plane",
-            RotorModel::Flexible => "flexible",
-        }
     }
 }

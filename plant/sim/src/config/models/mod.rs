@@ -1,21 +1,169 @@
-//! What each rotor model says of itself: the [`RotorParams`] trait, one implementation per
-//! model, each in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`). [`super::Rotor`]
-//! dispatches to it once ([`super::Rotor::params`]); a capability one model has and the others
-//! do not (bending, a linear open loop, whirl modes) is a method with a default, so a new model
-//! says only what it has.
+//! The rotor models: their one list ([`rotor_models!`]: `rotor.model`'s names, each model's key
+//! struct and parameters), and what each model says of itself, the [`RotorParams`] trait, one
+//! implementation per model in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`) beside its
+//! `[rotor]` keys and their defaults. [`Rotor`] dispatches to it once ([`Rotor::params`]); a
+//! capability one model has and the others do not (bending, a linear open loop, whirl modes) is
+//! a method with a default, so a new model says only what it has. `[rotor]` as written is
+//! [`RawRotor`] (`table.rs`): the shared keys and the model's key struct, which refuses every key
+//! that is not its own.
 
 pub(in crate::config) mod flexible;
 mod planar;
-mod two_plane;
+mod table;
+pub(in crate::config) mod two_plane;
 
-use super::raw::RawScene;
-use super::RotorModel;
+pub use flexible::FlexibleKeys;
+pub use flexible::RossAxes;
+pub use planar::PlanarKeys;
+pub use table::{RawRotor, RotorShared, SpinChoice};
+pub use two_plane::TwoPlaneKeys;
+
+use super::ConfigError;
 use crate::machine::{FailureState, Linearised};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
+use plant_physics::flex::machine as flexible_machine;
 use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane as rigid;
+use serde::{Deserialize, Serialize};
+
+/// Declares the rotor models, each once: its doc, its variant, `rotor.model`'s name for it, the
+/// model in words and what a rotor of it is (for messages), its key struct (`[rotor]`'s own
+/// keys, in its file) and its validated parameters. Gives [`RotorModel`] (the names), [`RotorKeys`]
+/// (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's validated
+/// rotor) and the one dispatch of each on the model; the compiler points a new model to what it
+/// must give (its key struct's [`Build`], its parameters' [`RotorParams`]).
+macro_rules! rotor_models {
+    ($(
+        $(#[$doc:meta])*
+        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty;
+    )+) => {
+        /// `rotor.model`: the rotor model (the tag of `[rotor]`; `planar` when absent).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+        pub enum RotorModel {
+            $( $(#[$doc])* #[serde(rename = $name)] $variant, )+
+        }
+
+        impl RotorModel {
+            /// Every model, in the list's order.
+            pub const ALL: &'static [RotorModel] = &[$(RotorModel::$variant),+];
+
+            /// The name `rotor.model` gives it.
+            pub fn name(self) -> &'static str {
+                match self { $(RotorModel::$variant => $name,)+ }
+            }
+
+            /// The model in words, for messages ("the flexible rotor").
+            pub fn what(self) -> &'static str {
+                match self { $(RotorModel::$variant => $what,)+ }
+            }
+
+            /// What a rotor of the model is, for messages ("rigid, on one bearing plane").
+            pub fn is(self) -> &'static str {
+                match self { $(RotorModel::$variant => $is,)+ }
+            }
+
+            /// The model's own `[rotor]` keys (its key struct's), in declaration order.
+            pub fn own_keys(self) -> &'static [&'static str] {
+                match self { $(RotorModel::$variant => $keys::KEYS,)+ }
+            }
+
+            /// The model's own keys, each at its default.
+            pub fn default_keys(self) -> RotorKeys {
+                match self { $(RotorModel::$variant => RotorKeys::$variant($keys::default()),)+ }
+            }
+        }
+
+        /// `[rotor]`'s tagged part: the model `rotor.model` names, holding its own keys (its key
+        /// struct refuses every other key).
+        #[derive(Clone, Debug, Serialize)]
+        #[serde(untagged)]
+        pub enum RotorKeys {
+            $( $(#[$doc])* $variant($keys), )+
+        }
+
+        impl RotorKeys {
+            /// The model these keys are of.
+            pub fn model(&self) -> RotorModel {
+                match self { $(RotorKeys::$variant(_) => RotorModel::$variant,)+ }
+            }
+
+            /// `model`'s keys read from `table` (no shared key, no `model`): the key struct
+            /// refuses a key that is not its own.
+            fn from_table(model: RotorModel, table: toml::Table) -> Result<RotorKeys, toml::de::Error> {
+                let table = toml::Value::Table(table);
+                Ok(match model { $(RotorModel::$variant => RotorKeys::$variant(table.try_into()?),)+ })
+            }
+
+            /// The model's parameters built from its keys with what the scene's validation gives
+            /// (`ctx`, [`Build`]).
+            pub fn build<Ctx>(&self, ctx: &Ctx) -> Result<Rotor, ConfigError>
+            where
+                $($keys: Build<Ctx, Params = $params>,)+
+            {
+                Ok(match self { $(RotorKeys::$variant(k) => Rotor::$variant(k.build(ctx)?),)+ })
+            }
+        }
+
+        /// The rotor of a scene, validated (SI): the model's parameters.
+        #[derive(Clone, Debug)]
+        // One value per scene, built once and read by reference: its size does not matter.
+        #[allow(clippy::large_enum_variant)]
+        pub enum Rotor {
+            $( $(#[$doc])* $variant($params), )+
+        }
+
+        impl Rotor {
+            /// The model's parameters, as the rest of the plant asks of them: the one dispatch on
+            /// the model ([`RotorParams`], one implementation per model in `config/models/`).
+            pub fn params(&self) -> &dyn RotorParams {
+                match self { $(Rotor::$variant(p) => p,)+ }
+            }
+
+            /// The same, mutable.
+            pub fn params_mut(&mut self) -> &mut dyn RotorParams {
+                match self { $(Rotor::$variant(p) => p,)+ }
+            }
+        }
+    };
+}
+
+rotor_models! {
+    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
+    Planar = "planar", "the planar rotor", "rigid, on one bearing plane": PlanarKeys => Params;
+    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
+    TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes": TwoPlaneKeys => rigid::Params;
+    /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
+    Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
+        FlexibleKeys => flexible_machine::Params;
+}
+
+/// `planar` when `[rotor]` has no `model`.
+impl Default for RotorModel {
+    fn default() -> Self {
+        RotorModel::Planar
+    }
+}
+
+impl Default for RotorKeys {
+    fn default() -> Self {
+        RotorModel::default().default_keys()
+    }
+}
+
+/// A model's key struct built into the model's parameters with `Ctx`, what the scene's
+/// validation gives it (`config::validate`'s context: the scene as written, the shared keys
+/// validated, the scene's folder). Implemented beside the validation (`config/validate/`), which
+/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
+/// imports neither.
+pub trait Build<Ctx> {
+    /// The model's validated parameters.
+    type Params;
+
+    /// The model's parameters, each error naming the key, value and unit.
+    fn build(&self, ctx: &Ctx) -> Result<Self::Params, ConfigError>;
+}
 
 /// A rotor model's parameters, as the scene and the rest of the plant ask of them.
 pub trait RotorParams {
@@ -41,10 +189,10 @@ pub trait RotorParams {
     /// the state first); `None` if `y` holds less than the model's state.
     fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState>;
 
-    /// Writes the model's defaults into the raw scene it was built from (as the user would have
+    /// Writes the model's defaults into the `[rotor]` table it was built from (as the user would have
     /// written them, in the file's units), so that the resolved `scene.toml` states them. The
     /// default: the model has none beyond the scene table's own.
-    fn record_defaults(&self, _raw: &mut RawScene) {}
+    fn record_defaults(&self, _rotor: &mut RawRotor) {}
 
     /// The rigid rotor on two bearing planes that the model is, or whose rigid body it bends
     /// about (the flexible rotor's: mass, inertias and unbalance from its elements, its planes

@@ -1,9 +1,17 @@
-//! The planar model (`rotor.model = "planar"`): one bearing plane, the study's.
+//! The planar model (`rotor.model = "planar"`): one bearing plane, the study's. It has no
+//! `[rotor]` keys of its own: its bearing is the shared tables' (`[touchdown]`, `[contact]`,
+//! `[amb]`), its rotor the shared `[rotor]` keys.
 
-use super::RotorParams;
-use crate::config::RotorModel;
+use super::{RotorModel, RotorParams};
+use crate::config::scene_table::scene_table;
 use crate::machine::{FailureState, Machine};
 use crate::model::{Model, Params, N};
+use serde::{Deserialize, Serialize};
+
+scene_table! {
+/// `[rotor]`'s own keys of the planar model: none (a key of another model is refused).
+pub struct PlanarKeys {}
+}
 
 impl RotorParams for Params {
     fn model(&self) -> RotorModel {

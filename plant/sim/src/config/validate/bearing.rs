@@ -15,6 +15,18 @@ pub(in crate::config) struct Share {
     pub(super) spin: Spin,
 }
 
+/// The planar model: its one bearing plane from the shared tables; a two-plane rotor's per-plane
+/// tables and initial slopes are refused by name (each would be ignored otherwise).
+impl crate::config::models::Build<Context<'_>> for crate::config::models::PlanarKeys {
+    type Params = Params;
+
+    fn build(&self, ctx: &Context) -> Result<Params, ConfigError> {
+        let raw = ctx.raw;
+        super::two_plane_keys::refuse_plane_tables(raw)?;
+        bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &Keys { plane: None }, ctx.whole)
+    }
+}
+
 /// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`
 /// where plane B's table sets it.
 pub(in crate::config) struct Keys<'a> {
@@ -56,6 +68,59 @@ pub(in crate::config) fn bearing(
     k: &Keys,
     share: &Share,
 ) -> Result<Params, ConfigError> {
+    let race = race(td, k)?;
+    let gap = race.gap;
+    let (contact, balls) = contact_laws(ct, k, td.ball_count, share.radius, gap, race.clearance)?;
+    let (support, race_when_clear) = supports(td, k, &balls)?;
+    let (amb_law, ki, ks) = amb_law(amb, k, gap, race.clearance)?;
+    let loop_constants = LoopConstants {
+        ki_n_per_a: ki,
+        ks_n_per_m: ks,
+        amp_gain_a_per_v: positive(&k.amb("amp_gain_a_per_v"), amb.amp_gain_a_per_v, "A/V")?,
+        sensor_gain_v_per_m: positive(&k.amb("sensor_gain_v_per_m"), amb.sensor_gain_v_per_m, "V/m")?,
+        rotor_mass_kg: share.mass,
+        gravity_m_s2: share.gravity,
+        air_gap_m: gap,
+    };
+    let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    let axes = axes(amb, ctl, k)?;
+    Ok(Params {
+        gravity: share.gravity,
+        rotor_mass: share.mass,
+        eccentricity: share.eccentricity,
+        rotor_inertia: share.inertia,
+        speed: share.speed,
+        spin: share.spin,
+        race_mass: race.mass,
+        race_inertia: race.inertia,
+        cage: td.cage,
+        cage_phase: race.cage_phase,
+        cage_ratio: race.cage_ratio,
+        contact,
+        balls,
+        support,
+        race_when_clear,
+        drag: race.drag,
+        amb: amb_law,
+        loop_constants,
+        current_limit,
+        axes,
+    })
+}
+
+/// A plane's touchdown race as `[touchdown]` gives it (SI).
+struct Race {
+    gap: f64,
+    mass: f64,
+    inertia: f64,
+    clearance: f64,
+    cage_phase: f64,
+    cage_ratio: f64,
+    drag: RaceDrag,
+}
+
+/// `[touchdown]`'s race, balls' geometry and drag.
+fn race(td: &RawTouchdown, k: &Keys) -> Result<Race, ConfigError> {
     let gap = positive(&k.td("air_gap_mm"), td.air_gap_mm, "mm")? * 1e-3;
     let race_mass = positive(&k.td("race_mass_kg"), td.race_mass_kg, "kg")?;
     let race_inertia = positive(&k.td("race_polar_inertia_kg_m2"), td.race_polar_inertia_kg_m2, "kg·m²")?;
@@ -87,6 +152,27 @@ pub(in crate::config) fn bearing(
         DragChoice::Palmgren => RaceDrag::Palmgren { f0, nu0_cst, f1, pitch_diameter_mm: dm, reg_speed },
     };
 
+    Ok(Race {
+        gap,
+        mass: race_mass,
+        inertia: race_inertia,
+        clearance,
+        cage_phase,
+        cage_ratio: r_in / (r_in + r_out),
+        drag,
+    })
+}
+
+/// `[contact]`: the rotor – race contact (on the rotor of radius `radius` in a bore `gap` wider)
+/// and the `balls`' (with their `clearance`).
+fn contact_laws(
+    ct: &RawContact,
+    k: &Keys,
+    balls: u32,
+    radius: f64,
+    gap: f64,
+    clearance: f64,
+) -> Result<(RotorRace, BallSet), ConfigError> {
     let damping_depth = positive(&k.ct("damping_depth_mm"), ct.damping_depth_mm, "mm")? * 1e-3;
     let v_static = positive(&k.ct("stribeck_static_m_s"), ct.stribeck_static_m_s, "m/s")?;
     let v_dynamic = positive(&k.ct("stribeck_dynamic_m_s"), ct.stribeck_dynamic_m_s, "m/s")?;
@@ -106,8 +192,8 @@ pub(in crate::config) fn bearing(
     };
     let contact = RotorRace {
         gap,
-        rotor_radius: share.radius,
-        bore_radius: share.radius + gap,
+        rotor_radius: radius,
+        bore_radius: radius + gap,
         stiffness: positive(
             &k.ct("rotor_race_stiffness_n_per_m10_9"),
             ct.rotor_race_stiffness_n_per_m10_9,
@@ -118,17 +204,23 @@ pub(in crate::config) fn bearing(
         friction,
     };
     let balls = BallSet::new(
-        td.ball_count as usize,
+        balls as usize,
         clearance,
         positive(&k.ct("ball_stiffness_n_per_m1_5"), ct.ball_stiffness_n_per_m1_5, "N/m^(3/2)")?,
         non_negative(&k.ct("ball_damping_n_s_per_m"), ct.ball_damping_n_s_per_m, "N·s/m")?,
         damping_depth,
     );
 
+    Ok((contact, balls))
+}
+
+/// `touchdown.support` (a lumped ring calibrated on `balls`), `touchdown.race_when_clear` and
+/// `touchdown.race_release`.
+fn supports(td: &RawTouchdown, k: &Keys, balls: &BallSet) -> Result<(Support, RaceWhenClear), ConfigError> {
     let lumped_reference = positive(&k.td("lumped_reference_mm"), td.lumped_reference_mm, "mm")? * 1e-3;
     let support = match td.support {
         SupportChoice::Balls => Support::Balls,
-        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(&balls, lumped_reference)),
+        SupportChoice::Lumped => Support::Lumped(LumpedSupport::calibrated(balls, lumped_reference)),
     };
     let release = match td.race_release {
         ReleaseChoice::Equilibrium => Release::Equilibrium,
@@ -138,6 +230,12 @@ pub(in crate::config) fn bearing(
         RaceWhenClearChoice::Free => RaceWhenClear::Free,
         RaceWhenClearChoice::Parked => RaceWhenClear::Parked(release),
     };
+    Ok((support, race_when_clear))
+}
+
+/// `[amb]`'s force law and its `k_i`, `k_s`; the nonlinear law's magnet gap must exceed the
+/// touchdown `gap` plus the balls' `clearance`.
+fn amb_law(amb: &RawAmb, k: &Keys, gap: f64, clearance: f64) -> Result<(AmbLaw, f64, f64), ConfigError> {
     let ki = positive(&k.amb("ki_n_per_a"), amb.ki_n_per_a, "N/A")?;
     let ks = non_negative(&k.amb("ks_n_per_m"), amb.ks_n_per_m, "N/m")?;
     let s0 = positive(&k.amb("nominal_gap_mm"), amb.nominal_gap_mm, "mm")? * 1e-3;
@@ -164,16 +262,12 @@ pub(in crate::config) fn bearing(
             AmbLaw::nonlinear_matching(ki, ks, s0, magnet_force_limit)
         }
     };
-    let loop_constants = LoopConstants {
-        ki_n_per_a: ki,
-        ks_n_per_m: ks,
-        amp_gain_a_per_v: positive(&k.amb("amp_gain_a_per_v"), amb.amp_gain_a_per_v, "A/V")?,
-        sensor_gain_v_per_m: positive(&k.amb("sensor_gain_v_per_m"), amb.sensor_gain_v_per_m, "V/m")?,
-        rotor_mass_kg: share.mass,
-        gravity_m_s2: share.gravity,
-        air_gap_m: gap,
-    };
-    let current_limit = positive("controller.current_limit_a", ctl.current_limit_a, "A")?;
+    Ok((amb_law, ki, ks))
+}
+
+/// `amb.axis_angle_deg`: the plane's axes; refused turned with a sampled or co-simulated law's
+/// gravity bias.
+fn axes(amb: &RawAmb, ctl: &RawController, k: &Keys) -> Result<plant_physics::axes::Axes, ConfigError> {
     let axes = match amb.axis_angle_deg {
         None => Default::default(),
         Some(deg) if deg.is_finite() && (-90.0..=90.0).contains(&deg) => {
@@ -194,26 +288,5 @@ pub(in crate::config) fn bearing(
              controller.mode = \"continuous\" (the plant's PD shares the bias between u and v)",
         ));
     }
-    Ok(Params {
-        gravity: share.gravity,
-        rotor_mass: share.mass,
-        eccentricity: share.eccentricity,
-        rotor_inertia: share.inertia,
-        speed: share.speed,
-        spin: share.spin,
-        race_mass,
-        race_inertia,
-        cage: td.cage,
-        cage_phase,
-        cage_ratio: r_in / (r_in + r_out),
-        contact,
-        balls,
-        support,
-        race_when_clear,
-        drag,
-        amb: amb_law,
-        loop_constants,
-        current_limit,
-        axes,
-    })
+    Ok(axes)
 }

@@ -1,52 +1,22 @@
 //! `rotor.model = "flexible"`: the shaft (a table in the scene or a ROSS file), its nodes for the
-//! AMBs, sensors and touchdown bearings, the reduction; the flexible keys refused in a rigid
-//! scene and the rigid rotor's geometry keys refused in a flexible one.
+//! AMBs, sensors and touchdown bearings, the reduction. (Other models' `[rotor]` keys are refused
+//! by the flexible model's key struct, and its own by theirs.)
 
 use super::*;
 use crate::config::models::flexible::{CUTOFF_HZ, MODAL_DAMPING};
+use crate::config::models::{FlexibleKeys, TwoPlaneKeys};
 use plant_physics::flex::{self, machine, Reduction};
 use std::sync::Arc;
 
 /// Reduced coordinates the flexible state has room for.
 const MAX_BASIS: usize = machine::MAX_MODES;
 
-/// The flexible rotor's keys given in a rigid scene, refused by name.
-pub(in crate::config) fn refuse_flexible_keys(raw: &RawScene) -> Result<(), ConfigError> {
-    let r = &raw.rotor;
-    const WHY: &str = "is a key of the flexible rotor and this scene's rotor is rigid: set rotor.model = \
-                       \"flexible\" or remove the key";
-    if r.shaft.is_some() {
-        return Err(range("rotor.shaft", "a table", "", WHY));
+impl crate::config::models::Build<Context<'_>> for FlexibleKeys {
+    type Params = machine::Params;
+
+    fn build(&self, ctx: &Context) -> Result<machine::Params, ConfigError> {
+        flexible_params(ctx.raw, self, ctx.whole, ctx.base_dir)
     }
-    if let Some(f) = &r.ross_file {
-        return Err(range("rotor.ross_file", f, "", WHY));
-    }
-    if let Some(b) = r.ross_bearings {
-        return Err(range("rotor.ross_bearings", at_ambs_name(b), "", WHY));
-    }
-    if let Some(b) = r.ross_ambs {
-        return Err(range("rotor.ross_ambs", super::ross_ambs::name(b), "", WHY));
-    }
-    if let Some(a) = r.ross_axes {
-        return Err(range("rotor.ross_axes", super::ross_axes::name(a), "", WHY));
-    }
-    let nodes = [
-        ("rotor.amb_a_node", r.amb_a_node),
-        ("rotor.amb_b_node", r.amb_b_node),
-        ("rotor.sensor_a_node", r.sensor_a_node),
-        ("rotor.sensor_b_node", r.sensor_b_node),
-        ("rotor.touchdown_a_node", r.touchdown_a_node),
-        ("rotor.touchdown_b_node", r.touchdown_b_node),
-    ];
-    if let Some((key, n)) = nodes.iter().find_map(|(k, v)| v.map(|v| (*k, v))) {
-        return Err(range(key, n, "", WHY));
-    }
-    for (key, value, unit) in [("rotor.cutoff_hz", r.cutoff_hz, "Hz"), ("rotor.modal_damping", r.modal_damping, "")] {
-        if let Some(v) = value {
-            return Err(range(key, v, unit, WHY));
-        }
-    }
-    Ok(())
 }
 
 fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
@@ -56,17 +26,82 @@ fn flex_error(key: &str, value: &str, e: flex::FlexError) -> ConfigError {
 /// The flexible machine of a scene, validated.
 pub(in crate::config) fn flexible_params(
     raw: &RawScene,
+    r: &FlexibleKeys,
     whole: &Share,
     base_dir: &Path,
 ) -> Result<machine::Params, ConfigError> {
-    let r = &raw.rotor;
-    const RIGID: &str = "is a key of the rigid two-plane rotor: a flexible rotor's geometry and inertia come from \
-                         its shaft (rotor.shaft or rotor.ross_file) and its nodes (rotor.amb_a_node, …)";
-    let rigid_keys = super::two_plane_keys::rigid_geometry_keys(raw);
-    if let Some((key, value, unit)) = rigid_keys.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
-        return Err(range(key, value, unit, RIGID));
+    let (shaft, file) = shaft_of(r, base_dir)?;
+    shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
+    let nodes = shaft.node_count();
+    let (amb, sensor, touchdown) = nodes_of(r, nodes)?;
+    let body = shaft.rigid_body();
+    let z: Vec<f64> = shaft.node_positions().iter().map(|p| p - body.centre).collect();
+    const SIDES: &str = "AMB A lies on the −z side of the rotor's centre of mass and AMB B on the +z side: the \
+                         centre of mass is between the AMBs";
+    if z[amb[0]] >= 0.0 {
+        return Err(range(
+            "rotor.amb_a_node",
+            amb[0],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[0]] * 1e3),
+        ));
     }
-    let (shaft, file) = match (&r.shaft, &r.ross_file) {
+    if z[amb[1]] <= 0.0 {
+        return Err(range(
+            "rotor.amb_b_node",
+            amb[1],
+            "",
+            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
+        ));
+    }
+    let (shaft, file_bearings) = match file {
+        None => (shaft, Vec::new()),
+        Some((name, read)) => {
+            let (rotor, used) = read
+                .bearings_with_ambs(amb, r.ross_bearings)
+                .map_err(|why| range("rotor.ross_bearings", "none", "", &format!("rotor.ross_file = {name}: {why}")))?;
+            rotor.validate().map_err(|e| flex_error("rotor.ross_file", name, e))?;
+            (rotor, used)
+        }
+    };
+    let reduced = reduce(r, &shaft, amb, touchdown)?;
+    // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
+    // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
+    let mm = |n: usize| Some(z[n] * 1e3);
+    let as_rigid = TwoPlaneKeys {
+        transverse_inertia_kg_m2: Some(body.transverse_inertia),
+        bearing_a_mm: mm(amb[0]),
+        bearing_b_mm: mm(amb[1]),
+        sensor_a_mm: mm(sensor[0]),
+        sensor_b_mm: mm(sensor[1]),
+        end_a_mm: Some(z[0] * 1e3),
+        end_b_mm: Some(z[nodes - 1] * 1e3),
+        ..TwoPlaneKeys::default()
+    };
+    let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
+    let machine = super::two_plane_keys::two_plane_params(raw, &as_rigid, &share)?;
+    let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
+    // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
+    // forms its terms at each evaluation, as before; the result is the same to the bit).
+    let reduced = reduced.hold_speed(machine.rotor.speed);
+    Ok(machine::Params {
+        machine,
+        nodes,
+        reduced: Arc::new(reduced),
+        shaft: Arc::new(shaft),
+        z,
+        file_bearings,
+        file_ambs: Vec::new(),
+    })
+}
+
+/// A ROSS file's name as the scene gives it, and the file as read.
+type FileRead<'a> = (&'a str, flex::ross::RossFile);
+
+/// The shaft of a flexible rotor: `rotor.shaft`'s table, or `rotor.ross_file`'s rotor with the
+/// file as read (its bearings are placed once the AMB nodes are known).
+fn shaft_of<'a>(r: &'a FlexibleKeys, base_dir: &Path) -> Result<(flex::Rotor, Option<FileRead<'a>>), ConfigError> {
+    Ok(match (&r.shaft, &r.ross_file) {
         (Some(_), Some(f)) => {
             return Err(range("rotor.ross_file", f, "", "a flexible rotor has either rotor.shaft or rotor.ross_file"))
         }
@@ -111,11 +146,17 @@ pub(in crate::config) fn flexible_params(
                 _ => flex::ross::parse_file,
             };
             let read = parse(&text, file).map_err(|e| flex_error("rotor.ross_file", file, e))?;
-            (read.rotor.clone(), Some((file, read)))
+            (read.rotor.clone(), Some((file.as_str(), read)))
         }
-    };
-    shaft.validate().map_err(|e| flex_error("rotor.shaft", "the shaft", e))?;
-    let nodes = shaft.node_count();
+    })
+}
+
+/// A node on each plane, A's and B's.
+type PlaneNodes = [usize; 2];
+
+/// The nodes of each plane's AMB, sensor and touchdown bearing (the sensor's and the touchdown
+/// bearing's the AMB's unless given), each on a shaft of `nodes` nodes.
+fn nodes_of(r: &FlexibleKeys, nodes: usize) -> Result<(PlaneNodes, PlaneNodes, PlaneNodes), ConfigError> {
     let node = |key: &str, value: Option<usize>, default: Option<usize>| -> Result<usize, ConfigError> {
         let Some(n) = value.or(default) else {
             return Err(range(key, "none", "", "a flexible rotor needs the node of each AMB"));
@@ -134,36 +175,18 @@ pub(in crate::config) fn flexible_params(
         node("rotor.touchdown_a_node", r.touchdown_a_node, Some(amb[0]))?,
         node("rotor.touchdown_b_node", r.touchdown_b_node, Some(amb[1]))?,
     ];
-    let body = shaft.rigid_body();
-    let z: Vec<f64> = shaft.node_positions().iter().map(|p| p - body.centre).collect();
-    const SIDES: &str = "AMB A lies on the −z side of the rotor's centre of mass and AMB B on the +z side: the \
-                         centre of mass is between the AMBs";
-    if z[amb[0]] >= 0.0 {
-        return Err(range(
-            "rotor.amb_a_node",
-            amb[0],
-            "",
-            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[0]] * 1e3),
-        ));
-    }
-    if z[amb[1]] <= 0.0 {
-        return Err(range(
-            "rotor.amb_b_node",
-            amb[1],
-            "",
-            &format!("is {:.1} mm from the centre of mass: {SIDES}", z[amb[1]] * 1e3),
-        ));
-    }
-    let (shaft, file_bearings) = match file {
-        None => (shaft, Vec::new()),
-        Some((name, read)) => {
-            let (rotor, used) = read
-                .bearings_with_ambs(amb, r.ross_bearings)
-                .map_err(|why| range("rotor.ross_bearings", "none", "", &format!("rotor.ross_file = {name}: {why}")))?;
-            rotor.validate().map_err(|e| flex_error("rotor.ross_file", name, e))?;
-            (rotor, used)
-        }
-    };
+    Ok((amb, sensor, touchdown))
+}
+
+/// The shaft reduced to its modes below `rotor.cutoff_hz` with the static correction at the
+/// force nodes (the AMBs' and the touchdown bearings'), `rotor.modal_damping` on every bending
+/// mode; within the room the flexible state has.
+fn reduce(
+    r: &FlexibleKeys,
+    shaft: &flex::Rotor,
+    amb: PlaneNodes,
+    touchdown: PlaneNodes,
+) -> Result<flex::Reduced, ConfigError> {
     let cutoff = positive("rotor.cutoff_hz", r.cutoff_hz.unwrap_or(CUTOFF_HZ), "Hz")?;
     let zeta = non_negative("rotor.modal_damping", r.modal_damping.unwrap_or(MODAL_DAMPING), "")?;
     if zeta >= 1.0 {
@@ -176,14 +199,14 @@ pub(in crate::config) fn flexible_params(
         gyroscopic_correction: false,
         modal_damping: zeta,
     };
-    let reduced = flex::Reduced::new(&shaft, &spec).map_err(|e| match e {
+    let reduced = flex::Reduced::new(shaft, &spec).map_err(|e| match e {
         flex::FlexError::CutoffBelowRigidModes { .. } | flex::FlexError::TooManyModes { .. } => {
             flex_error("rotor.cutoff_hz", &format!("{cutoff} Hz"), e)
         }
         // The free rotor's static correction is solved with the shift (2π f_c)²: a cutoff far
         // below the first bending mode leaves it too small to solve with. The cutoff is at fault.
         flex::FlexError::SingularStiffness => {
-            let first = flex::reduce::undamped_frequencies_hz(&shaft)
+            let first = flex::reduce::undamped_frequencies_hz(shaft)
                 .ok()
                 .and_then(|f| f.get(flex::reduce::RIGID_MODES).copied());
             let first = first.map_or(String::new(), |f| format!(" (the shaft's first bending mode is at {f:.1} Hz)"));
@@ -212,33 +235,7 @@ pub(in crate::config) fn flexible_params(
             ),
         ));
     }
-    // The rigid two-plane rotor with the shaft's mass and inertia, its bearings at the AMB nodes
-    // and its sensors at the sensor nodes: each plane's bearing (load share, design) as there.
-    let mm = |n: usize| Some(z[n] * 1e3);
-    let mut as_rigid = raw.clone();
-    let rr = &mut as_rigid.rotor;
-    rr.transverse_inertia_kg_m2 = Some(body.transverse_inertia);
-    rr.bearing_a_mm = mm(amb[0]);
-    rr.bearing_b_mm = mm(amb[1]);
-    rr.sensor_a_mm = mm(sensor[0]);
-    rr.sensor_b_mm = mm(sensor[1]);
-    rr.end_a_mm = Some(z[0] * 1e3);
-    rr.end_b_mm = Some(z[nodes - 1] * 1e3);
-    let share = Share { mass: body.mass, inertia: body.polar_inertia, ..*whole };
-    let machine = super::two_plane_keys::two_plane_params(&as_rigid, &share)?;
-    let nodes = [0, 1].map(|i| machine::PlaneNodes { amb: amb[i], sensor: sensor[i], touchdown: touchdown[i] });
-    // The rates' matrix at the rated speed, formed once: a held spin stays there (a free one
-    // forms its terms at each evaluation, as before; the result is the same to the bit).
-    let reduced = reduced.hold_speed(machine.rotor.speed);
-    Ok(machine::Params {
-        machine,
-        nodes,
-        reduced: Arc::new(reduced),
-        shaft: Arc::new(shaft),
-        z,
-        file_bearings,
-        file_ambs: Vec::new(),
-    })
+    Ok(reduced)
 }
 
 /// `rotor.ross_bearings`'s value as the scene writes it.
@@ -267,7 +264,7 @@ pub(in crate::config) fn file_bearings_note(raw: &RawScene, params: &machine::Pa
     if kept.is_empty() {
         return None;
     }
-    let file = raw.rotor.ross_file.as_deref().unwrap_or("the ROSS file");
+    let file = raw.rotor.flexible().and_then(|r| r.ross_file.as_deref()).unwrap_or("the ROSS file");
     Some(format!(
         "rotor.ross_file = {file}: the file's bearings act on the shaft besides the scene's AMBs: {} \
          (summary.json model.ross_bearings)",

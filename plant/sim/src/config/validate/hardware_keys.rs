@@ -15,7 +15,7 @@ pub(super) fn hardware(
     integrator: &IntegratorSettings,
     period: f64,
 ) -> Result<crate::config::hardware::Hardware, ConfigError> {
-    use crate::sensor::{Harmonic, LowPass};
+    use crate::sensor::LowPass;
     // The largest fixed step: an explicit method is stable on a real pole −ω for ω h ≤ 2
     // (Euler; RK4: 2.79), which also keeps the pole below the step's Nyquist rate 1/(2h).
     let resolve = |key: &str, value: f64, unit: &str, omega: f64, what: &str| -> Result<(), ConfigError> {
@@ -92,6 +92,17 @@ pub(super) fn hardware(
         None
     };
     let range_um = non_negative("sensor.range_um", s.range_um, "µm")?;
+    let runout = runout(s, planes, gaps)?;
+    Ok(crate::config::hardware::Hardware {
+        amplifiers,
+        unipolar,
+        front_end: crate::sensor::FrontEnd { low_pass, runout, range: (range_um > 0.0).then_some(range_um * 1e-6) },
+    })
+}
+
+/// `[[sensor.runout]]`'s harmonics, each on an axis of the scene's `planes` and at most the air
+/// gap of its plane (`gaps`, m).
+fn runout(s: &RawSensor, planes: usize, gaps: &[f64]) -> Result<Vec<crate::sensor::Harmonic>, ConfigError> {
     if s.runout.len() > MAX_RUNOUT {
         return Err(range("sensor.runout", s.runout.len(), "harmonics", &format!("must be at most {MAX_RUNOUT}")));
     }
@@ -134,13 +145,9 @@ pub(super) fn hardware(
             ));
         }
         let phase = finite(&key("phase_deg"), h.phase_deg, "deg")?.to_radians();
-        runout.push(Harmonic { axis, order: h.order, amplitude, phase, kind: h.kind });
+        runout.push(crate::sensor::Harmonic { axis, order: h.order, amplitude, phase, kind: h.kind });
     }
-    Ok(crate::config::hardware::Hardware {
-        amplifiers,
-        unipolar,
-        front_end: crate::sensor::FrontEnd { low_pass, runout, range: (range_um > 0.0).then_some(range_um * 1e-6) },
-    })
+    Ok(runout)
 }
 
 /// A plane's unipolar drive (`amb.amplifier_topology = "unipolar"`, docs/MODEL.md §12.3): it

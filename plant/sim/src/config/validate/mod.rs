@@ -33,8 +33,8 @@ use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
 use controller::LoopConstants;
 use std::path::Path;
 
-// The rotor models' keys, each built by the model's arm of `rotor_of::rotor_from_raw`
-// (config/rotor.rs) with the bearing planes of `bearing`.
+// The rotor models' keys, each built by its model's key struct (`config/models/`,
+// `ModelKeys::build`) with the bearing planes of `bearing`.
 pub(super) mod bearing;
 mod checks;
 mod controller_keys;
@@ -42,13 +42,25 @@ pub(super) mod flexible_keys;
 mod hardware_keys;
 mod ross_ambs;
 mod ross_axes;
-mod rotor_of;
 pub(super) mod two_plane_keys;
 
 use bearing::{bearing, Keys, Share};
 pub use checks::{finite, non_negative, positive, range};
 use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
 use hardware_keys::hardware;
+
+/// What a rotor model's key struct is built with ([`crate::config::models::Build`], implemented
+/// beside each model's validation: `bearing.rs` the planar, `two_plane_keys.rs`,
+/// `flexible_keys.rs`): the scene as written (its bearing planes' tables), the shared `[rotor]`
+/// keys validated, the scene's folder (the model's files).
+pub(in crate::config) struct Context<'a> {
+    /// The scene as written.
+    pub(in crate::config) raw: &'a RawScene,
+    /// The shared `[rotor]` keys, validated.
+    pub(in crate::config) whole: &'a Share,
+    /// The scene's folder.
+    pub(in crate::config) base_dir: &'a Path,
+}
 
 /// Longest simulated time (s): about 11.6 days.
 pub const MAX_DURATION_S: f64 = 1e6;
@@ -106,9 +118,7 @@ pub fn validate(raw: RawScene, base_dir: &Path) -> Result<Scene, ConfigError> {
     for arg in &overrides {
         super::apply_override(&mut table, arg)?;
     }
-    let fixed = toml::Value::Table(table)
-        .try_into::<RawScene>()
-        .map_err(|e| ConfigError::Parse { path: "the realtime setting".into(), message: e.to_string() })?;
+    let fixed = super::parse_raw(table, "the realtime setting")?;
     let mut fixed = validate_as_written(fixed, base_dir)?;
     // The first pass's warnings (deprecated keys are moved by it and not seen again).
     fixed.warnings = scene.warnings;
@@ -131,29 +141,10 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // A ROSS file's AMB elements as the planes' AMBs (rotor.ross_ambs): written into the scene.
     let mut file_ambs = ross_ambs::apply(&mut raw, base_dir)?;
     ross_axes::apply(&mut raw, &mut file_ambs)?;
-    let (r, ctl, int) = (&raw.rotor, &raw.controller, &raw.integrator);
-    let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
-    let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;
-    if duration > MAX_DURATION_S {
-        return Err(range("scene.duration_s", duration, "s", &format!("must be <= {MAX_DURATION_S:e} s")));
-    }
-    positive("housing.mass_kg", raw.housing.mass_kg, "kg")?;
-    let unbalance_phase = finite("rotor.unbalance_phase_deg", r.unbalance_phase_deg, "deg")?.to_radians();
-    let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
-    let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
-    let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
-    let rotor_radius = positive("rotor.radius_mm", r.radius_mm, "mm")? * 1e-3;
-    let speed = non_negative("rotor.speed_hz", r.speed_hz, "Hz")? * std::f64::consts::TAU;
-    let drive_gain = non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?;
-    let torque_limit = non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?;
-    let spin = match r.spin {
-        SpinChoice::Held => Spin::Held,
-        SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
-    };
-    let whole =
-        Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
-    // The rotor model, built from the scene by its own arm of `rotor_of::rotor_from_raw`.
-    let mut rotor = rotor_of::rotor_from_raw(&raw, &whole, base_dir)?;
+    let (gravity, duration) = span(&raw)?;
+    let (whole, unbalance_phase) = whole_rotor(&raw.rotor, gravity)?;
+    // The rotor model, built from the scene by its own key struct.
+    let mut rotor = raw.rotor.model.build(&Context { raw: &raw, whole: &whole, base_dir })?;
     // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
     // AMBs: the run's first line says so.
     if let Rotor::Flexible(f) = &mut rotor {
@@ -169,6 +160,96 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // `[controller]`), the same on every plane.
     let loop_constants = rotor.plane(0).loop_constants;
 
+    let controller = controller_settings(&raw.controller, duration, &mut warnings)?;
+    let rate = controller.rate_hz;
+
+    let integrator = integrator_settings(&raw.integrator)?;
+
+    let output_rate = output_rate(&raw.output, duration)?;
+    let initial = initial_settings(&raw.initial, unbalance_phase)?;
+    if raw.sensor.adc_bits > 24 {
+        return Err(range("sensor.adc_bits", raw.sensor.adc_bits, "bits", "must be between 0 (ideal) and 24"));
+    }
+    let sensor = crate::sensor::SensorSettings {
+        gain: loop_constants.sensor_gain_v_per_m,
+        noise_v: non_negative("sensor.noise_v_rms", raw.sensor.noise_v_rms, "V")?,
+        seed: raw.sensor.noise_seed,
+        adc_bits: raw.sensor.adc_bits,
+        adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
+    };
+    let gaps: Vec<f64> = rotor.bearings().map(|p| p.contact.gap).collect();
+    let laws: Vec<AmbLaw> = rotor.bearings().map(|p| p.amb).collect();
+    let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
+    let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
+    // The resolved scene states the rotor model's defaults.
+    rotor.record_defaults(&mut raw.rotor);
+    let scene = Scene {
+        name: raw.scene.name.clone(),
+        description: raw.scene.description.clone(),
+        duration,
+        rotor,
+        base,
+        controller,
+        integrator,
+        initial,
+        sensor,
+        hardware,
+        output_interval: 1.0 / output_rate,
+        plots: raw.output.plots,
+        mcap: raw.output.mcap.unwrap_or(false),
+        live_rate_hz: live_rate(raw.output.live_rate_hz, output_rate)?,
+        mcap_compression: raw.output.mcap_compression.unwrap_or(super::McapCompression::None),
+        warnings,
+        source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
+    };
+    // The law validates its own parameters: a scene it refuses is bad input, before any run.
+    // A controller command serves laws of its own: it checks them, in the handshake.
+    if let Some(spec) = &fmu {
+        super::fmu::check(spec, scene.rotor_design().axes() as usize)?;
+    } else if scene.controller.cosim.command.is_none() {
+        controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
+    }
+    Ok(scene)
+}
+
+/// `scene.gravity_m_s2` and `scene.duration_s` (bounded), and `housing.mass_kg` checked.
+fn span(raw: &RawScene) -> Result<(f64, f64), ConfigError> {
+    let gravity = non_negative("scene.gravity_m_s2", raw.scene.gravity_m_s2, "m/s²")?;
+    let duration = positive("scene.duration_s", raw.scene.duration_s, "s")?;
+    if duration > MAX_DURATION_S {
+        return Err(range("scene.duration_s", duration, "s", &format!("must be <= {MAX_DURATION_S:e} s")));
+    }
+    positive("housing.mass_kg", raw.housing.mass_kg, "kg")?;
+    Ok((gravity, duration))
+}
+
+/// The shared `[rotor]` keys: the whole rotor as each model shares it out over its planes, and
+/// the unbalance's angle at t = 0 (rad).
+fn whole_rotor(r: &RawRotor, gravity: f64) -> Result<(Share, f64), ConfigError> {
+    let unbalance_phase = finite("rotor.unbalance_phase_deg", r.unbalance_phase_deg, "deg")?.to_radians();
+    let rotor_mass = positive("rotor.mass_kg", r.mass_kg, "kg")?;
+    let eccentricity = non_negative("rotor.eccentricity_um", r.eccentricity_um, "µm")? * 1e-6;
+    let rotor_inertia = positive("rotor.polar_inertia_kg_m2", r.polar_inertia_kg_m2, "kg·m²")?;
+    let rotor_radius = positive("rotor.radius_mm", r.radius_mm, "mm")? * 1e-3;
+    let speed = non_negative("rotor.speed_hz", r.speed_hz, "Hz")? * std::f64::consts::TAU;
+    let drive_gain = non_negative("rotor.drive_gain_n_m_s", r.drive_gain_n_m_s, "N·m·s/rad")?;
+    let torque_limit = non_negative("rotor.drive_torque_limit_n_m", r.drive_torque_limit_n_m, "N·m")?;
+    let spin = match r.spin {
+        SpinChoice::Held => Spin::Held,
+        SpinChoice::Free => Spin::Free { drive_gain, torque_limit },
+    };
+    let whole =
+        Share { gravity, mass: rotor_mass, eccentricity, inertia: rotor_inertia, radius: rotor_radius, speed, spin };
+    Ok((whole, unbalance_phase))
+}
+
+/// `[controller]` validated: its rate within the bounds and the run's ticks (a warning when
+/// there are few), its parameters' length, its delay.
+fn controller_settings(
+    ctl: &RawController,
+    duration: f64,
+    warnings: &mut Vec<String>,
+) -> Result<ControllerSettings, ConfigError> {
     let rate = positive("controller.rate_hz", ctl.rate_hz, "Hz")?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
         return Err(range(
@@ -233,7 +314,11 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
             "must be >= 1 in realtime mode (the reply to sample k arrives during period k)",
         ));
     }
+    Ok(controller)
+}
 
+/// `[integrator]` validated.
+fn integrator_settings(int: &RawIntegrator) -> Result<IntegratorSettings, ConfigError> {
     let rtol = positive("integrator.rtol", int.rtol, "")?;
     let atol_all = positive("integrator.atol", int.atol, "")?;
     let pick = |key: &str, v: Option<f64>, unit: &str| v.map_or(Ok(atol_all), |v| positive(key, v, unit));
@@ -261,8 +346,12 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
         radius_guard: positive("integrator.radius_guard_mm", int.radius_guard_mm, "mm")? * 1e-3,
         realtime: int.realtime,
     };
+    Ok(integrator)
+}
 
-    let output_rate = positive("output.rate_hz", raw.output.rate_hz, "Hz")?;
+/// `output.rate_hz`, bounded, and the trace's rows over `duration`.
+fn output_rate(output: &RawOutput, duration: f64) -> Result<f64, ConfigError> {
+    let output_rate = positive("output.rate_hz", output.rate_hz, "Hz")?;
     if output_rate > MAX_OUTPUT_RATE_HZ {
         return Err(range("output.rate_hz", output_rate, "Hz", &format!("must be <= {MAX_OUTPUT_RATE_HZ:e} Hz")));
     }
@@ -278,61 +367,24 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
             ),
         ));
     }
+    Ok(output_rate)
+}
+
+/// `[initial]` validated; `unbalance_phase` is `rotor.unbalance_phase_deg` (rad).
+fn initial_settings(initial: &RawInitial, unbalance_phase: f64) -> Result<InitialSettings, ConfigError> {
     let initial = InitialSettings {
-        unbalance_orbit: raw.initial.unbalance_orbit,
+        unbalance_orbit: initial.unbalance_orbit,
         unbalance_phase,
         rotor_offset: [
-            finite("initial.rotor_x_um", raw.initial.rotor_x_um, "µm")? * 1e-6,
-            finite("initial.rotor_y_um", raw.initial.rotor_y_um, "µm")? * 1e-6,
+            finite("initial.rotor_x_um", initial.rotor_x_um, "µm")? * 1e-6,
+            finite("initial.rotor_y_um", initial.rotor_y_um, "µm")? * 1e-6,
         ],
         slope_offset: [
-            finite("initial.slope_x_urad", raw.initial.slope_x_urad.unwrap_or(0.0), "µrad")? * 1e-6,
-            finite("initial.slope_y_urad", raw.initial.slope_y_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+            finite("initial.slope_x_urad", initial.slope_x_urad.unwrap_or(0.0), "µrad")? * 1e-6,
+            finite("initial.slope_y_urad", initial.slope_y_urad.unwrap_or(0.0), "µrad")? * 1e-6,
         ],
     };
-    if raw.sensor.adc_bits > 24 {
-        return Err(range("sensor.adc_bits", raw.sensor.adc_bits, "bits", "must be between 0 (ideal) and 24"));
-    }
-    let sensor = crate::sensor::SensorSettings {
-        gain: loop_constants.sensor_gain_v_per_m,
-        noise_v: non_negative("sensor.noise_v_rms", raw.sensor.noise_v_rms, "V")?,
-        seed: raw.sensor.noise_seed,
-        adc_bits: raw.sensor.adc_bits,
-        adc_range_v: positive("sensor.adc_range_v", raw.sensor.adc_range_v, "V")?,
-    };
-    let gaps: Vec<f64> = rotor.bearings().map(|p| p.contact.gap).collect();
-    let laws: Vec<AmbLaw> = rotor.bearings().map(|p| p.amb).collect();
-    let hardware = hardware(&raw, rotor.planes(), &gaps, &laws, &integrator, 1.0 / rate)?;
-    let base = shock_table::programme_from_specs(&raw.shock, base_dir)?;
-    // The resolved scene states the rotor model's defaults.
-    rotor.record_defaults(&mut raw);
-    let scene = Scene {
-        name: raw.scene.name.clone(),
-        description: raw.scene.description.clone(),
-        duration,
-        rotor,
-        base,
-        controller,
-        integrator,
-        initial,
-        sensor,
-        hardware,
-        output_interval: 1.0 / output_rate,
-        plots: raw.output.plots,
-        mcap: raw.output.mcap.unwrap_or(false),
-        live_rate_hz: live_rate(raw.output.live_rate_hz, output_rate)?,
-        mcap_compression: raw.output.mcap_compression.unwrap_or(super::McapCompression::None),
-        warnings,
-        source: Source { shocks: raw.shock.len(), raw, base_dir: base_dir.to_path_buf() },
-    };
-    // The law validates its own parameters: a scene it refuses is bad input, before any run.
-    // A controller command serves laws of its own: it checks them, in the handshake.
-    if let Some(spec) = &fmu {
-        super::fmu::check(spec, scene.rotor_design().axes() as usize)?;
-    } else if scene.controller.cosim.command.is_none() {
-        controller::build_rotor_law(&scene.controller.law, &scene.rotor_design(), &scene.controller.params)?;
-    }
-    Ok(scene)
+    Ok(initial)
 }
 
 #[cfg(test)]

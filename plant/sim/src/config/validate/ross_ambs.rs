@@ -22,9 +22,9 @@ pub(super) fn name(choice: RossAmbs) -> &'static str {
 /// took (empty without the key, with `"refuse"`, or in a scene that is not flexible: those are
 /// refused or left as they were by the rotor's own validation).
 pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>, ConfigError> {
-    let r = &raw.rotor;
+    let Some(r) = raw.rotor.flexible() else { return Ok(Vec::new()) };
     let Some(choice) = r.ross_ambs else { return Ok(Vec::new()) };
-    if choice == RossAmbs::Refuse || r.model != RotorModel::Flexible {
+    if choice == RossAmbs::Refuse {
         return Ok(Vec::new());
     }
     let key = "rotor.ross_ambs";
@@ -146,7 +146,8 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
     for (i, m) in planes.iter().enumerate() {
         let Some(m) = m else { continue };
         let letter = ["a", "b"][i];
-        let sensor = [&mut raw.rotor.sensor_a_node, &mut raw.rotor.sensor_b_node];
+        let Some(r) = raw.rotor.flexible_mut() else { continue };
+        let sensor = [&mut r.sensor_a_node, &mut r.sensor_b_node];
         match *sensor[i] {
             Some(s) if s != m.sensor_node => {
                 return Err(range(
@@ -162,7 +163,7 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
             }
             _ => *sensor[i] = Some(m.sensor_node),
         }
-        *[&mut raw.rotor.amb_a_node, &mut raw.rotor.amb_b_node][i] = Some(m.node);
+        *[&mut r.amb_a_node, &mut r.amb_b_node][i] = Some(m.node);
         let u = m.used(["A", "B"][i], choice == RossAmbs::Use);
         let table = [&mut raw.amb.a, &mut raw.amb.b][i].get_or_insert_with(toml::Table::new);
         for (k, v) in [
@@ -202,7 +203,7 @@ pub(super) fn note(raw: &RawScene, used: &[UsedAmb]) -> Option<String> {
     if used.is_empty() {
         return None;
     }
-    let file = raw.rotor.ross_file.as_deref().unwrap_or("the ROSS file");
+    let file = raw.rotor.flexible().and_then(|r| r.ross_file.as_deref()).unwrap_or("the ROSS file");
     let planes: Vec<String> = used
         .iter()
         .map(|u| {

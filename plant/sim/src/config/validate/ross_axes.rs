@@ -19,11 +19,8 @@ pub(super) fn name(choice: RossAxes) -> &'static str {
 /// `rotor.ross_axes = "apply"`, and recorded as applied in `used`; refused where the scene gives
 /// the angle itself or has no file's AMBs to take it from.
 pub(super) fn apply(raw: &mut RawScene, used: &mut [UsedAmb]) -> Result<(), ConfigError> {
-    let Some(choice) = raw.rotor.ross_axes else { return Ok(()) };
-    if raw.rotor.model != RotorModel::Flexible {
-        // Refused as a flexible rotor's key by the rigid rotors' validation.
-        return Ok(());
-    }
+    // A rigid rotor's key struct refuses the key.
+    let Some(choice) = raw.rotor.flexible().and_then(|r| r.ross_axes) else { return Ok(()) };
     let key = "rotor.ross_axes";
     if used.is_empty() {
         return Err(range(

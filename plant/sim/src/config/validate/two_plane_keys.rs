@@ -1,38 +1,29 @@
 //! `rotor.model = "two_plane"`: the rotor's geometry and each plane's bearing, the per-plane
-//! tables, and the two-plane keys refused in a planar scene.
+//! tables, and the per-plane tables refused in a planar scene.
 
 use super::*;
+use crate::config::models::two_plane::{BEARING_A_MM, BEARING_B_MM, END_A_MM, END_B_MM, TRANSVERSE_INERTIA_KG_M2};
+use crate::config::models::TwoPlaneKeys;
 use plant_physics::two_plane;
 
-/// The `[rotor]` keys of the rigid two-plane rotor's geometry and inertia, as given: key, value,
-/// unit.
-pub(super) fn rigid_geometry_keys(raw: &RawScene) -> [(&'static str, Option<f64>, &'static str); 9] {
-    let r = &raw.rotor;
-    [
-        ("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2, "kg·m²"),
-        ("rotor.couple_unbalance_urad", r.couple_unbalance_urad, "µrad"),
-        ("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg, "deg"),
-        ("rotor.bearing_a_mm", r.bearing_a_mm, "mm"),
-        ("rotor.bearing_b_mm", r.bearing_b_mm, "mm"),
-        ("rotor.sensor_a_mm", r.sensor_a_mm, "mm"),
-        ("rotor.sensor_b_mm", r.sensor_b_mm, "mm"),
-        ("rotor.end_a_mm", r.end_a_mm, "mm"),
-        ("rotor.end_b_mm", r.end_b_mm, "mm"),
-    ]
+impl crate::config::models::Build<Context<'_>> for TwoPlaneKeys {
+    type Params = two_plane::Params;
+
+    fn build(&self, ctx: &Context) -> Result<two_plane::Params, ConfigError> {
+        two_plane_params(ctx.raw, self, ctx.whole)
+    }
 }
 
-/// The keys of the two-plane rotor given in a planar scene, refused by name: each would be
-/// silently ignored otherwise.
-pub(in crate::config) fn refuse_two_plane_keys(raw: &RawScene) -> Result<(), ConfigError> {
-    let mut given = rigid_geometry_keys(raw).to_vec();
-    given.extend([
-        ("initial.slope_x_urad", raw.initial.slope_x_urad, "µrad"),
-        ("initial.slope_y_urad", raw.initial.slope_y_urad, "µrad"),
-    ]);
+/// A two-plane rotor's per-plane tables (`[touchdown.a]`, …) and initial slopes given in a planar
+/// scene, refused by name: each would be silently ignored otherwise. (Its `[rotor]` keys are
+/// refused by the planar model's key struct.)
+pub(in crate::config) fn refuse_plane_tables(raw: &RawScene) -> Result<(), ConfigError> {
     const WHY: &str = "is a key of the two-plane rotor and this scene is planar (rotor.model = \"planar\"): set \
                        rotor.model = \"two_plane\" or remove the key";
-    if let Some((key, value, unit)) = given.iter().find_map(|(k, v, u)| v.map(|v| (*k, v, *u))) {
-        return Err(range(key, value, unit, WHY));
+    let slopes =
+        [("initial.slope_x_urad", raw.initial.slope_x_urad), ("initial.slope_y_urad", raw.initial.slope_y_urad)];
+    if let Some((key, value)) = slopes.iter().find_map(|(k, v)| v.map(|v| (*k, v))) {
+        return Err(range(key, value, "µrad", WHY));
     }
     let tables = [
         ("touchdown", &raw.touchdown.a, &raw.touchdown.b),
@@ -81,11 +72,14 @@ pub(super) fn plane_table<T: serde::Serialize + serde::de::DeserializeOwned>(
 
 /// The two-plane rotor of a scene (`rotor.model = "two_plane"`), validated: its geometry and
 /// inertia from `[rotor]`, each plane's bearing from the shared tables and its own.
-pub(in crate::config) fn two_plane_params(raw: &RawScene, whole: &Share) -> Result<two_plane::Params, ConfigError> {
-    let r = &raw.rotor;
+pub(in crate::config) fn two_plane_params(
+    raw: &RawScene,
+    r: &TwoPlaneKeys,
+    whole: &Share,
+) -> Result<two_plane::Params, ConfigError> {
     let mm = |key: &str, value: f64| finite(key, value, "mm");
-    let za = mm("rotor.bearing_a_mm", r.bearing_a_mm.unwrap_or(-180.0))?;
-    let zb = mm("rotor.bearing_b_mm", r.bearing_b_mm.unwrap_or(180.0))?;
+    let za = mm("rotor.bearing_a_mm", r.bearing_a_mm.unwrap_or(BEARING_A_MM))?;
+    let zb = mm("rotor.bearing_b_mm", r.bearing_b_mm.unwrap_or(BEARING_B_MM))?;
     const SIDES: &str = "bearing A lies on the −z side of the centre of mass (the origin of z) and bearing B on \
                          the +z side: the centre of mass is between the bearings";
     if za >= 0.0 {
@@ -94,8 +88,8 @@ pub(in crate::config) fn two_plane_params(raw: &RawScene, whole: &Share) -> Resu
     if zb <= 0.0 {
         return Err(range("rotor.bearing_b_mm", zb, "mm", &format!("must be > 0: {SIDES}")));
     }
-    let ea = mm("rotor.end_a_mm", r.end_a_mm.unwrap_or(-230.0))?;
-    let eb = mm("rotor.end_b_mm", r.end_b_mm.unwrap_or(230.0))?;
+    let ea = mm("rotor.end_a_mm", r.end_a_mm.unwrap_or(END_A_MM))?;
+    let eb = mm("rotor.end_b_mm", r.end_b_mm.unwrap_or(END_B_MM))?;
     if ea > za {
         return Err(range(
             "rotor.end_a_mm",
@@ -126,7 +120,11 @@ pub(in crate::config) fn two_plane_params(raw: &RawScene, whole: &Share) -> Resu
     };
     let sa = sensor("rotor.sensor_a_mm", r.sensor_a_mm.unwrap_or(za))?;
     let sb = sensor("rotor.sensor_b_mm", r.sensor_b_mm.unwrap_or(zb))?;
-    let transverse = positive("rotor.transverse_inertia_kg_m2", r.transverse_inertia_kg_m2.unwrap_or(0.414), "kg·m²")?;
+    let transverse = positive(
+        "rotor.transverse_inertia_kg_m2",
+        r.transverse_inertia_kg_m2.unwrap_or(TRANSVERSE_INERTIA_KG_M2),
+        "kg·m²",
+    )?;
     let couple = non_negative("rotor.couple_unbalance_urad", r.couple_unbalance_urad.unwrap_or(0.0), "µrad")? * 1e-6;
     let couple_phase =
         finite("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg.unwrap_or(0.0), "deg")?.to_radians();
