@@ -93,6 +93,7 @@ with open(sys.argv[1], "rb") as f:
     for m in reader.iter_metadata():
         out["metadata"][m.name] = dict(m.metadata)
     out["compressions"] = sorted({c.compression for c in reader.get_summary().chunk_indexes})
+    out["chunks_without_message_index"] = sum(1 for c in reader.get_summary().chunk_indexes if c.message_index_length == 0)
     for schema, channel, message in reader.iter_messages(log_time_order=False):
         if channel.topic == "/events":
             data = json.loads(message.data)
@@ -248,6 +249,11 @@ fn a_recording_holds_the_trace_bit_for_bit() {
     assert_eq!(topics, want);
     // Chunks, not compressed by default (the MCAP format's empty compression name).
     assert_eq!(rec["compressions"], serde_json::json!([""]));
+    // Every chunk has its message index: Lichtblick's and Foxglove's reader (`@mcap/core`)
+    // refuses a file with a chunk without one ("Chunks without message indexes are not
+    // currently supported"), which a chunk of schemas and channels alone, ended by the metadata
+    // record, was.
+    assert_eq!(rec["chunks_without_message_index"], 0);
     // The scene as metadata: the run's own scene.toml.
     assert_eq!(rec["metadata"]["scene"]["scene.toml"].as_str().unwrap(), read_text(&run.join("scene.toml")));
     // The events: the shock's start at its row (10 ms), contact onsets, the status at the end.

@@ -84,6 +84,12 @@ impl McapSink {
             .profile("")
             .library(concat!("plant ", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::with_capacity(1 << 20, file))?;
+        // The metadata first: writing it ends the open chunk, and a chunk of schemas and
+        // channels alone has no message index, which Lichtblick's and Foxglove's reader
+        // (`@mcap/core`) refuses ("Chunks without message indexes are not currently supported").
+        let toml = scene.to_toml()?;
+        let metadata = BTreeMap::from([("name".to_string(), scene.name.clone()), ("scene.toml".to_string(), toml)]);
+        writer.write_metadata(&mcap::records::Metadata { name: "scene".into(), metadata })?;
         let columns = Columns::of(scene);
         let none = BTreeMap::new();
         let mut channels = Vec::new();
@@ -99,9 +105,6 @@ impl McapSink {
             let schema = writer.add_schema(&extra.schema_name, "ros2msg", extra.schema.as_bytes())?;
             extra_channels.push(writer.add_channel(schema, &extra.topic, "cdr", &none)?);
         }
-        let toml = scene.to_toml()?;
-        let metadata = BTreeMap::from([("name".to_string(), scene.name.clone()), ("scene.toml".to_string(), toml)]);
-        writer.write_metadata(&mcap::records::Metadata { name: "scene".into(), metadata })?;
         Ok(Self {
             path: path.to_path_buf(),
             writer: Some(writer),
