@@ -193,7 +193,7 @@ fn orbit_message(bytes: &[u8]) -> (f64, f64, Vec<Vec<f64>>) {
     assert_eq!(&bytes[..4], &[0, 1, 0, 0], "CDR little-endian header");
     let body = &bytes[4..];
     let f = |at: usize| f64::from_le_bytes(body[at..at + 8].try_into().unwrap());
-    let mut at = 16;
+    let mut at: usize = 16;
     let mut arrays = Vec::new();
     for _ in 0..3 {
         at = at.next_multiple_of(4);
@@ -262,6 +262,49 @@ fn a_sampled_runs_loop_ticks_are_served_at_the_live_rate() {
         assert_eq!(c.len(), 2, "a planar run's two axes");
         assert_eq!((c[0].to_bits(), c[1].to_bits()), (ix[k + 1].to_bits(), iy[k + 1].to_bits()), "tick {k}");
     }
+}
+
+#[test]
+fn compare_realtime_serves_its_realtime_runs_one_after_the_other() {
+    common::controller_bin();
+    let dir = TempDir::new("live-compare");
+    let out = dir.join("out");
+    let mut cmd = std::process::Command::new(common::plant_bin());
+    cmd.arg("compare").arg(scene("cosim-10g.toml")).args(["--realtime", "--runs", "2", "--out"]).arg(&out);
+    cmd.args(["--set", "scene.duration_s=0.04", "--set", "shock[0].start_s=0.01"]);
+    // Whole runs whatever this machine's load (the budgets' default would end a late one).
+    cmd.args(["--set", "controller.max_miss_fraction=1", "--set", "controller.max_overrun_fraction=1"]);
+    cmd.args(["--live", "127.0.0.1:0"]);
+    let mut p = Proc::spawn(&mut cmd);
+    let addr = address(&mut p);
+    let mut viewer = Viewer::connect(&addr);
+    viewer.subscribe_all();
+    let (got, _) = viewer.read_all(LIMIT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(0), "{log}");
+    let (clients, frames, _) = served(&log);
+    assert_eq!(clients, 1, "{log}");
+    assert!(frames > 0, "{log}");
+    // A realtime run's loop: its ticks' topics too.
+    for topic in ["/plane_a/rotor", "/plane_a/orbit", "/loop/sample", "/loop/command"] {
+        assert!(viewer.channels.values().any(|c| c.topic == topic), "{topic} advertised");
+    }
+    let events: Vec<String> = got["/events"]
+        .iter()
+        .map(|(_, b)| serde_json::from_slice::<Value>(b).unwrap()["message"].as_str().unwrap().to_string())
+        .collect();
+    for n in [1, 2] {
+        assert!(events.iter().any(|m| *m == format!("realtime run {n} of 2 starts")), "{events:?}");
+    }
+    assert_eq!(events.iter().filter(|m| m.starts_with("realtime co-simulation: ")).count(), 2, "{events:?}");
+    // The second run's rows start again at 0: the times go back once.
+    let rotor = viewer.channels.values().find(|c| c.topic == "/plane_a/rotor").unwrap();
+    let n = fields(&rotor.schema).len();
+    let t: Vec<f64> = got["/plane_a/rotor"].iter().map(|(_, b)| doubles(b, n)[0]).collect();
+    assert_eq!(t.windows(2).filter(|w| w[1] < w[0]).count(), 1, "{t:?}");
+    assert_eq!(t.last().copied(), Some(0.04), "the last run's last row");
+    let csv = read_text(&out.join("realtime.csv"));
+    assert_eq!(csv.lines().count(), 4, "{csv}");
 }
 
 /// The same double, NaN as NaN.

@@ -510,3 +510,52 @@ fn a_bad_value_of_the_key_exits_2_naming_it() {
     assert!(stderr(&done).contains("mcap"), "{}", stderr(&done));
     assert!(!out.join("run.mcap").exists() && !out.join("trace.csv").exists());
 }
+
+#[test]
+fn an_ensembles_member_is_recorded_on_request() {
+    let dir = TempDir::new("mcap-member");
+    let out = dir.join("ens");
+    let mut cmd = Command::new(common::plant_bin());
+    cmd.arg("ensemble").arg(scene("paper-10g.toml")).arg("--out").arg(&out).args(["--record-member", "2"]);
+    for s in [
+        "scene.duration_s=0.06",
+        "shock[0].start_s=0.005",
+        "ensemble.members=3",
+        "ensemble.seed=7",
+        "ensemble.verify=false",
+    ] {
+        cmd.args(["--set", s]);
+    }
+    let done = output_within(&mut cmd, LIMIT);
+    assert_exit(&done, 0);
+    let member = out.join("member-2");
+    assert!(stderr(&done).contains("member 2 recorded in"), "{}", stderr(&done));
+    // The recording holds the member's rows, bit for bit.
+    let rec = read_back(&member);
+    assert_holds_trace(&member, &rec);
+    // It is member 2's run: its figures are members.csv's row of member 2 (parsed from the
+    // ensemble's table, the shortest decimal of each double, so equal to the bit).
+    let text = read_text(&out.join("members.csv"));
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}"));
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let row = rows.iter().find(|r| r[col("member")] == "2").expect("member 2's row");
+    let summary = common::read_json(&member.join("summary.json"));
+    for key in ["max_radius_m", "max_contact_force_n"] {
+        let want: f64 = row[col(key)].parse().unwrap();
+        assert_eq!(common::num(&summary, key), want, "{key}");
+    }
+    // The other members' figures differ (the test tells members apart).
+    let other: f64 =
+        rows.iter().find(|r| r[col("member")] == "0").unwrap()[col("max_contact_force_n")].parse().unwrap();
+    assert_ne!(common::num(&summary, "max_contact_force_n"), other);
+    // A member the ensemble does not have is bad input, before anything runs.
+    let out = dir.join("bad");
+    let mut cmd = Command::new(common::plant_bin());
+    cmd.arg("ensemble").arg(scene("paper-10g.toml")).arg("--out").arg(&out).args(["--record-member", "3"]);
+    cmd.args(["--set", "ensemble.members=3"]);
+    let done = output_within(&mut cmd, LIMIT);
+    assert_exit(&done, 2);
+    assert!(stderr(&done).contains("--record-member 3: the ensemble has 3 members"), "{}", stderr(&done));
+    assert!(!out.join("members.csv").exists());
+}

@@ -8,10 +8,12 @@
 //! * [`ticks`]: the loop's samples and commands.
 //! * [`extra`]: the topics besides the rows', in the sinks' order.
 //! * [`mcap_file`]: the file, a [`crate::run::Sink`].
+//! * [`member`]: an ensemble's member recorded on request (`plant ensemble --record-member`).
 
 pub mod events;
 pub mod extra;
 pub mod mcap_file;
+pub mod member;
 pub mod orbit;
 pub mod ticks;
 pub mod topics;

@@ -95,7 +95,7 @@ pub fn compare_realtime(
     let realtime = with(scene_path, &base, &["controller.mode=\"realtime\"".into()])?;
     let mut server = live.map(|addr| crate::live::start(addr, &realtime)).transpose()?;
     if let Some(s) = &server {
-        log(&format!("live view of the realtime runs at ws://{} (Foxglove WebSocket protocol)", s.addr()));
+        log(&format!("live view at ws://{} (Foxglove WebSocket protocol), serving the realtime runs", s.addr()));
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     // The realtime scene as resolved holds its integrator setting: the lockstep twin keeps it.
