@@ -63,9 +63,9 @@ pub fn messages(
         out.extend_from_slice(&s.t_s.to_le_bytes());
         out.extend_from_slice(&s.seq.to_le_bytes());
     }
-    for k in 0..axes {
-        sample.extend_from_slice(&s.sensor_v[k].to_le_bytes());
-        command.extend_from_slice(&applied[k].to_le_bytes());
+    for (v, i) in s.sensor_v.iter().zip(applied).take(axes) {
+        sample.extend_from_slice(&v.to_le_bytes());
+        command.extend_from_slice(&i.to_le_bytes());
     }
     sample.extend_from_slice(&s.speed_rad_s.to_le_bytes());
     sample.extend_from_slice(&s.angle_rad.to_le_bytes());
