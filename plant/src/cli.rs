@@ -147,6 +147,10 @@ pub enum Command {
         /// Realtime runs of `--realtime`.
         #[arg(long, default_value_t = 1, requires = "realtime", value_parser = count::<usize>("a number of realtime runs", 1, 1000))]
         runs: usize,
+        /// Serve `--realtime`'s realtime runs live over the Foxglove WebSocket protocol on ADDR,
+        /// one after the other, as `plant run --live` does (default 127.0.0.1:8765).
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = plant::live::DEFAULT_ADDR, requires = "realtime")]
+        live: Option<String>,
         /// Give each compared run (rates or laws) its robustness answer with N perturbed copies,
         /// as `plant run --robustness N`, and say whether each difference from the reference
         /// run lies within the runs' spreads (compare_robustness.csv and .json).

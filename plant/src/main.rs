@@ -114,7 +114,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             soak_cmd(&programme, out, &set, quiet, resume, live.as_deref())
         }
-        Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs, robustness } => {
+        Command::Compare { scene, rates, out, set, no_cosim, maps, laws, realtime, runs, robustness, live } => {
             let req = plant::compare::Request {
                 scene: &scene,
                 set: &set,
@@ -125,6 +125,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 laws: &laws,
                 realtime: realtime.then_some(runs),
                 robustness,
+                live: live.as_deref(),
             };
             let written = plant::compare::command(&req, &mut |l| eprintln!("plant compare: {l}"), &mut |w| warn(w))?;
             eprintln!("plant compare: wrote {}", written.display());

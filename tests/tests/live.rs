@@ -181,6 +181,132 @@ fn doubles(bytes: &[u8], n: usize) -> Vec<f64> {
     bytes[4..].chunks(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
 }
 
+/// A topic of the trace's rows (not `/events`, an orbit or the loop's).
+fn is_row_topic(topic: &str) -> bool {
+    topic != "/events" && !topic.ends_with("/orbit") && !topic.starts_with("/loop/")
+}
+
+/// An orbit message decoded by CDR's rules (written here from the layout of `plant.Orbit`: two
+/// doubles, then three `float64[]`, each a u32 count 4-aligned and doubles 8-aligned, counted
+/// after the 4-byte header): (t_s, clearance_m, [x_m, orbit_y_m, clearance_y_m]).
+fn orbit_message(bytes: &[u8]) -> (f64, f64, Vec<Vec<f64>>) {
+    assert_eq!(&bytes[..4], &[0, 1, 0, 0], "CDR little-endian header");
+    let body = &bytes[4..];
+    let f = |at: usize| f64::from_le_bytes(body[at..at + 8].try_into().unwrap());
+    let mut at: usize = 16;
+    let mut arrays = Vec::new();
+    for _ in 0..3 {
+        at = at.next_multiple_of(4);
+        let n = u32::from_le_bytes(body[at..at + 4].try_into().unwrap()) as usize;
+        at = (at + 4).next_multiple_of(8);
+        arrays.push((0..n).map(|k| f(at + 8 * k)).collect());
+        at += 8 * n;
+    }
+    assert_eq!(at, body.len(), "the message's length");
+    (f(0), f(8), arrays)
+}
+
+/// The orbit messages served: at 50 Hz (every 400th row of 20 kHz), each ending with its own
+/// row's `dx_m`, `dy_m` before the 73 points of the clearance circle (radius `clearance_m`).
+fn assert_orbit(msgs: &[(u64, Vec<u8>)], trace: &Csv, clearance_m: f64) {
+    assert!(msgs.len() >= 3, "{} orbit messages", msgs.len());
+    let (t, dx, dy) = (trace.column("t_s"), trace.column("dx_m"), trace.column("dy_m"));
+    for (ns, bytes) in msgs {
+        let (t_s, clearance, a) = orbit_message(bytes);
+        assert_eq!(clearance, clearance_m);
+        let row = t.iter().position(|&x| x == t_s).unwrap_or_else(|| panic!("orbit t_s = {t_s} is no row's"));
+        assert_eq!(row % 400, 0, "orbit at row {row}");
+        assert_eq!(*ns, (t_s * 1e9).round() as u64);
+        let last = a[0].len() - 73 - 1;
+        assert_eq!((a[0][last], a[1][last]), (dx[row], dy[row]), "orbit at row {row}");
+        assert!(a[1][last + 1..].iter().all(|v| v.is_nan()) && a[2][..=last].iter().all(|v| v.is_nan()));
+        let r = a[0][last + 1].hypot(a[2][last + 1]);
+        assert!((r - clearance_m).abs() < 1e-15, "circle radius {r}");
+    }
+}
+
+#[test]
+fn a_sampled_runs_loop_ticks_are_served_at_the_live_rate() {
+    let dir = TempDir::new("live-loop");
+    let out = dir.join("run");
+    let sets = ["scene.duration_s=0.1", "output.plots=false", "controller.mode=\"sampled\""];
+    let mut p = Proc::spawn(&mut live_run(&out, &sets, "127.0.0.1:0"));
+    let addr = address(&mut p);
+    let mut viewer = Viewer::connect(&addr);
+    viewer.subscribe_all();
+    let (got, _) = viewer.read_all(LIMIT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(0), "{log}");
+    let schema = |topic: &str| viewer.channels.values().find(|c| c.topic == topic).unwrap().schema.clone();
+    assert!(schema("/loop/sample").contains("float64 sensor_xa_v  # sensor_xa_v (V)"));
+    assert!(schema("/loop/command").contains("float64 command_ya_a  # command_ya_a (A)"));
+    let trace = Csv::read(&out.join("trace.csv"));
+    let (t, ix, iy) = (trace.column("t_s"), trace.column("ix_a"), trace.column("iy_a"));
+    // Each message: the header, t_s, seq (u64), then the axes' doubles.
+    let numbers = |b: &[u8]| -> (f64, u64, Vec<f64>) {
+        assert_eq!(&b[..4], &[0, 1, 0, 0]);
+        let d = |at: usize| f64::from_le_bytes(b[at..at + 8].try_into().unwrap());
+        let rest = (20..b.len()).step_by(8).map(d).collect();
+        (d(4), u64::from_le_bytes(b[12..20].try_into().unwrap()), rest)
+    };
+    let commands = &got["/loop/command"];
+    assert!(commands.len() >= 10, "{} commands", commands.len());
+    assert_eq!(got["/loop/sample"].len(), commands.len());
+    for (ns, bytes) in commands {
+        let (t_s, seq, c) = numbers(bytes);
+        // Sent with each 200 Hz row (every 100th): the tick that made that row, the one before.
+        let k = seq as usize;
+        assert_eq!((k + 1) % 100, 0, "tick {k}");
+        assert_eq!(t_s, t[k], "tick {k}'s time");
+        assert_eq!(*ns, (t_s * 1e9).round() as u64);
+        assert_eq!(c.len(), 2, "a planar run's two axes");
+        assert_eq!((c[0].to_bits(), c[1].to_bits()), (ix[k + 1].to_bits(), iy[k + 1].to_bits()), "tick {k}");
+    }
+}
+
+#[test]
+fn compare_realtime_serves_its_realtime_runs_one_after_the_other() {
+    common::controller_bin();
+    let dir = TempDir::new("live-compare");
+    let out = dir.join("out");
+    let mut cmd = std::process::Command::new(common::plant_bin());
+    cmd.arg("compare").arg(scene("cosim-10g.toml")).args(["--realtime", "--runs", "2", "--out"]).arg(&out);
+    cmd.args(["--set", "scene.duration_s=0.04", "--set", "shock[0].start_s=0.01"]);
+    // Whole runs whatever this machine's load (the budgets' default would end a late one).
+    cmd.args(["--set", "controller.max_miss_fraction=1", "--set", "controller.max_overrun_fraction=1"]);
+    cmd.args(["--live", "127.0.0.1:0"]);
+    let mut p = Proc::spawn(&mut cmd);
+    let addr = address(&mut p);
+    let mut viewer = Viewer::connect(&addr);
+    viewer.subscribe_all();
+    let (got, _) = viewer.read_all(LIMIT);
+    let (code, log) = p.finish_within(LIMIT);
+    assert_eq!(code, Some(0), "{log}");
+    let (clients, frames, _) = served(&log);
+    assert_eq!(clients, 1, "{log}");
+    assert!(frames > 0, "{log}");
+    // A realtime run's loop: its ticks' topics too.
+    for topic in ["/plane_a/rotor", "/plane_a/orbit", "/loop/sample", "/loop/command"] {
+        assert!(viewer.channels.values().any(|c| c.topic == topic), "{topic} advertised");
+    }
+    let events: Vec<String> = got["/events"]
+        .iter()
+        .map(|(_, b)| serde_json::from_slice::<Value>(b).unwrap()["message"].as_str().unwrap().to_string())
+        .collect();
+    for n in [1, 2] {
+        assert!(events.iter().any(|m| *m == format!("realtime run {n} of 2 starts")), "{events:?}");
+    }
+    assert_eq!(events.iter().filter(|m| m.starts_with("realtime co-simulation: ")).count(), 2, "{events:?}");
+    // The second run's rows start again at 0: the times go back once.
+    let rotor = viewer.channels.values().find(|c| c.topic == "/plane_a/rotor").unwrap();
+    let n = fields(&rotor.schema).len();
+    let t: Vec<f64> = got["/plane_a/rotor"].iter().map(|(_, b)| doubles(b, n)[0]).collect();
+    assert_eq!(t.windows(2).filter(|w| w[1] < w[0]).count(), 1, "{t:?}");
+    assert_eq!(t.last().copied(), Some(0.04), "the last run's last row");
+    let csv = read_text(&out.join("realtime.csv"));
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+}
+
 /// The same double, NaN as NaN.
 fn same(a: f64, b: f64) -> bool {
     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
@@ -220,6 +346,7 @@ fn a_client_gets_the_advertised_topics_and_the_trace_rows_at_the_live_rate() {
             ("/plane_a/coils", "plant_msgs/msg/Coils"),
             ("/housing", "plant_msgs/msg/Housing"),
             ("/events", "foxglove.Log"),
+            ("/plane_a/orbit", "plant_msgs/msg/Orbit"),
         ]
     );
     for c in viewer.channels.values().filter(|c| c.topic != "/events") {
@@ -236,7 +363,8 @@ fn a_client_gets_the_advertised_topics_and_the_trace_rows_at_the_live_rate() {
     assert_eq!(t[1], 1.0 / 20000.0, "the scene's output rate is 20 kHz");
     let (_, frames, dropped) = served(&log);
     let mut rows_seen = Vec::new();
-    for c in viewer.channels.values().filter(|c| c.topic != "/events") {
+    assert_orbit(&got["/plane_a/orbit"], &trace, 1.5e-4);
+    for c in viewer.channels.values().filter(|c| is_row_topic(&c.topic)) {
         let msgs = got.get(&c.topic).unwrap_or_else(|| panic!("no message on {}", c.topic));
         assert!(msgs.len() >= 10, "{}: {} messages", c.topic, msgs.len());
         let fields = fields(&c.schema);

@@ -62,15 +62,51 @@ const READER: &str = r#"
 import json, struct, sys
 from mcap.reader import make_reader
 out = {"topics": {}, "metadata": {}, "events": [], "log_times_ok": True, "headers_ok": True}
+def cdr(text, data):
+    # CDR, little-endian, by its rules: each primitive aligned to its size counted from the end
+    # of the 4-byte encapsulation header; a sequence is a uint32 count, then its items. Doubles
+    # are kept as their bits (signed 64-bit integers).
+    assert data[:4] == b"\x00\x01\x00\x00", data[:4]
+    body, at, fields = data[4:], 0, {}
+    def take(fmt, size):
+        nonlocal at
+        at += (-at) % size
+        (v,) = struct.unpack_from(fmt, body, at)
+        at += size
+        return v
+    for line in text.splitlines():
+        if not line or line.startswith('#'):
+            continue
+        kind, name = line.split()[:2]
+        if kind == "float64":
+            fields[name] = take("<q", 8)
+        elif kind == "uint64":
+            fields[name] = take("<Q", 8)
+        elif kind == "float64[]":
+            fields[name] = [take("<q", 8) for _ in range(take("<I", 4))]
+        else:
+            raise ValueError(line)
+    assert at == len(body), (at, len(body))
+    return fields
 with open(sys.argv[1], "rb") as f:
     reader = make_reader(f)
     for m in reader.iter_metadata():
         out["metadata"][m.name] = dict(m.metadata)
     out["compressions"] = sorted({c.compression for c in reader.get_summary().chunk_indexes})
+    out["chunks_without_message_index"] = sum(1 for c in reader.get_summary().chunk_indexes if c.message_index_length == 0)
     for schema, channel, message in reader.iter_messages(log_time_order=False):
         if channel.topic == "/events":
             data = json.loads(message.data)
             out["events"].append([message.log_time, data["level"], data["message"]])
+            continue
+        if channel.topic.endswith("/orbit") or channel.topic.startswith("/loop/"):
+            text = schema.data.decode()
+            t = out.setdefault("extra", {}).setdefault(channel.topic, {
+                "schema": schema.name, "encoding": schema.encoding, "message_encoding": channel.message_encoding,
+                "schema_text": text, "log_times": [], "fields": {}})
+            t["log_times"].append(message.log_time)
+            for name, value in cdr(text, bytes(message.data)).items():
+                t["fields"].setdefault(name, []).append(value)
             continue
         text = schema.data.decode()
         names = [l.split()[1] for l in text.splitlines() if l.startswith("float64 ")]
@@ -213,6 +249,11 @@ fn a_recording_holds_the_trace_bit_for_bit() {
     assert_eq!(topics, want);
     // Chunks, not compressed by default (the MCAP format's empty compression name).
     assert_eq!(rec["compressions"], serde_json::json!([""]));
+    // Every chunk has its message index: Lichtblick's and Foxglove's reader (`@mcap/core`)
+    // refuses a file with a chunk without one ("Chunks without message indexes are not
+    // currently supported"), which a chunk of schemas and channels alone, ended by the metadata
+    // record, was.
+    assert_eq!(rec["chunks_without_message_index"], 0);
     // The scene as metadata: the run's own scene.toml.
     assert_eq!(rec["metadata"]["scene"]["scene.toml"].as_str().unwrap(), read_text(&run.join("scene.toml")));
     // The events: the shock's start at its row (10 ms), contact onsets, the status at the end.
@@ -225,6 +266,108 @@ fn a_recording_holds_the_trace_bit_for_bit() {
     let last_ns = 50_000_000;
     assert!(events.iter().any(|(t, _, m)| *t == last_ns && m == "run completed"), "{events:?}");
     assert!(events.iter().any(|(_, _, m)| m.starts_with("motion after the shock: ")), "{events:?}");
+    assert_orbit(&run, &rec, "/plane_a/orbit", ("dx_m", "dy_m"), 0.15e-3);
+    // A continuous run has no loop ticks.
+    assert!(rec["extra"].get("/loop/sample").is_none());
+}
+
+/// Bits of a JSON list of doubles' bit patterns.
+fn doubles(v: &serde_json::Value) -> Vec<f64> {
+    let bits: Vec<i64> = serde_json::from_value(v.clone()).expect("a list of bit patterns");
+    bits.into_iter().map(|b| f64::from_bits(b as u64)).collect()
+}
+
+/// The orbit topic: a message every 20 ms of simulated time (rows 0, 400, 800 of a 20 kHz
+/// trace), each the window's rows 400 back, every 2nd ending at its own row, equal to the
+/// trace's `x`, `y` columns bit for bit, then a 73-point circle of radius `clearance_m` (the
+/// scene's `touchdown.air_gap_mm`), the two polylines separated by NaN in each y array.
+fn assert_orbit(run: &Path, rec: &serde_json::Value, topic: &str, (x, y): (&str, &str), clearance_m: f64) {
+    let trace = Csv::read(&run.join("trace.csv"));
+    let (xs, ys) = (trace.column(x), trace.column(y));
+    let orbit = &rec["extra"][topic];
+    assert_eq!(orbit["schema"], "plant_msgs/msg/Orbit");
+    assert_eq!(orbit["message_encoding"], "cdr");
+    let schema = orbit["schema_text"].as_str().unwrap();
+    for line in ["float64[] x_m  # x_m (m)", "float64 clearance_m  # clearance_m (m)"] {
+        assert!(schema.contains(line), "{schema}");
+    }
+    let log_times: Vec<u64> = serde_json::from_value(orbit["log_times"].clone()).unwrap();
+    let rows_per_message = 400;
+    let want: Vec<u64> = (0..xs.len()).step_by(rows_per_message).map(|j| j as u64 * 50_000).collect();
+    assert_eq!(log_times, want);
+    let fields = &orbit["fields"];
+    let (t, clearance) = (doubles(&fields["t_s"]), doubles(&fields["clearance_m"]));
+    for (m, &ns) in log_times.iter().enumerate() {
+        let j = (ns / 50_000) as usize;
+        assert_eq!(t[m], trace.column("t_s")[j]);
+        assert_eq!(clearance[m], clearance_m);
+        let (ox, oy, cy) =
+            (doubles(&fields["x_m"][m]), doubles(&fields["orbit_y_m"][m]), doubles(&fields["clearance_y_m"][m]));
+        let rows: Vec<usize> = (0..=j).rev().step_by(2).take_while(|&i| i + rows_per_message > j).collect();
+        let n = rows.len();
+        assert_eq!(ox.len(), n + 73, "message {m}");
+        assert!(oy.len() == ox.len() && cy.len() == ox.len());
+        for (k, &i) in rows.iter().rev().enumerate() {
+            assert_eq!((ox[k].to_bits(), oy[k].to_bits()), (xs[i].to_bits(), ys[i].to_bits()), "message {m} row {i}");
+            assert!(cy[k].is_nan());
+        }
+        for k in n..n + 73 {
+            assert!(oy[k].is_nan());
+            let r = ox[k].hypot(cy[k]);
+            assert!((r - clearance_m).abs() <= 1e-15, "message {m} circle point {k}: radius {r}");
+        }
+        assert_eq!((ox[n], cy[n]), (ox[n + 72], cy[n + 72]), "the circle is closed");
+    }
+}
+
+#[test]
+fn a_sampled_loops_samples_and_commands_are_recorded() {
+    // paper-10g's PD sampled at 20 kHz (the period of its output rows): one tick per row.
+    let dir = TempDir::new("mcap-loop");
+    let sets: Vec<&str> = SHORT.iter().copied().chain(["controller.mode=\"sampled\""]).collect();
+    let run = record(&dir, &scene("paper-10g.toml"), &sets);
+    let rec = read_back(&run);
+    let trace = Csv::read(&run.join("trace.csv"));
+    let sample = &rec["extra"]["/loop/sample"];
+    let command = &rec["extra"]["/loop/command"];
+    assert_eq!(sample["schema"], "plant_msgs/msg/LoopSample");
+    assert_eq!(command["schema"], "plant_msgs/msg/LoopCommand");
+    for (t, lines) in [
+        (
+            sample,
+            &["uint64 seq", "float64 sensor_xa_v  # sensor_xa_v (V)", "float64 speed_rad_s  # speed_rad_s (rad/s)"][..],
+        ),
+        (command, &["float64 command_xa_a  # command_xa_a (A)", "float64 command_ya_a  # command_ya_a (A)"][..]),
+    ] {
+        let text = t["schema_text"].as_str().unwrap();
+        for l in lines {
+            assert!(text.contains(l), "{text}");
+        }
+        assert!(!text.contains("_xb_"), "a planar run has two axes: {text}");
+    }
+    // 0.05 s at 50 µs: ticks 0 … 999, each at k·T.
+    let seq: Vec<u64> = serde_json::from_value(sample["fields"]["seq"].clone()).unwrap();
+    assert_eq!(seq, (0..1000).collect::<Vec<u64>>());
+    let t = doubles(&sample["fields"]["t_s"]);
+    let t_trace = trace.column("t_s");
+    for k in 0..1000 {
+        assert_eq!(t[k], t_trace[k], "tick {k} at row {k}'s time");
+    }
+    let log_times: Vec<u64> = serde_json::from_value(command["log_times"].clone()).unwrap();
+    assert_eq!(log_times, (0..1000).map(|k| k * 50_000).collect::<Vec<u64>>());
+    // The command applied over tick k is the current reference of the rows it makes: row k + 1's
+    // `ix_a`, `iy_a` (the trace's commanded currents), bit for bit.
+    let (ix, iy) = (trace.column("ix_a"), trace.column("iy_a"));
+    let (cx, cy) = (doubles(&command["fields"]["command_xa_a"]), doubles(&command["fields"]["command_ya_a"]));
+    for k in 0..1000 {
+        assert_eq!((cx[k].to_bits(), cy[k].to_bits()), (ix[k + 1].to_bits(), iy[k + 1].to_bits()), "tick {k}");
+    }
+    // The sensor reads the rotor's position relative to the housing at the tick: 25 000 V/m
+    // (paper-10g's `sensor_gain_v_per_m`) times row k's `dx_m`.
+    let (dx, v) = (trace.column("dx_m"), doubles(&sample["fields"]["sensor_xa_v"]));
+    for k in 0..1000 {
+        assert!((v[k] - 25_000.0 * dx[k]).abs() <= 1e-9 * v[k].abs().max(1e-9), "tick {k}: {} V for {} m", v[k], dx[k]);
+    }
 }
 
 #[test]
@@ -260,7 +403,14 @@ fn two_plane_and_flexible_recordings_hold_their_planes_and_mid_span() {
     assert!(paths.len() >= 10, "{paths:?}");
     for path in paths {
         let (topic, field) = path.split_once('.').unwrap_or_else(|| panic!("{path}"));
-        assert!(rec["topics"][topic]["fields"].get(field).is_some(), "the layout's {path} is not in the recording");
+        // An array's path (the orbit's `x_m[:]`) names the array.
+        let field = field.strip_suffix("[:]").unwrap_or(field);
+        let found = rec["topics"][topic]["fields"].get(field).or_else(|| rec["extra"][topic]["fields"].get(field));
+        assert!(found.is_some(), "the layout's {path} is not in the recording");
+    }
+    // Both planes' orbits, each with the clearance circle.
+    for topic in ["/plane_a/orbit", "/plane_b/orbit"] {
+        assert_eq!(rec["extra"][topic]["schema"], "plant_msgs/msg/Orbit", "{topic}");
     }
 }
 
@@ -359,4 +509,53 @@ fn a_bad_value_of_the_key_exits_2_naming_it() {
     assert_exit(&done, 2);
     assert!(stderr(&done).contains("mcap"), "{}", stderr(&done));
     assert!(!out.join("run.mcap").exists() && !out.join("trace.csv").exists());
+}
+
+#[test]
+fn an_ensembles_member_is_recorded_on_request() {
+    let dir = TempDir::new("mcap-member");
+    let out = dir.join("ens");
+    let mut cmd = Command::new(common::plant_bin());
+    cmd.arg("ensemble").arg(scene("paper-10g.toml")).arg("--out").arg(&out).args(["--record-member", "2"]);
+    for s in [
+        "scene.duration_s=0.06",
+        "shock[0].start_s=0.005",
+        "ensemble.members=3",
+        "ensemble.seed=7",
+        "ensemble.verify=false",
+    ] {
+        cmd.args(["--set", s]);
+    }
+    let done = output_within(&mut cmd, LIMIT);
+    assert_exit(&done, 0);
+    let member = out.join("member-2");
+    assert!(stderr(&done).contains("member 2 recorded in"), "{}", stderr(&done));
+    // The recording holds the member's rows, bit for bit.
+    let rec = read_back(&member);
+    assert_holds_trace(&member, &rec);
+    // It is member 2's run: its figures are members.csv's row of member 2 (parsed from the
+    // ensemble's table, the shortest decimal of each double, so equal to the bit).
+    let text = read_text(&out.join("members.csv"));
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}"));
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let row = rows.iter().find(|r| r[col("member")] == "2").expect("member 2's row");
+    let summary = common::read_json(&member.join("summary.json"));
+    for key in ["max_radius_m", "max_contact_force_n"] {
+        let want: f64 = row[col(key)].parse().unwrap();
+        assert_eq!(common::num(&summary, key), want, "{key}");
+    }
+    // The other members' figures differ (the test tells members apart).
+    let other: f64 =
+        rows.iter().find(|r| r[col("member")] == "0").unwrap()[col("max_contact_force_n")].parse().unwrap();
+    assert_ne!(common::num(&summary, "max_contact_force_n"), other);
+    // A member the ensemble does not have is bad input, before anything runs.
+    let out = dir.join("bad");
+    let mut cmd = Command::new(common::plant_bin());
+    cmd.arg("ensemble").arg(scene("paper-10g.toml")).arg("--out").arg(&out).args(["--record-member", "3"]);
+    cmd.args(["--set", "ensemble.members=3"]);
+    let done = output_within(&mut cmd, LIMIT);
+    assert_exit(&done, 2);
+    assert!(stderr(&done).contains("--record-member 3: the ensemble has 3 members"), "{}", stderr(&done));
+    assert!(!out.join("members.csv").exists());
 }

@@ -7,7 +7,7 @@ use crate::integrate::{IntegrationError, Settings};
 use crate::rows::Record;
 use crate::snapshot::SnapshotError;
 use crate::tick_time::Tet;
-use controller::{saturate, PdGains, ROTOR_AXES};
+use controller::{saturate, PdGains, RotorSample, ROTOR_AXES};
 
 /// Why a plant could not be built, or started from a saved state.
 #[derive(Debug, thiserror::Error)]
@@ -103,6 +103,17 @@ pub trait Sink {
     /// [`crate::machine::PlaneState`] to a visitor, computed only if the sink asks. The default
     /// ignores it.
     fn planes(&mut self, _planes: &dyn PlaneStates) {}
+
+    /// One controller tick of a sampled or co-simulated loop, before the tick's rows: the
+    /// sample the law read and the command (A, the wire's axis order) applied over the tick.
+    /// Called only if [`Sink::wants_ticks`]; the default ignores it.
+    fn tick(&mut self, _sample: &RotorSample, _command: &[f64; ROTOR_AXES]) {}
+
+    /// Whether the sink takes [`Sink::tick`] (the recordings of issue 42); false by default,
+    /// so that a run's loop hands ticks to no one who does not ask.
+    fn wants_ticks(&self) -> bool {
+        false
+    }
 }
 
 /// Every row kept in memory, in order: the simplest sink (an FMU's outputs or the CLI's

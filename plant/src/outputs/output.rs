@@ -282,6 +282,14 @@ impl Sink for RunFolder {
     fn sample(&mut self, record: &Record) {
         self.push(record);
     }
+
+    fn tick(&mut self, sample: &controller::RotorSample, command: &[f64; controller::ROTOR_AXES]) {
+        crate::recording::tick(&mut self.mcap, &mut self.live, sample, command);
+    }
+
+    fn wants_ticks(&self) -> bool {
+        crate::recording::wants_ticks(&self.mcap, &self.live)
+    }
 }
 
 /// `plant run`: runs `scene`, streaming its rows to `dir` (see the module docs).

@@ -251,6 +251,7 @@ fn drive(
     let started = plant.time();
     let start = Instant::now();
     let mut outcome = primed.err().unwrap_or(Outcome::Completed);
+    let ticks = sink.wants_ticks();
     while outcome == Outcome::Completed && !plant.finished() {
         let tick_start = Instant::now();
         let command = match digital.command(plant.sample(), hooks) {
@@ -260,6 +261,11 @@ fn drive(
                 break;
             }
         };
+        if ticks {
+            if let Command::Held(applied) = &command {
+                sink.tick(plant.sample(), applied);
+            }
+        }
         // A realtime tick starts when the plant wakes at its wall-clock time.
         let tick_start = digital.tick_started().unwrap_or(tick_start);
         if let Err(e) = plant.step_from(&command, sink, tick_start) {

@@ -19,6 +19,7 @@ use crate::hooks::Hooks;
 use crate::run::{run_into_from, SetupError, Sink, SinkRun};
 use crate::snapshot::Snapshot;
 use crate::trace::Record;
+use controller::{RotorSample, ROTOR_AXES};
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::time::Duration;
 
@@ -28,14 +29,45 @@ pub const CAPACITY: usize = 4096;
 /// How long the thread sleeps after taking what has come.
 const PAUSE: Duration = Duration::from_millis(2);
 
-/// The loop's side: sends each sample to the thread.
-struct Handoff(SyncSender<Record>);
+/// What the loop hands the thread: a sample, or a tick of the loop for a sink that takes them
+/// ([`Sink::tick`]).
+#[expect(
+    clippy::large_enum_variant,
+    reason = "the channel held rows before ticks were added: boxing the row would allocate in every tick"
+)]
+enum Item {
+    Row(Record),
+    Tick(RotorSample, [f64; ROTOR_AXES]),
+}
+
+/// The loop's side: sends each sample (and each tick, if the sink takes them) to the thread.
+struct Handoff {
+    tx: SyncSender<Item>,
+    ticks: bool,
+}
 
 impl Sink for Handoff {
     fn sample(&mut self, record: &Record) {
         // Fails only when the thread has ended, which it does by panicking: the scope's join
         // passes the panic on.
-        let _ = self.0.send(*record);
+        let _ = self.tx.send(Item::Row(*record));
+    }
+
+    fn tick(&mut self, sample: &RotorSample, command: &[f64; ROTOR_AXES]) {
+        let _ = self.tx.send(Item::Tick(*sample, *command));
+    }
+
+    fn wants_ticks(&self) -> bool {
+        self.ticks
+    }
+}
+
+impl Item {
+    fn to(self, sink: &mut dyn Sink) {
+        match self {
+            Item::Row(r) => sink.sample(&r),
+            Item::Tick(s, c) => sink.tick(&s, &c),
+        }
     }
 }
 
@@ -79,7 +111,7 @@ pub fn run_into_offloaded<S: Sink + Send>(
 /// The thread is an ordinary one (`SCHED_OTHER`, on any core the process may use but those
 /// in `avoid`, the loop's `controller.pin_cores`), whatever the caller's scheduling: a
 /// realtime loop puts its own thread under `SCHED_FIFO` and pins it. `sink` receives samples only:
-/// [`Sink::planes`] is not handed over, so a sink that
+/// [`Sink::planes`] is not handed over ([`Sink::tick`] is, if the sink takes ticks), so a sink that
 /// needs the planes must not be offloaded. A panic on the thread is passed on to the caller; a
 /// thread that cannot be started (a process at its thread limit) is an error, before `body`
 /// runs.
@@ -88,21 +120,22 @@ pub fn offload<S: Sink + Send, R>(
     avoid: &[usize],
     body: impl FnOnce(&mut dyn Sink) -> R,
 ) -> std::io::Result<R> {
-    let (tx, rx) = sync_channel::<Record>(CAPACITY);
+    let (tx, rx) = sync_channel::<Item>(CAPACITY);
+    let ticks = sink.wants_ticks();
     std::thread::scope(|scope| {
         let thread = std::thread::Builder::new().name("plant-rows".into()).spawn_scoped(scope, move || {
             // A run after a realtime one starts it from a thread under `SCHED_FIFO`,
             // pinned: it must not take the loop's core at the loop's priority.
             controller::link::ordinary_thread(avoid);
             while let Ok(first) = rx.recv() {
-                sink.sample(&first);
-                while let Ok(r) = rx.try_recv() {
-                    sink.sample(&r);
+                first.to(sink);
+                while let Ok(item) = rx.try_recv() {
+                    item.to(sink);
                 }
                 std::thread::sleep(PAUSE);
             }
         });
-        thread.map(|_| body(&mut Handoff(tx)))
+        thread.map(|_| body(&mut Handoff { tx, ticks }))
     })
 }
 

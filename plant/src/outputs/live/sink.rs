@@ -7,10 +7,13 @@ use super::protocol::Channel;
 use super::server::{Frame, Served, Server};
 use crate::config::Scene;
 use crate::recording::events::{Event, Events, LOG_SCHEMA};
+use crate::recording::extra::extras;
 use crate::recording::mcap_file::{ros2_name, EVENTS_TOPIC};
+use crate::recording::orbit::{self, Orbits};
 use crate::recording::topics::{topics, Columns, Topic};
 use crate::summary::Summary;
 use crate::trace::Record;
+use controller::{RotorSample, ROTOR_AXES};
 
 /// The live view of one run.
 pub struct LiveSink {
@@ -23,10 +26,19 @@ pub struct LiveSink {
     rate_hz: f64,
     /// The live period of the last row sent (see [`period`]).
     last: Option<f64>,
+    /// Each plane's orbit window, sent at [`orbit::RATE_HZ`] (or the live rate if lower).
+    orbits: Orbits,
+    /// The loop's last tick, sent with the next row that opens a live period (sampled and
+    /// co-simulated runs).
+    tick: Option<(RotorSample, [f64; ROTOR_AXES])>,
+    ticks: bool,
+    axes: usize,
 }
 
 /// The channels a run of `scene` advertises: each topic of the recording (CDR, its ROS 2
-/// message definition), then `/events` (`foxglove.Log`, JSON). Ids from 1, in this order.
+/// message definition), then `/events` (`foxglove.Log`, JSON), then the topics besides the
+/// rows' ([`crate::recording::extra`]: each plane's orbit, the loop's sample and command). Ids
+/// from 1, in this order.
 pub fn channels(scene: &Scene) -> Vec<Channel> {
     let mut out: Vec<Channel> = topics(&Columns::of(scene))
         .into_iter()
@@ -47,6 +59,14 @@ pub fn channels(scene: &Scene) -> Vec<Channel> {
         schema: LOG_SCHEMA.into(),
         schema_encoding: "jsonschema",
     });
+    out.extend(extras(scene).into_iter().map(|e| Channel {
+        id: 0,
+        topic: e.topic,
+        encoding: "cdr",
+        schema_name: e.schema_name,
+        schema: e.schema,
+        schema_encoding: "ros2msg",
+    }));
     for (i, c) in out.iter_mut().enumerate() {
         c.id = u32::try_from(i + 1).unwrap_or(u32::MAX);
     }
@@ -79,6 +99,10 @@ impl LiveSink {
             values: Vec::new(),
             rate_hz: scene.live_rate_hz,
             last: None,
+            orbits: Orbits::new(scene, orbit::RATE_HZ.min(scene.live_rate_hz)),
+            tick: None,
+            ticks: extras(scene).len() > scene.planes(),
+            axes: 2 * scene.planes(),
         }
     }
 
@@ -86,6 +110,7 @@ impl LiveSink {
     /// no client is connected.
     pub fn push(&mut self, r: &Record) {
         self.events.row(r, &mut self.pending);
+        let orbit_due = self.orbits.row(r);
         let t = r.t_s();
         let k = period(t, self.rate_hz);
         let due = self.last.is_none_or(|last| k > last);
@@ -96,7 +121,7 @@ impl LiveSink {
             self.pending.clear();
             return;
         }
-        if !due && self.pending.is_empty() {
+        if !due && !orbit_due && self.pending.is_empty() {
             return;
         }
         let ns = nanoseconds(t);
@@ -110,8 +135,35 @@ impl LiveSink {
             }
         }
         let events = self.topics.len();
+        let planes = self.orbits.topics().count();
+        if orbit_due {
+            for i in 0..planes {
+                let mut bytes = Vec::new();
+                self.orbits.message(i, &mut bytes);
+                frame.messages.push((events + 1 + i, ns, bytes));
+            }
+        }
+        if let Some((sample, command)) = if due { self.tick.take() } else { None } {
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            crate::recording::ticks::messages(&sample, &command, self.axes, &mut a, &mut b);
+            let at = nanoseconds(sample.t_s);
+            frame.messages.push((events + 1 + planes, at, a));
+            frame.messages.push((events + 2 + planes, at, b));
+        }
         self.push_events(&mut frame, events);
         self.server.hub().offer(frame);
+    }
+
+    /// One tick of the loop: kept, and sent with the next row that opens a live period.
+    pub fn tick(&mut self, sample: &RotorSample, command: &[f64; ROTOR_AXES]) {
+        if self.ticks {
+            self.tick = Some((*sample, *command));
+        }
+    }
+
+    /// Whether the live view has the loop's topics (a sampled or co-simulated run).
+    pub fn wants_ticks(&self) -> bool {
+        self.ticks
     }
 
     fn push_events(&mut self, frame: &mut Frame, channel: usize) {
@@ -124,7 +176,14 @@ impl LiveSink {
     /// Sends the run's end (with a `plant run`'s summary: its status, motion mode, a
     /// co-simulation's figures) and stops the server: the clients get what was queued for
     /// them, then are closed.
-    pub fn finish(mut self, summary: Option<&Summary>) -> Served {
+    pub fn finish(self, summary: Option<&Summary>) -> Served {
+        self.end_run(summary).stop()
+    }
+
+    /// Sends the run's end, as [`LiveSink::finish`] does, and hands the server back still
+    /// serving, for the next of several runs served in turn (`plant compare --realtime
+    /// --live`): a new [`LiveSink::new`] of it starts the next run's rows, whose times start again.
+    pub fn end_run(mut self, summary: Option<&Summary>) -> Server {
         if let Some(summary) = summary {
             self.pending.extend(self.events.end(summary));
         }
@@ -134,13 +193,27 @@ impl LiveSink {
         if self.server.hub().has_clients() {
             self.server.hub().offer(frame);
         }
-        self.server.stop()
+        self.server
+    }
+
+    /// Logs a line on `/events` at simulated time `t_s` (`realtime run 2 of 3 starts`), sent
+    /// with the next frame.
+    pub fn note(&mut self, t_s: f64, message: String) {
+        self.pending.push(Event { t_s, level: crate::recording::events::Level::Info, message });
     }
 }
 
 impl crate::run::Sink for LiveSink {
     fn sample(&mut self, record: &Record) {
         self.push(record);
+    }
+
+    fn tick(&mut self, sample: &RotorSample, command: &[f64; ROTOR_AXES]) {
+        LiveSink::tick(self, sample, command);
+    }
+
+    fn wants_ticks(&self) -> bool {
+        self.ticks
     }
 }
 

@@ -11,11 +11,14 @@
 //! written.
 
 use super::events::{Event, Events, LOG_SCHEMA};
+use super::extra::extras;
+use super::orbit::{self, Orbits};
 use super::topics::{topics, Columns, Topic};
 use crate::config::Scene;
 use crate::summary::Summary;
 use crate::trace::Record;
 use anyhow::Context;
+use controller::{RotorSample, ROTOR_AXES};
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -42,6 +45,11 @@ pub struct McapSink {
     bytes: Vec<u8>,
     sequence: u32,
     error: Option<anyhow::Error>,
+    orbits: Orbits,
+    /// Each plane's orbit channel, then the loop's sample and command channels (if sampled).
+    extra_channels: Vec<u16>,
+    axes: usize,
+    tick_bytes: Vec<u8>,
 }
 
 /// A simulated time (s) as an MCAP time (ns); a time before 0 (none is) or not finite is 0.
@@ -76,6 +84,12 @@ impl McapSink {
             .profile("")
             .library(concat!("plant ", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::with_capacity(1 << 20, file))?;
+        // The metadata first: writing it ends the open chunk, and a chunk of schemas and
+        // channels alone has no message index, which Lichtblick's and Foxglove's reader
+        // (`@mcap/core`) refuses ("Chunks without message indexes are not currently supported").
+        let toml = scene.to_toml()?;
+        let metadata = BTreeMap::from([("name".to_string(), scene.name.clone()), ("scene.toml".to_string(), toml)]);
+        writer.write_metadata(&mcap::records::Metadata { name: "scene".into(), metadata })?;
         let columns = Columns::of(scene);
         let none = BTreeMap::new();
         let mut channels = Vec::new();
@@ -86,9 +100,11 @@ impl McapSink {
         }
         let log = writer.add_schema("foxglove.Log", "jsonschema", LOG_SCHEMA.as_bytes())?;
         let events_channel = writer.add_channel(log, EVENTS_TOPIC, "json", &none)?;
-        let toml = scene.to_toml()?;
-        let metadata = BTreeMap::from([("name".to_string(), scene.name.clone()), ("scene.toml".to_string(), toml)]);
-        writer.write_metadata(&mcap::records::Metadata { name: "scene".into(), metadata })?;
+        let mut extra_channels = Vec::new();
+        for extra in extras(scene) {
+            let schema = writer.add_schema(&extra.schema_name, "ros2msg", extra.schema.as_bytes())?;
+            extra_channels.push(writer.add_channel(schema, &extra.topic, "cdr", &none)?);
+        }
         Ok(Self {
             path: path.to_path_buf(),
             writer: Some(writer),
@@ -101,6 +117,10 @@ impl McapSink {
             bytes: Vec::with_capacity(512),
             sequence: 0,
             error: None,
+            orbits: Orbits::new(scene, orbit::RATE_HZ),
+            extra_channels,
+            axes: 2 * scene.planes(),
+            tick_bytes: Vec::with_capacity(128),
         })
     }
 
@@ -119,6 +139,15 @@ impl McapSink {
             written = write(writer, *channel, &mut self.sequence, ns, &self.bytes);
             if written.is_err() {
                 break;
+            }
+        }
+        if self.orbits.row(r) {
+            let planes = self.orbits.topics().count();
+            for (i, channel) in self.extra_channels.iter().take(planes).enumerate() {
+                if written.is_ok() {
+                    self.orbits.message(i, &mut self.bytes);
+                    written = write(writer, *channel, &mut self.sequence, ns, &self.bytes);
+                }
             }
         }
         for event in self.pending.drain(..) {
@@ -173,8 +202,43 @@ fn write(writer: &mut Writer, channel: u16, sequence: &mut u32, ns: u64, data: &
     writer.write_to_known_channel(&header, data)
 }
 
+impl McapSink {
+    /// One tick of the loop: its messages on `/loop/sample` and `/loop/command`.
+    pub fn tick(&mut self, sample: &RotorSample, command: &[f64; ROTOR_AXES]) {
+        let planes = self.orbits.topics().count();
+        let (Some(&sample_channel), Some(&command_channel)) =
+            (self.extra_channels.get(planes), self.extra_channels.get(planes + 1))
+        else {
+            return;
+        };
+        let Some(writer) = self.writer.as_mut().filter(|_| self.error.is_none()) else { return };
+        super::ticks::messages(sample, command, self.axes, &mut self.bytes, &mut self.tick_bytes);
+        let ns = nanoseconds(sample.t_s);
+        let mut written = write(writer, sample_channel, &mut self.sequence, ns, &self.bytes);
+        if written.is_ok() {
+            written = write(writer, command_channel, &mut self.sequence, ns, &self.tick_bytes);
+        }
+        if let Err(e) = written {
+            self.error = Some(e.into());
+        }
+    }
+
+    /// Whether the recording has the loop's topics (a sampled or co-simulated run).
+    pub fn wants_ticks(&self) -> bool {
+        self.extra_channels.len() > self.orbits.topics().count()
+    }
+}
+
 impl crate::run::Sink for McapSink {
     fn sample(&mut self, record: &Record) {
         self.push(record);
+    }
+
+    fn tick(&mut self, sample: &RotorSample, command: &[f64; ROTOR_AXES]) {
+        McapSink::tick(self, sample, command);
+    }
+
+    fn wants_ticks(&self) -> bool {
+        McapSink::wants_ticks(self)
     }
 }

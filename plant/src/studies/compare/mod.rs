@@ -169,6 +169,8 @@ pub struct Request<'a> {
     /// Each compared run's robustness answer with this many perturbed members
     /// (`compare_robustness.csv`; the same as `--set robustness.members=N`).
     pub robustness: Option<u32>,
+    /// `--live ADDR` of `--realtime`: the realtime runs served live ([`compare_realtime`]).
+    pub live: Option<&'a str>,
 }
 
 /// `plant compare`: the rate comparison (and maps), or the law comparison; `warn` gets the
@@ -189,7 +191,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&s
     let _claim = crate::claim::claim(&dir, true)?;
     let stop = crate::interrupt::stop_flag();
     if let Some(runs) = req.realtime {
-        compare_realtime(req.scene, req.set, runs, &dir, log, &stop)?;
+        compare_realtime(req.scene, req.set, runs, &dir, log, &stop, req.live)?;
         return Ok(dir.join("realtime.csv"));
     }
     if req.laws.is_empty() {

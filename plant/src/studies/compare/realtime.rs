@@ -74,6 +74,11 @@ pub const REALTIME_HEADER: &str = RealtimeRow::HEADER;
 /// only difference is the wall clock: a realtime run without a deadline miss is the lockstep
 /// run bit for bit, and a run that differs shows what the host did to the outcome. Writes
 /// `realtime.csv` ([`RealtimeRow`]) and `realtime_radius.png`.
+///
+/// With `live` (`--live ADDR`), the realtime runs' rows are served live as `plant run --live`
+/// serves a run's ([`crate::live`]), one run after the other on one server (each run's times
+/// start again at 0; `/events` says which run starts); the lockstep run is not served. The
+/// address is listened on before any run (one that cannot be is bad input, exit 2).
 pub fn compare_realtime(
     scene_path: &Path,
     sets: &[String],
@@ -81,13 +86,18 @@ pub fn compare_realtime(
     out: &Path,
     log: &mut dyn FnMut(&str),
     stop: &AtomicBool,
+    live: Option<&str>,
 ) -> anyhow::Result<Vec<RealtimeRow>> {
     if !(1..=1000).contains(&runs) {
         return Err(crate::exit::BadArgument(format!("--runs {runs}: must be between 1 and 1000")).into());
     }
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let base: Vec<String> = sets.iter().cloned().chain(["output.plots=false".to_string()]).collect();
     let realtime = with(scene_path, &base, &["controller.mode=\"realtime\"".into()])?;
+    let mut server = live.map(|addr| crate::live::start(addr, &realtime)).transpose()?;
+    if let Some(s) = &server {
+        log(&format!("live view at ws://{} (Foxglove WebSocket protocol), serving the realtime runs", s.addr()));
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     // The realtime scene as resolved holds its integrator setting: the lockstep twin keeps it.
     let lockstep = realtime.reload(&["controller.mode=\"lockstep\"".into()])?;
     let reference = finished(&lockstep, stop)?.ok_or_else(nothing_finished)?;
@@ -148,13 +158,31 @@ pub fn compare_realtime(
     log(&say(&rows[0]));
     let mut traces: Vec<(String, RunResult)> = Vec::new();
     for n in 1..=runs {
-        let Some(r) = finished(&realtime, stop)? else { break };
+        let done = match server.take() {
+            None => finished(&realtime, stop)?,
+            Some(s) => {
+                let mut sink = crate::live::LiveSink::new(s, &realtime);
+                sink.note(0.0, format!("realtime run {n} of {runs} starts"));
+                let r = finished_live(&realtime, stop, &mut sink);
+                let summary = r.as_ref().ok().and_then(|r| r.as_ref()).map(|r| Summary::new(&realtime, r));
+                server = Some(sink.end_run(summary.as_ref()));
+                r?
+            }
+        };
+        let Some(r) = done else { break };
         let rw = row(n, &realtime, &r);
         log(&say(&rw));
         rows.push(rw);
         if traces.len() < 9 {
             traces.push((format!("realtime {n}"), r));
         }
+    }
+    if let Some(s) = server {
+        let served = s.stop();
+        log(&format!(
+            "live view: {} client(s); {} frames made, {} not delivered (a client's queue full)",
+            served.clients, served.frames, served.dropped
+        ));
     }
     crate::table::write_with_header(&out.join("realtime.csv"), REALTIME_HEADER, &rows)?;
     traces.insert(0, ("lockstep".into(), reference));
@@ -183,4 +211,48 @@ fn same_bits(a: &crate::trace::Trace, b: &crate::trace::Trace) -> bool {
             use crate::trace::Columns as _;
             x.values().iter().zip(&y.values()).all(|(p, q)| p.to_bits() == q.to_bits())
         })
+}
+
+/// [`finished`], the run's rows also served live by `live`: the trace kept in memory as
+/// [`finished`] keeps it, and both fed from the thread a realtime run hands its rows to
+/// ([`crate::offload`]), so that serving them stays out of the ticks.
+fn finished_live(
+    scene: &Scene,
+    stop: &AtomicBool,
+    live: &mut crate::live::LiveSink,
+) -> anyhow::Result<Option<RunResult>> {
+    if stop.load(Ordering::Relaxed) {
+        return Ok(None);
+    }
+    let mut trace = crate::trace::Trace::with_capacity((scene.duration / scene.output_interval).ceil() as usize + 2);
+    let mut tee = Tee { trace: &mut trace, live };
+    let launch = crate::cosim::Launch::default();
+    let when = crate::offload::When::Realtime;
+    match crate::offload::run_into_offloaded(scene, &launch, &mut Cancel(stop), &mut tee, None, when) {
+        Ok(run) if run.outcome == Outcome::Interrupted => Ok(None),
+        Ok(run) => Ok(Some(RunResult { trace, run })),
+        Err(_) if stop.load(Ordering::Relaxed) => Ok(None),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// The rows of a realtime run served live: into its trace and to the live view.
+struct Tee<'a> {
+    trace: &'a mut crate::trace::Trace,
+    live: &'a mut crate::live::LiveSink,
+}
+
+impl crate::run::Sink for Tee<'_> {
+    fn sample(&mut self, record: &crate::trace::Record) {
+        self.trace.push(record);
+        self.live.push(record);
+    }
+
+    fn tick(&mut self, sample: &controller::RotorSample, command: &[f64; controller::ROTOR_AXES]) {
+        self.live.tick(sample, command);
+    }
+
+    fn wants_ticks(&self) -> bool {
+        self.live.wants_ticks()
+    }
 }

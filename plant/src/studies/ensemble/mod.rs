@@ -43,6 +43,10 @@ pub struct EnsembleArgs {
     /// Common options.
     #[command(flatten)]
     pub run: RunArgs,
+    /// Also record member J (0-based, as in members.csv) after the ensemble: its run as `plant
+    /// run --mcap` writes one (trace.csv, summary.json, run.mcap) in `<out>/member-J/`.
+    #[arg(long, value_name = "J")]
+    pub record_member: Option<usize>,
 }
 
 /// `plant ensemble`: loads the scene and its `[ensemble]` (exit 2 on bad input): one point, no
@@ -59,7 +63,15 @@ pub fn command(args: &EnsembleArgs) -> anyhow::Result<()> {
         axes: Vec::new(),
     };
     grid.validate(&work)?;
+    if let Some(j) = args.record_member {
+        crate::recording::member::check(j, work.spec.members)?;
+    }
     let stem = args.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = args.run.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("ensemble-{stem}")));
-    execute(&grid, &work, &dir, &args.run)
+    execute(&grid, &work, &dir, &args.run)?;
+    if let Some(j) = args.record_member {
+        let out = crate::recording::member::record(&grid, &work.spec, j, &dir)?;
+        eprintln!("plant ensemble: member {j} recorded in {}", out.join(crate::recording::mcap_file::FILE).display());
+    }
+    Ok(())
 }

@@ -61,30 +61,7 @@ impl Session {
         }
 
         let cmd = if !self.connected {
-            self.figures.fallback_ticks += 1;
-            if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
-                return Err(Halt::MissBudget(why));
-            }
-            match self.poll_handshake(hooks) {
-                Some(Ok(())) => {
-                    self.first_seq = k;
-                    self.figures.last_reply_seq = None;
-                    let detail = self.controller.clone();
-                    self.event("reconnected", sample.t_s, k, detail);
-                    hooks.note(&format!("controller reconnected: {}", self.controller));
-                }
-                Some(Err(e)) => return Err(Halt::Lost(format!("no reconnection: {e}"))),
-                None => {
-                    let waited = self.lost_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
-                    if waited > self.settings.reconnect_timeout {
-                        return Err(Halt::Lost(format!(
-                            "controller lost; none reconnected within {} s",
-                            self.settings.reconnect_timeout
-                        )));
-                    }
-                }
-            }
-            self.last_cmd
+            self.fallback_tick(sample, hooks)?
         } else if k == 0 || k <= self.first_seq {
             self.last_cmd // nothing due yet: the bias (or the fallback after a reconnection)
         } else {
@@ -94,34 +71,10 @@ impl Session {
                     self.figures.misses.record(false);
                     self.accept(&reply)
                 }
-                None => {
-                    self.figures.misses.record(true);
-                    if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
-                        return Err(Halt::MissBudget(why));
-                    }
-                    if self.last_heard.elapsed() >= self.next_check {
-                        self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
-                        // A child of ours still running is alive: its exit is all there is to
-                        // watch, and a `waitpid` tells it. Listing the run's nodes reads the
-                        // file system (/tmp/iceoryx2) inside the tick, where a slow disk turns
-                        // a burst of misses into a longer one; an external controller has no
-                        // other sign of life.
-                        let running = self.child.as_mut().is_some_and(|c| c.exited().is_none());
-                        if !running {
-                            let every = Some(Duration::from_secs_f64(self.settings.reply_timeout));
-                            if let Some(why) = controller_gone(&mut self.child, &mut self.log, &mut self.watch, every) {
-                                return self.on_lost(sample, why, hooks);
-                            }
-                        }
-                        // Alive but silent (stopped, hung, answering another session) for
-                        // controller.lockstep_timeout_ms: lost, as in lockstep.
-                        if self.last_heard.elapsed().as_secs_f64() >= self.settings.lockstep_timeout {
-                            let seen = std::mem::take(&mut self.silent);
-                            return self.on_silent(sample, &seen, hooks);
-                        }
-                    }
-                    self.last_cmd
-                }
+                None => match self.missed(sample, hooks) {
+                    Some(ended) => return ended,
+                    None => self.last_cmd,
+                },
             }
         };
 
@@ -134,6 +87,68 @@ impl Session {
             self.figures.sent += 1;
         }
         Ok(cmd)
+    }
+
+    /// A tick while the controller is lost: the fallback command, and a reconnection if one
+    /// has come (or the run ends when none came in time, or the miss budget is spent).
+    fn fallback_tick(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Result<[f64; ROTOR_AXES], Halt> {
+        let k = sample.seq;
+        self.figures.fallback_ticks += 1;
+        if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
+            return Err(Halt::MissBudget(why));
+        }
+        match self.poll_handshake(hooks) {
+            Some(Ok(())) => {
+                self.first_seq = k;
+                self.figures.last_reply_seq = None;
+                let detail = self.controller.clone();
+                self.event("reconnected", sample.t_s, k, detail);
+                hooks.note(&format!("controller reconnected: {}", self.controller));
+            }
+            Some(Err(e)) => return Err(Halt::Lost(format!("no reconnection: {e}"))),
+            None => {
+                let waited = self.lost_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
+                if waited > self.settings.reconnect_timeout {
+                    return Err(Halt::Lost(format!(
+                        "controller lost; none reconnected within {} s",
+                        self.settings.reconnect_timeout
+                    )));
+                }
+            }
+        }
+        Ok(self.last_cmd)
+    }
+
+    /// A tick whose reply did not come: a deadline miss, the last command held (`None`: the
+    /// tick goes on), or the tick's end (a controller that exited or has been silent too long
+    /// is lost; the miss budget spent).
+    fn missed(&mut self, sample: &RotorSample, hooks: &mut dyn Hooks) -> Option<Result<[f64; ROTOR_AXES], Halt>> {
+        self.figures.misses.record(true);
+        if let Some(why) = self.miss_budget_exceeded(MISS_BUDGET_MIN_DUE) {
+            return Some(Err(Halt::MissBudget(why)));
+        }
+        if self.last_heard.elapsed() >= self.next_check {
+            self.next_check += Duration::from_secs_f64(self.settings.reply_timeout);
+            // A child of ours still running is alive: its exit is all there is to
+            // watch, and a `waitpid` tells it. Listing the run's nodes reads the
+            // file system (/tmp/iceoryx2) inside the tick, where a slow disk turns
+            // a burst of misses into a longer one; an external controller has no
+            // other sign of life.
+            let running = self.child.as_mut().is_some_and(|c| c.exited().is_none());
+            if !running {
+                let every = Some(Duration::from_secs_f64(self.settings.reply_timeout));
+                if let Some(why) = controller_gone(&mut self.child, &mut self.log, &mut self.watch, every) {
+                    return Some(self.on_lost(sample, why, hooks));
+                }
+            }
+            // Alive but silent (stopped, hung, answering another session) for
+            // controller.lockstep_timeout_ms: lost, as in lockstep.
+            if self.last_heard.elapsed().as_secs_f64() >= self.settings.lockstep_timeout {
+                let seen = std::mem::take(&mut self.silent);
+                return Some(self.on_silent(sample, &seen, hooks));
+            }
+        }
+        None
     }
 }
 
