@@ -56,13 +56,13 @@ pub fn progress(spec: &EnsembleSpec, present: &BTreeMap<usize, bool>) -> Progres
     Progress::Decided { counted: spec.members, decision: StoppedBy::Members }
 }
 
-/// Statistics of a point over its counted members.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// Statistics of a point over its counted members (serialised flat: the tally's fields after
+/// `index`, as `ensemble.csv` and `sweep.json` have them).
+#[derive(Clone, Debug, PartialEq)]
 pub struct PointStats {
     /// Point index.
     pub index: usize,
     /// The counted members' modes and recovery statistics.
-    #[serde(flatten)]
     pub tally: Tally,
     /// Largest peak contact force of all members (N).
     pub worst_contact_force_n: f64,
@@ -87,6 +87,27 @@ pub struct PointStats {
     pub max_radius_m: f64,
     /// `completed` if every counted run completed, else `diverged`.
     pub status: Status,
+}
+
+impl Serialize for PointStats {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = serializer.serialize_struct("PointStats", 22)?;
+        st.serialize_field("index", &self.index)?;
+        self.tally.serialize_fields(&mut st)?;
+        st.serialize_field("worst_contact_force_n", &self.worst_contact_force_n)?;
+        st.serialize_field("verified", &self.verified)?;
+        st.serialize_field("numerically_sensitive", &self.numerically_sensitive)?;
+        st.serialize_field("stopped_by", &self.stopped_by)?;
+        st.serialize_field("post_shock_mode", &self.post_shock_mode)?;
+        st.serialize_field("steady_class", &self.steady_class)?;
+        st.serialize_field("period_k", &self.period_k)?;
+        st.serialize_field("contact_fraction", &self.contact_fraction)?;
+        st.serialize_field("whirl_hz", &self.whirl_hz)?;
+        st.serialize_field("max_radius_m", &self.max_radius_m)?;
+        st.serialize_field("status", &self.status)?;
+        st.end()
+    }
 }
 
 /// The most frequent item, ties broken by `order` (the first there wins); `None` without items.

@@ -34,6 +34,24 @@ pub struct Tally {
     pub recovery_p90_s: Option<f64>,
 }
 
+impl Tally {
+    /// Writes the tally's fields into a structure being serialised, in their order. Written out
+    /// because `#[serde(flatten)]` turns the holder into a map, which the `csv` crate cannot
+    /// write (`ensemble.csv` holds a point's statistics with its tally inline).
+    pub(crate) fn serialize_fields<S: serde::ser::SerializeStruct>(&self, st: &mut S) -> Result<(), S::Error> {
+        st.serialize_field("members", &self.members)?;
+        st.serialize_field("recovered", &self.recovered)?;
+        st.serialize_field("dry_whirl", &self.dry_whirl)?;
+        st.serialize_field("rebound", &self.rebound)?;
+        st.serialize_field("diverged", &self.diverged)?;
+        st.serialize_field("p_recovered", &self.p_recovered)?;
+        st.serialize_field("p_lo", &self.p_lo)?;
+        st.serialize_field("p_hi", &self.p_hi)?;
+        st.serialize_field("recovery_median_s", &self.recovery_median_s)?;
+        st.serialize_field("recovery_p90_s", &self.recovery_p90_s)
+    }
+}
+
 /// The tally of `members` (their counted runs: the verification's where one was run).
 pub fn tally(members: &[&MemberResult]) -> Tally {
     let n = members.len();
