@@ -70,4 +70,4 @@ if ! target/ross-venv/bin/python -W ignore scripts/ross/amb_compare.py "$out" >t
     cat target/ross-amb-compare.log >&2
     exit 1
 fi
-grep -E '^(ufu_rig|amb_machine_ambs):' target/ross-amb-compare.log
+grep -E '^(ufu_rig|amb_machine_ambs|soft_machine):' target/ross-amb-compare.log
