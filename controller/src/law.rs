@@ -110,6 +110,14 @@ pub trait ControlLaw: Send {
     fn linear(&self) -> Option<LinearLaw> {
         self.linear_pd().map(|pd| LinearLaw { pd, filter: None })
     }
+    /// Whether the law starts holding its plane's weight itself, without the gravity bias: an
+    /// integrator preloaded with the weight's current on its y axis (`ross_pid` with
+    /// `controller.gravity_bias = false`: ROSS's way, the integral carries the weight), so that
+    /// at the plant's rest, where the sensors read zero, its first command is the static one
+    /// (docs/MODEL.md §13.6). The default: `false`.
+    fn holds_weight_at_rest(&self) -> bool {
+        false
+    }
 }
 
 /// A law around levitation as a linear filter ([`ControlLaw::linear`]).

@@ -29,7 +29,11 @@
 //! ```
 //!
 //! all states zero before the first sample (`u_{−1} = 0`, as ROSS's state-space starts at
-//! rest). The integral is held while the current is beyond the amplifier's limit and the
+//! rest), but for the integral without the gravity bias (`controller.gravity_bias = false`,
+//! ROSS's way: the integral carries the weight): it starts at `I_y = −m g / (k_i A_a k_i_pid)`,
+//! the value that holds the plane's share of the weight `m g` at a zero reading, so that at the
+//! plant's rest (the sensors at zero, MODEL.md §13.6) the law's first command is the static
+//! current and nothing moves (issue 38). The integral is held while the current is beyond the amplifier's limit and the
 //! increment pushes it further (as `pid` does; ROSS has no limit).
 
 use crate::law::{ControlLaw, Design, LawEntry, LawError, Sample};
@@ -57,8 +61,14 @@ fn build(design: &Design, params: &Params) -> Result<Box<dyn ControlLaw>, LawErr
     };
     p.finish()?;
     let c = &design.constants;
-    let bias_y = if design.gravity_bias { c.rotor_mass_kg * c.gravity_m_s2 / c.ki_n_per_a } else { 0.0 };
-    Ok(Box::new(RossPid::new(gains, c.amp_gain_a_per_v, [0.0, bias_y], design.period_s, design.current_limit_a)))
+    let weight_a = c.rotor_mass_kg * c.gravity_m_s2 / c.ki_n_per_a;
+    let bias_y = if design.gravity_bias { weight_a } else { 0.0 };
+    let law = RossPid::new(gains, c.amp_gain_a_per_v, [0.0, bias_y], design.period_s, design.current_limit_a);
+    // Without the bias the integral carries the weight (ROSS's way): it starts where it holds
+    // it, so that the law's first command at the rest (the sensors at zero) is the weight's
+    // current, not nothing (MODEL.md §13.6; the wire's hello carries the mass, gravity and k_i,
+    // so the controller process preloads it alike).
+    Ok(Box::new(if design.gravity_bias { law } else { law.holding_at_rest([0.0, weight_a]) }))
 }
 
 /// ROSS's PID gains (on the sensor voltage, V/V, 1/s, s) and its derivative filter (rad/s).
@@ -100,13 +110,39 @@ pub struct RossPid {
     prev_u: [f64; 2],
     integral: [f64; 2],
     derivative: [f64; 2],
+    /// The integral before the first sample (zero, or the one holding the weight).
+    rest_integral: [f64; 2],
 }
 
 impl RossPid {
     /// The law with `gains`, amplifier gain `A_a` (A/V), bias current per axis (A), period (s)
     /// and current limit (A).
     pub fn new(gains: RossPidGains, amp_gain: f64, bias: [f64; 2], period_s: f64, limit_a: f64) -> Self {
-        Self { gains, amp_gain, bias, period_s, limit_a, prev_u: [0.0; 2], integral: [0.0; 2], derivative: [0.0; 2] }
+        Self {
+            gains,
+            amp_gain,
+            bias,
+            period_s,
+            limit_a,
+            prev_u: [0.0; 2],
+            integral: [0.0; 2],
+            derivative: [0.0; 2],
+            rest_integral: [0.0; 2],
+        }
+    }
+
+    /// The law with its integral preloaded so that, at a zero sensor reading and before any
+    /// sample, its current is `bias + current_a` per axis (A): the static current the integral
+    /// carries at the rest. Without the integral term (`ki = 0`) there is nothing to preload:
+    /// the law is returned as it is.
+    pub fn holding_at_rest(mut self, current_a: [f64; 2]) -> Self {
+        let ki = self.gains.ki;
+        if ki != 0.0 && self.amp_gain != 0.0 {
+            // i = bias − A_a k_i I at u = 0 with the derivative's state at rest.
+            self.rest_integral = current_a.map(|i| -i / (self.amp_gain * ki));
+            self.integral = self.rest_integral;
+        }
+        self
     }
 }
 
@@ -156,9 +192,13 @@ impl ControlLaw for RossPid {
         Some(crate::law::LinearLaw { pd: crate::law::LinearPd { kp: 1.0, kd: 0.0 }, filter: Some(filter) })
     }
 
+    fn holds_weight_at_rest(&self) -> bool {
+        self.rest_integral != [0.0; 2]
+    }
+
     fn reset(&mut self) {
         self.prev_u = [0.0; 2];
-        self.integral = [0.0; 2];
+        self.integral = self.rest_integral;
         self.derivative = [0.0; 2];
     }
 }
@@ -270,5 +310,37 @@ mod tests {
             let err = build(&design, &Params::parse(text).unwrap()).err().unwrap().to_string();
             assert!(err.contains(expect), "{text}: {err}");
         }
+    }
+
+    /// Without the gravity bias (ROSS's way) the integral starts holding the plane's weight: at a
+    /// zero reading the first current, and every one after, is `m g / k_i` on y (by hand from
+    /// the design's constants), 0 on x, and a reset goes back there; with the bias the integral
+    /// starts at zero and the bias holds it alike; without the integral there is nothing to
+    /// preload.
+    #[test]
+    fn without_the_bias_its_integral_starts_holding_the_weight() {
+        let mut design = Design::study();
+        design.gravity_bias = false;
+        let c = design.constants;
+        let weight = c.rotor_mass_kg * c.gravity_m_s2 / c.ki_n_per_a;
+        let params = Params::parse("kp = 0.28\nki_per_s = 2.8\nkd_s = 0.000133\nn_f_rad_s = 5000.0").unwrap();
+        let sample = |k: u64| Sample { seq: k, t_s: k as f64 * design.period_s, ..Default::default() };
+        for bias in [false, true] {
+            design.gravity_bias = bias;
+            let mut law = build(&design, &params).unwrap();
+            assert_eq!(law.holds_weight_at_rest(), !bias);
+            for k in 0..100 {
+                let i = law.update(&sample(k));
+                assert!(i[0] == 0.0 && (i[1] - weight).abs() <= 1e-12 * weight, "bias {bias}, sample {k}: {i:?}");
+            }
+            law.reset();
+            let i = law.update(&sample(0));
+            assert!((i[1] - weight).abs() <= 1e-12 * weight, "after a reset: {i:?}");
+        }
+        design.gravity_bias = false;
+        let no_integral = Params::parse("kp = 0.28\nki_per_s = 0.0\nkd_s = 0.000133").unwrap();
+        let mut law = build(&design, &no_integral).unwrap();
+        assert!(!law.holds_weight_at_rest());
+        assert_eq!(law.update(&sample(0)), [0.0, 0.0]);
     }
 }

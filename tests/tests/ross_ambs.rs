@@ -13,6 +13,9 @@ use std::time::Duration;
 /// A short run in a debug build on a loaded machine.
 const RUN: Duration = Duration::from_secs(180);
 
+/// A sensitivity assessment against ROSS's figures ([`against_ross`]).
+const ASSESS: Duration = Duration::from_secs(900);
+
 /// The shipped scene cut to 25 ms (the shock at 7 ms).
 const SHORT: &[&str] = &["scene.duration_s=0.025", "shock[0].start_s=0.007", "output.plots=false"];
 
@@ -151,9 +154,50 @@ fn the_imported_pids_sensitivity_is_its_closed_form() {
 /// (`apply_sensitivity_disturbance`, amb_utils.py; `SensitivityResults`, results.py).
 #[test]
 fn the_imported_pids_sensitivity_matches_rosss_run_amb_sensitivity() {
+    // The rig: its 34.8 mm journals, 50 Hz; its peak near 9 Hz.
+    against_ross("ufu_rig", &["rotor.radius_mm=17.3", "rotor.speed_hz=50.0"], (3.0, 30.0), false);
+}
+
+/// Issue 38 item 6 on a machine of the testbed's own: the AMB machine's rotor
+/// (`scripts/ross/fixture.py`'s `machine()`, the shipped flexible machine) with two ROSS
+/// `MagneticBearingElement`s of a soft PID (`SOFT` in `scripts/ross/amb_compare.py`: static
+/// stiffness `k_i k_p − |k_s|` = 1.39·10⁵ N/m, ROSS's time-response loop 2.3·10⁵ N/m), whose
+/// time response ROSS's Newmark carries through the 2 s chirp; at rest and at 300 Hz, AMB A's x
+/// axis, as [`the_imported_pids_sensitivity_matches_rosss_run_amb_sensitivity`].
+#[test]
+fn a_machine_of_our_own_matches_rosss_run_amb_sensitivity() {
+    // No command delay: ROSS's force is about one step late; ours is held over the step after
+    // its sample, and with one sample of delay more (1.5 steps late) and no modal damping the
+    // 498 Hz bending mode goes unstable in this loop (docs/results/ross-amb.md).
+    against_ross("soft_machine", &["rotor.speed_hz=300.0", "controller.delay_samples=0"], (10.0, 60.0), false);
+}
+
+/// [`a_machine_of_our_own_matches_rosss_run_amb_sensitivity`] with the sensitivity's closed form
+/// (`plant assess`'s `closed_form_axes`: the linear model of the shaft and `ross_pid`'s linear
+/// form). Without modal damping the closed loop has poles just outside the unit circle (|z| =
+/// 1.00029 at 4.8 kHz and 1.00016 at 2.8 kHz: the reduction's static corrections above the
+/// cutoff, undamped and one step late, as ROSS's own 3.9 kHz mode); with the shipped scene's
+/// `rotor.modal_damping = 0.005` it is stable, and its peak and the measured one are each
+/// within 0.5 dB and 2 % of ROSS's (the damping lowers the 24 Hz peak by some 0.1 dB).
+#[test]
+fn a_machine_of_our_own_closed_form_matches_rosss_run_amb_sensitivity() {
+    let sets = ["rotor.speed_hz=300.0", "controller.delay_samples=0", "rotor.modal_damping=0.005"];
+    against_ross("soft_machine", &sets, (10.0, 60.0), true);
+}
+
+/// ROSS's `run_amb_sensitivity` figures of `name` in the committed `amb_compare.json` against
+/// `plant assess` on the same file: its elements with `rotor.ross_ambs = "use"`, plain bearings
+/// of `2 |k_s|` at the AMB nodes for ROSS's sign of the magnet in its time response (above), no
+/// gravity and no modal damping (ROSS's run has neither), `ross_pid` sampled at ROSS's step
+/// (20 kHz), `sets` on top, the sensitivity measured over `band` (Hz, 12 points and the peak's
+/// refinement). On AMB A's x axis at each speed of the fixture: the measured peak, and with
+/// `closed_form` the closed form's too (stable), within 0.5 dB of ROSS's and at its frequency
+/// within 2 % or half ROSS's FFT bin, whichever is larger.
+fn against_ross(name: &str, sets: &[&str], band: (f64, f64), closed_form: bool) {
     let root = common::workspace_root().join("plant/physics/tests/fixtures/ross");
     let ross = read_json(&root.join("amb_compare.json"));
-    let machine = &ross["machines"]["ufu_rig"];
+    let machine = &ross["machines"][name];
+    assert!(machine.is_object(), "no {name} in amb_compare.json");
     let mut file: toml::Table = common::read_text(&root.join(machine["rotor_file"].as_str().unwrap())).parse().unwrap();
     let spring = 2.0 * machine["ks_n_per_m"].as_f64().unwrap().abs();
     let nodes: Vec<i64> = machine["amb_nodes"].as_array().unwrap().iter().map(|n| n.as_i64().unwrap()).collect();
@@ -164,15 +208,12 @@ fn the_imported_pids_sensitivity_matches_rosss_run_amb_sensitivity() {
         );
         file.insert(format!("BearingElement_ROSS's magnet sign {plane}"), toml::Value::Table(text.parse().unwrap()));
     }
-    let dir = TempDir::new("ross-ambs-vs-ross");
+    let dir = TempDir::new(&format!("ross-ambs-vs-ross-{name}-{}", if closed_form { "closed" } else { "measured" }));
     common::flexible_scene_on_ross_file(&dir, &toml::to_string(&file).unwrap());
     let assess = dir.join("assess.toml");
-    // The rig: AMBs at nodes 12 and 43, its 34.8 mm journals, 50 Hz; ROSS's run has no gravity.
-    let sets = [
+    let mut all: Vec<String> = vec![
         format!("rotor.amb_a_node={}", nodes[0]),
         format!("rotor.amb_b_node={}", nodes[1]),
-        "rotor.radius_mm=17.3".into(),
-        "rotor.speed_hz=50.0".into(),
         "rotor.modal_damping=0.0".into(),
         "scene.gravity_m_s2=0.0".into(),
         "controller.gravity_bias=false".into(),
@@ -181,34 +222,57 @@ fn the_imported_pids_sensitivity_matches_rosss_run_amb_sensitivity() {
         "controller.mode=\"sampled\"".into(),
         "controller.rate_hz=20000.0".into(),
     ];
-    let sets: Vec<String> = sets.iter().map(|s| format!("{s:?}")).collect();
+    all.extend(sets.iter().map(|s| s.to_string()));
+    let all: Vec<String> = all.iter().map(|s| format!("{s:?}")).collect();
     std::fs::write(
         &assess,
         format!(
             "scene = \"scene.toml\"\nparts = [\"sensitivity\"]\nset = [{}]\n[[controller]]\nlabel = \"ross_pid\"\nset = []\n\
-             [sensitivity]\nf_min_hz = 3.0\nf_max_hz = 30.0\npoints = 12\n",
-            sets.join(", ")
+             [sensitivity]\nf_min_hz = {:?}\nf_max_hz = {:?}\npoints = 12\n",
+            all.join(", "),
+            band.0,
+            band.1
         ),
     )
     .unwrap();
     let out = dir.join("assess");
-    let run = output_within(Command::new(plant_bin()).arg("assess").arg(&assess).arg("--out").arg(&out), RUN);
+    // Eight axes' stepped sines, 20 kHz, in a debug build on a shared machine.
+    let run = output_within(Command::new(plant_bin()).arg("assess").arg(&assess).arg("--out").arg(&out), ASSESS);
     assert_exit(&run, 0);
     let report = read_json(&out.join("report.json"));
-    let axes = report["controllers"][0]["sensitivity"]["result"]["axes"].as_array().expect("axes").clone();
+    let result = &report["controllers"][0]["sensitivity"]["result"];
+    let axes = result["axes"].as_array().expect("axes");
     for theirs in machine["sensitivity"].as_array().unwrap() {
         let speed_hz = theirs["speed_rad_s"].as_f64().unwrap() / std::f64::consts::TAU;
-        let ours = axes
-            .iter()
-            .find(|a| a["axis"] == "x_A" && (a["speed_hz"].as_f64().unwrap() - speed_hz).abs() < 1e-6)
-            .unwrap_or_else(|| panic!("no x_A at {speed_hz} Hz: {axes:?}"));
-        let (db, f) = (ours["peak"]["s_db"].as_f64().unwrap(), ours["peak"]["f_hz"].as_f64().unwrap());
+        let at_speed = |list: &[serde_json::Value]| {
+            list.iter()
+                .find(|a| a["axis"] == "x_A" && (a["speed_hz"].as_f64().unwrap() - speed_hz).abs() < 1e-6)
+                .unwrap_or_else(|| panic!("{name}: no x_A at {speed_hz} Hz: {list:?}"))
+                .clone()
+        };
+        let ours = at_speed(axes);
+        let mut peaks =
+            vec![("measured", ours["peak"]["s_db"].as_f64().unwrap(), ours["peak"]["f_hz"].as_f64().unwrap())];
+        if closed_form {
+            let forms = result["closed_form_axes"].as_array().expect("closed_form_axes");
+            let form = at_speed(forms);
+            assert_eq!(form["stable"], true, "{name} at {speed_hz} Hz: the closed form: {form}");
+            peaks.push(("closed form", form["s_db"].as_f64().unwrap(), form["f_hz"].as_f64().unwrap()));
+        }
         let (ross_db, ross_f) = (theirs["peak_db"].as_f64().unwrap(), theirs["peak_hz"].as_f64().unwrap());
         let bin = theirs["resolution_hz"].as_f64().unwrap();
-        eprintln!("| {speed_hz:.0} Hz | ROSS {ross_db:.3} dB at {ross_f:.2} Hz | ours {db:.3} dB at {f:.3} Hz |");
-        assert!((db - ross_db).abs() < 0.5, "at {speed_hz} Hz: peak {db} dB against ROSS's {ross_db} dB");
-        let within = (0.02 * ross_f).max(0.5 * bin);
-        assert!((f - ross_f).abs() <= within, "at {speed_hz} Hz: peak at {f} Hz against ROSS's {ross_f} Hz");
+        for (what, db, f) in peaks {
+            eprintln!("| {name} | {speed_hz:.0} Hz | ROSS {ross_db:.3} dB at {ross_f:.2} Hz | {what} {db:.3} dB at {f:.3} Hz |");
+            assert!(
+                (db - ross_db).abs() < 0.5,
+                "{name} at {speed_hz} Hz: {what} peak {db} dB against ROSS's {ross_db} dB"
+            );
+            let within = (0.02 * ross_f).max(0.5 * bin);
+            assert!(
+                (f - ross_f).abs() <= within,
+                "{name} at {speed_hz} Hz: {what} peak at {f} Hz against ROSS's {ross_f} Hz"
+            );
+        }
     }
 }
 

@@ -70,7 +70,8 @@ pub fn flexible_initial_state(
     let design = controller::PdDesign {
         stiffness_n_per_m: scene.controller.stiffness,
         damping_ratio: scene.controller.damping_ratio,
-        gravity_bias: scene.controller.gravity_bias,
+        // A law whose integral holds the weight from the start rests as the bias would hold it.
+        gravity_bias: scene.controller.gravity_bias || crate::rest_law::holds_weight(scene),
     };
     // A shaft the levitation design cannot hold still has no equilibrium to start from: it
     // starts straight (the rigid start), and the run shows it move.

@@ -36,6 +36,24 @@ pub fn static_gains(scene: &Scene) -> [Option<f64>; 2] {
     out
 }
 
+/// Whether every plane's law of the run holds its plane's weight itself from the start
+/// ([`controller::ControlLaw::holds_weight_at_rest`]: `ross_pid`'s integral without the gravity
+/// bias). Its rest is then where the sensors read zero with each plane's share of the weight
+/// carried, which is the design's rest with the gravity bias (the bias and the preloaded
+/// integral give the same current at a zero reading): the flexible rotor's start is solved so
+/// (`crate::initial::flexible_initial_state`). `false` in continuous mode and for a command the
+/// plant cannot build.
+pub fn holds_weight(scene: &Scene) -> bool {
+    let c = &scene.controller;
+    let registry = c.mode == ControlMode::Sampled || (c.mode != ControlMode::Continuous && c.cosim.command.is_none());
+    let designs = scene.plane_designs();
+    registry
+        && !designs.is_empty()
+        && designs
+            .iter()
+            .all(|design| controller::build_law(&c.law, design, &c.params).is_ok_and(|law| law.holds_weight_at_rest()))
+}
+
 /// `k_p F(1)` of a linear law, `None` with a pole at z = 1 (an integrator) or not finite.
 pub fn static_gain(law: &controller::LinearLaw) -> Option<f64> {
     let Some((b, a)) = law.filter else { return Some(law.pd.kp) };

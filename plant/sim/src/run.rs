@@ -7,7 +7,7 @@ use crate::integrate::{IntegrationError, Settings};
 use crate::rows::Record;
 use crate::snapshot::SnapshotError;
 use crate::tick_time::Tet;
-use controller::{saturate, PdGains, RotorSample, ROTOR_AXES};
+use controller::{saturate, PdDesign, PdGains, RotorSample, ROTOR_AXES};
 
 /// Why a plant could not be built, or started from a saved state.
 #[derive(Debug, thiserror::Error)]
@@ -171,10 +171,22 @@ pub struct TickCost {
 
 /// The bias currents per axis (A) of each plane's design `gains`, each within its plane's
 /// limit (unused axes 0).
+///
+/// A law that holds the weight itself from the start without the gravity bias
+/// ([`crate::rest_law::holds_weight`]: `ross_pid`'s preloaded integral) answers its first sample
+/// with the weight's current: so do the commands before its first answer (the command delay's),
+/// or the rotor would drop for those ticks.
 pub fn bias_of(scene: &Scene, gains: &[PdGains]) -> [f64; ROTOR_AXES] {
+    let held: Vec<Option<PdGains>> = if !scene.controller.gravity_bias && crate::rest_law::holds_weight(scene) {
+        let with_bias = |d: &controller::Design| PdDesign { gravity_bias: true, ..d.pd() };
+        scene.plane_designs().iter().map(|d| PdGains::from_design(&with_bias(d), &d.constants).ok()).collect()
+    } else {
+        Vec::new()
+    };
     let mut bias = [0.0; ROTOR_AXES];
     for (i, g) in gains.iter().enumerate() {
-        let b = saturate(g.bias_a, scene.plane(i).current_limit);
+        let own = held.get(i).copied().flatten().map_or(g.bias_a, |w| scene.plane(i).axes.pair_to_plane(w.bias_a));
+        let b = saturate(own, scene.plane(i).current_limit);
         bias[2 * i..2 * i + 2].copy_from_slice(&b);
     }
     bias

@@ -27,8 +27,27 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
     if choice == RossAmbs::Refuse {
         return Ok(Vec::new());
     }
+    let (file, elements) = elements_of(raw, base_dir, choice)?;
+    let planes = planes_of(raw, &elements, &file, choice)?;
+    if choice == RossAmbs::Use {
+        check_use(raw, &planes, &file)?;
+    }
+    let used = write_planes(raw, &planes, &file, choice)?;
+    if choice == RossAmbs::Use {
+        write_pid(raw, &used)?;
+    }
+    Ok(used)
+}
+
+/// The file of `rotor.ross_file` read, its `MagneticBearingElement`s sorted by node: refused
+/// without a file or without an element.
+fn elements_of(
+    raw: &RawScene,
+    base_dir: &Path,
+    choice: RossAmbs,
+) -> Result<(String, Vec<MagneticBearing>), ConfigError> {
     let key = "rotor.ross_ambs";
-    let Some(file) = r.ross_file.clone() else {
+    let Some(file) = raw.rotor.flexible().and_then(|r| r.ross_file.clone()) else {
         return Err(range(
             key,
             name(choice),
@@ -46,7 +65,7 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
         unit: String::new(),
         why: e.to_string(),
     })?;
-    let mut elements: Vec<&MagneticBearing> = read.magnetics.iter().collect();
+    let mut elements = read.magnetics;
     if elements.is_empty() {
         return Err(range(
             key,
@@ -56,14 +75,25 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
         ));
     }
     elements.sort_by_key(|m| m.node);
-    // Each plane's node: the scene's, or (with two elements in the file and none given) the
-    // file's, A the lower node.
-    let scene_nodes = [r.amb_a_node, r.amb_b_node];
+    Ok((file, elements))
+}
+
+/// Each plane's element: at the scene's AMB node, or (with two elements in the file and no node
+/// given) the file's, A the lower node; refused where an element is at neither plane.
+fn planes_of<'a>(
+    raw: &RawScene,
+    elements: &'a [MagneticBearing],
+    file: &str,
+    choice: RossAmbs,
+) -> Result<[Option<&'a MagneticBearing>; 2], ConfigError> {
+    let key = "rotor.ross_ambs";
+    // `apply` runs on a flexible rotor only.
+    let scene_nodes = raw.rotor.flexible().map_or([None, None], |r| [r.amb_a_node, r.amb_b_node]);
     let mut planes: [Option<&MagneticBearing>; 2] = [None, None];
     for i in 0..2 {
         planes[i] = match scene_nodes[i] {
-            Some(n) => elements.iter().copied().find(|m| m.node == n),
-            None if elements.len() == 2 => Some(elements[i]),
+            Some(n) => elements.iter().find(|m| m.node == n),
+            None if elements.len() == 2 => Some(&elements[i]),
             None => {
                 return Err(range(
                     ["rotor.amb_a_node", "rotor.amb_b_node"][i],
@@ -91,57 +121,73 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
             ),
         ));
     }
-    if choice == RossAmbs::Use {
-        if let Some(i) = planes.iter().position(Option::is_none) {
-            return Err(range(
-                key,
-                "\"use\"",
-                "",
-                &format!(
-                    "makes the file's PID each plane's law, and plane {} has no MagneticBearingElement in \
-                     rotor.ross_file = {file}: rotor.ross_ambs = \"constants\" takes the file's AMB constants with \
-                     the scene's [controller]",
-                    ["A", "B"][i]
-                ),
-            ));
-        }
-        let (a, b) = (planes[0].map(|m| m.ross_pid()), planes[1].map(|m| m.ross_pid()));
-        if a != b {
-            return Err(range(
-                key,
-                "\"use\"",
-                "",
-                &format!(
-                    "rotor.ross_file = {file}: the two MagneticBearingElements' PIDs differ ({a:?} and {b:?}), and \
-                     law ross_pid takes one set of gains for both planes: rotor.ross_ambs = \"constants\" with a \
-                     [controller] of your own"
-                ),
-            ));
-        }
-        if raw.controller.mode == ControlMode::Continuous {
-            return Err(range(
-                "controller.mode",
-                "\"continuous\"",
-                "",
-                "runs the plant's continuous PD, and rotor.ross_ambs = \"use\" makes the file's PID the law \
-                 (ross_pid, sampled as ROSS samples it). It cannot run continuously: the continuous mode's law is \
-                 a PD evaluated inside the derivative on the sensor's reading and its rate, with no state of its \
-                 own, and ROSS's PID has two per axis (its integral, and its derivative's filter at n_f) that the \
-                 continuous model's state does not carry. Set controller.mode = \"sampled\" (or lockstep, \
-                 realtime), or rotor.ross_ambs = \"constants\" for the continuous PD on the file's AMB constants",
-            ));
-        }
-        let law = raw.controller.law.as_str();
-        if law != "pd" && law != controller::ross_pid::LAW.name {
-            return Err(range(
-                "controller.law",
-                format!("\"{law}\""),
-                "",
-                "rotor.ross_ambs = \"use\" makes the file's PID the law (ross_pid): remove controller.law, or \
-                 rotor.ross_ambs = \"constants\" to run this law on the file's AMB constants",
-            ));
-        }
+    Ok(planes)
+}
+
+/// With `"use"`: refused where the file's PID cannot be the law (a plane without an element,
+/// two PIDs, the continuous mode, another law).
+fn check_use(raw: &RawScene, planes: &[Option<&MagneticBearing>; 2], file: &str) -> Result<(), ConfigError> {
+    let key = "rotor.ross_ambs";
+    if let Some(i) = planes.iter().position(Option::is_none) {
+        return Err(range(
+            key,
+            "\"use\"",
+            "",
+            &format!(
+                "makes the file's PID each plane's law, and plane {} has no MagneticBearingElement in \
+                 rotor.ross_file = {file}: rotor.ross_ambs = \"constants\" takes the file's AMB constants with \
+                 the scene's [controller]",
+                ["A", "B"][i]
+            ),
+        ));
     }
+    let (a, b) = (planes[0].map(|m| m.ross_pid()), planes[1].map(|m| m.ross_pid()));
+    if a != b {
+        return Err(range(
+            key,
+            "\"use\"",
+            "",
+            &format!(
+                "rotor.ross_file = {file}: the two MagneticBearingElements' PIDs differ ({a:?} and {b:?}), and \
+                 law ross_pid takes one set of gains for both planes: rotor.ross_ambs = \"constants\" with a \
+                 [controller] of your own"
+            ),
+        ));
+    }
+    if raw.controller.mode == ControlMode::Continuous {
+        return Err(range(
+            "controller.mode",
+            "\"continuous\"",
+            "",
+            "runs the plant's continuous PD, and rotor.ross_ambs = \"use\" makes the file's PID the law \
+             (ross_pid, sampled as ROSS samples it). It cannot run continuously: the continuous mode's law is \
+             a PD evaluated inside the derivative on the sensor's reading and its rate, with no state of its \
+             own, and ROSS's PID has two per axis (its integral, and its derivative's filter at n_f) that the \
+             continuous model's state does not carry. Set controller.mode = \"sampled\" (or lockstep, \
+             realtime), or rotor.ross_ambs = \"constants\" for the continuous PD on the file's AMB constants",
+        ));
+    }
+    let law = raw.controller.law.as_str();
+    if law != "pd" && law != controller::ross_pid::LAW.name {
+        return Err(range(
+            "controller.law",
+            format!("\"{law}\""),
+            "",
+            "rotor.ross_ambs = \"use\" makes the file's PID the law (ross_pid): remove controller.law, or \
+             rotor.ross_ambs = \"constants\" to run this law on the file's AMB constants",
+        ));
+    }
+    Ok(())
+}
+
+/// Each plane's element written into the scene: its nodes into `rotor.amb_*_node` and
+/// `rotor.sensor_*_node`, its constants into `[amb.a]` / `[amb.b]`; what each plane took.
+fn write_planes(
+    raw: &mut RawScene,
+    planes: &[Option<&MagneticBearing>; 2],
+    file: &str,
+    choice: RossAmbs,
+) -> Result<Vec<UsedAmb>, ConfigError> {
     let mut used = Vec::new();
     for (i, m) in planes.iter().enumerate() {
         let Some(m) = m else { continue };
@@ -177,25 +223,28 @@ pub(super) fn apply(raw: &mut RawScene, base_dir: &Path) -> Result<Vec<UsedAmb>,
         }
         used.push(u);
     }
-    if choice == RossAmbs::Use {
-        let pid = used[0].pid.expect("\"use\" records the PID");
-        let mut params = toml::Table::new();
-        for (k, v) in [("kp", pid.kp), ("ki_per_s", pid.ki_per_s), ("kd_s", pid.kd_s), ("n_f_rad_s", pid.n_f_rad_s)] {
-            params.insert(k.into(), toml::Value::Float(v));
-        }
-        if !raw.controller.params.is_empty() && raw.controller.params != params {
-            return Err(range(
-                "controller.params",
-                "a table",
-                "",
-                "rotor.ross_ambs = \"use\" gives law ross_pid the file's PID: remove controller.params, or \
-                 rotor.ross_ambs = \"constants\" with a [controller] of your own",
-            ));
-        }
-        raw.controller.law = controller::ross_pid::LAW.name.into();
-        raw.controller.params = params;
-    }
     Ok(used)
+}
+
+/// With `"use"`: the file's PID as law `ross_pid` and its `controller.params`.
+fn write_pid(raw: &mut RawScene, used: &[UsedAmb]) -> Result<(), ConfigError> {
+    let pid = used[0].pid.expect("\"use\" records the PID");
+    let mut params = toml::Table::new();
+    for (k, v) in [("kp", pid.kp), ("ki_per_s", pid.ki_per_s), ("kd_s", pid.kd_s), ("n_f_rad_s", pid.n_f_rad_s)] {
+        params.insert(k.into(), toml::Value::Float(v));
+    }
+    if !raw.controller.params.is_empty() && raw.controller.params != params {
+        return Err(range(
+            "controller.params",
+            "a table",
+            "",
+            "rotor.ross_ambs = \"use\" gives law ross_pid the file's PID: remove controller.params, or \
+             rotor.ross_ambs = \"constants\" with a [controller] of your own",
+        ));
+    }
+    raw.controller.law = controller::ross_pid::LAW.name.into();
+    raw.controller.params = params;
+    Ok(())
 }
 
 /// The line the run starts with when the file's AMB elements are the planes' AMBs.
