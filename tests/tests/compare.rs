@@ -282,7 +282,7 @@ fn compare_says_how_robust_each_run_and_each_difference_is() {
     );
     assert_exit(&o, 2);
     assert!(
-        String::from_utf8_lossy(&o.stderr).contains("robustness.members = 300"),
+        ["--robustness", "`300`", "from 0 to 256"].iter().all(|n| String::from_utf8_lossy(&o.stderr).contains(n)),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );

@@ -245,10 +245,10 @@ fn bad_input_is_refused_by_name_and_nothing_is_written() {
     let paper = scene("paper-10g.toml");
     let out = dir.join("out");
     let cases: [(&[&str], &[&str]); 6] = [
-        (&["--speed-hz", "-5"], &["--speed-hz -5 Hz", "from 0 to 100000 Hz"]),
-        (&["--speed-hz", "1e300"], &["--speed-hz 1e300 Hz"]),
-        (&["--speed-hz", "NaN"], &["--speed-hz NaN Hz"]),
-        (&["--speed-hz", "inf"], &["--speed-hz inf Hz"]),
+        (&["--speed-hz", "-5"], &["--speed-hz", "`-5`", "from 0 to 100000 Hz"]),
+        (&["--speed-hz", "1e300"], &["--speed-hz", "`1e300`", "from 0 to 100000 Hz"]),
+        (&["--speed-hz", "NaN"], &["--speed-hz", "`NaN`", "from 0 to 100000 Hz"]),
+        (&["--speed-hz", "inf"], &["--speed-hz", "`inf`", "from 0 to 100000 Hz"]),
         (&["--set", "rotor.speed_hz=-3"], &["speed_hz"]),
         (&["--set", "amb.no_such_key=1"], &["no_such_key"]),
     ];

@@ -284,11 +284,11 @@ impl Sink for RunFolder {
     }
 
     fn tick(&mut self, sample: &controller::RotorSample, command: &[f64; controller::ROTOR_AXES]) {
-        crate::recording::tick(&mut self.mcap, &mut self.live, sample, command);
+        crate::live::tick(&mut self.mcap, &mut self.live, sample, command);
     }
 
     fn wants_ticks(&self) -> bool {
-        crate::recording::wants_ticks(&self.mcap, &self.live)
+        crate::live::wants_ticks(&self.mcap, &self.live)
     }
 }
 

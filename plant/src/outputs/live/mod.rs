@@ -38,3 +38,24 @@ pub fn start(addr: &str, scene: &Scene) -> Result<Server, crate::argument::BadAr
     let info = protocol::server_info(concat!("plant ", env!("CARGO_PKG_VERSION")), &scene.name, &session);
     Server::start(addr, info, sink::channels(scene))
 }
+
+/// Hands a tick of the loop to the recording and the live view a run's sink holds (`plant
+/// run`'s folder, a soak's sink): their [`crate::run::Sink::tick`] in one call.
+pub fn tick(
+    mcap: &mut Option<crate::recording::mcap_file::McapSink>,
+    live: &mut Option<LiveSink>,
+    sample: &controller::RotorSample,
+    command: &[f64; controller::ROTOR_AXES],
+) {
+    if let Some(m) = mcap {
+        m.tick(sample, command);
+    }
+    if let Some(l) = live {
+        l.tick(sample, command);
+    }
+}
+
+/// Whether either takes the loop's ticks ([`crate::run::Sink::wants_ticks`]).
+pub fn wants_ticks(mcap: &Option<crate::recording::mcap_file::McapSink>, live: &Option<LiveSink>) -> bool {
+    mcap.as_ref().is_some_and(|m| m.wants_ticks()) || live.as_ref().is_some_and(|l| l.wants_ticks())
+}

@@ -8,7 +8,9 @@ use super::server::{Frame, Served, Server};
 use crate::config::Scene;
 use crate::recording::events::{Event, Events, LOG_SCHEMA};
 use crate::recording::extra::extras;
-use crate::recording::mcap_file::{ros2_name, EVENTS_TOPIC};
+use crate::recording::extra::ros2_name;
+use crate::recording::mcap_file::EVENTS_TOPIC;
+pub use crate::recording::orbit::period;
 use crate::recording::orbit::{self, Orbits};
 use crate::recording::topics::{topics, Columns, Topic};
 use crate::summary::Summary;
@@ -71,13 +73,6 @@ pub fn channels(scene: &Scene) -> Vec<Channel> {
         c.id = u32::try_from(i + 1).unwrap_or(u32::MAX);
     }
     out
-}
-
-/// The live period a row at `t_s` falls in at `rate_hz`: the row is sent if it is the first
-/// of its period, i.e. the first row at or after each multiple of 1/`rate_hz`. The 1e-9
-/// keeps a row whose time is a multiple of the period, up to rounding, in that period.
-pub fn period(t_s: f64, rate_hz: f64) -> f64 {
-    (t_s * rate_hz + 1e-9).floor()
 }
 
 /// A simulated time (s) as nanoseconds (0 for a negative or non-finite time).

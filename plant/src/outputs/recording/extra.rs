@@ -24,12 +24,20 @@ pub fn extras(scene: &Scene) -> Vec<Extra> {
         .topics()
         .map(|t| Extra {
             topic: t.to_string(),
-            schema_name: super::mcap_file::ros2_name(orbit::SCHEMA),
+            schema_name: ros2_name(orbit::SCHEMA),
             schema: orbit::SCHEMA_TEXT.to_string(),
         })
         .collect();
     for (topic, schema, text) in ticks::topics(scene) {
-        out.push(Extra { topic: topic.to_string(), schema_name: super::mcap_file::ros2_name(schema), schema: text });
+        out.push(Extra { topic: topic.to_string(), schema_name: ros2_name(schema), schema: text });
     }
     out
+}
+
+/// A ROS 2 type name for a schema: `plant.Rotor` → `plant_msgs/msg/Rotor`.
+pub fn ros2_name(schema: &str) -> String {
+    match schema.split_once('.') {
+        Some((package, name)) => format!("{package}_msgs/msg/{name}"),
+        None => schema.to_string(),
+    }
 }

@@ -11,7 +11,7 @@
 //! written.
 
 use super::events::{Event, Events, LOG_SCHEMA};
-use super::extra::extras;
+use super::extra::{extras, ros2_name};
 use super::orbit::{self, Orbits};
 use super::topics::{topics, Columns, Topic};
 use crate::config::Scene;
@@ -184,14 +184,6 @@ impl McapSink {
         // Not synced to disk: a streamed output, as `trace.csv` is.
         file.into_inner().map_err(|e| e.into_error())?;
         Ok(())
-    }
-}
-
-/// A ROS 2 type name for a schema: `plant.Rotor` → `plant_msgs/msg/Rotor`.
-pub fn ros2_name(schema: &str) -> String {
-    match schema.split_once('.') {
-        Some((package, name)) => format!("{package}_msgs/msg/{name}"),
-        None => schema.to_string(),
     }
 }
 

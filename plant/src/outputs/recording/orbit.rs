@@ -91,7 +91,7 @@ impl Orbits {
             w.points.push_back((m.dx_m, m.dy_m));
         }
         self.last_t = r.t_s();
-        let k = crate::live::sink::period(self.last_t, self.rate_hz);
+        let k = period(self.last_t, self.rate_hz);
         let due = self.last_period.is_none_or(|last| k > last);
         if due {
             self.last_period = Some(k);
@@ -143,6 +143,13 @@ fn align(out: &mut Vec<u8>, to: usize) {
     while !(out.len() - CDR_LE.len()).is_multiple_of(to) {
         out.push(0);
     }
+}
+
+/// The live period a row at `t_s` falls in at `rate_hz`: the row is sent if it is the first
+/// of its period, i.e. the first row at or after each multiple of 1/`rate_hz`. The 1e-9
+/// keeps a row whose time is a multiple of the period, up to rounding, in that period.
+pub fn period(t_s: f64, rate_hz: f64) -> f64 {
+    (t_s * rate_hz + 1e-9).floor()
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ pub mod charts;
 pub mod member;
 pub mod merge;
 pub mod point;
+pub mod record_member;
 pub mod spec;
 pub mod stats;
 pub mod tally;
@@ -64,13 +65,13 @@ pub fn command(args: &EnsembleArgs) -> anyhow::Result<()> {
     };
     grid.validate(&work)?;
     if let Some(j) = args.record_member {
-        crate::recording::member::check(j, work.spec.members)?;
+        record_member::check(j, work.spec.members)?;
     }
     let stem = args.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = args.run.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("ensemble-{stem}")));
     execute(&grid, &work, &dir, &args.run)?;
     if let Some(j) = args.record_member {
-        let out = crate::recording::member::record(&grid, &work.spec, j, &dir)?;
+        let out = record_member::record(&grid, &work.spec, j, &dir)?;
         eprintln!("plant ensemble: member {j} recorded in {}", out.join(crate::recording::mcap_file::FILE).display());
     }
     Ok(())

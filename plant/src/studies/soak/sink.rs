@@ -179,11 +179,11 @@ impl SoakSink<'_> {
 
 impl Sink for SoakSink<'_> {
     fn tick(&mut self, sample: &controller::RotorSample, command: &[f64; controller::ROTOR_AXES]) {
-        crate::recording::tick(&mut self.mcap, &mut self.live, sample, command);
+        crate::live::tick(&mut self.mcap, &mut self.live, sample, command);
     }
 
     fn wants_ticks(&self) -> bool {
-        crate::recording::wants_ticks(&self.mcap, &self.live)
+        crate::live::wants_ticks(&self.mcap, &self.live)
     }
 
     fn sample(&mut self, record: &Record) {
