@@ -724,6 +724,102 @@ fn run_copy(
     Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.simulated)))
 }
 
+/// Each rung of the ladder from its counted members (sorted by member here) and whether its
+/// own stopping rule decided it.
+fn rungs_of(counted: &mut [Vec<Counted>], decided: &[bool], settings: &Settings) -> Vec<Rung> {
+    let mut rungs = Vec::new();
+    for (i, c) in counted.iter_mut().enumerate() {
+        c.sort_by_key(|m| m.result.member);
+        let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
+        // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
+        // is not read.
+        let (verified, numerically_sensitive) = crate::ensemble::tally::verified(&refs);
+        let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
+        rungs.push(Rung {
+            peak_g: settings.peaks_g[i],
+            tally: tally(&refs),
+            verified,
+            numerically_sensitive,
+            complete: decided[i],
+            duty: rung_duty(&duties),
+            duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
+                .map(|k| rung_duty(&duties.iter().map(|d| &d.planes[k]).collect::<Vec<_>>()))
+                .collect(),
+        });
+    }
+    rungs
+}
+
+/// What the perturbed copies of the ladder's members run with.
+struct Copies<'a> {
+    path: &'a Path,
+    base: &'a crate::config::Scene,
+    bearing: Bearing,
+    end_early: bool,
+    stop: &'a AtomicBool,
+    log: &'a (dyn Fn(&str) + Sync),
+}
+
+impl Copies<'_> {
+    /// Runs `settings.robustness` perturbed copies of every counted member and judges the
+    /// ladder on them: the answer (none when interrupted or failed), the copies' simulated time,
+    /// whether a copy was interrupted, and the first failure.
+    fn judged(
+        &self,
+        counted: &[Vec<Counted>],
+        rungs: &[Rung],
+        settings: &Settings,
+        safe_up_to_g: Option<f64>,
+    ) -> (Option<LadderRobustness>, f64, bool, Option<anyhow::Error>) {
+        let (path, bearing, end_early, stop) = (self.path, self.bearing, self.end_early, self.stop);
+        let copies = settings.robustness;
+        let work: Vec<(usize, usize, usize)> = counted
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| (0..c.len()).flat_map(move |m| (1..=copies).map(move |k| (i, m, k))))
+            .collect();
+        (self.log)(&format!("ladder robustness: {} perturbed copies of {} members", work.len(), work.len() / copies));
+        let done: Vec<anyhow::Result<Option<(Mode, f64)>>> = super::jobs_for(self.base, || {
+            work.par_iter().map(|&(i, m, k)| run_copy(path, &counted[i][m], k, bearing, end_early, stop)).collect()
+        });
+        let (mut simulated_s, mut interrupted, mut failed) = (0.0, false, None);
+        let mut modes: Vec<Vec<Vec<Mode>>> = counted.iter().map(|c| c.iter().map(|_| Vec::new()).collect()).collect();
+        for (&(i, m, _), r) in work.iter().zip(done) {
+            match r {
+                Ok(Some((mode, t))) => {
+                    modes[i][m].push(mode);
+                    simulated_s += t;
+                }
+                Ok(None) => interrupted = true,
+                Err(e) => {
+                    failed.get_or_insert(e);
+                }
+            }
+        }
+        if failed.is_some() || interrupted || stop.load(Ordering::Relaxed) {
+            return (None, simulated_s, interrupted, failed);
+        }
+        let members: Vec<Vec<MemberCopies>> = counted
+            .iter()
+            .zip(modes)
+            .map(|(c, modes)| {
+                c.iter()
+                    .zip(modes)
+                    .map(|(m, copies)| MemberCopies {
+                        member: m.result.member,
+                        angle_deg: m.result.angle_deg,
+                        mode: m.result.counted().mode,
+                        copies,
+                    })
+                    .collect()
+            })
+            .collect();
+        let complete: Vec<bool> = rungs.iter().map(|r| r.complete).collect();
+        let answer = judge(&settings.peaks_g, &complete, &members, settings.min_p, copies, safe_up_to_g);
+        (Some(answer), simulated_s, false, failed)
+    }
+}
+
 /// Runs the ladder for the controller whose scene is `path` with `sets`. A member that fails
 /// (its controller lost, a run that cannot start) stops the ladder after its round: the result
 /// then holds the rungs so far, the undecided ones marked incomplete, with the error beside it.
@@ -811,75 +907,19 @@ pub fn ladder(
             decided[i] = decided[i] || lo >= settings.min_p || hi < settings.min_p || n >= spec.members;
         }
     }
-    let mut rungs = Vec::new();
-    for (i, c) in counted.iter_mut().enumerate() {
-        c.sort_by_key(|m| m.result.member);
-        let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
-        // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
-        // is not read.
-        let (verified, numerically_sensitive) = crate::ensemble::tally::verified(&refs);
-        let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
-        rungs.push(Rung {
-            peak_g: settings.peaks_g[i],
-            tally: tally(&refs),
-            verified,
-            numerically_sensitive,
-            complete: decided[i],
-            duty: rung_duty(&duties),
-            duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
-                .map(|k| rung_duty(&duties.iter().map(|d| &d.planes[k]).collect::<Vec<_>>()))
-                .collect(),
-        });
-    }
+    let rungs = rungs_of(&mut counted, &decided, settings);
     let safe_up_to_g =
         rungs.iter().take_while(|r| r.complete && r.tally.p_lo >= settings.min_p).last().map(|r| r.peak_g);
     let mut simulated_s: f64 = counted.iter().flatten().map(|m| m.simulated_s).sum();
     let mut robustness = None;
     if settings.robustness > 0 && failed.is_none() && !interrupted {
-        let copies = settings.robustness;
-        let work: Vec<(usize, usize, usize)> = counted
-            .iter()
-            .enumerate()
-            .flat_map(|(i, c)| (0..c.len()).flat_map(move |m| (1..=copies).map(move |k| (i, m, k))))
-            .collect();
-        log(&format!("ladder robustness: {} perturbed copies of {} members", work.len(), work.len() / copies));
-        let done: Vec<anyhow::Result<Option<(Mode, f64)>>> = super::jobs_for(&base, || {
-            work.par_iter().map(|&(i, m, k)| run_copy(path, &counted[i][m], k, bearing, end_early, stop)).collect()
-        });
-        let mut modes: Vec<Vec<Vec<Mode>>> = counted.iter().map(|c| c.iter().map(|_| Vec::new()).collect()).collect();
-        for (&(i, m, _), r) in work.iter().zip(done) {
-            match r {
-                Ok(Some((mode, t))) => {
-                    modes[i][m].push(mode);
-                    simulated_s += t;
-                }
-                Ok(None) => interrupted = true,
-                Err(e) => {
-                    failed.get_or_insert(e);
-                }
-            }
-        }
-        if failed.is_none() && !interrupted && !stop.load(Ordering::Relaxed) {
-            let members: Vec<Vec<MemberCopies>> = counted
-                .iter()
-                .zip(modes)
-                .map(|(c, modes)| {
-                    c.iter()
-                        .zip(modes)
-                        .map(|(m, copies)| MemberCopies {
-                            member: m.result.member,
-                            angle_deg: m.result.angle_deg,
-                            mode: m.result.counted().mode,
-                            copies,
-                        })
-                        .collect()
-                })
-                .collect();
-            let complete: Vec<bool> = rungs.iter().map(|r| r.complete).collect();
-            robustness = Some(judge(&settings.peaks_g, &complete, &members, settings.min_p, copies, safe_up_to_g));
-        } else {
-            interrupted = interrupted || failed.is_none();
-        }
+        let run = Copies { path, base: &base, bearing, end_early, stop, log };
+        let (answer, copies_s, copies_interrupted, copies_failed) =
+            run.judged(&counted, &rungs, settings, safe_up_to_g);
+        simulated_s += copies_s;
+        interrupted = copies_interrupted || (answer.is_none() && copies_failed.is_none());
+        robustness = answer;
+        failed = copies_failed;
     }
     let verified = rungs.iter().map(|r| r.verified).sum();
     let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();

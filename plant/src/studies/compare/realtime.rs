@@ -134,28 +134,8 @@ pub fn compare_realtime(
             load_1min: crate::bench::tick::load_average(),
         }
     };
-    let say = |r: &RealtimeRow| {
-        format!(
-            "{} {}: {}, {} deadline misses ({:.3} %, longest burst {}), {} plant overruns, tick p99.9 {:.1} µs max {:.1} µs; \
-             {}, {}, peak force {:.0} N; {}; load {:.2}",
-            snake_name(&r.mode),
-            r.run,
-            r.status,
-            r.deadline_misses,
-            100.0 * r.deadline_miss_fraction,
-            r.longest_miss_burst,
-            r.plant_overruns,
-            r.tick_p999_us,
-            r.tick_max_us,
-            r.post_shock_mode,
-            recovered(r.recovery_s),
-            r.max_contact_force_n,
-            if r.same_as_lockstep { "the lockstep trace bit for bit".to_string() } else { format!("max {:.2e} m from lockstep", r.max_dev_m) },
-            r.load_1min
-        )
-    };
     let mut rows = vec![row(0, &lockstep, &reference)];
-    log(&say(&rows[0]));
+    log(&describe(&rows[0]));
     let mut traces: Vec<(String, RunResult)> = Vec::new();
     for n in 1..=runs {
         let done = match server.take() {
@@ -171,7 +151,7 @@ pub fn compare_realtime(
         };
         let Some(r) = done else { break };
         let rw = row(n, &realtime, &r);
-        log(&say(&rw));
+        log(&describe(&rw));
         rows.push(rw);
         if traces.len() < 9 {
             traces.push((format!("realtime {n}"), r));
@@ -202,6 +182,28 @@ pub fn compare_realtime(
     )?;
     interrupted(stop, || format!("{} of {} runs finished, written to realtime.csv", rows.len(), runs + 1))?;
     Ok(rows)
+}
+
+/// A run's row as its log line.
+fn describe(r: &RealtimeRow) -> String {
+    format!(
+        "{} {}: {}, {} deadline misses ({:.3} %, longest burst {}), {} plant overruns, tick p99.9 {:.1} µs max {:.1} µs; \
+         {}, {}, peak force {:.0} N; {}; load {:.2}",
+        snake_name(&r.mode),
+        r.run,
+        r.status,
+        r.deadline_misses,
+        100.0 * r.deadline_miss_fraction,
+        r.longest_miss_burst,
+        r.plant_overruns,
+        r.tick_p999_us,
+        r.tick_max_us,
+        r.post_shock_mode,
+        recovered(r.recovery_s),
+        r.max_contact_force_n,
+        if r.same_as_lockstep { "the lockstep trace bit for bit".to_string() } else { format!("max {:.2e} m from lockstep", r.max_dev_m) },
+        r.load_1min
+    )
 }
 
 /// Two traces hold the same numbers, bit for bit.
