@@ -51,6 +51,14 @@ impl Bearing {
             capacity_fraction,
         }
     }
+
+    /// The touchdown bearing of a scene, with these materials: plane A's geometry from the
+    /// validated parameters (SI), the one bearing the duty grades (a two-plane scene's planes
+    /// share it unless a plane's table gives its own).
+    pub fn of_scene(scene: &crate::config::Scene, materials: Materials, capacity_fraction: f64) -> Self {
+        let g = scene.rotor.plane(0).touchdown;
+        Self::new(materials, g.ball_diameter, g.pitch_diameter, g.width, capacity_fraction)
+    }
 }
 
 /// The duty of one run.
