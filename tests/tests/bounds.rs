@@ -385,3 +385,166 @@ fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
     let err = stderr(&o);
     assert!(err.contains("00000.json") && err.contains("not a regular file"), "{err}");
 }
+
+/// The base scene of each rotor model: the shipped scene of the model.
+const MODEL_SCENES: &[(&str, &str)] =
+    &[("planar", "paper-10g.toml"), ("two_plane", "two-plane-asymmetric-10g.toml"), ("flexible", "flexible-10g.toml")];
+
+/// The keys that legitimately take 1e-300, and why: a key whose range starts at 0 takes a tiny
+/// value as the zero it stands for (no speed, no unbalance, no damping, no friction, an ideal
+/// sensor, no timeout); a signed key (a phase, an offset, an axial position from the centre of
+/// mass where the geometry allows 0) takes it as 0; and any
+/// positive run length is a run (`scene.duration_s`, whose last line prints it in exponent
+/// form). A positive size (a mass, a gap, a stiffness, a tolerance) is not among them.
+const TINY_IS_ZERO: &[&str] = &[
+    "scene.duration_s",
+    "scene.gravity_m_s2",
+    "rotor.eccentricity_um",
+    "rotor.speed_hz",
+    "rotor.unbalance_phase_deg",
+    "rotor.drive_gain_n_m_s",
+    "rotor.drive_torque_limit_n_m",
+    "rotor.couple_unbalance_urad",
+    "rotor.couple_unbalance_phase_deg",
+    "rotor.bearing_b_mm",
+    "rotor.sensor_a_mm",
+    "rotor.sensor_b_mm",
+    "rotor.modal_damping",
+    "touchdown.ball_clearance_mm",
+    "touchdown.cage_phase_deg",
+    "touchdown.drag_torque_n_m",
+    "touchdown.palmgren_f0",
+    "touchdown.palmgren_f1",
+    "contact.rotor_race_damping_n_s_per_m",
+    "contact.ball_damping_n_s_per_m",
+    "contact.friction_static",
+    "contact.friction_dynamic",
+    "amb.ks_n_per_m",
+    "amb.coil_resistance_ohm",
+    "amb.back_emf_v_s_per_m",
+    "amb.axis_angle_deg",
+    "controller.damping_ratio",
+    "controller.reconnect_timeout_ms",
+    "controller.spin_us",
+    "controller.max_miss_fraction",
+    "controller.max_invalid_fraction",
+    "controller.max_overrun_fraction",
+    "initial.rotor_x_um",
+    "initial.rotor_y_um",
+    "initial.slope_x_urad",
+    "initial.slope_y_urad",
+    "sensor.noise_v_rms",
+    "sensor.bandwidth_hz",
+    "sensor.range_um",
+];
+
+/// The keys that take any value because the scene ignores them, each with a warning that says
+/// so: the deprecated `controller.relev_*` aliases of law `relev`'s parameters, under another
+/// law (the base scenes' `pd`).
+fn ignored_with_a_warning(key: &str, warnings: &[String]) -> bool {
+    key.starts_with("controller.relev_") && warnings.iter().any(|w| w.contains(key) && w.contains("ignored"))
+}
+
+/// Issue 40 (bad input): every key of every rotor model's scene, set to 1e300, -1e300 and
+/// 1e-300, is refused at load naming the key, or loads for a reason listed above. The keys come
+/// from the format's key lists (`RawScene::tables`, each model's `RawRotor::keys_of`, and a
+/// two-plane or flexible scene's plane tables `[touchdown.b]`, …), not from this file. Loads
+/// only (the loader `plant run` uses and its step check): bounded in time, nothing runs.
+#[test]
+fn every_key_of_every_model_refuses_absurd_finite_values_at_load() {
+    use plant::config::raw::{RawRotor, RawScene, RotorModel};
+    let mut problems = Vec::new();
+    let mut cases = 0;
+    for model in RotorModel::ALL {
+        let file = MODEL_SCENES.iter().find(|(m, _)| *m == model.name()).map(|(_, f)| *f);
+        let file = file.unwrap_or_else(|| panic!("no base scene for rotor model {}", model.name()));
+        let base = scene(file);
+        let mut keys: Vec<String> = Vec::new();
+        for (table, list) in RawScene::tables() {
+            let list = if table == "rotor" { RawRotor::keys_of(*model) } else { list };
+            keys.extend(list.iter().filter(|k| !["model", "a", "b"].contains(k)).map(|k| format!("{table}.{k}")));
+            // A plane's own table, on the models with two planes.
+            if ["touchdown", "contact", "amb"].contains(&table) && *model != RotorModel::Planar {
+                keys.extend(list.iter().filter(|k| !["a", "b"].contains(k)).map(|k| format!("{table}.b.{k}")));
+            }
+        }
+        for key in &keys {
+            for value in ["1e300", "-1e300", "1e-300"] {
+                cases += 1;
+                let set = [format!("{key}={value}")];
+                let loaded = std::panic::catch_unwind(|| plant::config::load_scene(&base, &set));
+                let leaf = key.rsplit('.').next().unwrap_or_default();
+                match loaded {
+                    Err(_) => problems.push(format!("{file}: --set {}: the load panicked", set[0])),
+                    Ok(Err(e)) => {
+                        let why: Vec<String> =
+                            std::iter::successors(Some(&e as &dyn std::error::Error), |e| e.source())
+                                .map(|e| e.to_string())
+                                .collect();
+                        let why = why.join(": ");
+                        if !why.contains(leaf) {
+                            problems.push(format!("{file}: --set {}: refused without naming the key: {why}", set[0]));
+                        }
+                    }
+                    Ok(Ok(s)) => {
+                        let why = match plant::stability::check(&s) {
+                            plant::stability::StepVerdict::Refuse(why) => Some(why),
+                            _ => None,
+                        };
+                        let listed = (value == "1e-300" && TINY_IS_ZERO.contains(&key.replace(".b.", ".").as_str()))
+                            || ignored_with_a_warning(key, &s.warnings);
+                        match why {
+                            Some(why) if !why.contains(leaf) => problems
+                                .push(format!("{file}: --set {}: refused without naming the key: {why}", set[0])),
+                            Some(_) => {}
+                            None if !listed => problems.push(format!("{file}: --set {}: accepted", set[0])),
+                            None => {}
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{cases} cases over {} rotor models", RotorModel::ALL.len());
+    assert!(cases > 3 * 3 * 100, "{cases} cases: the key lists are not read");
+    assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
+}
+
+/// The issue's named cases through the binary: exit 2 at once, naming key, value, unit and the
+/// allowed range, nothing written (they ended as a numerical divergence, exit 3).
+#[test]
+fn the_campaigns_absurd_values_are_bad_input() {
+    let paper = scene("paper-10g.toml");
+    for (set, needles) in [
+        ("rotor.mass_kg=1e300", ["rotor.mass_kg = 1e300 kg", "between 1e-6 and 1e6 kg"]),
+        ("rotor.mass_kg=1e-300", ["rotor.mass_kg = 1e-300 kg", "between 1e-6 and 1e6 kg"]),
+        ("rotor.speed_hz=1e300", ["rotor.speed_hz = 1e300 Hz", "between 0 and 1e6 Hz"]),
+        ("controller.damping_ratio=1e300", ["controller.damping_ratio = 1e300", "between 0 and 1000"]),
+        ("initial.rotor_x_um=1e300", ["initial.rotor_x_um = 1e300 µm", "between -1e6 and 1e6 µm"]),
+    ] {
+        refused(&format!("absurd-{set}"), &paper, &sets(&[set]), &needles);
+    }
+    // A plane's own table is held to its table's range, named as written.
+    refused(
+        "absurd-plane-b",
+        &scene("two-plane-asymmetric-10g.toml"),
+        &sets(&["touchdown.b.air_gap_mm=1e300"]),
+        &["touchdown.b.air_gap_mm = 1e300 mm", "between 1e-6 and 1000 mm"],
+    );
+}
+
+/// Issue 40: a run of 1e-300 s says its length in exponent form, not in 302 digits.
+#[test]
+fn a_tiny_run_says_its_length_in_exponent_form() {
+    let dir = TempDir::new("tiny-run");
+    let out = dir.join("run");
+    let o = output_within(
+        &mut plant_run(&scene("paper-10g.toml"), &out, &["scene.duration_s=1e-300", "output.plots=false"]),
+        RUN,
+    );
+    assert_exit(&o, 0);
+    let err = stderr(&o);
+    assert!(err.contains("completed 1e-300 s simulated"), "{err}");
+    assert!(err.contains("scene.duration_s = 1e-300 s"), "{err}");
+    assert!(!err.contains("0.0000000000000000"), "{err}");
+}

@@ -17,6 +17,7 @@ pub mod force;
 pub mod initial;
 pub mod integrate;
 pub mod model;
+pub mod number;
 pub mod park;
 pub mod stability;
 pub mod two_plane;

@@ -136,6 +136,18 @@ pub enum Release {
     Held,
 }
 
+/// The touchdown bearing's geometry (SI): what its duty (contact pressures, ball loads) needs
+/// beyond the equations of motion, which do not read it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct TouchdownGeometry {
+    /// Ball diameter D (m).
+    pub ball_diameter: f64,
+    /// Pitch diameter d_m (m).
+    pub pitch_diameter: f64,
+    /// Race width B, the rotor – race contact length (m).
+    pub width: f64,
+}
+
 /// Physical parameters, validated, SI.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Params {
@@ -181,6 +193,10 @@ pub struct Params {
     /// ([`crate::axes`]); the default: not turned. Not serialised at 0°.
     #[serde(skip_serializing_if = "Axes::is_housings")]
     pub axes: Axes,
+    /// The touchdown bearing's geometry, for its duty (not in the equations of motion; not
+    /// serialised, so that what is serialised of the parameters stays as it was).
+    #[serde(skip)]
+    pub touchdown: TouchdownGeometry,
 }
 
 impl Params {

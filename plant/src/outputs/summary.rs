@@ -273,7 +273,7 @@ impl Summary {
         format!(
             "{} {} s simulated in {:.2} s ({:.2}x real time); max radius {}, max contact force {}",
             self.status,
-            self.simulated_s,
+            crate::argument::shown(self.simulated_s),
             self.wall_time_s,
             self.realtime_factor,
             or_none(self.max_radius_m, 1e6, 1, "µm"),

@@ -60,15 +60,9 @@ pub fn number(
 }
 
 /// A number as a message shows it: as Rust prints it where that is short, in exponent form
-/// where it is not (1e300 would print as 301 digits, 1e-300 as 302).
-pub fn shown(v: f64) -> String {
-    let plain = v.to_string();
-    if plain.len() <= 16 {
-        plain
-    } else {
-        format!("{v:e}")
-    }
-}
+/// where it is not (1e300 would print as 301 digits, 1e-300 as 302); the physics' own, which its
+/// messages use too.
+pub use plant_physics::number::shown;
 
 #[cfg(test)]
 mod tests {

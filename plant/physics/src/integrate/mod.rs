@@ -329,7 +329,7 @@ pub enum IntegrationError {
         state: Vec<f64>,
     },
     /// The error controller asked for a step below the floor of [`Settings::h_min`].
-    #[error("step size underflow at t = {t} s (h = {h} s): {state:?}")]
+    #[error("step size underflow at t = {t} s (h = {} s): {state:?}", crate::number::shown(*h))]
     StepSizeUnderflow {
         /// Time, s.
         t: f64,

@@ -7,7 +7,7 @@ use plant_physics::force::balls::BallSet;
 use plant_physics::force::drag::RaceDrag;
 use plant_physics::force::friction::Friction;
 use plant_physics::force::rotor_race::RotorRace;
-use plant_physics::model::{Cage, Control, Model, Params, RaceWhenClear, Spin, Support};
+use plant_physics::model::{Cage, Control, Model, Params, RaceWhenClear, Spin, Support, TouchdownGeometry};
 use shock_table::Programme;
 use std::f64::consts::TAU;
 
@@ -57,6 +57,7 @@ pub fn study_params() -> Params {
         loop_constants: LoopConstants::study(),
         current_limit: 2.0,
         axes: Default::default(),
+        touchdown: TouchdownGeometry { ball_diameter: ball_d * 1e-3, pitch_diameter: dm * 1e-3, width: 12e-3 },
     }
 }
 

@@ -51,6 +51,14 @@ impl Bearing {
             capacity_fraction,
         }
     }
+
+    /// The touchdown bearing of a scene, with these materials: plane A's geometry from the
+    /// validated parameters (SI), the one bearing the duty grades (a two-plane scene's planes
+    /// share it unless a plane's table gives its own).
+    pub fn of_scene(scene: &crate::config::Scene, materials: Materials, capacity_fraction: f64) -> Self {
+        let g = scene.rotor.plane(0).touchdown;
+        Self::new(materials, g.ball_diameter, g.pitch_diameter, g.width, capacity_fraction)
+    }
 }
 
 /// The duty of one run.
@@ -249,6 +257,22 @@ mod tests {
     use super::*;
     use crate::shipped;
     use crate::trace::Trace;
+
+    /// Issue 41 item 4: the duty's bearing is the scene's `[touchdown]` geometry in metres (the
+    /// figures of config/paper-10g.toml: D = 5.5 mm, d_m = 51 mm, B = 12 mm), read from the
+    /// validated parameters; a two-plane scene's plane A table gives plane A's own.
+    #[test]
+    fn the_duty_bearing_is_the_scenes_touchdown_geometry_in_si() {
+        // Millimetres to metres within an ulp or two (51 mm × 1e-3 is 0.051000000000000004).
+        let same = |b: &Bearing, want: [f64; 3]| {
+            let got = [b.ball_diameter_m, b.pitch_diameter_m, b.width_m];
+            assert!(got.iter().zip(want).all(|(g, w)| (g - w).abs() <= 1e-15 * w), "{got:?} vs {want:?}");
+        };
+        same(&Bearing::of_scene(&shipped("paper-10g.toml", &[]), Materials::default(), 0.5), [5.5e-3, 51e-3, 12e-3]);
+        let own = ["touchdown.a.ball_diameter_mm=6.0", "touchdown.a.width_mm=10.0"];
+        let scene = shipped("two-plane-asymmetric-10g.toml", &own);
+        same(&Bearing::of_scene(&scene, Materials::default(), 0.5), [6e-3, 51e-3, 10e-3]);
+    }
 
     /// Every layout of the plant's state (bare, with amplifiers, with unipolar amplifiers; planar
     /// and two-plane) hands the duty each of its planes in contact: the duty reads the planes

@@ -1029,15 +1029,7 @@ mod tests {
         let sets = ["controller.mode=\"sampled\"", "controller.law=\"pd_delay\"", "controller.damping_ratio=0.1"]
             .map(String::from);
         let scene = load_scene(&path, &sets).expect("scene");
-        let raw = scene.resolved().expect("resolved");
-        let t = &raw.touchdown;
-        let bearing = Bearing::new(
-            Default::default(),
-            t.ball_diameter_mm * 1e-3,
-            t.pitch_diameter_mm * 1e-3,
-            t.width_mm * 1e-3,
-            0.5,
-        );
+        let bearing = Bearing::of_scene(&scene, Default::default(), 0.5);
         let settings = |early| Settings {
             peaks_g: vec![1.0, 20.0],
             members: 3,

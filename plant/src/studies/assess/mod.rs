@@ -42,7 +42,7 @@ pub use closed_forms::{closed_form_of, closed_form_of_plane};
 pub use measure::measure_axis;
 pub use outcome::{AssessError, ClosedFormPeak, ControllerReport, Failure, PartOutcome, Report, SensitivityPart};
 pub use parts::UNSTABLE_ZONE;
-use parts::{bearing, ladder_part, sensitivity_part, vibration_part};
+use parts::{ladder_part, sensitivity_part, vibration_part};
 use paths::roots;
 pub use paths::{relative_text, relative_to, shown, shown_relative};
 
@@ -236,7 +236,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
             eprintln!("plant assess: {l}");
         }
     };
-    let bearing = first.as_ref().map(|s| bearing(s, &a)).transpose()?;
+    let bearing = first.as_ref().map(|s| duty::Bearing::of_scene(s, a.materials, a.capacity_fraction));
     // Paths as seen from where the command ran: the report names no folder of this machine.
     let cwd = std::env::current_dir().unwrap_or_default();
     let shown_here = |p: &Path| if cwd.as_os_str().is_empty() { shown(p) } else { shown_relative(p, &cwd) };

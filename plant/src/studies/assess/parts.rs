@@ -136,19 +136,6 @@ pub(super) fn vibration_part(
     Ok(sink.figures(scene.plane(0).current_limit, speed_hz, settle, window))
 }
 
-/// The bearing of a scene with the assessment's materials.
-pub(super) fn bearing(scene: &Scene, a: &Assessment) -> anyhow::Result<duty::Bearing> {
-    let raw = scene.resolved()?;
-    let t = &raw.touchdown;
-    Ok(duty::Bearing::new(
-        a.materials,
-        t.ball_diameter_mm * 1e-3,
-        t.pitch_diameter_mm * 1e-3,
-        t.width_mm * 1e-3,
-        a.capacity_fraction,
-    ))
-}
-
 /// The shock ladder of one controller: none where the rotor was not levitated before the
 /// shock; a member may end once decided only where the probe measured the loop stable.
 pub(super) fn ladder_part(
@@ -167,7 +154,7 @@ pub(super) fn ladder_part(
     }
     log(&format!("{}: shock ladder", c.label));
     let t = Instant::now();
-    let b = bearing(scene, a)?;
+    let b = duty::Bearing::of_scene(scene, a.materials, a.capacity_fraction);
     let stable = decay_at_speed.is_some_and(|s| s > 0.0);
     let kind = |e: &anyhow::Error| {
         if interrupted() {

@@ -105,6 +105,7 @@ pub(in crate::config) fn bearing(
         loop_constants,
         current_limit,
         axes,
+        touchdown: race.geometry,
     })
 }
 
@@ -117,6 +118,7 @@ struct Race {
     cage_phase: f64,
     cage_ratio: f64,
     drag: RaceDrag,
+    geometry: TouchdownGeometry,
 }
 
 /// `[touchdown]`'s race, balls' geometry and drag.
@@ -160,6 +162,11 @@ fn race(td: &RawTouchdown, k: &Keys) -> Result<Race, ConfigError> {
         cage_phase,
         cage_ratio: r_in / (r_in + r_out),
         drag,
+        geometry: TouchdownGeometry {
+            ball_diameter: ball_d * 1e-3,
+            pitch_diameter: dm * 1e-3,
+            width: td.width_mm * 1e-3,
+        },
     })
 }
 

@@ -16,6 +16,9 @@
 //! | `[controller.params]` as TOML text | ≤ [`controller::PARAMS_LEN`] bytes |
 //! | `controller.stiffness_n_per_m` | ≤ [`MAX_STIFFNESS_N_PER_M`] |
 //!
+//! Every numeric key has a physical range besides ([`bounds::BOUNDS`], one table): a finite
+//! value no machine has (a mass of 1e300 or 1e-300 kg) is bad input, not a divergence.
+//!
 //! A run with fewer than [`FEW_TICKS`] controller ticks is allowed, with a warning.
 //!
 //! Every key is checked whatever the choices that read it: a NaN
@@ -29,13 +32,14 @@ use super::{
 use crate::force::lumped::LumpedSupport;
 use crate::force::{amb::AmbLaw, balls::BallSet, drag::RaceDrag, friction::Friction, rotor_race::RotorRace};
 use crate::integrate::Method;
-use crate::model::{Params, RaceWhenClear, Release, Spin, Support};
+use crate::model::{Params, RaceWhenClear, Release, Spin, Support, TouchdownGeometry};
 use controller::LoopConstants;
 use std::path::Path;
 
 // The rotor models' keys, each built by its model's key struct (`config/models/`,
 // `ModelKeys::build`) with the bearing planes of `bearing`.
 pub(super) mod bearing;
+pub mod bounds;
 mod checks;
 mod controller_keys;
 pub(super) mod flexible_keys;
@@ -141,6 +145,8 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // A ROSS file's AMB elements as the planes' AMBs (rotor.ross_ambs): written into the scene.
     let mut file_ambs = ross_ambs::apply(&mut raw, base_dir)?;
     ross_axes::apply(&mut raw, &mut file_ambs)?;
+    // Every numeric key within its physical range, before any model is built from them.
+    bounds::check(&raw)?;
     let (gravity, duration) = span(&raw)?;
     let (whole, unbalance_phase) = whole_rotor(&raw.rotor, gravity)?;
     // The rotor model, built from the scene by its own key struct.
@@ -273,8 +279,9 @@ fn controller_settings(
     }
     if ticks < FEW_TICKS {
         warnings.push(format!(
-            "controller.rate_hz = {rate} Hz gives {ticks} controller tick(s) in scene.duration_s = {duration} s \
-             (fewer than {FEW_TICKS}): the controller acts once per tick"
+            "controller.rate_hz = {rate} Hz gives {ticks} controller tick(s) in scene.duration_s = {} s \
+             (fewer than {FEW_TICKS}): the controller acts once per tick",
+            plant_physics::number::shown(duration)
         ));
     }
     let params = controller::Params::new(ctl.params.clone());
