@@ -29,6 +29,10 @@ use crate::trace::Trace;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
+/// The fixed-step methods whose stability limits the bench finds (and whose failure charts
+/// `--redraw` draws again from `stability.csv`).
+const FIXED_STEP: [Method; 3] = [Method::ExplicitEuler, Method::SymplecticEuler, Method::Rk4];
+
 /// The settings swept for each method.
 pub fn grid(quick: bool) -> Vec<(Method, Vec<IntegratorSetting>)> {
     let rtols: Vec<IntegratorSetting> = if quick {
@@ -246,7 +250,7 @@ pub fn accuracy(
             }
             report.rows.extend(rows);
         }
-        for method in [Method::ExplicitEuler, Method::SymplecticEuler, Method::Rk4] {
+        for method in FIXED_STEP {
             let found = stability_limit(&b, method, &reference.trace)?;
             let estimate = crate::stability::estimate(&b.scene, method, reference.peak_contact_force);
             log(&format!(
@@ -377,10 +381,7 @@ fn redraw(config: &Path, csv: &Path, dir: &Path, log: &mut dyn FnMut(&str)) -> a
         let reference = reference(&b)?;
         floors.push((b.name.to_string(), reference.floor));
         for s in stability.iter().filter(|s| s.scene == b.name) {
-            let Some(method) = [Method::ExplicitEuler, Method::SymplecticEuler, Method::Rk4]
-                .into_iter()
-                .find(|m| method_name(*m) == s.method)
-            else {
+            let Some(method) = FIXED_STEP.into_iter().find(|m| method_name(*m) == s.method) else {
                 continue;
             };
             if let Some(n) = s.substeps.filter(|n| *n > 1) {
