@@ -355,6 +355,18 @@ fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
         }
     }
 
+    // --redraw: the chart again from the table alone, the crossings found again from its
+    // points: the same picture, to the byte.
+    let again = dir.join("overlay-again");
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("overlay").arg("--redraw").arg(out.join("overlay.csv")).arg("--out").arg(&again);
+    assert_exit(&output_within(&mut cmd, LIMIT), 0);
+    assert!(
+        std::fs::read(again.join("overlay.png")).unwrap() == std::fs::read(out.join("overlay.png")).unwrap(),
+        "the redrawn chart differs from the one drawn from the sweeps"
+    );
+    assert!(!again.join("overlay.csv").exists(), "--redraw wrote a table");
+
     // A sweep of single runs, another key, a map: each refused.
     let plain = dir.join("plain");
     let o = output_within(&mut plant_sweep(&plain_sweep(&dir, ""), &plain, &["--quiet"]), LIMIT);
@@ -372,12 +384,14 @@ fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
     .unwrap();
     let missing = dir.join("no-such-sweep");
     let bad = dir.join("bad-out");
-    let cases: [(&[&str], Vec<&Path>, &str); 5] = [
+    let cases: [(&[&str], Vec<&Path>, &str); 7] = [
         (&[], vec![sweep.as_path(), missing.as_path()], "no-such-sweep: no such sweep folder"),
         (&[], vec![plain.as_path()], "a sweep of single runs"),
         (&[], vec![sweep.as_path(), other.as_path()], "mismatched axes"),
         (&[], vec![map.as_path()], "a sweep of 2 keys"),
         (&["--label", "one"], vec![sweep.as_path(), sweep.as_path()], "--label given 1 times for 2 sweep folders"),
+        (&["--redraw", "overlay.csv"], vec![sweep.as_path()], "cannot be used with"),
+        (&["--redraw", "no-such-table.csv"], vec![], "no-such-table.csv"),
     ];
     for (args, dirs, needle) in cases {
         let o = overlay(args, &dirs, &bad);

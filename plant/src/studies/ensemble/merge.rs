@@ -14,7 +14,7 @@ use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::point::{point_stats, PointStats, StoppedBy};
 use crate::ensemble::spec::EnsembleSpec;
-use crate::ensemble::stats::{thresholds, Threshold};
+use crate::ensemble::stats::{thresholds_along, Threshold};
 use crate::grid::outputs::{csv_writer, e, finish, mode_plots, opt, single_fields, ModePoint, SINGLE_COLUMNS};
 use crate::grid::{Grid, Kind, Mode, Spacing};
 use crate::status::Status;
@@ -115,26 +115,15 @@ struct JsonSummary<'a> {
 /// The thresholds of a 1-D ensemble sweep, in the axis's own units.
 pub fn sweep_thresholds(grid: &Grid, stats: &[PointStats]) -> Vec<Threshold> {
     let Some(axis) = grid.axes.first().filter(|_| grid.axes.len() == 1) else { return Vec::new() };
-    let log = axis.spacing == Spacing::Log;
-    let mut order: Vec<usize> = (0..stats.len()).collect();
-    let x_of = |i: usize| {
-        let v = axis.value(i);
-        if log {
-            v.log10()
-        } else {
-            v
-        }
-    };
-    order.sort_by(|a, b| x_of(*a).total_cmp(&x_of(*b)));
-    let x: Vec<f64> = order.iter().map(|&i| x_of(i)).collect();
-    let p: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_recovered).collect();
-    let lo: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_lo).collect();
-    let hi: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_hi).collect();
-    let back = |v: f64| if log { 10f64.powf(v) } else { v };
-    thresholds(&x, &p, &lo, &hi)
-        .into_iter()
-        .map(|t| Threshold { value: back(t.value), interval: [back(t.interval[0]), back(t.interval[1])], ..t })
-        .collect()
+    let values: Vec<f64> = (0..stats.len()).map(|i| axis.value(i)).collect();
+    let column = |f: fn(&PointStats) -> f64| -> Vec<f64> { stats.iter().map(f).collect() };
+    thresholds_along(
+        &values,
+        axis.spacing == Spacing::Log,
+        &column(|s| s.tally.p_recovered),
+        &column(|s| s.tally.p_lo),
+        &column(|s| s.tally.p_hi),
+    )
 }
 
 /// Writes the outputs of an ensemble sweep (or a single scene's ensemble) from each point's

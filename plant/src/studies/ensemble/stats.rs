@@ -95,6 +95,22 @@ pub fn thresholds(x: &[f64], p: &[f64], lo: &[f64], hi: &[f64]) -> Vec<Threshold
     out
 }
 
+/// The crossings of 0.5 by a sweep's points in the axis's own units: `values` in any order
+/// (sorted here), interpolated linearly in the value, or in `log10` of it on a log axis and
+/// converted back.
+pub fn thresholds_along(values: &[f64], log: bool, p: &[f64], lo: &[f64], hi: &[f64]) -> Vec<Threshold> {
+    let x_of = |v: f64| if log { v.log10() } else { v };
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|a, b| x_of(values[*a]).total_cmp(&x_of(values[*b])));
+    let pick = |column: &[f64]| -> Vec<f64> { order.iter().map(|&i| column[i]).collect() };
+    let x: Vec<f64> = order.iter().map(|&i| x_of(values[i])).collect();
+    let back = |v: f64| if log { 10f64.powf(v) } else { v };
+    thresholds(&x, &pick(p), &pick(lo), &pick(hi))
+        .into_iter()
+        .map(|t| Threshold { value: back(t.value), interval: [back(t.interval[0]), back(t.interval[1])], ..t })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,12 +9,18 @@
 //! that does not exist, one that is not a finished ensemble sweep (a sweep of single runs has
 //! no probabilities; an unmerged one no `sweep.json`), a 2-D map, sweeps of different keys or
 //! spacings, a `--label` count that is not the folders'.
+//!
+//! `--redraw CSV` draws the chart again from an earlier `overlay.csv` alone (the committed
+//! tables of `docs/charts/`, whose sweeps take hours): its curves in their order, their 0.5
+//! crossings found again from the points' probabilities and intervals, as `plant sweep` finds
+//! them; only `overlay.png` is written.
 
+use crate::ensemble::stats::thresholds_along;
 use crate::exit::Ending;
-use crate::grid::outputs::{csv_writer, e, finish};
 use crate::plot::{self, ProbabilityCurve};
+use crate::table::sci;
 use anyhow::Context;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// `plant overlay` arguments.
@@ -22,12 +28,16 @@ use std::path::{Path, PathBuf};
 pub struct OverlayArgs {
     /// Folders of finished ensemble sweeps (`plant sweep` of a file with an `[ensemble]` table)
     /// of the same key, one curve each, in the legend's order.
-    #[arg(required = true, value_name = "SWEEP_DIR")]
+    #[arg(required_unless_present = "redraw", value_name = "SWEEP_DIR")]
     pub sweeps: Vec<PathBuf>,
     /// A curve's legend text, one per folder in their order (repeatable; default: the folder's
     /// name).
     #[arg(long = "label", value_name = "TEXT")]
     pub labels: Vec<String>,
+    /// Draw the chart again from an earlier `overlay.csv` (its labels, points and spacing),
+    /// reading no sweep folder; writes `overlay.png` only.
+    #[arg(long, value_name = "CSV", conflicts_with_all = ["sweeps", "labels"])]
+    pub redraw: Option<PathBuf>,
     /// The chart's title (default: "probability of recovery against KEY").
     #[arg(long)]
     pub title: Option<String>,
@@ -74,6 +84,33 @@ struct JsonThreshold {
     interval: [f64; 2],
     #[serde(default)]
     open: bool,
+}
+
+/// A row of `overlay.csv`: one point of one curve (its header: the fields' names, in order).
+#[derive(Serialize, Deserialize)]
+struct OverlayRow {
+    label: String,
+    folder: String,
+    key: String,
+    #[serde(with = "sci")]
+    value: f64,
+    members: usize,
+    recovered: usize,
+    #[serde(with = "sci")]
+    p_recovered: f64,
+    #[serde(with = "sci")]
+    p_lo: f64,
+    #[serde(with = "sci")]
+    p_hi: f64,
+    numerically_sensitive: usize,
+    /// The axis's spacing, `linear` or `log` (a table written before this column read as
+    /// linear: every shipped overlay was).
+    #[serde(default = "linear")]
+    spacing: String,
+}
+
+fn linear() -> String {
+    "linear".to_string()
 }
 
 /// One sweep as read.
@@ -175,13 +212,20 @@ fn short(v: f64) -> String {
 /// `plant overlay`: checks every folder (exit 2 on bad input), then writes the chart and the
 /// table into `--out`.
 pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
-    let curves = read_curves(args)?;
+    let curves = match &args.redraw {
+        Some(csv) => curves_of_table(csv)?,
+        None => read_curves(args)?,
+    };
+    same_axis(&curves)?;
     let (key, log) = (curves[0].key.clone(), curves[0].log);
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join("overlay"));
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    write_table(&curves, &key, &out)?;
+    if args.redraw.is_none() {
+        write_table(&curves, &key, &out)?;
+    }
     write_chart(args, &curves, &key, log, &out)?;
-    eprintln!("plant overlay: {} sweeps of {key} → {}/overlay.png, overlay.csv", curves.len(), out.display());
+    let written = if args.redraw.is_some() { "overlay.png" } else { "overlay.png, overlay.csv" };
+    eprintln!("plant overlay: {} curves of {key} → {}/{written}", curves.len(), out.display());
     Ok(())
 }
 
@@ -201,6 +245,70 @@ fn read_curves(args: &OverlayArgs) -> anyhow::Result<Vec<Curve>> {
         });
         curves.push(read_sweep(dir, label)?);
     }
+    Ok(curves)
+}
+
+/// The curves of an earlier `overlay.csv`: consecutive rows of one label and folder make a
+/// curve; each curve's crossings are found again from its points.
+fn curves_of_table(csv: &Path) -> anyhow::Result<Vec<Curve>> {
+    let shown = csv.display();
+    let rows: Vec<OverlayRow> = crate::table::read(csv).map_err(|e| bad(format!("--redraw: {e:#}")))?;
+    let mut curves: Vec<Curve> = Vec::new();
+    for (i, r) in rows.into_iter().enumerate() {
+        let line = i + 2;
+        let log = match r.spacing.as_str() {
+            "linear" => false,
+            "log" => true,
+            other => return Err(bad(format!("--redraw {shown}: line {line}: spacing \"{other}\": linear or log"))),
+        };
+        if !r.value.is_finite() {
+            return Err(bad(format!("--redraw {shown}: line {line}: value {} of {} is not finite", r.value, r.key)));
+        }
+        let point = JsonPoint {
+            value: Some(r.value),
+            members: r.members,
+            recovered: r.recovered,
+            p_recovered: r.p_recovered,
+            p_lo: r.p_lo,
+            p_hi: r.p_hi,
+            numerically_sensitive: r.numerically_sensitive,
+        };
+        match curves.last_mut() {
+            Some(c) if c.label == r.label && c.dir.as_os_str() == r.folder.as_str() => {
+                if c.log != log {
+                    return Err(bad(format!(
+                        "--redraw {shown}: line {line}: curve \"{}\" changes its spacing",
+                        r.label
+                    )));
+                }
+                c.points.push(point);
+            }
+            _ => curves.push(Curve {
+                label: r.label,
+                dir: PathBuf::from(r.folder),
+                key: r.key,
+                log,
+                points: vec![point],
+                thresholds: Vec::new(),
+            }),
+        }
+    }
+    if curves.is_empty() {
+        return Err(bad(format!("--redraw {shown}: no rows")));
+    }
+    for c in &mut curves {
+        let column = |f: fn(&JsonPoint) -> f64| -> Vec<f64> { c.points.iter().map(f).collect() };
+        let values = column(|p| p.value.unwrap_or(f64::NAN));
+        let found =
+            thresholds_along(&values, c.log, &column(|p| p.p_recovered), &column(|p| p.p_lo), &column(|p| p.p_hi));
+        c.thresholds =
+            found.into_iter().map(|t| JsonThreshold { value: t.value, interval: t.interval, open: t.open }).collect();
+    }
+    Ok(curves)
+}
+
+/// Refuses curves that do not share one x axis (key and spacing).
+fn same_axis(curves: &[Curve]) -> anyhow::Result<()> {
     let first = &curves[0];
     for c in &curves[1..] {
         if c.key != first.key {
@@ -223,43 +331,30 @@ fn read_curves(args: &OverlayArgs) -> anyhow::Result<Vec<Curve>> {
             )));
         }
     }
-    Ok(curves)
+    Ok(())
 }
 
 /// `overlay.csv`: a row per point of every curve.
 fn write_table(curves: &[Curve], key: &str, out: &Path) -> anyhow::Result<()> {
-    let mut w = csv_writer();
-    w.write_record([
-        "label",
-        "folder",
-        "key",
-        "value",
-        "members",
-        "recovered",
-        "p_recovered",
-        "p_lo",
-        "p_hi",
-        "numerically_sensitive",
-    ])?;
-    for c in curves {
-        for p in &c.points {
-            w.write_record([
-                c.label.clone(),
-                c.dir.display().to_string(),
-                key.to_string(),
-                e(p.value.unwrap_or(f64::NAN)),
-                p.members.to_string(),
-                p.recovered.to_string(),
-                e(p.p_recovered),
-                e(p.p_lo),
-                e(p.p_hi),
-                p.numerically_sensitive.to_string(),
-            ])?;
-        }
-    }
-    finish(w, &out.join("overlay.csv"))?;
-
-    Ok(())
+    let rows: Vec<OverlayRow> = curves
+        .iter()
+        .flat_map(|c| {
+            c.points.iter().map(|p| OverlayRow {
+                label: c.label.clone(),
+                folder: c.dir.display().to_string(),
+                key: key.to_string(),
+                value: p.value.unwrap_or(f64::NAN),
+                members: p.members,
+                recovered: p.recovered,
+                p_recovered: p.p_recovered,
+                p_lo: p.p_lo,
+                p_hi: p.p_hi,
+                numerically_sensitive: p.numerically_sensitive,
+                spacing: if c.log { "log" } else { "linear" }.to_string(),
+            })
+        })
+        .collect();
+    crate::table::write(&out.join("overlay.csv"), &rows)
 }
 
 /// `overlay.png`: x in the axis's own scale (log10 for a log axis), the 0.5 crossings in the
@@ -341,6 +436,60 @@ mod tests {
         assert_eq!(unit_of("contact.rotor_race_damping_n_s_per_m"), Some("N·s/m"));
         assert_eq!(unit_of("sensor.range_um"), Some("µm"));
         assert_eq!(unit_of("controller.damping_ratio"), None);
+    }
+
+    fn table_file(name: &str, text: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("overlay-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("overlay.csv");
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    const HEADER: &str = "label,folder,key,value,members,recovered,p_recovered,p_lo,p_hi,numerically_sensitive";
+
+    #[test]
+    fn a_redrawn_table_finds_its_crossings_again() {
+        // Linear: p̂ 1, 1, 0 at 1, 2, 3 G crosses 0.5 half-way from 2 to 3 G, between the points
+        // whose bands exclude 0.5 (2 and 3). Log: p̂ 1, 0 at 10 and 100 crosses at 10^1.5.
+        let text = format!(
+            "{HEADER},spacing\n\
+             a,runs/a,shock[0].peak_g,1e0,16,16,1e0,8e-1,1e0,0,linear\n\
+             a,runs/a,shock[0].peak_g,2e0,16,16,1e0,8e-1,1e0,0,linear\n\
+             a,runs/a,shock[0].peak_g,3e0,16,0,0e0,0e0,2e-1,0,linear\n\
+             b,runs/b,shock[0].peak_g,1e0,16,16,1e0,8e-1,1e0,0,linear\n"
+        );
+        let curves = curves_of_table(&table_file("linear", &text)).unwrap();
+        assert_eq!(curves.iter().map(|c| (c.label.as_str(), c.points.len())).collect::<Vec<_>>(), [("a", 3), ("b", 1)]);
+        let t = &curves[0].thresholds;
+        assert_eq!(t.len(), 1);
+        assert_eq!((t[0].value, t[0].interval, t[0].open), (2.5, [2.0, 3.0], false));
+        assert!(curves[1].thresholds.is_empty());
+
+        let text = format!(
+            "{HEADER},spacing\n\
+             l,runs/l,controller.stiffness_n_per_m,1e1,16,16,1e0,8e-1,1e0,0,log\n\
+             l,runs/l,controller.stiffness_n_per_m,1e2,16,0,0e0,0e0,2e-1,0,log\n"
+        );
+        let curves = curves_of_table(&table_file("log", &text)).unwrap();
+        assert!(curves[0].log);
+        let t = &curves[0].thresholds[0];
+        assert!((t.value - 10f64.powf(1.5)).abs() < 1e-9, "{}", t.value);
+        assert!((t.interval[0] - 10.0).abs() < 1e-12 && (t.interval[1] - 100.0).abs() < 1e-9, "{:?}", t.interval);
+    }
+
+    #[test]
+    fn a_table_without_its_spacing_reads_as_linear_and_a_bad_one_is_refused() {
+        let old = format!("{HEADER}\nx,runs/x,shock[0].peak_g,1e0,16,16,1e0,8e-1,1e0,0\n");
+        assert!(!curves_of_table(&table_file("old", &old)).unwrap()[0].log);
+        let bad_spacing = format!("{HEADER},spacing\nx,runs/x,shock[0].peak_g,1e0,16,16,1e0,8e-1,1e0,0,cubic\n");
+        let e = format!("{:#}", curves_of_table(&table_file("cubic", &bad_spacing)).err().unwrap());
+        assert!(e.contains("line 2: spacing \"cubic\": linear or log"), "{e}");
+        let infinite = format!("{HEADER}\nx,runs/x,shock[0].peak_g,inf,16,16,1e0,8e-1,1e0,0\n");
+        let e = format!("{:#}", curves_of_table(&table_file("inf", &infinite)).err().unwrap());
+        assert!(e.contains("line 2: value inf of shock[0].peak_g is not finite"), "{e}");
+        let e = format!("{:#}", curves_of_table(&table_file("empty", &format!("{HEADER}\n"))).err().unwrap());
+        assert!(e.contains("no rows"), "{e}");
     }
 
     #[test]
