@@ -30,6 +30,8 @@ pub(crate) enum Mark {
     Open(RGBColor, Shape),
     /// A solid line with a filled marker on it.
     LineMarker(RGBColor, Shape),
+    /// A dashed line with a filled marker on it (a curve of the second round of shapes).
+    DashedMarker(RGBColor, Shape),
 }
 
 /// A marker's shape.
@@ -120,6 +122,12 @@ pub(crate) fn draw_mark(
         Mark::Open(c, shape) => draw_shape(area, shape, (mid, y), c.stroke_width(2)),
         Mark::LineMarker(c, shape) => {
             area.draw(&PathElement::new(vec![(x, y), (x + w, y)], c.stroke_width(2)))?;
+            draw_shape(area, shape, (mid, y), c.filled())
+        }
+        Mark::DashedMarker(c, shape) => {
+            for k in (0..w).step_by(10) {
+                area.draw(&PathElement::new(vec![(x + k, y), (x + (k + 6).min(w), y)], c.stroke_width(2)))?;
+            }
             draw_shape(area, shape, (mid, y), c.filled())
         }
     }

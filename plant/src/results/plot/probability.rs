@@ -25,7 +25,8 @@ pub struct ProbabilityCurve<'a> {
 }
 
 /// Draws probability curves against a shared x axis into a 1200×900 PNG at `path`: each a line
-/// through its estimates with a marker per point (colour and marker shape per curve), its
+/// through its estimates with a marker per point (colour and marker shape per curve; the
+/// lines of curves 5 to 8 dashed), its
 /// intervals as error bars with caps, and a dashed line at P = 0.5. Curve `k` of `n` is drawn
 /// `(k − (n − 1)/2) · offset` to the side of its x values, so that the error bars of curves
 /// at the same x stay apart (0: none; say so in `x_label`). The legend is a strip of rows above
@@ -52,6 +53,9 @@ pub fn probability(
         }
     }
     let n = curves.len();
+    // The second round of marker shapes draws its lines dashed: colour, shape and line together
+    // tell eight curves apart.
+    let dashed = |k: usize| (k / Shape::ALL.len()) % 2 == 1;
     let shift = |k: usize| if offset.is_finite() { (k as f64 - (n as f64 - 1.0) / 2.0) * offset } else { 0.0 };
     let xs = || curves.iter().enumerate().flat_map(move |(k, c)| c.x.iter().map(move |x| x + shift(k)));
     let Some((x0, x1)) = finite_bounds(xs()) else {
@@ -66,7 +70,12 @@ pub fn probability(
         let entries: Vec<(String, Mark)> = curves
             .iter()
             .enumerate()
-            .map(|(k, c)| (c.label.to_string(), Mark::LineMarker(colour(k), Shape::ALL[k % Shape::ALL.len()])))
+            .map(|(k, c)| {
+                let shape = Shape::ALL[k % Shape::ALL.len()];
+                let mark =
+                    if dashed(k) { Mark::DashedMarker(colour(k), shape) } else { Mark::LineMarker(colour(k), shape) };
+                (c.label.to_string(), mark)
+            })
             // The reference line named for what it is.
             .chain(std::iter::once(("P = 0.5".to_string(), Mark::Dashed(RGBColor(0x70, 0x70, 0x70)))))
             .collect();
@@ -95,7 +104,15 @@ pub fn probability(
             let finite = |i: usize| c.x[i].is_finite() && c.p[i].is_finite();
             let points: Vec<(f64, f64)> =
                 (0..c.x.len()).filter(|&i| finite(i)).map(|i| (c.x[i] + dx, c.p[i])).collect();
-            chart.draw_series(LineSeries::new(points.iter().copied(), tint.stroke_width(2))).map_err(draw_err(path))?;
+            if dashed(k) {
+                chart
+                    .draw_series(DashedLineSeries::new(points.iter().copied(), 10, 6, tint.stroke_width(2)))
+                    .map_err(draw_err(path))?;
+            } else {
+                chart
+                    .draw_series(LineSeries::new(points.iter().copied(), tint.stroke_width(2)))
+                    .map_err(draw_err(path))?;
+            }
             let style = tint.mix(0.8).stroke_width(1);
             let bars: Vec<(f64, f64, f64)> = (0..c.x.len())
                 .filter(|&i| c.x[i].is_finite() && c.lo[i].is_finite() && c.hi[i].is_finite())
