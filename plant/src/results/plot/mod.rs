@@ -57,7 +57,7 @@
 //! circles.
 
 mod axes;
-pub(crate) use axes::{linear_ticks, log_padded, log_ticks};
+pub(crate) use axes::{linear_ticks, log_axis, log_padded, log_ticks};
 mod campbell;
 pub(crate) use campbell::{campbell, ModePoints};
 mod decimate;

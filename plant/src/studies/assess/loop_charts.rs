@@ -10,7 +10,10 @@
 use super::margins::AxisMargins;
 use super::sensitivity::AxisResult;
 use super::{ControllerReport, Report};
-use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
+use crate::plot::{
+    builder, colour, draw_err, draw_mesh, ensure_font, legend_strip, log_axis, log_ticks, titled_root, Mark, PlotError,
+    Shape, WIDE_SIZE,
+};
 use nalgebra::Complex;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
@@ -38,12 +41,10 @@ struct Panel<'a> {
     labels: (&'a str, &'a str),
     /// Each curve's points.
     data: &'a [Drawn],
-    /// Each curve's name.
-    names: &'a [String],
     /// A jump in y that breaks a line (a phase wrap); infinite: none.
     jump: f64,
-    /// Whether the panel carries the legend.
-    legend: bool,
+    /// The x axis's tick labels.
+    x_ticks: &'a dyn Fn(&f64) -> String,
 }
 
 /// One axis at one speed: its label, its closed form `(f, G_o)` and its measured points.
@@ -127,38 +128,62 @@ where
 {
     let (xr, yr) = (x.range(), y.range());
     let mut c = builder(area).build_cartesian_2d(x, y).map_err(draw_err(path))?;
-    let fx = |v: &f64| format!("{v}");
     let fy = |v: &f64| format!("{v}");
-    draw_mesh(&mut c, p.labels.0, p.labels.1, &fx, &fy, path)?;
+    draw_mesh(&mut c, p.labels.0, p.labels.1, p.x_ticks, &fy, path)?;
     extras(&mut c)?;
     let inside = |p: &(f64, f64)| p.0 >= xr.start && p.0 <= xr.end && p.1 >= yr.start && p.1 <= yr.end;
-    for (i, ((closed, measured), name)) in p.data.iter().zip(p.names).enumerate() {
+    for (i, (closed, measured)) in p.data.iter().enumerate() {
         let col = colour(i);
         let style = col.stroke_width(2);
-        let mut first = true;
         for seg in segments(closed, &inside, p.jump) {
-            let s = c.draw_series(LineSeries::new(seg, style)).map_err(draw_err(path))?;
-            if first {
-                s.label(format!("{name}: closed form"))
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
-                first = false;
+            if dashed(i) {
+                c.draw_series(DashedLineSeries::new(seg, 10, 6, style)).map_err(draw_err(path))?;
+            } else {
+                c.draw_series(LineSeries::new(seg, style)).map_err(draw_err(path))?;
             }
         }
-        let dots = c
-            .draw_series(measured.iter().filter(|p| inside(p)).map(|p| Circle::new(*p, 4, col.filled())))
+        c.draw_series(measured.iter().filter(|p| inside(p)).map(|p| Circle::new(*p, dot_radius(i), col.filled())))
             .map_err(draw_err(path))?;
-        dots.label(format!("{name}: measured")).legend(move |(x, y)| Circle::new((x + 12, y), 4, col.filled()));
     }
-    if !p.legend {
-        return Ok(());
-    }
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(crate::plot::font(15))
-        .position(SeriesLabelPosition::LowerLeft)
-        .draw()
-        .map_err(draw_err(path))
+    Ok(())
+}
+
+/// Curves of a symmetric rotor lie on each other (x and y, or two speeds): every other one's
+/// line is dashed and each one's dots are smaller than the one's before, so that those beneath
+/// still show.
+fn dashed(i: usize) -> bool {
+    i % 2 == 1
+}
+
+fn dot_radius(i: usize) -> i32 {
+    (7 - i as i32).max(3)
+}
+
+/// The legend above the three panels: each curve (its closed form a line, its measured points
+/// dots on it), then the reference lines, named for what they are.
+fn legend(curves: &[Curve]) -> Vec<(String, Mark)> {
+    let grey = RGBColor(150, 150, 150);
+    curves
+        .iter()
+        .enumerate()
+        .map(|(i, k)| {
+            if k.closed.is_empty() {
+                (format!("{}: measured (no closed form)", k.label), Mark::Marker(colour(i), Shape::Circle))
+            } else {
+                let mark = if dashed(i) {
+                    Mark::DashedMarker(colour(i), Shape::Circle)
+                } else {
+                    Mark::LineMarker(colour(i), Shape::Circle)
+                };
+                (format!("{}: closed form (line), measured (dots)", k.label), mark)
+            }
+        })
+        .chain([
+            ("0 dB and −180°: the margins' crossings".to_string(), Mark::Line(BLACK)),
+            ("unit circle |G_o| = 1".to_string(), Mark::Line(grey)),
+            ("critical point −1".to_string(), Mark::Cross(BLACK)),
+        ])
+        .collect()
 }
 
 /// `open_loop_N.png` of one controller: Bode magnitude and phase on the left, Nyquist on the
@@ -168,7 +193,6 @@ fn chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
     if curves.is_empty() {
         return Ok(false);
     }
-    let names: Vec<String> = curves.iter().map(|k| k.label.clone()).collect();
     let map = |f: &dyn Fn(f64, C64) -> (f64, f64)| -> Vec<Drawn> {
         curves
             .iter()
@@ -194,21 +218,16 @@ fn chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
     ensure_font(path)?;
     crate::plot::draw_png(path, (WIDE_SIZE.0 * 3 / 2, WIDE_SIZE.1), |root| {
         let area = titled_root(root, path, &format!("{}: open loop G_o per axis (S = 1/(1 + G_o))", c.label))?;
+        let area = legend_strip(&area, &legend(&curves), path)?;
         let (left, right) = area.split_horizontally(WIDE_SIZE.0 * 3 / 4 + 60);
         let (top, bottom) = left.split_vertically(left.dim_in_pixel().1 / 2);
-        let log = || -> plotters::coord::combinators::LogCoord<f64> { (f0..f1).log_scale().into() };
+        let log = || log_axis(f0, f1);
         let lin = |a: f64, b: f64| -> plotters::coord::types::RangedCoordf64 { (a..b).into() };
         panel(
             &top,
             path,
             (log(), lin(m0, m1)),
-            &Panel {
-                labels: ("frequency (Hz)", "|G_o| (dB)"),
-                data: &mag,
-                names: &names,
-                jump: f64::INFINITY,
-                legend: false,
-            },
+            &Panel { labels: ("frequency (Hz)", "|G_o| (dB)"), data: &mag, jump: f64::INFINITY, x_ticks: &log_ticks },
             &|c| {
                 c.draw_series(std::iter::once(PathElement::new(vec![(f0, 0.0), (f1, 0.0)], BLACK.stroke_width(1))))
                     .map_err(draw_err(path))?;
@@ -219,13 +238,7 @@ fn chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
             &bottom,
             path,
             (log(), lin(-360.0, 0.0)),
-            &Panel {
-                labels: ("frequency (Hz)", "arg G_o (°)"),
-                data: &phase,
-                names: &names,
-                jump: 180.0,
-                legend: false,
-            },
+            &Panel { labels: ("frequency (Hz)", "arg G_o (°)"), data: &phase, jump: 180.0, x_ticks: &log_ticks },
             &|c| {
                 c.draw_series(std::iter::once(PathElement::new(
                     vec![(f0, -180.0), (f1, -180.0)],
@@ -239,7 +252,12 @@ fn chart(path: &Path, c: &ControllerReport) -> Result<bool, PlotError> {
             &right,
             path,
             (lin(NYQUIST_RE.0, NYQUIST_RE.1), lin(-half, half)),
-            &Panel { labels: ("Re G_o", "Im G_o"), data: &nyq, names: &names, jump: f64::INFINITY, legend: true },
+            &Panel {
+                labels: ("Re G_o", "Im G_o"),
+                data: &nyq,
+                jump: f64::INFINITY,
+                x_ticks: &|v: &f64| format!("{v}"),
+            },
             &|c| {
                 let circle: Vec<(f64, f64)> =
                     (0..=180).map(|i| i as f64 * std::f64::consts::TAU / 180.0).map(|t| (t.cos(), t.sin())).collect();

@@ -158,7 +158,7 @@ fn panel(
         }};
     }
     if x_log {
-        let x_coord: plotters::coord::combinators::LogCoord<f64> = (x0..x1).log_scale().into();
+        let x_coord = crate::plot::log_axis(x0, x1);
         let mut c = builder(area).build_cartesian_2d(x_coord, y0..y1).map_err(draw_err(path))?;
         draw_mesh(&mut c, x_label, y_label, &crate::plot::log_ticks, &fmt_y, path)?;
         body!(c);
