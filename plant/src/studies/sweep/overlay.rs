@@ -439,9 +439,7 @@ mod tests {
     }
 
     fn table_file(name: &str, text: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("overlay-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("overlay.csv");
+        let path = crate::util::scratch(&format!("overlay-{name}")).join("overlay.csv");
         std::fs::write(&path, text).unwrap();
         path
     }
