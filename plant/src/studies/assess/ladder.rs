@@ -25,7 +25,7 @@
 
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
-use crate::ensemble::member::{close_to_decision, figures, member_overrides, verify_overrides, MemberResult};
+use crate::ensemble::member::{close_to_decision, figures, member_overrides, verification_overrides, MemberResult};
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
 use crate::ensemble::tally::{tally, Tally};
@@ -679,9 +679,7 @@ fn run_counted(
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
-        sets = point.sets.to_vec();
-        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
-        sets.extend(drawn.iter().cloned());
+        sets = verification_overrides(point, spec, &drawn);
         let reference = load_scene(point.path, &sets)?;
         let Some((result, d, decision)) = run(&reference)? else { return Ok(None) };
         verified = Some(figures_of(&reference, &result, &decision));
@@ -690,15 +688,7 @@ fn run_counted(
         duty = d;
     }
     Ok(Some(Counted {
-        result: MemberResult {
-            point: point.index,
-            member: j,
-            angle_deg: draw.angle_deg,
-            drawn,
-            run: first,
-            verified,
-            poincare: Vec::new(),
-        },
+        result: MemberResult::new(point, j, &draw, drawn, first, verified),
         duty,
         decided,
         simulated_s,
@@ -909,7 +899,7 @@ pub fn ladder(
     }
     let rungs = rungs_of(&mut counted, &decided, settings);
     let safe_up_to_g =
-        rungs.iter().take_while(|r| r.complete && r.tally.p_lo >= settings.min_p).last().map(|r| r.peak_g);
+        rungs.iter().take_while(|r| r.complete && r.tally.share.lo >= settings.min_p).last().map(|r| r.peak_g);
     let mut simulated_s: f64 = counted.iter().flatten().map(|m| m.simulated_s).sum();
     let mut robustness = None;
     if settings.robustness > 0 && failed.is_none() && !interrupted {

@@ -127,9 +127,9 @@ pub fn sweep_thresholds(grid: &Grid, stats: &[PointStats]) -> Vec<Threshold> {
     };
     order.sort_by(|a, b| x_of(*a).total_cmp(&x_of(*b)));
     let x: Vec<f64> = order.iter().map(|&i| x_of(i)).collect();
-    let p: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_recovered).collect();
-    let lo: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_lo).collect();
-    let hi: Vec<f64> = order.iter().map(|&i| stats[i].tally.p_hi).collect();
+    let p: Vec<f64> = order.iter().map(|&i| stats[i].tally.share.value).collect();
+    let lo: Vec<f64> = order.iter().map(|&i| stats[i].tally.share.lo).collect();
+    let hi: Vec<f64> = order.iter().map(|&i| stats[i].tally.share.hi).collect();
     let back = |v: f64| if log { 10f64.powf(v) } else { v };
     thresholds(&x, &p, &lo, &hi)
         .into_iter()
@@ -295,11 +295,11 @@ fn write_points(
                 dry_whirl: s.tally.dry_whirl.to_string(),
                 rebound: s.tally.rebound.to_string(),
                 diverged: s.tally.diverged.to_string(),
-                p_recovered: e(s.tally.p_recovered),
-                p_lo: e(s.tally.p_lo),
-                p_hi: e(s.tally.p_hi),
-                recovery_median_s: opt(s.tally.recovery_median_s),
-                recovery_p90_s: opt(s.tally.recovery_p90_s),
+                p_recovered: e(s.tally.share.value),
+                p_lo: e(s.tally.share.lo),
+                p_hi: e(s.tally.share.hi),
+                recovery_median_s: opt(s.tally.recovery.median_s),
+                recovery_p90_s: opt(s.tally.recovery.p90_s),
                 worst_contact_force_n: e(s.worst_contact_force_n),
                 verified: s.verified.to_string(),
                 numerically_sensitive: s.numerically_sensitive.to_string(),

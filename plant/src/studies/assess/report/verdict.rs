@@ -183,7 +183,7 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 let at = l.rungs.iter().find(|x| x.peak_g == g).map_or(String::new(), |x| {
                     format!(
                         "; at {g} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
+                        x.tally.recovered, x.tally.members, x.tally.share.lo, x.tally.share.hi
                     )
                 });
                 format!(
@@ -195,7 +195,7 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 let first = l.rungs.iter().find(|x| x.tally.members > 0).map_or(String::new(), |x| {
                     format!(
                         ": at {} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.peak_g, x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
+                        x.peak_g, x.tally.recovered, x.tally.members, x.tally.share.lo, x.tally.share.hi
                     )
                 });
                 format!(
