@@ -28,7 +28,7 @@ use crate::config::{load_scene, Scene};
 use crate::ensemble::member::{close_to_decision, figures, member_overrides, verification_overrides, MemberResult};
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
-use crate::ensemble::tally::{tally, Tally};
+use crate::ensemble::tally::{tally, Tally, Verification};
 use crate::grid::{Mode, Point};
 use crate::hooks::Hooks;
 use crate::run::{run_into, Outcome, RunResult, Sink};
@@ -203,9 +203,8 @@ pub struct Rung {
     #[serde(flatten)]
     pub tally: Tally,
     /// Members re-run at the reference setting, and of those, members whose mode changed.
-    pub verified: usize,
-    /// Numerically sensitive members.
-    pub numerically_sensitive: usize,
+    #[serde(flatten)]
+    pub verification: Verification,
     /// The rung was decided (false: the ladder was interrupted).
     pub complete: bool,
     /// The duty over the counted members (two-plane rotor: each figure the larger bearing's).
@@ -723,13 +722,11 @@ fn rungs_of(counted: &mut [Vec<Counted>], decided: &[bool], settings: &Settings)
         let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
         // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
         // is not read.
-        let (verified, numerically_sensitive) = crate::ensemble::tally::verified(&refs);
         let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
         rungs.push(Rung {
             peak_g: settings.peaks_g[i],
             tally: tally(&refs),
-            verified,
-            numerically_sensitive,
+            verification: crate::ensemble::tally::verified(&refs),
             complete: decided[i],
             duty: rung_duty(&duties),
             duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
@@ -911,7 +908,7 @@ pub fn ladder(
         robustness = answer;
         failed = copies_failed;
     }
-    let verified = rungs.iter().map(|r| r.verified).sum();
+    let verified = rungs.iter().map(|r| r.verification.verified).sum();
     let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();
     let result = LadderResult {
         rungs,

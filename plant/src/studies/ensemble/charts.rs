@@ -74,7 +74,7 @@ fn band_panel(
         ("P(recovered), members counted per point".to_string(), plot::Mark::LineMarker(BLUE, plot::Shape::Circle)),
         ("P = 0.5".to_string(), plot::Mark::Line(grey)),
     ];
-    if stats.iter().any(|s| s.numerically_sensitive > 0) {
+    if stats.iter().any(|s| s.verification.numerically_sensitive > 0) {
         entries.push(("numerically sensitive members".into(), plot::Mark::Open(SENSITIVE, plot::Shape::Circle)));
     }
     if !thresholds.is_empty() {
@@ -111,7 +111,7 @@ fn band_panel(
     let sensitive: Vec<(f64, f64)> = x
         .iter()
         .zip(stats)
-        .filter(|(_, s)| s.numerically_sensitive > 0)
+        .filter(|(_, s)| s.verification.numerically_sensitive > 0)
         .map(|(x, s)| (*x, s.tally.share.value))
         .collect();
     if !sensitive.is_empty() {
@@ -238,8 +238,11 @@ fn probability_map(
         root.fill(&WHITE).map_err(draw_err(path))?;
         let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
         let root = plot::titled_root(root, path, &title)?;
-        let crossed: Vec<(f64, f64)> =
-            stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
+        let crossed: Vec<(f64, f64)> = stats
+            .iter()
+            .filter(|s| s.verification.numerically_sensitive > 0)
+            .map(|s| (x[s.index % n1], y[s.index / n1]))
+            .collect();
         // The crosses' legend in a strip above the map, never over its cells.
         let root = if crossed.is_empty() {
             root

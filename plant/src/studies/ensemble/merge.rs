@@ -159,7 +159,7 @@ pub fn write_ensemble(
     let base = grid.scene_for(0)?;
     let thresholds = sweep_thresholds(grid, &stats);
     let sensitive: Vec<String> =
-        stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| grid.point_name(s.index)).collect();
+        stats.iter().filter(|s| s.verification.numerically_sensitive > 0).map(|s| grid.point_name(s.index)).collect();
     let summary = JsonSummary {
         program: crate::grid::store::PROGRAM,
         kind: grid.kind,
@@ -172,7 +172,7 @@ pub fn write_ensemble(
         sensitive_share: sensitive.len() as f64 / stats.len().max(1) as f64,
         numerically_sensitive_points: sensitive,
         members_run: stats.iter().map(|s| s.tally.members).sum(),
-        members_verified: stats.iter().map(|s| s.verified).sum(),
+        members_verified: stats.iter().map(|s| s.verification.verified).sum(),
     };
     let json_name = if grid.kind == Kind::Ensemble { "ensemble.json" } else { "sweep.json" };
     crate::outfile::write(&dir.join(json_name), (serde_json::to_string_pretty(&summary)? + "\n").as_bytes())?;
@@ -301,9 +301,9 @@ fn write_points(
                 recovery_median_s: opt(s.tally.recovery.median_s),
                 recovery_p90_s: opt(s.tally.recovery.p90_s),
                 worst_contact_force_n: e(s.worst_contact_force_n),
-                verified: s.verified.to_string(),
-                numerically_sensitive: s.numerically_sensitive.to_string(),
-                sensitive: (s.numerically_sensitive > 0).to_string(),
+                verified: s.verification.verified.to_string(),
+                numerically_sensitive: s.verification.numerically_sensitive.to_string(),
+                sensitive: (s.verification.numerically_sensitive > 0).to_string(),
                 stopped_by: crate::summary::snake_name(&s.stopped_by),
             }
             .into_fields(),

@@ -13,7 +13,7 @@ use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
-use crate::ensemble::tally::{tally, Tally};
+use crate::ensemble::tally::{tally, Tally, Verification};
 use crate::grid::{Mode, Progress};
 use crate::status::Status;
 use serde::Serialize;
@@ -66,10 +66,8 @@ pub struct PointStats {
     pub tally: Tally,
     /// Largest peak contact force of all members (N).
     pub worst_contact_force_n: f64,
-    /// Members re-run at the reference setting.
-    pub verified: usize,
-    /// Verified members whose mode changed.
-    pub numerically_sensitive: usize,
+    /// Members re-run at the reference setting, and of those, members whose mode changed.
+    pub verification: Verification,
     /// Which rule stopped the point: `members`, `width` or `agree`.
     pub stopped_by: StoppedBy,
     /// The most frequent mode (ties: recovered, dry whirl, rebound, diverged); none without
@@ -96,8 +94,8 @@ impl Serialize for PointStats {
         st.serialize_field("index", &self.index)?;
         self.tally.serialize_fields(&mut st)?;
         st.serialize_field("worst_contact_force_n", &self.worst_contact_force_n)?;
-        st.serialize_field("verified", &self.verified)?;
-        st.serialize_field("numerically_sensitive", &self.numerically_sensitive)?;
+        st.serialize_field("verified", &self.verification.verified)?;
+        st.serialize_field("numerically_sensitive", &self.verification.numerically_sensitive)?;
         st.serialize_field("stopped_by", &self.stopped_by)?;
         st.serialize_field("post_shock_mode", &self.post_shock_mode)?;
         st.serialize_field("steady_class", &self.steady_class)?;
@@ -136,15 +134,13 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedB
     k_order.dedup();
     let period_k = most_frequent(&ks, &k_order);
     let t = tally(members);
-    let (verified, numerically_sensitive) = super::tally::verified(members);
     let whirl: Vec<f64> = members.iter().map(|m| m.counted().whirl_hz).collect();
     let max = |f: fn(&MemberResult) -> f64| members.iter().map(|m| f(m)).filter(|v| v.is_finite()).fold(0.0, f64::max);
     PointStats {
         index,
         tally: t,
         worst_contact_force_n: max(|m| m.counted().max_contact_force_n),
-        verified,
-        numerically_sensitive,
+        verification: super::tally::verified(members),
         stopped_by,
         post_shock_mode: mode,
         steady_class: class,

@@ -102,7 +102,20 @@ pub fn tally(members: &[&MemberResult]) -> Tally {
     }
 }
 
-/// Members re-run at the reference setting, and of those, members whose mode changed there.
-pub fn verified(members: &[&MemberResult]) -> (usize, usize) {
-    (members.iter().filter(|m| m.verified.is_some()).count(), members.iter().filter(|m| m.sensitive()).count())
+/// How many counted members were verified at the reference setting, and of those, how many
+/// changed mode there (serialised flat into the structure that holds it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Verification {
+    /// Members re-run at the reference setting.
+    pub verified: usize,
+    /// Verified members whose mode changed (numerically sensitive).
+    pub numerically_sensitive: usize,
+}
+
+/// The verification of `members`.
+pub fn verified(members: &[&MemberResult]) -> Verification {
+    Verification {
+        verified: members.iter().filter(|m| m.verified.is_some()).count(),
+        numerically_sensitive: members.iter().filter(|m| m.sensitive()).count(),
+    }
 }
