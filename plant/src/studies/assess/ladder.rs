@@ -673,7 +673,7 @@ fn run_counted(
     let scene = load_scene(point.path, &sets)?;
     let Some((result, mut duty, decision)) = run(&scene)? else { return Ok(None) };
     let first = figures_of(&scene, &result, &decision);
-    let mut simulated_s = result.run.simulated;
+    let mut simulated_s = result.run.clock.simulated;
     let mut decided = decision.is_some_and(|d| d.decided.get());
     drop(result);
     let mut verified = None;
@@ -682,7 +682,7 @@ fn run_counted(
         let reference = load_scene(point.path, &sets)?;
         let Some((result, d, decision)) = run(&reference)? else { return Ok(None) };
         verified = Some(figures_of(&reference, &result, &decision));
-        simulated_s += result.run.simulated;
+        simulated_s += result.run.clock.simulated;
         decided = decision.is_some_and(|d| d.decided.get());
         duty = d;
     }
@@ -710,7 +710,7 @@ fn run_copy(
     sets.extend(crate::robustness::perturbation(&scene, k)?);
     let scene = load_scene(path, &sets)?;
     let Some((result, _, decision)) = run_scene(&scene, bearing, end_when_decided, stop)? else { return Ok(None) };
-    Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.simulated)))
+    Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.clock.simulated)))
 }
 
 /// Each rung of the ladder from its counted members (sorted by member here) and whether its

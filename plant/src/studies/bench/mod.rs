@@ -139,10 +139,10 @@ pub struct Measured {
 /// Runs a scene `repeats` times (stopping early after a divergence).
 pub fn measure(scene: &Scene, repeats: usize) -> anyhow::Result<Measured> {
     let result = run(scene, &mut Quiet)?;
-    let mut best_wall = result.run.wall_time;
+    let mut best_wall = result.run.clock.wall_time;
     if result.run.outcome == Outcome::Completed {
         for _ in 1..repeats {
-            best_wall = best_wall.min(run(scene, &mut Quiet)?.run.wall_time);
+            best_wall = best_wall.min(run(scene, &mut Quiet)?.run.clock.wall_time);
         }
     }
     Ok(Measured { result, best_wall })

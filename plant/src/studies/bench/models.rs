@@ -264,7 +264,7 @@ fn machine_run(scene: &Scene, repeats: usize) -> anyhow::Result<MachineRun> {
     let mut sink = DutySink::new(&mut trace, bearing, scene.plane(0).balls.count());
     let run = run_into(scene, &Default::default(), &mut Quiet, &mut sink)?;
     let duty = sink.finish();
-    let mut best = run.wall_time;
+    let mut best = run.clock.wall_time;
     anyhow::ensure!(
         run.outcome == crate::run::Outcome::Completed,
         "scene `{}` did not complete: {:?}",
@@ -272,7 +272,7 @@ fn machine_run(scene: &Scene, repeats: usize) -> anyhow::Result<MachineRun> {
         run.outcome
     );
     for _ in 1..repeats {
-        best = best.min(crate::run::run(scene, &mut Quiet)?.run.wall_time);
+        best = best.min(crate::run::run(scene, &mut Quiet)?.run.clock.wall_time);
     }
     let result = RunResult { trace, run };
     let summary = Summary::new(scene, &result);
