@@ -200,7 +200,7 @@ pub fn write_ensemble(
             .map(|s| ModePoint {
                 value: values[s.index].0.unwrap_or(f64::NAN),
                 value2: values[s.index].1,
-                mode: s.post_shock_mode,
+                mode: s.typical.post_shock_mode,
                 poincare: &[],
             })
             .collect();
@@ -275,9 +275,9 @@ fn write_points(
         let v1 = v1.unwrap_or(f64::NAN);
         let mut row = single_fields(
             v1,
-            s.post_shock_mode.map_or("", Mode::name),
-            s.steady_class.map_or("", SteadyClass::name),
-            s.period_k,
+            s.typical.post_shock_mode.map_or("", Mode::name),
+            s.typical.steady_class.map_or("", SteadyClass::name),
+            s.typical.period_k,
             s.contact_fraction,
             s.whirl_hz,
             s.max_radius_m,
