@@ -67,6 +67,20 @@ pub const PARKED: &str = "touchdown.race_when_clear=\"parked\"";
 /// Window after the shock over which errors are measured (s).
 pub const WINDOW: f64 = 0.05;
 
+/// Runs a bench study into its folder: `out`, default `runs/<default>`, created first; returns
+/// the path of `table` there (the table the study wrote).
+pub fn study_into(
+    out: Option<&Path>,
+    default: &str,
+    table: &str,
+    study: impl FnOnce(&Path) -> anyhow::Result<()>,
+) -> anyhow::Result<std::path::PathBuf> {
+    let dir = crate::output::out_dir(out, default);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    study(&dir)?;
+    Ok(dir.join(table))
+}
+
 /// The three bench scenes, from the scene files in `config_dir`.
 pub fn scenes(config_dir: &Path) -> anyhow::Result<Vec<BenchScene>> {
     let make = |name, what, file: &str, peak: f64| -> anyhow::Result<BenchScene> {

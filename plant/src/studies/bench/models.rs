@@ -110,7 +110,6 @@ pub fn models(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<Vec<ModelRow>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut rows = Vec::new();
     for b in super::scenes(config_dir)? {
         let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
@@ -382,9 +381,7 @@ pub fn command(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
-    let dir = crate::output::out_dir(out, "bench-models");
-    models(config, &dir, repeats, log)?;
-    Ok(dir.join("models.csv"))
+    super::study_into(out, "bench-models", "models.csv", |dir| models(config, dir, repeats, log).map(drop))
 }
 
 /// `plant bench models --redraw CSV`: the charts of an earlier `models.csv` drawn again with
