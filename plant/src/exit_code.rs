@@ -14,6 +14,7 @@ use plant::cosim::CosimError;
 use plant::exit::{BadArgument, Ending, Interrupted, StopKind};
 use plant::grid::GridError;
 use plant::output::AnalyzeError;
+use plant::status::CosimFailure;
 
 /// An exit code of `plant`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,25 +143,11 @@ impl HasExitCode for Ending {
 
 impl HasExitCode for CosimError {
     fn exit_code(&self) -> Code {
-        use controller::link::LinkError;
-        use controller::lock::LockError;
-        match self {
-            CosimError::Refused { .. }
-            | CosimError::RunId(_)
-            | CosimError::Pin(_)
-            | CosimError::Params(_)
-            | CosimError::Protocol(_)
-            | CosimError::Overrides { .. }
-            | CosimError::Command { .. }
-            | CosimError::Lock(LockError::InUse { .. })
-            | CosimError::Link(LinkError::Incompatible { .. }) => Code::BadInput,
-            CosimError::ControllerExited { code: Some(2), .. } => Code::BadInput,
-            CosimError::NoController { .. } | CosimError::ControllerExited { .. } => Code::PeerLost,
-            CosimError::Interrupted => Code::Interrupted,
-            CosimError::ControllerMissing { .. }
-            | CosimError::Spawn { .. }
-            | CosimError::Lock(LockError::Io { .. })
-            | CosimError::Link(LinkError::Ipc { .. }) => Code::Io,
+        match self.failure() {
+            CosimFailure::Refusal | CosimFailure::BadCommand => Code::BadInput,
+            CosimFailure::PeerLost => Code::PeerLost,
+            CosimFailure::Interrupted => Code::Interrupted,
+            CosimFailure::Io => Code::Io,
         }
     }
 }

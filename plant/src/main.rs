@@ -454,7 +454,7 @@ fn run_scene(
         }
         Err(plant::output::RunDirError::Output(e)) => return Err(e.context("writing the results")),
     };
-    if hooks.terminal && !quiet && written.run.wall_time >= 1.0 {
+    if hooks.terminal && !quiet && written.run.clock.wall_time >= 1.0 {
         eprintln!();
     }
     for chart in &written.skipped_charts {

@@ -365,7 +365,7 @@ fn the_imported_pid_starts_at_rest_in_sampled_mode() {
     let start = plant::initial::flexible_initial_state(&scene, f);
     let mut hooks = Saves { at: (1..=50).map(|k| k as f64 * 0.01).collect(), states: Vec::new() };
     let run = plant::run::run(&scene, &mut hooks).unwrap_or_else(|e| panic!("{e}"));
-    assert!((run.run.simulated - 0.5).abs() < 1e-9, "ran to {} s", run.run.simulated);
+    assert!((run.run.clock.simulated - 0.5).abs() < 1e-9, "ran to {} s", run.run.clock.simulated);
     assert_eq!(hooks.states.len(), 50);
     let nodes = f.z.len();
     let at = |y: &[f64], n: usize| f.reduced.motion_of(&y[..r], &vec![0.0; r], n)[0];

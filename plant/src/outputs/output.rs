@@ -669,9 +669,7 @@ mod tests {
         let state = vec![f64::NAN; crate::model::N];
         let run = SinkRun {
             stats: Stats::default(),
-            simulated: scene.controller.period,
-            started: 0.0,
-            wall_time: 0.0,
+            clock: crate::run::RunClock { simulated: scene.controller.period, started: 0.0, wall_time: 0.0 },
             outcome: Outcome::Diverged(RunError::Integration(IntegrationError::NonFinite { t: 0.0, state })),
             final_state: vec![0.0; crate::model::N],
             cosim: None,

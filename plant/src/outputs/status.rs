@@ -21,25 +21,53 @@ impl SetupError {
     }
 }
 
-impl CosimError {
+/// What kind of failure a co-simulation error is: the one sorting of its variants that the
+/// status of a run that could not start ([`SetupError::status`]) and `plant`'s exit code both
+/// read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CosimFailure {
     /// The controller (or the run's setting) refused the run: bad input on the plant's side
-    /// (exit 2), status `refused`. A `controller.command` that cannot be run is bad input too,
-    /// but the run did not start (`not_started`).
-    pub fn is_refusal(&self) -> bool {
+    /// (exit 2), status `refused`.
+    Refusal,
+    /// A `controller.command` that cannot be run: bad input too, but the run did not start
+    /// (`not_started`).
+    BadCommand,
+    /// No controller came, or it exited.
+    PeerLost,
+    /// A signal while waiting for the controller.
+    Interrupted,
+    /// The system refused a resource (the controller's executable, a process, a lock, IPC).
+    Io,
+}
+
+impl CosimError {
+    /// Which kind of failure this is.
+    pub fn failure(&self) -> CosimFailure {
         use controller::link::LinkError;
         use controller::lock::LockError;
-        matches!(
-            self,
+        match self {
             CosimError::Refused { .. }
-                | CosimError::RunId(_)
-                | CosimError::Pin(_)
-                | CosimError::Params(_)
-                | CosimError::Protocol(_)
-                | CosimError::Overrides { .. }
-                | CosimError::Lock(LockError::InUse { .. })
-                | CosimError::Link(LinkError::Incompatible { .. })
-                | CosimError::ControllerExited { code: Some(2), .. }
-        )
+            | CosimError::RunId(_)
+            | CosimError::Pin(_)
+            | CosimError::Params(_)
+            | CosimError::Protocol(_)
+            | CosimError::Overrides { .. }
+            | CosimError::Lock(LockError::InUse { .. })
+            | CosimError::Link(LinkError::Incompatible { .. })
+            | CosimError::ControllerExited { code: Some(2), .. } => CosimFailure::Refusal,
+            CosimError::Command { .. } => CosimFailure::BadCommand,
+            CosimError::NoController { .. } | CosimError::ControllerExited { .. } => CosimFailure::PeerLost,
+            CosimError::Interrupted => CosimFailure::Interrupted,
+            CosimError::ControllerMissing { .. }
+            | CosimError::Spawn { .. }
+            | CosimError::Lock(LockError::Io { .. })
+            | CosimError::Link(LinkError::Ipc { .. }) => CosimFailure::Io,
+        }
+    }
+
+    /// The controller (or the run's setting) refused the run ([`CosimFailure::Refusal`]).
+    pub fn is_refusal(&self) -> bool {
+        self.failure() == CosimFailure::Refusal
     }
 }
 

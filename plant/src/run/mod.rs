@@ -96,12 +96,8 @@ pub fn run_with(scene: &Scene, launch: &Launch, hooks: &mut dyn Hooks) -> Result
 pub struct SinkRun {
     /// Integrator statistics.
     pub stats: Stats,
-    /// Simulated time reached (s).
-    pub simulated: f64,
-    /// Where the run started (s): 0, or a saved state's time (`plant run --from-state`).
-    pub started: f64,
-    /// Wall time of the loop (s).
-    pub wall_time: f64,
+    /// Where it started and ended in simulated time, and how long it took.
+    pub clock: RunClock,
     /// How it ended.
     pub outcome: Outcome,
     /// Final state (ordered as the model's state: [`crate::model::ix`] or
@@ -122,11 +118,22 @@ pub struct SinkRun {
     pub ticks: TickCost,
 }
 
+/// A run's clock: simulated time at its start and end, and the wall time of its loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunClock {
+    /// Simulated time reached (s).
+    pub simulated: f64,
+    /// Where the run started (s): 0, or a saved state's time (`plant run --from-state`).
+    pub started: f64,
+    /// Wall time of the loop (s).
+    pub wall_time: f64,
+}
+
 impl SinkRun {
     /// The simulated time this run covered (s): from its start (0, or a saved state's time) to
     /// where it ended.
     pub fn span(&self) -> f64 {
-        self.simulated - self.started
+        self.clock.simulated - self.clock.started
     }
 }
 
@@ -298,9 +305,7 @@ fn drive(
     }
     SinkRun {
         stats: plant.stats(),
-        simulated: t,
-        started,
-        wall_time,
+        clock: RunClock { simulated: t, started, wall_time },
         outcome,
         final_state: plant.state().to_vec(),
         cosim,

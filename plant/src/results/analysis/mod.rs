@@ -97,6 +97,15 @@ pub fn graded_window(first: f64, end: f64, spec: &AnalysisSpec) -> ([f64; 2], Op
     ([start, end], Some(takeover))
 }
 
+/// The largest peaks of the complex orbit spectrum over the steady window, largest first.
+#[derive(Clone, Debug, Serialize)]
+pub struct DominantPeaks {
+    /// Their frequencies (Hz, negative = backward whirl).
+    pub dominant_frequencies_hz: Vec<f64>,
+    /// Their amplitudes (m).
+    pub dominant_amplitudes_m: Vec<f64>,
+}
+
 /// The analysis of one run, as it goes into `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Analysis {
@@ -108,10 +117,9 @@ pub struct Analysis {
     pub period_k: Option<u32>,
     /// True when the steady window still shows a transient dying away onto that orbit.
     pub steady_converging: bool,
-    /// Largest peaks of the complex orbit spectrum over the steady window (Hz, negative = backward whirl), largest first.
-    pub dominant_frequencies_hz: Vec<f64>,
-    /// Their amplitudes (m).
-    pub dominant_amplitudes_m: Vec<f64>,
+    /// Largest peaks of the complex orbit spectrum over the steady window.
+    #[serde(flatten)]
+    pub dominant: DominantPeaks,
     /// Mean whirl rate of the orbit over the steady window (Hz, negative = backward).
     pub whirl_hz: f64,
     /// Share of samples in contact over the steady window.
@@ -252,8 +260,10 @@ impl Analyzer {
             steady_class: class.class,
             period_k: class.k,
             steady_converging: class.converging,
-            dominant_frequencies_hz: peaks.iter().map(|p| p.freq_hz).collect(),
-            dominant_amplitudes_m: peaks.iter().map(|p| p.amplitude).collect(),
+            dominant: DominantPeaks {
+                dominant_frequencies_hz: peaks.iter().map(|p| p.freq_hz).collect(),
+                dominant_amplitudes_m: peaks.iter().map(|p| p.amplitude).collect(),
+            },
             whirl_hz: classify::mean_whirl_hz(&t, &x, &y),
             steady_contact_fraction: fraction,
             steady_contact_episodes: classify::contact_episodes(&contact),

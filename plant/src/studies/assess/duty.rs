@@ -72,10 +72,9 @@ pub struct Duty {
     pub peak_race_pressure_mpa: f64,
     /// The line contact's half-width at that force (mm).
     pub race_contact_half_width_mm: f64,
-    /// Peak load of the most loaded ball (N); `None` with the lumped support (no balls).
-    pub peak_ball_load_n: Option<f64>,
-    /// Its Hertz pressure at the inner raceway (MPa).
-    pub peak_ball_pressure_mpa: Option<f64>,
+    /// The most loaded ball's peak load and pressure; `None` with the lumped support (no balls).
+    #[serde(flatten)]
+    pub ball: BallPeak,
     /// Friction energy dissipated at the rotor – race contact (J).
     pub friction_energy_j: f64,
     /// Peak race spin speed (rpm).
@@ -88,6 +87,15 @@ pub struct Duty {
     /// each the larger of the two); empty for the planar model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub planes: Vec<Duty>,
+}
+
+/// The peak of the most loaded ball; `None` with the lumped support (no balls).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct BallPeak {
+    /// Peak load of the most loaded ball (N).
+    pub peak_ball_load_n: Option<f64>,
+    /// Its Hertz pressure at the inner raceway (MPa).
+    pub peak_ball_pressure_mpa: Option<f64>,
 }
 
 /// One touchdown bearing's duty, accumulated sample by sample.
@@ -161,12 +169,12 @@ impl PlaneDuty {
             }
             p.balls.loads(s.race.0, s.race.1, cage, rate, &mut self.loads);
             let d = &mut self.duty;
-            let mut most = d.peak_ball_load_n.unwrap_or(0.0);
+            let mut most = d.ball.peak_ball_load_n.unwrap_or(0.0);
             for (l, c) in self.loads.iter().zip(&mut self.counters) {
                 c.push(*l);
                 most = most.max(*l);
             }
-            d.peak_ball_load_n = Some(most);
+            d.ball.peak_ball_load_n = Some(most);
         }
     }
 
@@ -174,13 +182,12 @@ impl PlaneDuty {
         let mut d = self.duty;
         let m = &bearing.materials;
         if self.lumped {
-            d.peak_ball_load_n = None;
-            d.peak_ball_pressure_mpa = None;
+            d.ball = BallPeak::default();
             d.ball_cycles = None;
         } else {
-            let q = d.peak_ball_load_n.unwrap_or(0.0);
+            let q = d.ball.peak_ball_load_n.unwrap_or(0.0);
             let p = hertz::ball_inner(m, q, bearing.ball_diameter_m, bearing.pitch_diameter_m);
-            d.peak_ball_pressure_mpa = Some(p.p_max_pa * 1e-6);
+            d.ball.peak_ball_pressure_mpa = Some(p.p_max_pa * 1e-6);
             d.ball_cycles = Some(self.counters.into_iter().map(|c| c.finish().0).sum());
         }
         d
@@ -229,8 +236,10 @@ impl<'a> DutySink<'a> {
             peak_contact_force_n: governing.peak_contact_force_n,
             peak_race_pressure_mpa: governing.peak_race_pressure_mpa,
             race_contact_half_width_mm: governing.race_contact_half_width_mm,
-            peak_ball_load_n: most_opt(|d| d.peak_ball_load_n),
-            peak_ball_pressure_mpa: most_opt(|d| d.peak_ball_pressure_mpa),
+            ball: BallPeak {
+                peak_ball_load_n: most_opt(|d| d.ball.peak_ball_load_n),
+                peak_ball_pressure_mpa: most_opt(|d| d.ball.peak_ball_pressure_mpa),
+            },
             friction_energy_j: most(|d| d.friction_energy_j),
             race_peak_speed_rpm: most(|d| d.race_peak_speed_rpm),
             race_peak_accel_rad_s2: most(|d| d.race_peak_accel_rad_s2),

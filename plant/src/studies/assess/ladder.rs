@@ -25,10 +25,10 @@
 
 use super::duty::{Bearing, Duty, DutySink};
 use crate::config::{load_scene, Scene};
-use crate::ensemble::member::{close_to_decision, figures, member_overrides, verify_overrides, MemberResult};
+use crate::ensemble::member::{close_to_decision, figures, member_overrides, verification_overrides, MemberResult};
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
-use crate::ensemble::tally::{tally, Tally};
+use crate::ensemble::tally::{tally, Tally, Verification};
 use crate::grid::{Mode, Point};
 use crate::hooks::Hooks;
 use crate::run::{run_into, Outcome, RunResult, Sink};
@@ -185,8 +185,8 @@ fn rung_duty(d: &[&Duty]) -> RungDuty {
         contact_time_s: v(|d| Some(d.contact_time_s)),
         peak_contact_force_n: v(|d| Some(d.peak_contact_force_n)),
         peak_race_pressure_mpa: v(|d| Some(d.peak_race_pressure_mpa)),
-        peak_ball_load_n: v(|d| d.peak_ball_load_n),
-        peak_ball_pressure_mpa: v(|d| d.peak_ball_pressure_mpa),
+        peak_ball_load_n: v(|d| d.ball.peak_ball_load_n),
+        peak_ball_pressure_mpa: v(|d| d.ball.peak_ball_pressure_mpa),
         friction_energy_j: v(|d| Some(d.friction_energy_j)),
         race_peak_speed_rpm: v(|d| Some(d.race_peak_speed_rpm)),
         race_peak_accel_rad_s2: v(|d| Some(d.race_peak_accel_rad_s2)),
@@ -203,9 +203,8 @@ pub struct Rung {
     #[serde(flatten)]
     pub tally: Tally,
     /// Members re-run at the reference setting, and of those, members whose mode changed.
-    pub verified: usize,
-    /// Numerically sensitive members.
-    pub numerically_sensitive: usize,
+    #[serde(flatten)]
+    pub verification: Verification,
     /// The rung was decided (false: the ladder was interrupted).
     pub complete: bool,
     /// The duty over the counted members (two-plane rotor: each figure the larger bearing's).
@@ -674,31 +673,21 @@ fn run_counted(
     let scene = load_scene(point.path, &sets)?;
     let Some((result, mut duty, decision)) = run(&scene)? else { return Ok(None) };
     let first = figures_of(&scene, &result, &decision);
-    let mut simulated_s = result.run.simulated;
+    let mut simulated_s = result.run.clock.simulated;
     let mut decided = decision.is_some_and(|d| d.decided.get());
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
-        sets = point.sets.to_vec();
-        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
-        sets.extend(drawn.iter().cloned());
+        sets = verification_overrides(point, spec, &drawn);
         let reference = load_scene(point.path, &sets)?;
         let Some((result, d, decision)) = run(&reference)? else { return Ok(None) };
         verified = Some(figures_of(&reference, &result, &decision));
-        simulated_s += result.run.simulated;
+        simulated_s += result.run.clock.simulated;
         decided = decision.is_some_and(|d| d.decided.get());
         duty = d;
     }
     Ok(Some(Counted {
-        result: MemberResult {
-            point: point.index,
-            member: j,
-            angle_deg: draw.angle_deg,
-            drawn,
-            run: first,
-            verified,
-            poincare: Vec::new(),
-        },
+        result: MemberResult::new(point, j, &draw, drawn, first, verified),
         duty,
         decided,
         simulated_s,
@@ -721,7 +710,7 @@ fn run_copy(
     sets.extend(crate::robustness::perturbation(&scene, k)?);
     let scene = load_scene(path, &sets)?;
     let Some((result, _, decision)) = run_scene(&scene, bearing, end_when_decided, stop)? else { return Ok(None) };
-    Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.simulated)))
+    Ok(Some((figures_of(&scene, &result, &decision).mode, result.run.clock.simulated)))
 }
 
 /// Each rung of the ladder from its counted members (sorted by member here) and whether its
@@ -733,13 +722,11 @@ fn rungs_of(counted: &mut [Vec<Counted>], decided: &[bool], settings: &Settings)
         let refs: Vec<&MemberResult> = c.iter().map(|m| &m.result).collect();
         // The ladder stops a rung by its own rule (`decided`); the statistics' stopping reason
         // is not read.
-        let (verified, numerically_sensitive) = crate::ensemble::tally::verified(&refs);
         let duties: Vec<&Duty> = c.iter().map(|m| &m.duty).collect();
         rungs.push(Rung {
             peak_g: settings.peaks_g[i],
             tally: tally(&refs),
-            verified,
-            numerically_sensitive,
+            verification: crate::ensemble::tally::verified(&refs),
             complete: decided[i],
             duty: rung_duty(&duties),
             duty_planes: (0..duties.iter().map(|d| d.planes.len()).min().unwrap_or(0))
@@ -909,7 +896,7 @@ pub fn ladder(
     }
     let rungs = rungs_of(&mut counted, &decided, settings);
     let safe_up_to_g =
-        rungs.iter().take_while(|r| r.complete && r.tally.p_lo >= settings.min_p).last().map(|r| r.peak_g);
+        rungs.iter().take_while(|r| r.complete && r.tally.share.lo >= settings.min_p).last().map(|r| r.peak_g);
     let mut simulated_s: f64 = counted.iter().flatten().map(|m| m.simulated_s).sum();
     let mut robustness = None;
     if settings.robustness > 0 && failed.is_none() && !interrupted {
@@ -921,7 +908,7 @@ pub fn ladder(
         robustness = answer;
         failed = copies_failed;
     }
-    let verified = rungs.iter().map(|r| r.verified).sum();
+    let verified = rungs.iter().map(|r| r.verification.verified).sum();
     let ended_when_decided = counted.iter().flatten().filter(|m| m.decided).count();
     let result = LadderResult {
         rungs,

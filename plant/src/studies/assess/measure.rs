@@ -122,7 +122,7 @@ pub(super) fn measure_axis_or_abandon(
     if let Some((kind, why)) = run_failure(&run.outcome, stop) {
         return Err(MeasureError::Run { kind, why });
     }
-    m.result(run.simulated)
+    m.result(run.clock.simulated)
 }
 
 pub(super) fn setup_failure(e: &crate::run::SetupError, stop: &AtomicBool) -> Failure {

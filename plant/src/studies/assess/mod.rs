@@ -21,6 +21,7 @@ pub mod coupled;
 pub mod duty;
 mod failure;
 pub mod hertz;
+mod iso_zone;
 pub mod ladder;
 #[cfg(test)]
 mod linear_check;

@@ -185,12 +185,7 @@ pub struct Peak {
 
 /// The ISO 14839-3 zone of a peak sensitivity (boundaries 3, 4, 5: 9.5, 12, 14 dB).
 pub fn zone(s_abs: f64) -> &'static str {
-    match s_abs {
-        s if s < 3.0 => "A",
-        s if s < 4.0 => "B",
-        s if s < 5.0 => "C",
-        _ => "D",
-    }
+    super::iso_zone::grade(s_abs, [3.0, 4.0, 5.0])
 }
 
 /// The measurement of one axis at one speed.

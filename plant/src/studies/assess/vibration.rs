@@ -16,12 +16,7 @@ use serde::Serialize;
 
 /// The ISO 14839-2 zone of a displacement ratio `d / C_min`.
 pub fn zone(ratio: f64) -> &'static str {
-    match ratio {
-        r if r < 0.3 => "A",
-        r if r < 0.4 => "B",
-        r if r < 0.5 => "C",
-        _ => "D",
-    }
+    super::iso_zone::grade(ratio, [0.3, 0.4, 0.5])
 }
 
 /// The vibration figures: the governing plane's (the largest `peak / C_min`) at the top,
@@ -38,14 +33,9 @@ pub struct Vibration {
     pub ratio: f64,
     /// `A` … `D`: the governing plane's, the worst.
     pub zone: String,
-    /// Mean coil current per axis (A): x, y of each plane in order.
-    pub current_mean_a: Vec<f64>,
-    /// Largest swing of the coil current about its mean per axis (A).
-    pub current_swing_a: Vec<f64>,
-    /// RMS of the swing per axis (A).
-    pub current_rms_a: Vec<f64>,
-    /// The amplifier's current limit (A).
-    pub current_limit_a: f64,
+    /// The coil currents over the window and the amplifier's limit.
+    #[serde(flatten)]
+    pub coil: Currents,
     /// Settling left out and window (s).
     pub settle_s: f64,
     /// Window (s).
@@ -54,6 +44,20 @@ pub struct Vibration {
     pub plane: String,
     /// Each plane's peak, clearance, ratio and zone.
     pub planes: Vec<PlaneVibration>,
+}
+
+/// The coil currents over the window, per axis (x, y of each plane in order), against the
+/// amplifier's limit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Currents {
+    /// Mean coil current per axis (A).
+    pub current_mean_a: Vec<f64>,
+    /// Largest swing of the coil current about its mean per axis (A).
+    pub current_swing_a: Vec<f64>,
+    /// RMS of the swing per axis (A).
+    pub current_rms_a: Vec<f64>,
+    /// The amplifier's current limit (A).
+    pub current_limit_a: f64,
 }
 
 /// One bearing plane's vibration.
@@ -145,10 +149,7 @@ impl VibrationSink {
             clearance_um: worst.clearance_um,
             ratio: worst.ratio,
             zone: worst.zone,
-            current_mean_a: mean,
-            current_swing_a: swing,
-            current_rms_a: rms,
-            current_limit_a: limit,
+            coil: Currents { current_mean_a: mean, current_swing_a: swing, current_rms_a: rms, current_limit_a: limit },
             settle_s,
             window_s,
             plane: worst.plane,

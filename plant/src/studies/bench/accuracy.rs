@@ -177,7 +177,7 @@ fn timed_row(
         err_max: Some(max),
         wall_s_per_sim_s: m.best_wall / b.scene.duration,
         rhs_evals: Some(m.result.run.stats.rhs_evals),
-        sim_s: Some(m.result.run.simulated),
+        sim_s: Some(m.result.run.clock.simulated),
     })
 }
 

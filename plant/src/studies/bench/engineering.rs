@@ -131,14 +131,13 @@ pub fn table(figures: &[Figures]) -> Vec<EngineeringRow> {
         .collect()
 }
 
-/// Runs the comparison and writes `engineering.csv` into `out`.
+/// Runs the comparison and writes `engineering.csv` into the folder `out`.
 pub fn engineering(
     config_dir: &Path,
     out: &Path,
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<Vec<EngineeringRow>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut runs = Vec::new();
     // The co-simulation scene runs with its law in the plant's process (`sampled`: the
     // arithmetic of lockstep, and of a realtime run without a miss), on its own setting and on
@@ -196,9 +195,9 @@ pub fn command(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
-    let dir = crate::output::out_dir(out, "bench-engineering");
-    engineering(config, &dir, repeats, log)?;
-    Ok(dir.join("engineering.csv"))
+    super::study_into(out, "bench-engineering", "engineering.csv", |dir| {
+        engineering(config, dir, repeats, log).map(drop)
+    })
 }
 
 #[cfg(test)]

@@ -67,6 +67,20 @@ pub const PARKED: &str = "touchdown.race_when_clear=\"parked\"";
 /// Window after the shock over which errors are measured (s).
 pub const WINDOW: f64 = 0.05;
 
+/// Runs a bench study into its folder: `out`, default `runs/<default>`, created first; returns
+/// the path of `table` there (the table the study wrote).
+pub fn study_into(
+    out: Option<&Path>,
+    default: &str,
+    table: &str,
+    study: impl FnOnce(&Path) -> anyhow::Result<()>,
+) -> anyhow::Result<std::path::PathBuf> {
+    let dir = crate::output::out_dir(out, default);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    study(&dir)?;
+    Ok(dir.join(table))
+}
+
 /// The three bench scenes, from the scene files in `config_dir`.
 pub fn scenes(config_dir: &Path) -> anyhow::Result<Vec<BenchScene>> {
     let make = |name, what, file: &str, peak: f64| -> anyhow::Result<BenchScene> {
@@ -139,10 +153,10 @@ pub struct Measured {
 /// Runs a scene `repeats` times (stopping early after a divergence).
 pub fn measure(scene: &Scene, repeats: usize) -> anyhow::Result<Measured> {
     let result = run(scene, &mut Quiet)?;
-    let mut best_wall = result.run.wall_time;
+    let mut best_wall = result.run.clock.wall_time;
     if result.run.outcome == Outcome::Completed {
         for _ in 1..repeats {
-            best_wall = best_wall.min(run(scene, &mut Quiet)?.run.wall_time);
+            best_wall = best_wall.min(run(scene, &mut Quiet)?.run.clock.wall_time);
         }
     }
     Ok(Measured { result, best_wall })

@@ -110,7 +110,6 @@ pub fn models(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<Vec<ModelRow>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut rows = Vec::new();
     for b in super::scenes(config_dir)? {
         let (t0, t1, gap) = (b.window_start, b.window_start + WINDOW, b.scene.plane(0).contact.gap);
@@ -264,7 +263,7 @@ fn machine_run(scene: &Scene, repeats: usize) -> anyhow::Result<MachineRun> {
     let mut sink = DutySink::new(&mut trace, bearing, scene.plane(0).balls.count());
     let run = run_into(scene, &Default::default(), &mut Quiet, &mut sink)?;
     let duty = sink.finish();
-    let mut best = run.wall_time;
+    let mut best = run.clock.wall_time;
     anyhow::ensure!(
         run.outcome == crate::run::Outcome::Completed,
         "scene `{}` did not complete: {:?}",
@@ -272,7 +271,7 @@ fn machine_run(scene: &Scene, repeats: usize) -> anyhow::Result<MachineRun> {
         run.outcome
     );
     for _ in 1..repeats {
-        best = best.min(crate::run::run(scene, &mut Quiet)?.run.wall_time);
+        best = best.min(crate::run::run(scene, &mut Quiet)?.run.clock.wall_time);
     }
     let result = RunResult { trace, run };
     let summary = Summary::new(scene, &result);
@@ -382,9 +381,7 @@ pub fn command(
     repeats: usize,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PathBuf> {
-    let dir = crate::output::out_dir(out, "bench-models");
-    models(config, &dir, repeats, log)?;
-    Ok(dir.join("models.csv"))
+    super::study_into(out, "bench-models", "models.csv", |dir| models(config, dir, repeats, log).map(drop))
 }
 
 /// `plant bench models --redraw CSV`: the charts of an earlier `models.csv` drawn again with

@@ -310,7 +310,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<PathB
                 tick_p999_us: report.tick.p999,
                 tick_max_us: report.tick.max,
                 max_rhs_evals_per_tick: result.run.ticks.max_rhs_evals,
-                wall_time_s: result.run.wall_time,
+                wall_time_s: result.run.clock.wall_time,
                 post_shock_mode: s.analysis.post_shock_mode,
                 max_contact_force_n: s.max_contact_force_n.unwrap_or(f64::NAN),
                 max_radius_m: s.max_radius_m.unwrap_or(f64::NAN),

@@ -74,7 +74,7 @@ fn band_panel(
         ("P(recovered), members counted per point".to_string(), plot::Mark::LineMarker(BLUE, plot::Shape::Circle)),
         ("P = 0.5".to_string(), plot::Mark::Line(grey)),
     ];
-    if stats.iter().any(|s| s.numerically_sensitive > 0) {
+    if stats.iter().any(|s| s.verification.numerically_sensitive > 0) {
         entries.push(("numerically sensitive members".into(), plot::Mark::Open(SENSITIVE, plot::Shape::Circle)));
     }
     if !thresholds.is_empty() {
@@ -97,22 +97,22 @@ fn band_panel(
     let band: Vec<(f64, f64)> = x
         .iter()
         .zip(stats)
-        .map(|(x, s)| (*x, s.tally.p_hi))
-        .chain(x.iter().zip(stats).rev().map(|(x, s)| (*x, s.tally.p_lo)))
+        .map(|(x, s)| (*x, s.tally.share.hi))
+        .chain(x.iter().zip(stats).rev().map(|(x, s)| (*x, s.tally.share.lo)))
         .collect();
     chart.draw_series(std::iter::once(Polygon::new(band, BLUE.mix(0.22).filled()))).map_err(draw_err(path))?;
     chart.draw_series(LineSeries::new([(xr.0, 0.5), (xr.1, 0.5)], grey.stroke_width(1))).map_err(draw_err(path))?;
     chart
-        .draw_series(LineSeries::new(x.iter().zip(stats).map(|(x, s)| (*x, s.tally.p_recovered)), BLUE.stroke_width(2)))
+        .draw_series(LineSeries::new(x.iter().zip(stats).map(|(x, s)| (*x, s.tally.share.value)), BLUE.stroke_width(2)))
         .map_err(draw_err(path))?;
     chart
-        .draw_series(x.iter().zip(stats).map(|(x, s)| Circle::new((*x, s.tally.p_recovered), 4, BLUE.filled())))
+        .draw_series(x.iter().zip(stats).map(|(x, s)| Circle::new((*x, s.tally.share.value), 4, BLUE.filled())))
         .map_err(draw_err(path))?;
     let sensitive: Vec<(f64, f64)> = x
         .iter()
         .zip(stats)
-        .filter(|(_, s)| s.numerically_sensitive > 0)
-        .map(|(x, s)| (*x, s.tally.p_recovered))
+        .filter(|(_, s)| s.verification.numerically_sensitive > 0)
+        .map(|(x, s)| (*x, s.tally.share.value))
         .collect();
     if !sensitive.is_empty() {
         chart
@@ -238,8 +238,11 @@ fn probability_map(
         root.fill(&WHITE).map_err(draw_err(path))?;
         let title = format!("{scene}: probability of recovery over {} × {}", grid.axes[0].key, grid.axes[1].key);
         let root = plot::titled_root(root, path, &title)?;
-        let crossed: Vec<(f64, f64)> =
-            stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| (x[s.index % n1], y[s.index / n1])).collect();
+        let crossed: Vec<(f64, f64)> = stats
+            .iter()
+            .filter(|s| s.verification.numerically_sensitive > 0)
+            .map(|s| (x[s.index % n1], y[s.index / n1]))
+            .collect();
         // The crosses' legend in a strip above the map, never over its cells.
         let root = if crossed.is_empty() {
             root
@@ -265,7 +268,7 @@ fn probability_map(
         chart
             .draw_series(stats.iter().map(|s| {
                 let (c, r) = (s.index % n1, s.index / n1);
-                Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.tally.p_recovered).filled())
+                Rectangle::new([(xe[c], ye[r]), (xe[c + 1], ye[r + 1])], plot::viridis(s.tally.share.value).filled())
             }))
             .map_err(draw_err(path))?;
         chart

@@ -84,6 +84,19 @@ pub struct MemberResult {
 }
 
 impl MemberResult {
+    /// Member `j` of `point`: its draw, its run at the members' setting and its verification;
+    /// no Poincaré points yet.
+    pub fn new(
+        point: &Point,
+        j: usize,
+        draw: &Draw,
+        drawn: Vec<String>,
+        run: Figures,
+        verified: Option<Figures>,
+    ) -> Self {
+        Self { point: point.index, member: j, angle_deg: draw.angle_deg, drawn, run, verified, poincare: Vec::new() }
+    }
+
     /// The run that counts: the verified one if there is one.
     pub fn counted(&self) -> &Figures {
         self.verified.as_ref().unwrap_or(&self.run)
@@ -193,6 +206,15 @@ pub fn verify_overrides(scene: &Scene, rtol: f64) -> Vec<String> {
     ]
 }
 
+/// The overrides of a member's verification run: the point's, the reference setting's, then the
+/// member's draws (`drawn`).
+pub fn verification_overrides(point: &Point, spec: &EnsembleSpec, drawn: &[String]) -> Vec<String> {
+    let mut sets = point.sets.to_vec();
+    sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
+    sets.extend(drawn.iter().cloned());
+    sets
+}
+
 /// `--set` overrides of a draw on a point's scene.
 ///
 /// The angle at the shock's arrival θ sets the unbalance phase at t = 0: with the spin held,
@@ -266,10 +288,7 @@ pub fn run_member(
     drop(result);
     let mut verified = None;
     if spec.verify && close_to_decision(&first, scene.first_shock_start(), spec) {
-        let mut sets = point.sets.clone();
-        sets.extend(verify_overrides(&point.scene, spec.verify_rtol));
-        sets.extend(drawn.iter().cloned());
-        let reference = load_scene(point.path, &sets)?;
+        let reference = load_scene(point.path, &verification_overrides(point, spec, &drawn))?;
         let result = run(&reference, &mut Cancel(stop))?;
         if result.run.outcome == Outcome::Interrupted {
             return Ok(None);
@@ -281,15 +300,7 @@ pub fn run_member(
     if j >= POINCARE_MEMBERS {
         poincare.clear();
     }
-    Ok(Some(MemberResult {
-        point: point.index,
-        member: j,
-        angle_deg: draw.angle_deg,
-        drawn,
-        run: first,
-        verified,
-        poincare,
-    }))
+    Ok(Some(MemberResult { poincare, ..MemberResult::new(point, j, &draw, drawn, first, verified) }))
 }
 
 #[cfg(test)]

@@ -120,9 +120,9 @@ pub fn sweep_thresholds(grid: &Grid, stats: &[PointStats]) -> Vec<Threshold> {
     thresholds_along(
         &values,
         axis.spacing == Spacing::Log,
-        &column(|s| s.tally.p_recovered),
-        &column(|s| s.tally.p_lo),
-        &column(|s| s.tally.p_hi),
+        &column(|s| s.tally.share.value),
+        &column(|s| s.tally.share.lo),
+        &column(|s| s.tally.share.hi),
     )
 }
 
@@ -148,7 +148,7 @@ pub fn write_ensemble(
     let base = grid.scene_for(0)?;
     let thresholds = sweep_thresholds(grid, &stats);
     let sensitive: Vec<String> =
-        stats.iter().filter(|s| s.numerically_sensitive > 0).map(|s| grid.point_name(s.index)).collect();
+        stats.iter().filter(|s| s.verification.numerically_sensitive > 0).map(|s| grid.point_name(s.index)).collect();
     let summary = JsonSummary {
         program: crate::grid::store::PROGRAM,
         kind: grid.kind,
@@ -161,7 +161,7 @@ pub fn write_ensemble(
         sensitive_share: sensitive.len() as f64 / stats.len().max(1) as f64,
         numerically_sensitive_points: sensitive,
         members_run: stats.iter().map(|s| s.tally.members).sum(),
-        members_verified: stats.iter().map(|s| s.verified).sum(),
+        members_verified: stats.iter().map(|s| s.verification.verified).sum(),
     };
     let json_name = if grid.kind == Kind::Ensemble { "ensemble.json" } else { "sweep.json" };
     crate::outfile::write(&dir.join(json_name), (serde_json::to_string_pretty(&summary)? + "\n").as_bytes())?;
@@ -189,7 +189,7 @@ pub fn write_ensemble(
             .map(|s| ModePoint {
                 value: values[s.index].0.unwrap_or(f64::NAN),
                 value2: values[s.index].1,
-                mode: s.post_shock_mode,
+                mode: s.typical.post_shock_mode,
                 poincare: &[],
             })
             .collect();
@@ -264,9 +264,9 @@ fn write_points(
         let v1 = v1.unwrap_or(f64::NAN);
         let mut row = single_fields(
             v1,
-            s.post_shock_mode.map_or("", Mode::name),
-            s.steady_class.map_or("", SteadyClass::name),
-            s.period_k,
+            s.typical.post_shock_mode.map_or("", Mode::name),
+            s.typical.steady_class.map_or("", SteadyClass::name),
+            s.typical.period_k,
             s.contact_fraction,
             s.whirl_hz,
             s.max_radius_m,
@@ -284,15 +284,15 @@ fn write_points(
                 dry_whirl: s.tally.dry_whirl.to_string(),
                 rebound: s.tally.rebound.to_string(),
                 diverged: s.tally.diverged.to_string(),
-                p_recovered: e(s.tally.p_recovered),
-                p_lo: e(s.tally.p_lo),
-                p_hi: e(s.tally.p_hi),
-                recovery_median_s: opt(s.tally.recovery_median_s),
-                recovery_p90_s: opt(s.tally.recovery_p90_s),
+                p_recovered: e(s.tally.share.value),
+                p_lo: e(s.tally.share.lo),
+                p_hi: e(s.tally.share.hi),
+                recovery_median_s: opt(s.tally.recovery.median_s),
+                recovery_p90_s: opt(s.tally.recovery.p90_s),
                 worst_contact_force_n: e(s.worst_contact_force_n),
-                verified: s.verified.to_string(),
-                numerically_sensitive: s.numerically_sensitive.to_string(),
-                sensitive: (s.numerically_sensitive > 0).to_string(),
+                verified: s.verification.verified.to_string(),
+                numerically_sensitive: s.verification.numerically_sensitive.to_string(),
+                sensitive: (s.verification.numerically_sensitive > 0).to_string(),
                 stopped_by: crate::summary::snake_name(&s.stopped_by),
             }
             .into_fields(),

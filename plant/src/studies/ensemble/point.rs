@@ -13,7 +13,7 @@ use crate::analysis::classify::SteadyClass;
 use crate::ensemble::member::MemberResult;
 use crate::ensemble::spec::EnsembleSpec;
 use crate::ensemble::stats::{quantile, wilson};
-use crate::ensemble::tally::{tally, Tally};
+use crate::ensemble::tally::{tally, Tally, Verification};
 use crate::grid::{Mode, Progress};
 use crate::status::Status;
 use serde::Serialize;
@@ -66,19 +66,12 @@ pub struct PointStats {
     pub tally: Tally,
     /// Largest peak contact force of all members (N).
     pub worst_contact_force_n: f64,
-    /// Members re-run at the reference setting.
-    pub verified: usize,
-    /// Verified members whose mode changed.
-    pub numerically_sensitive: usize,
+    /// Members re-run at the reference setting, and of those, members whose mode changed.
+    pub verification: Verification,
     /// Which rule stopped the point: `members`, `width` or `agree`.
     pub stopped_by: StoppedBy,
-    /// The most frequent mode (ties: recovered, dry whirl, rebound, diverged); none without
-    /// members.
-    pub post_shock_mode: Option<Mode>,
-    /// The most frequent steady class (ties: the first by name); none without members.
-    pub steady_class: Option<SteadyClass>,
-    /// The most frequent period k among members of that class.
-    pub period_k: Option<u32>,
+    /// The members' most frequent mode, steady class and period k.
+    pub typical: Typical,
     /// Mean contact fraction.
     pub contact_fraction: f64,
     /// Median whirl rate (Hz).
@@ -89,6 +82,17 @@ pub struct PointStats {
     pub status: Status,
 }
 
+/// The most frequent outcome of a point's counted members; each `None` without members.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Typical {
+    /// The most frequent mode (ties: recovered, dry whirl, rebound, diverged).
+    pub post_shock_mode: Option<Mode>,
+    /// The most frequent steady class (ties: the first by name).
+    pub steady_class: Option<SteadyClass>,
+    /// The most frequent period k among members of that class.
+    pub period_k: Option<u32>,
+}
+
 impl Serialize for PointStats {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
@@ -96,12 +100,12 @@ impl Serialize for PointStats {
         st.serialize_field("index", &self.index)?;
         self.tally.serialize_fields(&mut st)?;
         st.serialize_field("worst_contact_force_n", &self.worst_contact_force_n)?;
-        st.serialize_field("verified", &self.verified)?;
-        st.serialize_field("numerically_sensitive", &self.numerically_sensitive)?;
+        st.serialize_field("verified", &self.verification.verified)?;
+        st.serialize_field("numerically_sensitive", &self.verification.numerically_sensitive)?;
         st.serialize_field("stopped_by", &self.stopped_by)?;
-        st.serialize_field("post_shock_mode", &self.post_shock_mode)?;
-        st.serialize_field("steady_class", &self.steady_class)?;
-        st.serialize_field("period_k", &self.period_k)?;
+        st.serialize_field("post_shock_mode", &self.typical.post_shock_mode)?;
+        st.serialize_field("steady_class", &self.typical.steady_class)?;
+        st.serialize_field("period_k", &self.typical.period_k)?;
         st.serialize_field("contact_fraction", &self.contact_fraction)?;
         st.serialize_field("whirl_hz", &self.whirl_hz)?;
         st.serialize_field("max_radius_m", &self.max_radius_m)?;
@@ -117,11 +121,9 @@ fn most_frequent<T: PartialEq + Copy>(items: &[T], order: &[T]) -> Option<T> {
     order.iter().copied().find(|o| count(o) == best)
 }
 
-/// The statistics of a point's counted members (`members` sorted by index).
-pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedBy) -> PointStats {
-    let n = members.len();
+/// The most frequent outcome of `members`.
+fn typical(members: &[&MemberResult]) -> Typical {
     let modes: Vec<Mode> = members.iter().map(|m| m.counted().mode).collect();
-    let mode = most_frequent(&modes, &Mode::ALL);
     let classes: Vec<SteadyClass> = members.iter().map(|m| m.counted().steady_class).collect();
     let mut by_name = SteadyClass::ALL;
     by_name.sort_by_key(|c| c.name());
@@ -134,21 +136,26 @@ pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedB
     let mut k_order = ks.clone();
     k_order.sort_unstable();
     k_order.dedup();
-    let period_k = most_frequent(&ks, &k_order);
+    Typical {
+        post_shock_mode: most_frequent(&modes, &Mode::ALL),
+        steady_class: class,
+        period_k: most_frequent(&ks, &k_order),
+    }
+}
+
+/// The statistics of a point's counted members (`members` sorted by index).
+pub fn point_stats(index: usize, members: &[&MemberResult], stopped_by: StoppedBy) -> PointStats {
+    let n = members.len();
     let t = tally(members);
-    let (verified, numerically_sensitive) = super::tally::verified(members);
     let whirl: Vec<f64> = members.iter().map(|m| m.counted().whirl_hz).collect();
     let max = |f: fn(&MemberResult) -> f64| members.iter().map(|m| f(m)).filter(|v| v.is_finite()).fold(0.0, f64::max);
     PointStats {
         index,
         tally: t,
         worst_contact_force_n: max(|m| m.counted().max_contact_force_n),
-        verified,
-        numerically_sensitive,
+        verification: super::tally::verified(members),
         stopped_by,
-        post_shock_mode: mode,
-        steady_class: class,
-        period_k,
+        typical: typical(members),
         contact_fraction: if n > 0 {
             members.iter().map(|m| m.counted().contact_fraction).sum::<f64>() / n as f64
         } else {

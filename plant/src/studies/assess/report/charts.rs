@@ -295,13 +295,13 @@ pub(super) fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, Strin
                 l.rungs
                     .iter()
                     .filter(|x| x.tally.members > 0)
-                    .map(|x| (x.peak_g, x.tally.p_lo, x.tally.p_hi))
+                    .map(|x| (x.peak_g, x.tally.share.lo, x.tally.share.hi))
                     .collect(),
             )
         })
         .collect();
     // A ladder interrupted or stopped before any member was counted has nothing to draw.
-    let lines = series(&|x| Some(x.tally.p_recovered), false, "");
+    let lines = series(&|x| Some(x.tally.share.value), false, "");
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_probability.png");
         let min_p = format!("required probability (min_p = {})", r.ladder_settings.min_p);
@@ -316,8 +316,8 @@ pub(super) fn ladder_charts(dir: &Path, r: &Report) -> Result<Vec<(String, Strin
         )?;
         out.push(("ladder_probability.png".into(), "Probability of recovery per rung".into()));
     }
-    let mut lines = series(&|x| x.tally.recovery_median_s.map(|v| v * 1e3), false, " median");
-    lines.extend(series(&|x| x.tally.recovery_p90_s.map(|v| v * 1e3), true, " p90"));
+    let mut lines = series(&|x| x.tally.recovery.median_s.map(|v| v * 1e3), false, " median");
+    lines.extend(series(&|x| x.tally.recovery.p90_s.map(|v| v * 1e3), true, " p90"));
     if lines.iter().any(|l| !l.points.is_empty()) {
         let p = dir.join("ladder_recovery.png");
         chart(

@@ -149,9 +149,9 @@ fn vibration(c: &ControllerReport) -> String {
                 .collect::<Vec<_>>()
                 .join("; "),
             v.speed_hz,
-            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_limit_a
+            v.coil.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.coil.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.coil.current_limit_a
         ),
         Some(v) => format!(
             "zone <b>{}</b>: {:.2} µm = {:.3} C_min (C_min = {:.0} µm) at {:.0} Hz; coil current swing {} A (RMS {} A) of {:.1} A",
@@ -160,9 +160,9 @@ fn vibration(c: &ControllerReport) -> String {
             v.ratio,
             v.clearance_um,
             v.speed_hz,
-            v.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
-            v.current_limit_a
+            v.coil.current_swing_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.coil.current_rms_a.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" / "),
+            v.coil.current_limit_a
         ),
         None => format!("<span class=\"bad\">{}</span>: {}", c.vibration.status, esc(c.vibration.why.as_deref().unwrap_or(""))),
     }
@@ -183,7 +183,7 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 let at = l.rungs.iter().find(|x| x.peak_g == g).map_or(String::new(), |x| {
                     format!(
                         "; at {g} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
+                        x.tally.recovered, x.tally.members, x.tally.share.lo, x.tally.share.hi
                     )
                 });
                 format!(
@@ -195,7 +195,7 @@ fn highest_safe(c: &ControllerReport, r: &Report) -> String {
                 let first = l.rungs.iter().find(|x| x.tally.members > 0).map_or(String::new(), |x| {
                     format!(
                         ": at {} G {}/{} recovered, [{:.2}, {:.2}]",
-                        x.peak_g, x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi
+                        x.peak_g, x.tally.recovered, x.tally.members, x.tally.share.lo, x.tally.share.hi
                     )
                 });
                 format!(

@@ -90,9 +90,9 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
             parts.push(format!(
                 "at {duty_g} G{}: P = {:.2} [{:.2}, {:.2}], median {:.3} s in contact, {:.0} J friction, peak ball {:.0} MPa",
                 if rung.complete { "" } else { " (incomplete)" },
-                rung.tally.p_recovered,
-                rung.tally.p_lo,
-                rung.tally.p_hi,
+                rung.tally.share.value,
+                rung.tally.share.lo,
+                rung.tally.share.hi,
                 d.contact_time_s.median.unwrap_or(f64::NAN),
                 d.friction_energy_j.median.unwrap_or(f64::NAN),
                 d.peak_ball_pressure_mpa.median.unwrap_or(f64::NAN)
@@ -108,7 +108,10 @@ pub fn verdict(r: &ControllerReport, duty_g: f64, min_p: f64) -> String {
 /// [lower, upper], or where none is safe the first rung's (the one that failed), and the counts.
 fn safe_words(l: &LadderResult, min_p: f64) -> String {
     let interval = |x: &Rung| {
-        format!("{}/{} recovered, [{:.2}, {:.2}]", x.tally.recovered, x.tally.members, x.tally.p_lo, x.tally.p_hi)
+        format!(
+            "{}/{} recovered, [{:.2}, {:.2}]",
+            x.tally.recovered, x.tally.members, x.tally.share.lo, x.tally.share.hi
+        )
     };
     match l.safe_up_to_g {
         Some(g) => {
