@@ -27,7 +27,7 @@ pub use raw::{
     ControlMode, DragChoice, Fallback, ForceLaw, McapCompression, Pacing, RaceWhenClearChoice, RawController, RawScene,
     RealtimeSetting, ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
-pub use rotor::{Rotor, RotorParams};
+pub use rotor::{FailureState, Rotor, RotorParams};
 pub use validate::{finite, non_negative, positive, range, validate};
 
 use crate::integrate::Method;

@@ -3,10 +3,10 @@
 
 use super::{RawRotor, RotorKeys, RotorModel, RotorParams};
 use crate::config::scene_table::scene_table;
-use crate::machine::{mid_span_weight, FailureState, FlexibleLinear, Linearised, Machine};
+use crate::machine::{mid_span_weight, FlexibleLinear, Linearised};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
-use plant_physics::flex::machine::{self as flexible, Model, N};
+use plant_physics::flex::machine as flexible;
 use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane;
@@ -115,14 +115,6 @@ impl RotorParams for flexible::Params {
 
     fn plane_mut(&mut self, i: usize) -> &mut Params {
         &mut self.machine.planes[i].params
-    }
-
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        Model::atol(groups).to_vec()
-    }
-
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
-        Some(Model::failure(t, y.get(..N)?.try_into().ok()?))
     }
 
     fn record_defaults(&self, rotor: &mut RawRotor) {

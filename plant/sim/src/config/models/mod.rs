@@ -19,25 +19,48 @@ pub use table::{RawRotor, RotorShared, SpinChoice};
 pub use two_plane::TwoPlaneKeys;
 
 use super::ConfigError;
-use crate::machine::{FailureState, Linearised};
+use crate::machine::{Builds, FailureOf, Linearised, Machine};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
-use plant_physics::flex::machine as flexible_machine;
 use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane as rigid;
 use serde::{Deserialize, Serialize};
 
-/// Declares the rotor models, each once: its doc, its variant, `rotor.model`'s name for it, the
-/// model in words and what a rotor of it is (for messages), its key struct (`[rotor]`'s own
-/// keys, in its file) and its validated parameters. Gives [`RotorModel`] (the names), [`RotorKeys`]
-/// (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's validated
-/// rotor) and the one dispatch of each on the model; the compiler points a new model to what it
-/// must give (its key struct's [`Build`], its parameters' [`RotorParams`]).
+/// The one list of rotor models, handed to the macro `$then`: each model once, with its doc, its
+/// variant, `rotor.model`'s name for it, the model in words and what a rotor of it is (for
+/// messages), its key struct (`[rotor]`'s own keys, in its file of `config/models/`), its
+/// validated parameters and its state (`[f64; N]`; the model that the parameters build is in its
+/// file of `machine/`, [`Builds`]). Expanded here ([`declare_models`]: [`RotorModel`],
+/// [`RotorKeys`], [`Rotor`], [`FailureState`] and their dispatch on the model) and by
+/// `stepper::with_machine` (the model built and stepped): a new model is a line here, and the
+/// compiler points to what it must give (its key struct's [`Build`], its parameters'
+/// [`RotorParams`] and [`Builds`]).
 macro_rules! rotor_models {
+    ($then:ident) => {
+        $then! {
+            /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
+            Planar = "planar", "the planar rotor", "rigid, on one bearing plane":
+                PlanarKeys => plant_physics::model::Params, [f64; plant_physics::model::N];
+            /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
+            TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes":
+                TwoPlaneKeys => plant_physics::two_plane::Params, [f64; plant_physics::two_plane::N];
+            /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
+            Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
+                FlexibleKeys => plant_physics::flex::machine::Params, [f64; plant_physics::flex::machine::N];
+        }
+    };
+}
+pub(crate) use rotor_models;
+
+/// Declares, from the list of models ([`rotor_models`]), [`RotorModel`] (the names),
+/// [`RotorKeys`] (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's
+/// validated rotor), [`FailureState`] (a run's failing state) and the one dispatch of each on
+/// the model.
+macro_rules! declare_models {
     ($(
         $(#[$doc:meta])*
-        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty;
+        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty, [f64; $n:path];
     )+) => {
         /// `rotor.model`: the rotor model (the tag of `[rotor]`; `planar` when absent).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -125,19 +148,40 @@ macro_rules! rotor_models {
             pub fn params_mut(&mut self) -> &mut dyn RotorParams {
                 match self { $(Rotor::$variant(p) => p,)+ }
             }
+
+            /// Absolute tolerances per state component of the model, laid out from those of
+            /// positions (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
+            /// ([`Machine::atol`]).
+            pub fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
+                match self {
+                    $(Rotor::$variant(_) => <<$params as Builds<{ $n }>>::Machine as Machine<{ $n }>>::atol(groups).to_vec(),)+
+                }
+            }
+
+            /// The failing state of a run that stopped at time `t` in state `y` (the model's part
+            /// of the state first, the hardware's after it); `None` if `y` holds less than the
+            /// model's state.
+            pub fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
+                Some(match self {
+                    $(Rotor::$variant(_) => FailureState::$variant(
+                        <<$params as Builds<{ $n }>>::Machine as Machine<{ $n }>>::failure(t, y.get(..$n)?.try_into().ok()?),
+                    ),)+
+                })
+            }
+        }
+
+        /// The state a diverged run failed in (`failure_state` in `summary.json`), as its rotor
+        /// model lays it out ([`Machine::failure`], its struct in the model's file of
+        /// `machine/`); non-finite values are written as `null`.
+        #[derive(Clone, Debug, PartialEq, Serialize)]
+        #[serde(untagged)]
+        pub enum FailureState {
+            $( $(#[$doc])* $variant(FailureOf<$params, { $n }>), )+
         }
     };
 }
 
-rotor_models! {
-    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
-    Planar = "planar", "the planar rotor", "rigid, on one bearing plane": PlanarKeys => Params;
-    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
-    TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes": TwoPlaneKeys => rigid::Params;
-    /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
-    Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
-        FlexibleKeys => flexible_machine::Params;
-}
+rotor_models!(declare_models);
 
 /// `planar` when `[rotor]` has no `model`.
 impl Default for RotorModel {
@@ -179,15 +223,6 @@ pub trait RotorParams {
 
     /// Plane `i`'s bearing, mutable (a sweep or a test that moves one plane's value).
     fn plane_mut(&mut self, i: usize) -> &mut Params;
-
-    /// Absolute tolerances per state component of the model, laid out from those of positions
-    /// (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
-    /// ([`crate::machine::Machine::atol`]).
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64>;
-
-    /// The failing state of a run that stopped at time `t` in state `y` (the model's part of
-    /// the state first); `None` if `y` holds less than the model's state.
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState>;
 
     /// Writes the model's defaults into the `[rotor]` table it was built from (as the user would have
     /// written them, in the file's units), so that the resolved `scene.toml` states them. The

@@ -4,8 +4,7 @@
 
 use super::{RotorModel, RotorParams};
 use crate::config::scene_table::scene_table;
-use crate::machine::{FailureState, Machine};
-use crate::model::{Model, Params, N};
+use crate::model::Params;
 use serde::{Deserialize, Serialize};
 
 scene_table! {
@@ -30,13 +29,5 @@ impl RotorParams for Params {
     fn plane_mut(&mut self, i: usize) -> &mut Params {
         assert_eq!(i, 0, "the planar rotor has one bearing plane");
         self
-    }
-
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        Model::atol(groups).to_vec()
-    }
-
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
-        Some(Model::failure(t, y.get(..N)?.try_into().ok()?))
     }
 }

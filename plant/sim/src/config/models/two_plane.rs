@@ -3,9 +3,9 @@
 
 use super::{RawRotor, RotorKeys, RotorModel, RotorParams};
 use crate::config::scene_table::scene_table;
-use crate::machine::{FailureState, Linearised, Machine};
+use crate::machine::Linearised;
 use crate::model::Params;
-use plant_physics::two_plane::{self, Model, N};
+use plant_physics::two_plane;
 use serde::{Deserialize, Serialize};
 
 /// `transverse_inertia_kg_m2` when none is given (kg·m²).
@@ -71,14 +71,6 @@ impl RotorParams for two_plane::Params {
 
     fn plane_mut(&mut self, i: usize) -> &mut Params {
         &mut self.planes[i].params
-    }
-
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        Model::atol(groups).to_vec()
-    }
-
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
-        Some(Model::failure(t, y.get(..N)?.try_into().ok()?))
     }
 
     fn record_defaults(&self, rotor: &mut RawRotor) {
