@@ -21,6 +21,8 @@ pub mod rotor;
 mod rotor_tests;
 mod scene_table;
 pub mod validate;
+// The checks every key goes through (below `models` and `validate`, which both use them).
+mod checks;
 
 pub use overrides::apply_override;
 pub use raw::{

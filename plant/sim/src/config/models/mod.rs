@@ -26,6 +26,7 @@ use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane as rigid;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The one list of rotor models, handed to the macro `$then`: each model once, with its doc, its
 /// variant, `rotor.model`'s name for it, the model in words and what a rotor of it is (for
@@ -121,10 +122,7 @@ macro_rules! declare_models {
 
             /// The model's parameters built from its keys with what the scene's validation gives
             /// (`ctx`, [`Build`]).
-            pub fn build<Ctx>(&self, ctx: &Ctx) -> Result<Rotor, ConfigError>
-            where
-                $($keys: Build<Ctx, Params = $params>,)+
-            {
+            pub(crate) fn build(&self, ctx: &dyn BuildContext) -> Result<Rotor, ConfigError> {
                 Ok(match self { $(RotorKeys::$variant(k) => Rotor::$variant(k.build(ctx)?),)+ })
             }
         }
@@ -196,17 +194,55 @@ impl Default for RotorKeys {
     }
 }
 
-/// A model's key struct built into the model's parameters with `Ctx`, what the scene's
-/// validation gives it (`config::validate`'s context: the scene as written, the shared keys
-/// validated, the scene's folder). Implemented beside the validation (`config/validate/`), which
-/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
-/// imports neither.
-pub trait Build<Ctx> {
+/// A model's key struct built into the model's parameters (in the model's file, beside its
+/// keys), with what the scene's validation gives it ([`BuildContext`]).
+pub(crate) trait Build {
     /// The model's validated parameters.
     type Params;
 
     /// The model's parameters, each error naming the key, value and unit.
-    fn build(&self, ctx: &Ctx) -> Result<Self::Params, ConfigError>;
+    fn build(&self, ctx: &dyn BuildContext) -> Result<Self::Params, ConfigError>;
+}
+
+/// What a model's builder ([`Build`]) asks of the scene being validated: the shared `[rotor]`
+/// keys, the scene's folder and its bearing planes, each from the bearing tables (`[touchdown]`,
+/// `[contact]`, `[amb]`), validated as for every model. Implemented by `config::validate`, which
+/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
+/// imports neither.
+pub(crate) trait BuildContext {
+    /// The shared `[rotor]` keys, validated: the whole rotor.
+    fn whole(&self) -> &Share;
+
+    /// The scene's folder (a model's files are named from it).
+    fn base_dir(&self) -> &Path;
+
+    /// A model's one bearing plane, from the shared tables with the rotor's `share`; a
+    /// two-plane rotor's per-plane tables and initial slopes are refused by name (each would be
+    /// ignored otherwise).
+    fn single_plane(&self, share: &Share) -> Result<Params, ConfigError>;
+
+    /// Bearing plane `i` (0 is A, 1 is B): the shared tables with the plane's own
+    /// (`[touchdown.a]`, …) set over them, with the plane's `share` of the rotor.
+    fn plane(&self, i: usize, share: &Share) -> Result<Params, ConfigError>;
+}
+
+/// The rotor's values a bearing plane's planar parameters take: for the planar model the
+/// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
+pub(crate) struct Share {
+    /// Gravity (m/s²).
+    pub(crate) gravity: f64,
+    /// Mass (kg).
+    pub(crate) mass: f64,
+    /// Eccentricity of the static unbalance (m).
+    pub(crate) eccentricity: f64,
+    /// Polar moment of inertia (kg·m²).
+    pub(crate) inertia: f64,
+    /// Radius at the touchdown bearing (m).
+    pub(crate) radius: f64,
+    /// Spin speed (rad/s).
+    pub(crate) speed: f64,
+    /// Spin: held or driven.
+    pub(crate) spin: crate::model::Spin,
 }
 
 /// A rotor model's parameters, as the scene and the rest of the plant ask of them.
