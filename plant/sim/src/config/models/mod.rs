@@ -1,7 +1,8 @@
 //! The rotor models: their one list ([`rotor_models!`]: `rotor.model`'s names, each model's key
-//! struct and parameters), and what each model says of itself, the [`RotorParams`] trait, one
-//! implementation per model in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`) beside its
-//! `[rotor]` keys and their defaults. [`Rotor`] dispatches to it once ([`Rotor::params`]); a
+//! struct, parameters and state), and what each model says of itself, the [`RotorParams`] trait,
+//! one implementation per model in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`) beside
+//! its `[rotor]` keys, their defaults and their builder ([`Build`], with what the scene's
+//! validation gives, [`BuildContext`]). [`Rotor`] dispatches to it once ([`Rotor::params`]); a
 //! capability one model has and the others do not (bending, a linear open loop, whirl modes) is
 //! a method with a default, so a new model says only what it has. `[rotor]` as written is
 //! [`RawRotor`] (`table.rs`): the shared keys and the model's key struct, which refuses every key
@@ -10,7 +11,7 @@
 pub(in crate::config) mod flexible;
 mod planar;
 mod table;
-pub(in crate::config) mod two_plane;
+mod two_plane;
 
 pub use flexible::FlexibleKeys;
 pub use flexible::RossAxes;
