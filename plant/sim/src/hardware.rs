@@ -29,7 +29,7 @@
 //! sampled controller's.
 
 pub use crate::config::hardware::Hardware;
-use crate::machine::{FailureState, Machine, PlaneState};
+use crate::machine::{Machine, PlaneState};
 use crate::model::{Control, Params, Release};
 use crate::rows::{Record, RowHw, RowMagnets};
 use crate::sensor::{runout, runout_rate};
@@ -429,7 +429,9 @@ impl<M: Machine<N> + Clone, const N: usize, const NA: usize> Machine<NA> for Wir
     }
 
     /// The model's failing state (the hardware's states are not in it).
-    fn failure(t: f64, y: &[f64; NA]) -> FailureState {
+    type Failure = M::Failure;
+
+    fn failure(t: f64, y: &[f64; NA]) -> M::Failure {
         M::failure(t, &split::<N, NA>(y).0)
     }
 

@@ -41,7 +41,7 @@ pub fn static_gains(scene: &Scene) -> [Option<f64>; 2] {
 /// bias). Its rest is then where the sensors read zero with each plane's share of the weight
 /// carried, which is the design's rest with the gravity bias (the bias and the preloaded
 /// integral give the same current at a zero reading): the flexible rotor's start is solved so
-/// (`crate::initial::flexible_initial_state`). `false` in continuous mode and for a command the
+/// (the flexible rotor's `machine::Builds::initial_state`). `false` in continuous mode and for a command the
 /// plant cannot build.
 pub fn holds_weight(scene: &Scene) -> bool {
     let c = &scene.controller;

@@ -43,17 +43,15 @@
 use crate::config::{Rotor, Scene};
 use crate::hardware::{Wired, EXTRA, EXTRA_UNIPOLAR};
 pub use crate::hooks::Excitation;
-use crate::initial::initial_state;
 use crate::integrate::{IntegrationError, Integrator, Settings, Stats, System};
-use crate::machine::Machine;
-use crate::model::{Control, Model, RaceWhenClear};
+use crate::machine::{Builds, Machine};
+use crate::model::{Control, RaceWhenClear};
 use crate::run::{plane_gains, settings_with, PlantError, RunError, Sink, TickCost};
 use crate::sensor::Sensor;
 use crate::snapshot::{Fingerprint, Snapshot, SnapshotError};
 use crate::tick_time::{Tet, TickTime};
 use controller::{wrap_angle, PdGains, RotorSample, ROTOR_AXES};
 use plant_physics::integrate::AdaptiveState;
-use plant_physics::two_plane;
 use std::time::{Duration, Instant};
 
 /// What the plant applies over one tick.
@@ -96,45 +94,32 @@ pub trait WithMachine {
         M: Machine<N> + Clone + 'static;
 }
 
-/// The scene's rotor model built from its parameters with `controls` (one per plane; a planar
-/// model takes the first), at its initial state (levitated on the unbalance orbit, each race at
-/// rest), handed to `what`. The one place the plant tells the rotor models apart: a new model
-/// is an arm here.
-pub fn with_machine<W: WithMachine>(scene: &Scene, controls: [Control; 2], what: W) -> W::Output {
-    match &scene.rotor {
-        Rotor::Planar(params) => {
-            const N: usize = crate::model::N;
-            let model =
-                Model { params: params.clone(), base: scene.base.clone(), control: controls[0], race_parked: false };
-            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, initial_state(scene, params))
+/// Writes [`with_machine`] from the list of models (`config::models::rotor_models!`): an arm per
+/// model, each with the model's state length, which the hardware's lengths are added to here
+/// (a sum of a generic constant is not a type's parameter in stable Rust).
+macro_rules! with_machine {
+    ($(
+        $(#[$doc:meta])*
+        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty, [f64; $n:path];
+    )+) => {
+        /// The scene's rotor model built from its parameters with `controls` (one per plane; a
+        /// planar model takes the first), at its initial state (levitated on the unbalance orbit,
+        /// each race at rest), handed to `what`. The one place the plant tells the rotor models
+        /// apart, an arm per model of the list ([`Builds`], in each model's file of `machine/`).
+        pub fn with_machine<W: WithMachine>(scene: &Scene, controls: [Control; 2], what: W) -> W::Output {
+            match &scene.rotor {
+                $(Rotor::$variant(params) => {
+                    const N: usize = $n;
+                    let model = Builds::<N>::machine(params, &scene.base, controls);
+                    let y = crate::initial::start(scene, |start| Builds::<N>::initial_state(params, start));
+                    what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, y)
+                })+
+            }
         }
-        Rotor::TwoPlane(params) => {
-            const N: usize = two_plane::N;
-            let model = two_plane::Model {
-                params: params.clone(),
-                base: scene.base.clone(),
-                control: controls,
-                race_parked: [false; 2],
-            };
-            let y = crate::initial::two_plane_initial_state(scene, params);
-            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, y)
-        }
-        Rotor::Flexible(params) => {
-            use plant_physics::flex::machine as flexible;
-            const N: usize = flexible::N;
-            // At rest on its bearings under gravity (the sagged shaft), the two-plane rotor's
-            // unbalance orbit and offsets on top as a rigid motion of the shaft.
-            let y = crate::initial::flexible_initial_state(scene, params);
-            let model = flexible::Model {
-                params: params.clone(),
-                base: scene.base.clone(),
-                control: controls,
-                race_parked: [false; 2],
-            };
-            what.with::<_, N, { N + EXTRA }, { N + EXTRA_UNIPOLAR }>(model, y)
-        }
-    }
+    };
 }
+
+crate::config::models::rotor_models!(with_machine);
 
 /// [`Plant::new`]'s [`WithMachine`]: the stepper of the model, wrapped in the scene's hardware
 /// ([`Wired`]) when it has amplifiers or a sensor front end.

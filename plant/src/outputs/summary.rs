@@ -383,7 +383,8 @@ impl Summary {
     }
 }
 
-pub use crate::machine::{FailureState, PlanarFailure, RaceFailure, TwoPlaneFailure};
+pub use crate::config::FailureState;
+pub use crate::machine::{PlanarFailure, RaceFailure, TwoPlaneFailure};
 
 /// The failing state of a divergence of a run of `scene` ([`crate::config::Rotor::failure`]):
 /// the rotor model's part of the state (the hardware's states of a run with amplifiers or a

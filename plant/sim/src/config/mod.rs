@@ -21,13 +21,15 @@ pub mod rotor;
 mod rotor_tests;
 mod scene_table;
 pub mod validate;
+// The checks every key goes through (below `models` and `validate`, which both use them).
+mod checks;
 
 pub use overrides::apply_override;
 pub use raw::{
     ControlMode, DragChoice, Fallback, ForceLaw, McapCompression, Pacing, RaceWhenClearChoice, RawController, RawScene,
     RealtimeSetting, ReleaseChoice, RotorModel, SpinChoice, SupportChoice,
 };
-pub use rotor::{Rotor, RotorParams};
+pub use rotor::{FailureState, Rotor, RotorParams};
 pub use validate::{finite, non_negative, positive, range, validate};
 
 use crate::integrate::Method;

@@ -7,8 +7,8 @@
 //! by the model itself through [`crate::machine::Machine`].
 //! docs/ARCHITECTURE.md ("Adding a rotor model") lists what a new model touches.
 
+pub use super::models::{FailureState, Rotor, RotorParams};
 use super::models::{RawRotor, RotorModel};
-pub use super::models::{Rotor, RotorParams};
 use crate::model::Params;
 
 impl Rotor {
@@ -110,20 +110,6 @@ impl Rotor {
             bearing_z_m: [a.station, b.station],
             sensor_z_m: [a.sensor, b.sensor],
         })
-    }
-
-    /// Absolute tolerances per state component of the model, laid out from those of
-    /// positions (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
-    /// ([`crate::machine::Machine::atol`]).
-    pub fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        self.params().atol(groups)
-    }
-
-    /// The failing state of a run that stopped at time `t` in state `y` (the model's part of
-    /// the state first, the hardware's after it); `None` if `y` holds less than the model's
-    /// state.
-    pub fn failure(&self, t: f64, y: &[f64]) -> Option<crate::machine::FailureState> {
-        self.params().failure(t, y)
     }
 
     /// The rotor linearised about the centre on the continuous PD `gains` of each plane, for its

@@ -7,7 +7,7 @@
 //! rotor at mid-span ([`mid_span`], the trace's `mid_dx_m`, `mid_dy_m`).
 
 use super::two_plane::RaceFailure;
-use super::{FailureState, Linearised, Machine, PlaneState, WhirlMode};
+use super::{Builds, Linearised, Machine, PlaneState, Start, WhirlMode};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
 use crate::rows::{self, Record};
@@ -16,6 +16,7 @@ use plant_physics::flex::linear::{OpenLoop, PlanePd};
 use plant_physics::flex::machine::{ix, Model, Params as FlexParams, State, MAX_MODES, N};
 use plant_physics::flex::reduce::Kind;
 use serde::Serialize;
+use shock_table::Programme;
 
 /// The flexible rotor's failing state.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -222,7 +223,9 @@ impl Machine<N> for Model {
         t
     }
 
-    fn failure(t: f64, y: &State) -> FailureState {
+    type Failure = FlexibleFailure;
+
+    fn failure(t: f64, y: &State) -> FlexibleFailure {
         let race = |x: usize| RaceFailure {
             race_radius_m: y[x].hypot(y[x + 1]),
             race_m: [y[x], y[x + 1]],
@@ -231,14 +234,52 @@ impl Machine<N> for Model {
         };
         // The node displacements need the model's basis, which `failure` does not have: the
         // races and the spin are what the state alone says.
-        FailureState::Flexible(FlexibleFailure {
+        FlexibleFailure {
             t_s: t,
             rotor_at_touchdown_m: [[f64::NAN; 2]; 2],
             rotor_velocity_at_touchdown_m_s: [[f64::NAN; 2]; 2],
             rotor_spin: [y[ix::TR], y[ix::WR]],
             race_a: race(ix::RACE_A),
             race_b: race(ix::RACE_B),
-        })
+        }
+    }
+}
+
+impl Builds<N> for FlexParams {
+    type Machine = Model;
+
+    fn machine(&self, base: &Programme, controls: [Control; 2]) -> Model {
+        Model { params: self.clone(), base: base.clone(), control: controls, race_parked: [false; 2] }
+    }
+
+    /// At rest on its bearings (the shaft sagged under gravity, the bias currents and the
+    /// levitation design's loop, or the run's law where it has a static gain:
+    /// [`plant_physics::flex::initial::static_sag_with`]), with the two-plane rotor's unbalance
+    /// orbit and the scene's `[initial]` offsets as a rigid motion of the shaft on top of it.
+    fn initial_state(&self, start: &Start<'_>) -> State {
+        // The rigid rotor's start without its sag under gravity (the shaft's own is solved for
+        // below, with or without the gravity bias): its unbalance orbit, offsets and races.
+        let rigid_start = super::two_plane::rigid_conditions(start, true);
+        let rigid = plant_physics::two_plane::initial::initial_state(&self.machine, &rigid_start);
+        let mut y = Model::from_rigid(self, &rigid);
+        let ic = &start.conditions;
+        let at_rest = (start.law_at_rest)();
+        let design = controller::PdDesign {
+            stiffness_n_per_m: ic.stiffness,
+            damping_ratio: ic.damping_ratio,
+            // A law whose integral holds the weight from the start rests as the bias would hold it.
+            gravity_bias: ic.gravity_bias || at_rest.holds_weight,
+        };
+        // A shaft the levitation design cannot hold still has no equilibrium to start from: it
+        // starts straight (the rigid start), and the run shows it move.
+        // Held by the run's law at rest where it has a static gain (crate::rest_law).
+        let kp = at_rest.static_gains;
+        if let Some(sag) = plant_physics::flex::initial::static_sag_with(self, &design, kp, &y) {
+            for (k, s) in sag.iter().enumerate() {
+                y[k] += s;
+            }
+        }
+        y
     }
 }
 

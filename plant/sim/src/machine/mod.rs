@@ -21,8 +21,10 @@ use crate::model::{Control, Params, Release};
 use crate::rows::Record;
 use controller::{saturate, PdGains};
 use nalgebra::Vector2;
+use plant_physics::initial::InitialConditions;
 use plant_physics::integrate::System;
 use serde::Serialize;
+use shock_table::Programme;
 
 /// How far [`Machine::contact_state`] presses the rotor into each race (m): about a kilonewton of
 /// contact on the study's bearing.
@@ -84,17 +86,45 @@ pub struct PlaneState<'p> {
     pub race_accel: f64,
 }
 
-/// The state a diverged run failed in (`failure_state` in `summary.json`), as its rotor model
-/// lays it out ([`Machine::failure`]); non-finite values are written as `null`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum FailureState {
-    /// The planar model's.
-    Planar(PlanarFailure),
-    /// The two-plane rotor's.
-    TwoPlane(TwoPlaneFailure),
-    /// The flexible rotor's.
-    Flexible(FlexibleFailure),
+/// A rotor model's failing state, as [`Machine::failure`] gives it for the model that `P` (its
+/// parameters, on `N` states) builds: `failure_state` in `summary.json`
+/// ([`crate::config::FailureState`] holds one of each model's, from the list of models).
+pub type FailureOf<P, const N: usize> = <<P as Builds<N>>::Machine as Machine<N>>::Failure;
+
+/// What a model's initial state is built from besides its parameters: the scene's `[initial]`
+/// table and the levitation design ([`crate::initial::start`] reads them from a scene).
+pub struct Start<'a> {
+    /// The conditions of the planar model's start (each plane's of the two-plane rotor's).
+    pub conditions: InitialConditions,
+    /// Offset added to the slopes (rad), x then y: a rotor that tilts.
+    pub slope_offset: [f64; 2],
+    /// The run's law at rest ([`crate::rest_law`]), asked only by a model whose rest depends on
+    /// it (the flexible rotor's sag): building the law is left to the model that needs it.
+    pub law_at_rest: &'a dyn Fn() -> LawAtRest,
+}
+
+/// The run's law at rest, as a model's start asks of it ([`crate::rest_law`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawAtRest {
+    /// Each plane's static gain where it is not the design's `k_p` ([`crate::rest_law::static_gains`]).
+    pub static_gains: [Option<f64>; 2],
+    /// Whether every plane's law holds its weight from the start ([`crate::rest_law::holds_weight`]).
+    pub holds_weight: bool,
+}
+
+/// A rotor model's parameters, as the run loop builds the model from them: one implementation
+/// per model on `N` states, in the model's file (the list of models, `config::models`, names
+/// each model's parameters and `N`; `stepper::with_machine` builds through this).
+pub trait Builds<const N: usize> {
+    /// The model the run loop steps.
+    type Machine: Machine<N> + Clone + 'static;
+
+    /// The model with the housing's motion `base` and `controls` (one per plane; a model of one
+    /// plane takes the first), each race free.
+    fn machine(&self, base: &Programme, controls: [Control; 2]) -> Self::Machine;
+
+    /// The model's initial state: levitated on the unbalance orbit, each race at rest.
+    fn initial_state(&self, start: &Start<'_>) -> [f64; N];
 }
 
 /// A rotor model on a state of `N` numbers with one or two bearing planes, each with its AMB,
@@ -165,9 +195,13 @@ pub trait Machine<const N: usize>: System<N> {
         N
     }
 
+    /// The model's failing state (`failure_state` in `summary.json`); non-finite values are
+    /// written as `null`.
+    type Failure: Clone + std::fmt::Debug + PartialEq + Serialize;
+
     /// The failing state of a run stopped at time `t` in state `y` (`failure_state` in
     /// `summary.json`).
-    fn failure(t: f64, y: &[f64; N]) -> FailureState
+    fn failure(t: f64, y: &[f64; N]) -> Self::Failure
     where
         Self: Sized;
 

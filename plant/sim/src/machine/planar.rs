@@ -1,12 +1,13 @@
 //! The planar model (one bearing plane, the study's, MODEL.md §1–§6) behind [`Machine`].
 
-use super::{FailureState, Machine, PlaneState};
+use super::{Builds, Machine, PlaneState, Start};
 use crate::model::ix::*;
 use crate::model::{Control, Model, Params, Release, State, N};
 use crate::park;
 use crate::rows::{self, Record};
 use nalgebra::Vector2;
 use serde::Serialize;
+use shock_table::Programme;
 
 /// The planar model's failing state.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -122,8 +123,10 @@ impl Machine<N> for Model {
         [p, p, a, p, p, a, v, v, w, v, v, w]
     }
 
-    fn failure(t: f64, y: &State) -> FailureState {
-        FailureState::Planar(PlanarFailure {
+    type Failure = PlanarFailure;
+
+    fn failure(t: f64, y: &State) -> PlanarFailure {
+        PlanarFailure {
             t_s: t,
             rotor_radius_m: y[XR].hypot(y[YR]),
             race_radius_m: y[XB].hypot(y[YB]),
@@ -133,6 +136,18 @@ impl Machine<N> for Model {
             race_velocity_m_s: [y[VXB], y[VYB]],
             rotor_spin: [y[TR], y[WR]],
             race_spin: [y[TB], y[WB]],
-        })
+        }
+    }
+}
+
+impl Builds<N> for Params {
+    type Machine = Model;
+
+    fn machine(&self, base: &Programme, controls: [Control; 2]) -> Model {
+        Model { params: self.clone(), base: base.clone(), control: controls[0], race_parked: false }
+    }
+
+    fn initial_state(&self, start: &Start<'_>) -> State {
+        plant_physics::initial::initial_state(self, &start.conditions)
     }
 }

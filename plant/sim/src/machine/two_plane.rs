@@ -1,13 +1,14 @@
 //! The two-plane rotor (the whole rigid rotor on bearing planes A and B, with tilt and
 //! gyroscopics, MODEL.md §9) behind [`Machine`].
 
-use super::{FailureState, Machine, PlaneState};
+use super::{Builds, Machine, PlaneState, Start};
 use crate::model::{Control, Params, Release};
 use crate::park::{self, GapMotion};
 use crate::rows::{self, Record};
 use nalgebra::Vector2;
 use plant_physics::two_plane::{self, ix, Model, State, N};
 use serde::Serialize;
+use shock_table::Programme;
 
 /// One race of the two-plane rotor's failing state.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -163,14 +164,16 @@ impl Machine<N> for Model {
         [p, p, a, a, a, p, p, a, p, p, a, v, v, w, w, w, v, v, w, v, v, w]
     }
 
-    fn failure(t: f64, y: &State) -> FailureState {
+    type Failure = TwoPlaneFailure;
+
+    fn failure(t: f64, y: &State) -> TwoPlaneFailure {
         let race = |x: usize| RaceFailure {
             race_radius_m: y[x].hypot(y[x + 1]),
             race_m: [y[x], y[x + 1]],
             race_velocity_m_s: [y[x + ix::V], y[x + 1 + ix::V]],
             race_spin: [y[x + 2], y[x + 2 + ix::V]],
         };
-        FailureState::TwoPlane(TwoPlaneFailure {
+        TwoPlaneFailure {
             t_s: t,
             rotor_m: [y[ix::X], y[ix::Y]],
             rotor_velocity_m_s: [y[ix::VX], y[ix::VY]],
@@ -179,7 +182,35 @@ impl Machine<N> for Model {
             rotor_spin: [y[ix::TR], y[ix::WR]],
             race_a: race(ix::RACE_A),
             race_b: race(ix::RACE_B),
-        })
+        }
+    }
+}
+
+impl Builds<N> for two_plane::Params {
+    type Machine = Model;
+
+    fn machine(&self, base: &Programme, controls: [Control; 2]) -> Model {
+        Model { params: self.clone(), base: base.clone(), control: controls, race_parked: [false; 2] }
+    }
+
+    fn initial_state(&self, start: &Start<'_>) -> State {
+        let gravity_bias = start.conditions.gravity_bias;
+        two_plane::initial::initial_state(self, &rigid_conditions(start, gravity_bias))
+    }
+}
+
+/// The rigid rotor's initial conditions of `start`, with `gravity_bias` (the flexible rotor
+/// solves its sag itself and starts the rigid motion without it).
+pub(super) fn rigid_conditions(start: &Start<'_>, gravity_bias: bool) -> two_plane::initial::InitialConditions {
+    let ic = &start.conditions;
+    two_plane::initial::InitialConditions {
+        unbalance_orbit: ic.unbalance_orbit,
+        unbalance_phase: ic.unbalance_phase,
+        stiffness: ic.stiffness,
+        damping_ratio: ic.damping_ratio,
+        gravity_bias,
+        rotor_offset: ic.rotor_offset,
+        slope_offset: start.slope_offset,
     }
 }
 

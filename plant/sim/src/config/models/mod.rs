@@ -1,7 +1,8 @@
 //! The rotor models: their one list ([`rotor_models!`]: `rotor.model`'s names, each model's key
-//! struct and parameters), and what each model says of itself, the [`RotorParams`] trait, one
-//! implementation per model in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`) beside its
-//! `[rotor]` keys and their defaults. [`Rotor`] dispatches to it once ([`Rotor::params`]); a
+//! struct, parameters and state), and what each model says of itself, the [`RotorParams`] trait,
+//! one implementation per model in its file (`planar.rs`, `two_plane.rs`, `flexible.rs`) beside
+//! its `[rotor]` keys, their defaults and their builder ([`Build`], with what the scene's
+//! validation gives, [`BuildContext`]). [`Rotor`] dispatches to it once ([`Rotor::params`]); a
 //! capability one model has and the others do not (bending, a linear open loop, whirl modes) is
 //! a method with a default, so a new model says only what it has. `[rotor]` as written is
 //! [`RawRotor`] (`table.rs`): the shared keys and the model's key struct, which refuses every key
@@ -10,7 +11,7 @@
 pub(in crate::config) mod flexible;
 mod planar;
 mod table;
-pub(in crate::config) mod two_plane;
+mod two_plane;
 
 pub use flexible::FlexibleKeys;
 pub use flexible::RossAxes;
@@ -19,25 +20,49 @@ pub use table::{RawRotor, RotorShared, SpinChoice};
 pub use two_plane::TwoPlaneKeys;
 
 use super::ConfigError;
-use crate::machine::{FailureState, Linearised};
+use crate::machine::{Builds, FailureOf, Linearised, Machine};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
-use plant_physics::flex::machine as flexible_machine;
 use plant_physics::flex::ross::UsedBearing;
 use plant_physics::flex::ross_amb::UsedAmb;
 use plant_physics::two_plane as rigid;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
-/// Declares the rotor models, each once: its doc, its variant, `rotor.model`'s name for it, the
-/// model in words and what a rotor of it is (for messages), its key struct (`[rotor]`'s own
-/// keys, in its file) and its validated parameters. Gives [`RotorModel`] (the names), [`RotorKeys`]
-/// (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's validated
-/// rotor) and the one dispatch of each on the model; the compiler points a new model to what it
-/// must give (its key struct's [`Build`], its parameters' [`RotorParams`]).
+/// The one list of rotor models, handed to the macro `$then`: each model once, with its doc, its
+/// variant, `rotor.model`'s name for it, the model in words and what a rotor of it is (for
+/// messages), its key struct (`[rotor]`'s own keys, in its file of `config/models/`), its
+/// validated parameters and its state (`[f64; N]`; the model that the parameters build is in its
+/// file of `machine/`, [`Builds`]). Expanded here ([`declare_models`]: [`RotorModel`],
+/// [`RotorKeys`], [`Rotor`], [`FailureState`] and their dispatch on the model) and by
+/// `stepper::with_machine` (the model built and stepped): a new model is a line here, and the
+/// compiler points to what it must give (its key struct's [`Build`], its parameters'
+/// [`RotorParams`] and [`Builds`]).
 macro_rules! rotor_models {
+    ($then:ident) => {
+        $then! {
+            /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
+            Planar = "planar", "the planar rotor", "rigid, on one bearing plane":
+                PlanarKeys => plant_physics::model::Params, [f64; plant_physics::model::N];
+            /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
+            TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes":
+                TwoPlaneKeys => plant_physics::two_plane::Params, [f64; plant_physics::two_plane::N];
+            /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
+            Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
+                FlexibleKeys => plant_physics::flex::machine::Params, [f64; plant_physics::flex::machine::N];
+        }
+    };
+}
+pub(crate) use rotor_models;
+
+/// Declares, from the list of models ([`rotor_models`]), [`RotorModel`] (the names),
+/// [`RotorKeys`] (the tagged part of `[rotor]`: the model's key struct), [`Rotor`] (the scene's
+/// validated rotor), [`FailureState`] (a run's failing state) and the one dispatch of each on
+/// the model.
+macro_rules! declare_models {
     ($(
         $(#[$doc:meta])*
-        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty;
+        $variant:ident = $name:literal, $what:literal, $is:literal: $keys:ident => $params:ty, [f64; $n:path];
     )+) => {
         /// `rotor.model`: the rotor model (the tag of `[rotor]`; `planar` when absent).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -98,10 +123,7 @@ macro_rules! rotor_models {
 
             /// The model's parameters built from its keys with what the scene's validation gives
             /// (`ctx`, [`Build`]).
-            pub fn build<Ctx>(&self, ctx: &Ctx) -> Result<Rotor, ConfigError>
-            where
-                $($keys: Build<Ctx, Params = $params>,)+
-            {
+            pub(crate) fn build(&self, ctx: &dyn BuildContext) -> Result<Rotor, ConfigError> {
                 Ok(match self { $(RotorKeys::$variant(k) => Rotor::$variant(k.build(ctx)?),)+ })
             }
         }
@@ -125,19 +147,40 @@ macro_rules! rotor_models {
             pub fn params_mut(&mut self) -> &mut dyn RotorParams {
                 match self { $(Rotor::$variant(p) => p,)+ }
             }
+
+            /// Absolute tolerances per state component of the model, laid out from those of
+            /// positions (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
+            /// ([`Machine::atol`]).
+            pub fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
+                match self {
+                    $(Rotor::$variant(_) => <<$params as Builds<{ $n }>>::Machine as Machine<{ $n }>>::atol(groups).to_vec(),)+
+                }
+            }
+
+            /// The failing state of a run that stopped at time `t` in state `y` (the model's part
+            /// of the state first, the hardware's after it); `None` if `y` holds less than the
+            /// model's state.
+            pub fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
+                Some(match self {
+                    $(Rotor::$variant(_) => FailureState::$variant(
+                        <<$params as Builds<{ $n }>>::Machine as Machine<{ $n }>>::failure(t, y.get(..$n)?.try_into().ok()?),
+                    ),)+
+                })
+            }
+        }
+
+        /// The state a diverged run failed in (`failure_state` in `summary.json`), as its rotor
+        /// model lays it out ([`Machine::failure`], its struct in the model's file of
+        /// `machine/`); non-finite values are written as `null`.
+        #[derive(Clone, Debug, PartialEq, Serialize)]
+        #[serde(untagged)]
+        pub enum FailureState {
+            $( $(#[$doc])* $variant(FailureOf<$params, { $n }>), )+
         }
     };
 }
 
-rotor_models! {
-    /// One bearing plane (the study's model): x, y, the race of one touchdown bearing.
-    Planar = "planar", "the planar rotor", "rigid, on one bearing plane": PlanarKeys => Params;
-    /// The whole rigid rotor on two bearing planes, A and B: translation and tilt, four axes.
-    TwoPlane = "two_plane", "the two-plane rotor", "rigid, on two bearing planes": TwoPlaneKeys => rigid::Params;
-    /// A flexible shaft (finite elements reduced to its modes) on two bearing planes, A and B.
-    Flexible = "flexible", "the flexible rotor", "flexible, its geometry and inertia those of its shaft":
-        FlexibleKeys => flexible_machine::Params;
-}
+rotor_models!(declare_models);
 
 /// `planar` when `[rotor]` has no `model`.
 impl Default for RotorModel {
@@ -152,17 +195,55 @@ impl Default for RotorKeys {
     }
 }
 
-/// A model's key struct built into the model's parameters with `Ctx`, what the scene's
-/// validation gives it (`config::validate`'s context: the scene as written, the shared keys
-/// validated, the scene's folder). Implemented beside the validation (`config/validate/`), which
-/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
-/// imports neither.
-pub trait Build<Ctx> {
+/// A model's key struct built into the model's parameters (in the model's file, beside its
+/// keys), with what the scene's validation gives it ([`BuildContext`]).
+pub(crate) trait Build {
     /// The model's validated parameters.
     type Params;
 
     /// The model's parameters, each error naming the key, value and unit.
-    fn build(&self, ctx: &Ctx) -> Result<Self::Params, ConfigError>;
+    fn build(&self, ctx: &dyn BuildContext) -> Result<Self::Params, ConfigError>;
+}
+
+/// What a model's builder ([`Build`]) asks of the scene being validated: the shared `[rotor]`
+/// keys, the scene's folder and its bearing planes, each from the bearing tables (`[touchdown]`,
+/// `[contact]`, `[amb]`), validated as for every model. Implemented by `config::validate`, which
+/// reads the whole scene: this module holds `[rotor]`, which the scene's file format holds, and
+/// imports neither.
+pub(crate) trait BuildContext {
+    /// The shared `[rotor]` keys, validated: the whole rotor.
+    fn whole(&self) -> &Share;
+
+    /// The scene's folder (a model's files are named from it).
+    fn base_dir(&self) -> &Path;
+
+    /// A model's one bearing plane, from the shared tables with the rotor's `share`; a
+    /// two-plane rotor's per-plane tables and initial slopes are refused by name (each would be
+    /// ignored otherwise).
+    fn single_plane(&self, share: &Share) -> Result<Params, ConfigError>;
+
+    /// Bearing plane `i` (0 is A, 1 is B): the shared tables with the plane's own
+    /// (`[touchdown.a]`, …) set over them, with the plane's `share` of the rotor.
+    fn plane(&self, i: usize, share: &Share) -> Result<Params, ConfigError>;
+}
+
+/// The rotor's values a bearing plane's planar parameters take: for the planar model the
+/// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
+pub(crate) struct Share {
+    /// Gravity (m/s²).
+    pub(crate) gravity: f64,
+    /// Mass (kg).
+    pub(crate) mass: f64,
+    /// Eccentricity of the static unbalance (m).
+    pub(crate) eccentricity: f64,
+    /// Polar moment of inertia (kg·m²).
+    pub(crate) inertia: f64,
+    /// Radius at the touchdown bearing (m).
+    pub(crate) radius: f64,
+    /// Spin speed (rad/s).
+    pub(crate) speed: f64,
+    /// Spin: held or driven.
+    pub(crate) spin: crate::model::Spin,
 }
 
 /// A rotor model's parameters, as the scene and the rest of the plant ask of them.
@@ -179,15 +260,6 @@ pub trait RotorParams {
 
     /// Plane `i`'s bearing, mutable (a sweep or a test that moves one plane's value).
     fn plane_mut(&mut self, i: usize) -> &mut Params;
-
-    /// Absolute tolerances per state component of the model, laid out from those of positions
-    /// (m), velocities (m/s), angles (rad) and angular speeds (rad/s)
-    /// ([`crate::machine::Machine::atol`]).
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64>;
-
-    /// The failing state of a run that stopped at time `t` in state `y` (the model's part of
-    /// the state first); `None` if `y` holds less than the model's state.
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState>;
 
     /// Writes the model's defaults into the `[rotor]` table it was built from (as the user would have
     /// written them, in the file's units), so that the resolved `scene.toml` states them. The

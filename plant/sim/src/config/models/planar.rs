@@ -2,10 +2,10 @@
 //! `[rotor]` keys of its own: its bearing is the shared tables' (`[touchdown]`, `[contact]`,
 //! `[amb]`), its rotor the shared `[rotor]` keys.
 
-use super::{RotorModel, RotorParams};
+use super::{Build, BuildContext, RotorModel, RotorParams};
 use crate::config::scene_table::scene_table;
-use crate::machine::{FailureState, Machine};
-use crate::model::{Model, Params, N};
+use crate::config::ConfigError;
+use crate::model::Params;
 use serde::{Deserialize, Serialize};
 
 scene_table! {
@@ -31,12 +31,14 @@ impl RotorParams for Params {
         assert_eq!(i, 0, "the planar rotor has one bearing plane");
         self
     }
+}
 
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        Model::atol(groups).to_vec()
-    }
+/// The planar model: its one bearing plane from the shared tables; a two-plane rotor's per-plane
+/// tables and initial slopes are refused by name (each would be ignored otherwise).
+impl Build for PlanarKeys {
+    type Params = Params;
 
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
-        Some(Model::failure(t, y.get(..N)?.try_into().ok()?))
+    fn build(&self, ctx: &dyn BuildContext) -> Result<Params, ConfigError> {
+        ctx.single_plane(ctx.whole())
     }
 }

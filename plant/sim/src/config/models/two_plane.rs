@@ -1,23 +1,26 @@
 //! The rigid rotor on two bearing planes (`rotor.model = "two_plane"`): its `[rotor]` keys and
 //! their defaults, and what the model says of itself.
 
-use super::{RawRotor, RotorKeys, RotorModel, RotorParams};
+use super::{Build, BuildContext, RawRotor, RotorKeys, RotorModel, RotorParams, Share};
+use crate::config::checks::{finite, non_negative, positive, range};
 use crate::config::scene_table::scene_table;
-use crate::machine::{FailureState, Linearised, Machine};
+use crate::config::ConfigError;
+use crate::machine::Linearised;
 use crate::model::Params;
-use plant_physics::two_plane::{self, Model, N};
+use crate::model::Spin;
+use plant_physics::two_plane;
 use serde::{Deserialize, Serialize};
 
 /// `transverse_inertia_kg_m2` when none is given (kg·m²).
-pub(in crate::config) const TRANSVERSE_INERTIA_KG_M2: f64 = 0.414;
+const TRANSVERSE_INERTIA_KG_M2: f64 = 0.414;
 /// `bearing_a_mm` when none is given (mm).
-pub(in crate::config) const BEARING_A_MM: f64 = -180.0;
+const BEARING_A_MM: f64 = -180.0;
 /// `bearing_b_mm` when none is given (mm).
-pub(in crate::config) const BEARING_B_MM: f64 = 180.0;
+const BEARING_B_MM: f64 = 180.0;
 /// `end_a_mm` when none is given (mm).
-pub(in crate::config) const END_A_MM: f64 = -230.0;
+const END_A_MM: f64 = -230.0;
 /// `end_b_mm` when none is given (mm).
-pub(in crate::config) const END_B_MM: f64 = 230.0;
+const END_B_MM: f64 = 230.0;
 
 scene_table! {
 /// `[rotor]`'s own keys of the two-plane rotor, each `None` unless given (the resolved scene
@@ -73,14 +76,6 @@ impl RotorParams for two_plane::Params {
         &mut self.planes[i].params
     }
 
-    fn atol(&self, groups: [f64; 4]) -> Vec<f64> {
-        Model::atol(groups).to_vec()
-    }
-
-    fn failure(&self, t: f64, y: &[f64]) -> Option<FailureState> {
-        Some(Model::failure(t, y.get(..N)?.try_into().ok()?))
-    }
-
     fn record_defaults(&self, rotor: &mut RawRotor) {
         if let RotorKeys::TwoPlane(keys) = &mut rotor.model {
             record_two_plane(keys);
@@ -112,4 +107,101 @@ fn record_two_plane(r: &mut TwoPlaneKeys) {
     r.sensor_b_mm.get_or_insert(b);
     r.end_a_mm.get_or_insert(END_A_MM);
     r.end_b_mm.get_or_insert(END_B_MM);
+}
+
+impl Build for TwoPlaneKeys {
+    type Params = two_plane::Params;
+
+    fn build(&self, ctx: &dyn BuildContext) -> Result<two_plane::Params, ConfigError> {
+        two_plane_params(ctx, self, ctx.whole())
+    }
+}
+
+/// The two-plane rotor of a scene (`rotor.model = "two_plane"`), validated: its geometry and
+/// inertia from `[rotor]`, each plane's bearing from the shared tables and its own.
+pub(in crate::config) fn two_plane_params(
+    ctx: &dyn BuildContext,
+    r: &TwoPlaneKeys,
+    whole: &Share,
+) -> Result<two_plane::Params, ConfigError> {
+    let mm = |key: &str, value: f64| finite(key, value, "mm");
+    let za = mm("rotor.bearing_a_mm", r.bearing_a_mm.unwrap_or(BEARING_A_MM))?;
+    let zb = mm("rotor.bearing_b_mm", r.bearing_b_mm.unwrap_or(BEARING_B_MM))?;
+    const SIDES: &str = "bearing A lies on the −z side of the centre of mass (the origin of z) and bearing B on \
+                         the +z side: the centre of mass is between the bearings";
+    if za >= 0.0 {
+        return Err(range("rotor.bearing_a_mm", za, "mm", &format!("must be < 0: {SIDES}")));
+    }
+    if zb <= 0.0 {
+        return Err(range("rotor.bearing_b_mm", zb, "mm", &format!("must be > 0: {SIDES}")));
+    }
+    let ea = mm("rotor.end_a_mm", r.end_a_mm.unwrap_or(END_A_MM))?;
+    let eb = mm("rotor.end_b_mm", r.end_b_mm.unwrap_or(END_B_MM))?;
+    if ea > za {
+        return Err(range(
+            "rotor.end_a_mm",
+            ea,
+            "mm",
+            &format!("must be <= rotor.bearing_a_mm = {za} mm: the bearing sits on the rotor"),
+        ));
+    }
+    if eb < zb {
+        return Err(range(
+            "rotor.end_b_mm",
+            eb,
+            "mm",
+            &format!("must be >= rotor.bearing_b_mm = {zb} mm: the bearing sits on the rotor"),
+        ));
+    }
+    let sensor = |key: &str, value: f64| -> Result<f64, ConfigError> {
+        let v = mm(key, value)?;
+        if !(ea..=eb).contains(&v) {
+            return Err(range(
+                key,
+                v,
+                "mm",
+                &format!("must lie on the rotor, between rotor.end_a_mm = {ea} mm and rotor.end_b_mm = {eb} mm"),
+            ));
+        }
+        Ok(v)
+    };
+    let sa = sensor("rotor.sensor_a_mm", r.sensor_a_mm.unwrap_or(za))?;
+    let sb = sensor("rotor.sensor_b_mm", r.sensor_b_mm.unwrap_or(zb))?;
+    let transverse = positive(
+        "rotor.transverse_inertia_kg_m2",
+        r.transverse_inertia_kg_m2.unwrap_or(TRANSVERSE_INERTIA_KG_M2),
+        "kg·m²",
+    )?;
+    let couple = non_negative("rotor.couple_unbalance_urad", r.couple_unbalance_urad.unwrap_or(0.0), "µrad")? * 1e-6;
+    let couple_phase =
+        finite("rotor.couple_unbalance_phase_deg", r.couple_unbalance_phase_deg.unwrap_or(0.0), "deg")?.to_radians();
+    let stations = [za * 1e-3, zb * 1e-3];
+    let sensors = [sa * 1e-3, sb * 1e-3];
+    let plane = |i: usize| -> Result<two_plane::Plane, ConfigError> {
+        let mass = two_plane::load_share(whole.mass, stations, i);
+        let fraction = mass / whole.mass;
+        let spin = match whole.spin {
+            Spin::Held => Spin::Held,
+            Spin::Free { drive_gain, torque_limit } => {
+                Spin::Free { drive_gain: drive_gain * fraction, torque_limit: torque_limit * fraction }
+            }
+        };
+        let share = Share { mass, inertia: whole.inertia * fraction, spin, ..*whole };
+        let params = ctx.plane(i, &share)?;
+        Ok(two_plane::Plane { station: stations[i], sensor: sensors[i], params })
+    };
+    Ok(two_plane::Params {
+        gravity: whole.gravity,
+        rotor: two_plane::Rotor {
+            mass: whole.mass,
+            transverse_inertia: transverse,
+            polar_inertia: whole.inertia,
+            eccentricity: whole.eccentricity,
+            couple,
+            couple_phase,
+            speed: whole.speed,
+            spin: whole.spin,
+        },
+        planes: [plane(0)?, plane(1)?],
+    })
 }

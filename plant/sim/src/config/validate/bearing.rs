@@ -2,29 +2,94 @@
 //! [`Params`], for the planar rotor or a plane's share of the two-plane rotor.
 
 use super::*;
+use crate::config::models::{BuildContext, Share};
 
-/// The rotor's values a bearing plane's planar parameters take: for the planar model the
-/// rotor's own, for a plane of the two-plane rotor its share ([`plant_physics::two_plane::Plane`]).
-pub(in crate::config) struct Share {
-    pub(super) gravity: f64,
-    pub(super) mass: f64,
-    pub(super) eccentricity: f64,
-    pub(super) inertia: f64,
-    pub(super) radius: f64,
-    pub(super) speed: f64,
-    pub(super) spin: Spin,
+impl BuildContext for Context<'_> {
+    fn whole(&self) -> &Share {
+        self.whole
+    }
+
+    fn base_dir(&self) -> &Path {
+        self.base_dir
+    }
+
+    fn single_plane(&self, share: &Share) -> Result<Params, ConfigError> {
+        let raw = self.raw;
+        refuse_plane_tables(raw)?;
+        bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &Keys { plane: None }, share)
+    }
+
+    fn plane(&self, i: usize, share: &Share) -> Result<Params, ConfigError> {
+        let raw = self.raw;
+        let letter = ["a", "b"][i];
+        let pick = |a: &Option<toml::Table>, b: &Option<toml::Table>| if i == 0 { a.clone() } else { b.clone() };
+        let own = [
+            pick(&raw.touchdown.a, &raw.touchdown.b),
+            pick(&raw.contact.a, &raw.contact.b),
+            pick(&raw.amb.a, &raw.amb.b),
+        ];
+        let td = plane_table(&raw.touchdown, own[0].as_ref(), &format!("touchdown.{letter}"))?;
+        let ct = plane_table(&raw.contact, own[1].as_ref(), &format!("contact.{letter}"))?;
+        let amb = plane_table(&raw.amb, own[2].as_ref(), &format!("amb.{letter}"))?;
+        let keys = Keys { plane: Some((letter, [own[0].as_ref(), own[1].as_ref(), own[2].as_ref()])) };
+        bearing(&td, &ct, &amb, &raw.controller, &keys, share)
+    }
 }
 
-/// The planar model: its one bearing plane from the shared tables; a two-plane rotor's per-plane
-/// tables and initial slopes are refused by name (each would be ignored otherwise).
-impl crate::config::models::Build<Context<'_>> for crate::config::models::PlanarKeys {
-    type Params = Params;
-
-    fn build(&self, ctx: &Context) -> Result<Params, ConfigError> {
-        let raw = ctx.raw;
-        super::two_plane_keys::refuse_plane_tables(raw)?;
-        bearing(&raw.touchdown, &raw.contact, &raw.amb, &raw.controller, &Keys { plane: None }, ctx.whole)
+/// A two-plane rotor's per-plane tables (`[touchdown.a]`, …) and initial slopes given in a planar
+/// scene, refused by name: each would be silently ignored otherwise. (Its `[rotor]` keys are
+/// refused by the planar model's key struct.)
+fn refuse_plane_tables(raw: &RawScene) -> Result<(), ConfigError> {
+    const WHY: &str = "is a key of the two-plane rotor and this scene is planar (rotor.model = \"planar\"): set \
+                       rotor.model = \"two_plane\" or remove the key";
+    let slopes =
+        [("initial.slope_x_urad", raw.initial.slope_x_urad), ("initial.slope_y_urad", raw.initial.slope_y_urad)];
+    if let Some((key, value)) = slopes.iter().find_map(|(k, v)| v.map(|v| (*k, v))) {
+        return Err(range(key, value, "µrad", WHY));
     }
+    let tables = [
+        ("touchdown", &raw.touchdown.a, &raw.touchdown.b),
+        ("contact", &raw.contact.a, &raw.contact.b),
+        ("amb", &raw.amb.a, &raw.amb.b),
+    ];
+    for (table, a, b) in tables {
+        for (plane, own) in [("a", a), ("b", b)] {
+            if let Some(own) = own {
+                return Err(ConfigError::Range {
+                    key: format!("{table}.{plane}"),
+                    value: format!("a table of {} key(s)", own.len()),
+                    unit: String::new(),
+                    why: format!(
+                        "per-plane tables ([{table}.a], [{table}.b]) are for the two-plane rotor and this scene is \
+                         planar (rotor.model = \"planar\"): set rotor.model = \"two_plane\" or write the keys in [{table}]"
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A per-plane table: the shared table `shared` (`[touchdown]`) with plane `plane`'s own keys
+/// (`[touchdown.b]`) set over it, read as the same table.
+pub(super) fn plane_table<T: serde::Serialize + serde::de::DeserializeOwned>(
+    shared: &T,
+    own: Option<&toml::Table>,
+    name: &str,
+) -> Result<T, ConfigError> {
+    let parse = |message: String| ConfigError::Parse { path: name.to_string(), message };
+    let mut table = toml::Table::try_from(shared).map_err(|e| parse(e.to_string()))?;
+    table.remove("a");
+    table.remove("b");
+    if let Some(own) = own {
+        if let Some(nested) = ["a", "b"].into_iter().find(|k| own.contains_key(*k)) {
+            return Err(parse(format!("a plane's table holds keys, not another plane's table (`{nested}`)")));
+        }
+        for (key, value) in own {
+            table.insert(key.clone(), value.clone());
+        }
+    }
+    toml::Value::Table(table).try_into::<T>().map_err(|e| parse(e.to_string()))
 }
 
 /// The full names of a bearing plane's keys: `touchdown.air_gap_mm`, or `touchdown.b.air_gap_mm`

@@ -1,6 +1,6 @@
 //! `amb.amplifier*` and `[sensor]`'s front end: the hardware between the wire and the physics.
 
-use super::two_plane_keys::plane_table;
+use super::bearing::plane_table;
 use super::*;
 
 /// The hardware between the wire and the physics (`amb.amplifier` and its keys, per plane;

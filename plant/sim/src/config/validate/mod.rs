@@ -36,34 +36,30 @@ use crate::model::{Params, RaceWhenClear, Release, Spin, Support, TouchdownGeome
 use controller::LoopConstants;
 use std::path::Path;
 
-// The rotor models' keys, each built by its model's key struct (`config/models/`,
-// `ModelKeys::build`) with the bearing planes of `bearing`.
-pub(super) mod bearing;
+// The bearing planes' tables, validated for every model's key struct (`config/models/`,
+// `RotorKeys::build`) through `Context`.
+mod bearing;
 pub mod bounds;
-mod checks;
 mod controller_keys;
-pub(super) mod flexible_keys;
 mod hardware_keys;
 mod ross_ambs;
 mod ross_axes;
-pub(super) mod two_plane_keys;
 
-use bearing::{bearing, Keys, Share};
-pub use checks::{finite, non_negative, positive, range};
+pub use super::checks::{finite, non_negative, positive, range};
+use super::models::Share;
 use controller_keys::{cosim_settings, migrate_relev_aliases, resolve_command, stiffness};
 use hardware_keys::hardware;
 
-/// What a rotor model's key struct is built with ([`crate::config::models::Build`], implemented
-/// beside each model's validation: `bearing.rs` the planar, `two_plane_keys.rs`,
-/// `flexible_keys.rs`): the scene as written (its bearing planes' tables), the shared `[rotor]`
-/// keys validated, the scene's folder (the model's files).
-pub(in crate::config) struct Context<'a> {
+/// What a rotor model's key struct is built with ([`crate::config::models::BuildContext`],
+/// implemented in `bearing.rs`): the scene as written (its bearing planes' tables), the shared
+/// `[rotor]` keys validated, the scene's folder (the model's files).
+struct Context<'a> {
     /// The scene as written.
-    pub(in crate::config) raw: &'a RawScene,
+    raw: &'a RawScene,
     /// The shared `[rotor]` keys, validated.
-    pub(in crate::config) whole: &'a Share,
+    whole: &'a Share,
     /// The scene's folder.
-    pub(in crate::config) base_dir: &'a Path,
+    base_dir: &'a Path,
 }
 
 /// Longest simulated time (s): about 11.6 days.
@@ -154,7 +150,7 @@ fn validate_as_written(mut raw: RawScene, base_dir: &Path) -> Result<Scene, Conf
     // A ROSS file's bearings that act besides the AMBs, and its AMB elements made the planes'
     // AMBs: the run's first line says so.
     if let Rotor::Flexible(f) = &mut rotor {
-        if let Some(note) = flexible_keys::file_bearings_note(&raw, f) {
+        if let Some(note) = super::models::flexible::file_bearings_note(&raw.rotor, f) {
             warnings.insert(0, note);
         }
         if let Some(note) = ross_ambs::note(&raw, &file_ambs) {

@@ -6,17 +6,9 @@
 //! (and the resolved `scene.toml`) sees them as if the scene had written them.
 
 use super::*;
+use crate::config::models::flexible::ross_ambs_name as name;
 use plant_physics::flex::ross::{self, RossAmbs};
 use plant_physics::flex::ross_amb::{MagneticBearing, UsedAmb};
-
-/// `rotor.ross_ambs`'s value as the scene writes it.
-pub(super) fn name(choice: RossAmbs) -> &'static str {
-    match choice {
-        RossAmbs::Refuse => "\"refuse\"",
-        RossAmbs::Use => "\"use\"",
-        RossAmbs::Constants => "\"constants\"",
-    }
-}
 
 /// The file's AMB elements written into `raw` as `rotor.ross_ambs` says, and what each plane
 /// took (empty without the key, with `"refuse"`, or in a scene that is not flexible: those are

@@ -1,7 +1,7 @@
 //! The checks every key goes through: a value in range, or an error naming the key, the value
 //! and its unit.
 
-use super::*;
+use super::ConfigError;
 
 /// An out-of-range error naming the key, the value and its unit.
 pub fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) -> ConfigError {
@@ -15,7 +15,7 @@ pub fn range(key: &str, value: impl std::fmt::Display, unit: &str, why: &str) ->
 
 /// A number as it reads best in a message: Rust prints `1e300_f64` as 301 digits, so a long
 /// decimal becomes scientific notation (`1e300`); anything else is kept as written.
-pub(super) fn readable(value: String) -> String {
+fn readable(value: String) -> String {
     match value.parse::<f64>() {
         Ok(v) if value.len() > 16 && v.is_finite() => format!("{v:e}"),
         _ => value,
