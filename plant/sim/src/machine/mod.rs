@@ -10,10 +10,12 @@
 //! file per model.
 
 mod flexible;
+pub mod mechanics;
 mod planar;
 mod two_plane;
 
 pub use flexible::{mid_span, mid_span_weight, FlexibleFailure, FlexibleLinear};
+pub use mechanics::{Mechanics, Signal};
 pub use planar::PlanarFailure;
 pub use two_plane::{RaceFailure, TwoPlaneFailure};
 

@@ -32,25 +32,8 @@ use crate::config::{Rotor, Scene};
 use crate::sensor::LowPass;
 use nalgebra::DMatrix;
 use plant_physics::amplifier::Amplifier;
-use serde::Serialize;
+pub use plant_sim::machine::mechanics::{Mechanics, Signal};
 use std::f64::consts::{SQRT_2, TAU};
-
-/// A named signal or state with its unit.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Signal {
-    /// Name (an identifier: letters, digits, `_`).
-    pub name: String,
-    /// SI unit.
-    pub unit: String,
-    /// What it is.
-    pub description: String,
-}
-
-impl Signal {
-    fn new(name: impl Into<String>, unit: &str, description: impl Into<String>) -> Self {
-        Signal { name: name.into(), unit: unit.into(), description: description.into() }
-    }
-}
 
 /// A linear time-invariant system `ẋ = A x + B u`, `y = C x + D u` (or `x⁺ = A x + B u`).
 #[derive(Clone, Debug, PartialEq)]
@@ -121,16 +104,6 @@ pub enum LinearError {
     },
 }
 
-/// The mechanical part: `ẋ = A x + B i` on `x = [q, q̇]`, the sensors' displacements `C_s x`,
-/// the actuators' `C_a x` (both m, one row per axis).
-struct Mechanics {
-    a: DMatrix<f64>,
-    b: DMatrix<f64>,
-    sensor: DMatrix<f64>,
-    actuator: DMatrix<f64>,
-    states: Vec<Signal>,
-}
-
 /// The axes' names: `x`, `y` (planar) or `x_A`, `y_A`, `x_B`, `y_B`.
 pub fn axis_names(rotor: &Rotor) -> Vec<&'static str> {
     match rotor.planes() {
@@ -146,23 +119,11 @@ pub fn continuous(scene: &Scene, speed_hz: f64) -> Result<LinearPlant, LinearErr
         return Err(LinearError::Speed(speed_hz));
     }
     let omega = TAU * speed_hz;
-    let mut mech = mechanics(&scene.rotor, omega);
+    let mut mech = scene.rotor.params().mechanics(omega);
     let names = axis_names(&scene.rotor);
     let m = names.len();
     let plane_of = |k: usize| k / 2;
-    let mut parts = vec![match scene.rotor {
-        Rotor::Planar(_) => "planar rotor: mass, AMB negative stiffness k_s and current gain k_i".to_string(),
-        Rotor::TwoPlane(_) => {
-            "rigid two-plane rotor: mass, transverse and polar inertia (gyroscopics at the speed), each plane's \
-             AMB k_s and k_i at its station, its sensor at its own"
-                .to_string()
-        }
-        Rotor::Flexible(ref f) => format!(
-            "flexible shaft reduced to {} coordinates (its retained modes and static corrections), damping and \
-             gyroscopics at the speed, each plane's AMB k_s and k_i at its node, the sensors at theirs",
-            f.reduced.size()
-        ),
-    }];
+    let mut parts = vec![std::mem::take(&mut mech.what)];
     let hw = &scene.hardware;
     // A unipolar drive about its bias, both magnets conducting and neither amplifier limited:
     // the differential current `(i₊ − i₋)/2` obeys the bipolar coil's equation with each
@@ -363,108 +324,4 @@ fn sense(
         "sensor low-pass of order {order}, corner {:.6} Hz; the range, noise, ADC and runout left out",
         w / TAU
     ))
-}
-
-/// The rotor's mechanics at spin speed `omega` (rad/s).
-fn mechanics(rotor: &Rotor, omega: f64) -> Mechanics {
-    match rotor {
-        Rotor::Planar(p) => {
-            let lc = &p.loop_constants;
-            let mass = DMatrix::from_diagonal_element(2, 2, p.rotor_mass);
-            let gyro = DMatrix::zeros(2, 2);
-            let ident = DMatrix::identity(2, 2);
-            let states = ["x", "y"]
-                .iter()
-                .map(|a| Signal::new(*a, "m", format!("rotor {a}, relative to the housing")))
-                .chain(["x", "y"].iter().map(|a| Signal::new(format!("v{a}"), "m/s", format!("rotor {a} velocity"))))
-                .collect();
-            rigid(&mass, &gyro, &ident, &ident, [lc.ks_n_per_m; 4], [lc.ki_n_per_a; 4], states)
-        }
-        Rotor::TwoPlane(p) => {
-            let r = &p.rotor;
-            let mass = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&[
-                r.mass,
-                r.mass,
-                r.transverse_inertia,
-                r.transverse_inertia,
-            ]));
-            let mut gyro = DMatrix::zeros(4, 4);
-            // I_t ä + I_p Ω ḃ = …,  I_t b̈ − I_p Ω ȧ = …
-            gyro[(2, 3)] = r.polar_inertia * omega;
-            gyro[(3, 2)] = -r.polar_inertia * omega;
-            let rows = |station: &dyn Fn(usize) -> f64| {
-                DMatrix::from_fn(4, 4, |k, col| {
-                    let dir = k % 2;
-                    if col == dir {
-                        1.0
-                    } else if col == 2 + dir {
-                        station(k / 2)
-                    } else {
-                        0.0
-                    }
-                })
-            };
-            let actuator = rows(&|i| p.planes[i].station);
-            let sensor = rows(&|i| p.planes[i].sensor);
-            let lc = |k: usize| p.planes[k / 2].params.loop_constants;
-            let ks = std::array::from_fn(|k| lc(k).ks_n_per_m);
-            let ki = std::array::from_fn(|k| lc(k).ki_n_per_a);
-            let q = [
-                ("x", "m", "rotor axis x at the centre of mass's station"),
-                ("y", "m", "rotor axis y at the centre of mass's station"),
-                ("a", "rad", "slope dx/dz of the rotor axis"),
-                ("b", "rad", "slope dy/dz of the rotor axis"),
-            ];
-            let states = q
-                .iter()
-                .map(|(n, u, d)| Signal::new(*n, u, *d))
-                .chain(
-                    q.iter().map(|(n, u, d)| Signal::new(format!("{n}dot"), &format!("{u}/s"), format!("rate of {d}"))),
-                )
-                .collect();
-            rigid(&mass, &gyro, &actuator, &sensor, ks, ki, states)
-        }
-        Rotor::Flexible(f) => {
-            let ss = plant_physics::flex::linear::OpenLoop::of(f).state_space(omega);
-            let r = ss.a.nrows() / 2;
-            let states = (1..=r)
-                .map(|k| {
-                    Signal::new(format!("eta_{k}"), "m*kg^0.5", format!("reduced coordinate {k} (mass-normalised)"))
-                })
-                .chain((1..=r).map(|k| {
-                    Signal::new(format!("etadot_{k}"), "m*kg^0.5/s", format!("rate of reduced coordinate {k}"))
-                }))
-                .collect();
-            Mechanics { a: ss.a, b: ss.b, sensor: ss.c, actuator: ss.actuator, states }
-        }
-    }
-}
-
-/// A rigid rotor's mechanics: `M q̈ + G q̇ = Φ_aᵀ (K_i i + K_s Φ_a q)`, sensors `Φ_s q`
-/// (`Φ_a`, `Φ_s` one row per axis; `ks`, `ki` per axis, the first `Φ_a.nrows()` used).
-fn rigid(
-    mass: &DMatrix<f64>,
-    gyro: &DMatrix<f64>,
-    actuator: &DMatrix<f64>,
-    sensor: &DMatrix<f64>,
-    ks: [f64; 4],
-    ki: [f64; 4],
-    states: Vec<Signal>,
-) -> Mechanics {
-    let (dof, axes) = (mass.nrows(), actuator.nrows());
-    let inv = DMatrix::from_diagonal(&mass.diagonal().map(|m| 1.0 / m));
-    let ks = DMatrix::from_diagonal(&nalgebra::DVector::from_fn(axes, |k, _| ks[k]));
-    let ki = DMatrix::from_diagonal(&nalgebra::DVector::from_fn(axes, |k, _| ki[k]));
-    let mut a = DMatrix::zeros(2 * dof, 2 * dof);
-    a.view_mut((0, dof), (dof, dof)).fill_with_identity();
-    a.view_mut((dof, 0), (dof, dof)).copy_from(&(&inv * actuator.transpose() * ks * actuator));
-    a.view_mut((dof, dof), (dof, dof)).copy_from(&(-(&inv * gyro)));
-    let mut b = DMatrix::zeros(2 * dof, axes);
-    b.view_mut((dof, 0), (dof, axes)).copy_from(&(&inv * actuator.transpose() * ki));
-    let pad = |rows: &DMatrix<f64>| {
-        let mut m = DMatrix::zeros(axes, 2 * dof);
-        m.view_mut((0, 0), (axes, dof)).copy_from(rows);
-        m
-    };
-    Mechanics { a, b, sensor: pad(sensor), actuator: pad(actuator), states }
 }

@@ -5,6 +5,7 @@ use super::{Build, BuildContext, RawRotor, RotorKeys, RotorModel, RotorParams, S
 use crate::config::checks::{non_negative, positive, range};
 use crate::config::scene_table::scene_table;
 use crate::config::ConfigError;
+use crate::machine::mechanics::{Mechanics, Signal};
 use crate::machine::{mid_span_weight, FlexibleLinear, Linearised};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
@@ -112,6 +113,27 @@ impl RotorParams for flexible::Params {
 
     fn planes(&self) -> usize {
         self.machine.planes.len()
+    }
+
+    /// The reduced shaft's [`OpenLoop::state_space`]: its retained modes, damping and
+    /// gyroscopics at the speed.
+    fn mechanics(&self, omega: f64) -> Mechanics {
+        let ss = OpenLoop::of(self).state_space(omega);
+        let r = ss.a.nrows() / 2;
+        let states = (1..=r)
+            .map(|k| Signal::new(format!("eta_{k}"), "m*kg^0.5", format!("reduced coordinate {k} (mass-normalised)")))
+            .chain(
+                (1..=r).map(|k| {
+                    Signal::new(format!("etadot_{k}"), "m*kg^0.5/s", format!("rate of reduced coordinate {k}"))
+                }),
+            )
+            .collect();
+        let what = format!(
+            "flexible shaft reduced to {} coordinates (its retained modes and static corrections), damping and \
+             gyroscopics at the speed, each plane's AMB k_s and k_i at its node, the sensors at theirs",
+            self.reduced.size()
+        );
+        Mechanics { a: ss.a, b: ss.b, sensor: ss.c, actuator: ss.actuator, states, what }
     }
 
     fn plane(&self, i: usize) -> &Params {

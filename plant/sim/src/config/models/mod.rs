@@ -20,7 +20,7 @@ pub use table::{RawRotor, RotorShared, SpinChoice};
 pub use two_plane::TwoPlaneKeys;
 
 use super::ConfigError;
-use crate::machine::{Builds, FailureOf, Linearised, Machine};
+use crate::machine::{Builds, FailureOf, Linearised, Machine, Mechanics};
 use crate::model::Params;
 use plant_physics::flex::linear::OpenLoop;
 use plant_physics::flex::ross::UsedBearing;
@@ -253,6 +253,10 @@ pub trait RotorParams {
 
     /// Bearing planes: each with its AMB, sensor and touchdown bearing.
     fn planes(&self) -> usize;
+
+    /// The rotor's linear mechanics about the centre at spin speed `omega` (rad/s), races
+    /// clear, the AMBs linear (`F = k_i i + k_s Δ`): `plant linear`'s first block.
+    fn mechanics(&self, omega: f64) -> Mechanics;
 
     /// Plane `i`'s bearing: its touchdown bearing, AMB, loop constants and its share of the
     /// rotor (the planar model's whole parameters). Panics if `i` is not a plane.

@@ -5,9 +5,11 @@ use super::{Build, BuildContext, RawRotor, RotorKeys, RotorModel, RotorParams, S
 use crate::config::checks::{finite, non_negative, positive, range};
 use crate::config::scene_table::scene_table;
 use crate::config::ConfigError;
+use crate::machine::mechanics::{rigid, Mechanics, Signal};
 use crate::machine::Linearised;
 use crate::model::Params;
 use crate::model::Spin;
+use nalgebra::DMatrix;
 use plant_physics::two_plane;
 use serde::{Deserialize, Serialize};
 
@@ -66,6 +68,55 @@ impl RotorParams for two_plane::Params {
 
     fn planes(&self) -> usize {
         self.planes.len()
+    }
+
+    /// `q = (x, y, a, b)` at the centre of mass: `M q̈ + Ω G q̇ = Φ_aᵀ (K_i i + K_s Φ_a q)` with
+    /// `M = diag(M, M, I_t, I_t)`, `G`'s `(a, b)` rows `(+I_p ḃ, −I_p ȧ)`, `Φ_a` the axes' rows
+    /// at the actuators' stations (`x + z_i a`), the sensors read `Φ_s q` at theirs.
+    fn mechanics(&self, omega: f64) -> Mechanics {
+        let r = &self.rotor;
+        let mass = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&[
+            r.mass,
+            r.mass,
+            r.transverse_inertia,
+            r.transverse_inertia,
+        ]));
+        let mut gyro = DMatrix::zeros(4, 4);
+        // I_t ä + I_p Ω ḃ = …,  I_t b̈ − I_p Ω ȧ = …
+        gyro[(2, 3)] = r.polar_inertia * omega;
+        gyro[(3, 2)] = -r.polar_inertia * omega;
+        let rows = |station: &dyn Fn(usize) -> f64| {
+            DMatrix::from_fn(4, 4, |k, col| {
+                let dir = k % 2;
+                if col == dir {
+                    1.0
+                } else if col == 2 + dir {
+                    station(k / 2)
+                } else {
+                    0.0
+                }
+            })
+        };
+        let actuator = rows(&|i| self.planes[i].station);
+        let sensor = rows(&|i| self.planes[i].sensor);
+        let lc = |k: usize| self.planes[k / 2].params.loop_constants;
+        let ks = std::array::from_fn(|k| lc(k).ks_n_per_m);
+        let ki = std::array::from_fn(|k| lc(k).ki_n_per_a);
+        let q = [
+            ("x", "m", "rotor axis x at the centre of mass's station"),
+            ("y", "m", "rotor axis y at the centre of mass's station"),
+            ("a", "rad", "slope dx/dz of the rotor axis"),
+            ("b", "rad", "slope dy/dz of the rotor axis"),
+        ];
+        let states = q
+            .iter()
+            .map(|(n, u, d)| Signal::new(*n, u, *d))
+            .chain(q.iter().map(|(n, u, d)| Signal::new(format!("{n}dot"), &format!("{u}/s"), format!("rate of {d}"))))
+            .collect();
+        let what = "rigid two-plane rotor: mass, transverse and polar inertia (gyroscopics at the speed), each \
+                    plane's AMB k_s and k_i at its station, its sensor at its own"
+            .to_string();
+        rigid(&mass, &gyro, &actuator, &sensor, ks, ki, states, what)
     }
 
     fn plane(&self, i: usize) -> &Params {
