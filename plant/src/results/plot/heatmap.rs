@@ -103,21 +103,15 @@ pub fn heatmap(
             }
         }
         let (x_fmt, y_fmt) = (linear_ticks(xr.0, xr.1), linear_ticks(yr.0, yr.1));
-        chart
-            .configure_mesh()
-            .disable_mesh()
+        let mut mesh = chart.configure_mesh();
+        mesh.disable_mesh()
             .x_labels(MAX_TICKS)
             .y_labels(MAX_TICKS)
             .x_desc(x_label)
             .y_desc(y_label)
             .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .label_style(font(TICK_PX))
-            .axis_desc_style(font(LABEL_PX))
-            .axis_style(BLACK)
-            .set_all_tick_mark_size(6)
-            .draw()
-            .map_err(draw_err(path))?;
+            .y_label_formatter(&y_fmt);
+        axis_look(&mut mesh).draw().map_err(draw_err(path))?;
 
         colour_bar(&bar, path, (z0, z1), z_label)?;
         Ok(())
@@ -186,19 +180,9 @@ fn colour_bar<DB: DrawingBackend>(
         }))
         .map_err(draw_err(path))?;
     let z_fmt = linear_ticks(z0, z1);
-    bar_chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_labels(MAX_TICKS)
-        .y_desc(z_label)
-        .y_label_formatter(&z_fmt)
-        .label_style(font(TICK_PX))
-        .axis_desc_style(font(LABEL_PX))
-        .axis_style(BLACK)
-        .set_all_tick_mark_size(6)
-        .draw()
-        .map_err(draw_err(path))?;
+    let mut mesh = bar_chart.configure_mesh();
+    mesh.disable_mesh().disable_x_axis().y_labels(MAX_TICKS).y_desc(z_label).y_label_formatter(&z_fmt);
+    axis_look(&mut mesh).draw().map_err(draw_err(path))?;
     Ok(())
 }
 

@@ -284,22 +284,28 @@ where
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    chart
-        .configure_mesh()
-        .x_labels(MAX_TICKS)
+    let mut mesh = chart.configure_mesh();
+    mesh.x_labels(MAX_TICKS)
         .y_labels(MAX_TICKS)
         .x_desc(x_label)
         .y_desc(y_label)
         .x_label_formatter(x_fmt)
         .y_label_formatter(y_fmt)
-        .label_style(font(TICK_PX))
-        .axis_desc_style(font(LABEL_PX))
         .bold_line_style(GRID_BOLD)
-        .light_line_style(GRID_LIGHT)
-        .axis_style(BLACK)
-        .set_all_tick_mark_size(6)
-        .draw()
-        .map_err(draw_err(path))
+        .light_line_style(GRID_LIGHT);
+    axis_look(&mut mesh).draw().map_err(draw_err(path))
+}
+
+/// The look every chart's axes share: the tick and label fonts, black axes, 6-pixel tick marks.
+pub(crate) fn axis_look<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: Ranged,
+    Y: Ranged,
+    DB: DrawingBackend,
+{
+    mesh.label_style(font(TICK_PX)).axis_desc_style(font(LABEL_PX)).axis_style(BLACK).set_all_tick_mark_size(6)
 }
 
 /// Draws a chart of `size` pixels in memory with `draw`, then writes it to `path` as PNG
