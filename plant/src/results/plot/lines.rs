@@ -126,6 +126,16 @@ impl SeriesStyle {
             Mark::Line(self.colour)
         }
     }
+
+    /// Its legend symbol with a filled marker of `shape` on the line (a series drawn with a
+    /// marker at each point).
+    pub(crate) fn mark_with(&self, shape: Shape) -> Mark {
+        if self.dashed {
+            Mark::DashedMarker(self.colour, shape)
+        } else {
+            Mark::LineMarker(self.colour, shape)
+        }
+    }
 }
 
 pub(crate) fn draw_pieces<'a, Y>(

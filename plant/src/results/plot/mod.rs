@@ -66,6 +66,7 @@ pub(crate) use heatmap::viridis;
 mod legend;
 pub(crate) use legend::{legend_strip, Mark, Shape};
 mod lines;
+pub(crate) use lines::SeriesStyle;
 mod loglog;
 mod orbit;
 mod probability;

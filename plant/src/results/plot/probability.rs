@@ -71,10 +71,8 @@ pub fn probability(
             .iter()
             .enumerate()
             .map(|(k, c)| {
-                let shape = Shape::ALL[k % Shape::ALL.len()];
-                let mark =
-                    if dashed(k) { Mark::DashedMarker(colour(k), shape) } else { Mark::LineMarker(colour(k), shape) };
-                (c.label.to_string(), mark)
+                let style = SeriesStyle { colour: colour(k), dashed: dashed(k) };
+                (c.label.to_string(), style.mark_with(Shape::ALL[k % Shape::ALL.len()]))
             })
             // The reference line named for what it is.
             .chain(std::iter::once(("P = 0.5".to_string(), Mark::Dashed(RGBColor(0x70, 0x70, 0x70)))))

@@ -12,7 +12,7 @@ use super::sensitivity::AxisResult;
 use super::{ControllerReport, Report};
 use crate::plot::{
     builder, colour, draw_err, draw_mesh, ensure_font, legend_strip, log_axis, log_ticks, titled_root, Mark, PlotError,
-    Shape, WIDE_SIZE,
+    SeriesStyle, Shape, WIDE_SIZE,
 };
 use nalgebra::Complex;
 use plotters::coord::ranged1d::ValueFormatter;
@@ -170,12 +170,8 @@ fn legend(curves: &[Curve]) -> Vec<(String, Mark)> {
             if k.closed.is_empty() {
                 (format!("{}: measured (no closed form)", k.label), Mark::Marker(colour(i), Shape::Circle))
             } else {
-                let mark = if dashed(i) {
-                    Mark::DashedMarker(colour(i), Shape::Circle)
-                } else {
-                    Mark::LineMarker(colour(i), Shape::Circle)
-                };
-                (format!("{}: closed form (line), measured (dots)", k.label), mark)
+                let style = SeriesStyle { colour: colour(i), dashed: dashed(i) };
+                (format!("{}: closed form (line), measured (dots)", k.label), style.mark_with(Shape::Circle))
             }
         })
         .chain([
