@@ -21,8 +21,12 @@ use base64::Engine;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The ISO 14839-3 zone boundaries of the peak sensitivity, in dB (3, 4, 5).
-const ZONE_DB: [(f64, &str); 3] = [(9.542, "A/B"), (12.041, "B/C"), (13.979, "C/D")];
+/// The ISO 14839-3 zone boundaries of the peak sensitivity in dB, each named, from the grading's
+/// own limits ([`super::sensitivity::ZONE_LIMITS`]), so the lines drawn are the ones graded by.
+fn zone_db() -> [(f64, &'static str); 3] {
+    let [ab, bc, cd] = super::sensitivity::ZONE_LIMITS.map(|s| 20.0 * s.log10());
+    [(ab, "A/B"), (bc, "B/C"), (cd, "C/D")]
+}
 
 /// The class (colour) of a highest safe shock of `g` (G): `ok` (green) from the duty rung
 /// `duty_g` up, `low` (amber) below it; none at all is `bad` (red).
@@ -71,7 +75,11 @@ pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
     h.push_str(&legend(r));
     ladder_table::section(&mut h, dir, r, &ladder)?;
     if !charts.is_empty() {
-        let _ = writeln!(h, "<h2>Sensitivity functions</h2><p class=\"note\">Measured by adding a sine to the sensor signal the controller reads, one axis at a time (stepped sine, settled, fitted by least squares over whole periods; docs/guide/assess.md). Horizontal lines: the zone boundaries at |S| = 3, 4, 5 (9.5, 12, 14 dB). Dashed black: the closed form of the law where it has one.</p>");
+        // The boundaries as the grading has them: |S| = 3, 4, 5 (9.5, 12, 14 dB).
+        let short = |v: f64| format!("{v:.1}").trim_end_matches(".0").to_string();
+        let limits = super::sensitivity::ZONE_LIMITS.map(short).join(", ");
+        let dbs = zone_db().map(|(db, _)| short(db)).join(", ");
+        let _ = writeln!(h, "<h2>Sensitivity functions</h2><p class=\"note\">Measured by adding a sine to the sensor signal the controller reads, one axis at a time (stepped sine, settled, fitted by least squares over whole periods; docs/guide/assess.md). Horizontal lines: the zone boundaries at |S| = {limits} ({dbs} dB). Dashed black: the closed form of the law where it has one.</p>");
         for (i, name) in &charts {
             h.push_str(&image(dir, name, &format!("{}: |S| and |T|", r.controllers[*i].label))?);
         }
@@ -132,8 +140,22 @@ fn duty_basis(b: &super::duty::Bearing) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::sensitivity::{AxisResult, Peak};
-    use super::{safe_class, worst_axis};
+    use super::super::sensitivity::{zone, AxisResult, Peak};
+    use super::{safe_class, worst_axis, zone_db};
+
+    /// Each zone line the report draws is where the grading changes zone, and is named for the
+    /// pair of zones on its two sides (a peak 0.001 dB below is graded in the first, above in the
+    /// second), and they are the standard's 9.5, 12 and 14 dB to the drawn precision.
+    #[test]
+    fn the_zone_lines_are_the_grading_boundaries() {
+        let lines = zone_db();
+        for (db, name) in lines {
+            let graded = |d: f64| zone(10f64.powf(d / 20.0));
+            assert_eq!(format!("{}/{}", graded(db - 1e-3), graded(db + 1e-3)), name, "line at {db} dB");
+        }
+        let shown: Vec<String> = lines.iter().map(|(db, _)| format!("{db:.1}")).collect();
+        assert_eq!(shown, ["9.5", "12.0", "14.0"]);
+    }
 
     fn axis(name: &str, speed_hz: f64, zone: &str, s_db: Option<f64>) -> AxisResult {
         AxisResult {

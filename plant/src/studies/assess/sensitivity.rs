@@ -183,9 +183,12 @@ pub struct Peak {
     pub spacing: f64,
 }
 
-/// The ISO 14839-3 zone of a peak sensitivity (boundaries 3, 4, 5: 9.5, 12, 14 dB).
+/// The ISO 14839-3 zone boundaries of the peak `|S|`: A/B, B/C, C/D (9.5, 12, 14 dB).
+pub const ZONE_LIMITS: [f64; 3] = [3.0, 4.0, 5.0];
+
+/// The ISO 14839-3 zone of a peak sensitivity ([`ZONE_LIMITS`]).
 pub fn zone(s_abs: f64) -> &'static str {
-    super::iso_zone::grade(s_abs, [3.0, 4.0, 5.0])
+    super::iso_zone::grade(s_abs, ZONE_LIMITS)
 }
 
 /// The measurement of one axis at one speed.

@@ -3,7 +3,7 @@
 
 use super::super::ladder::LadderResult;
 use super::super::{ControllerReport, Report};
-use super::ZONE_DB;
+use super::zone_db;
 use crate::plot::{builder, colour, draw_err, draw_mesh, ensure_font, titled_root, PlotError, WIDE_SIZE};
 use plotters::prelude::*;
 use std::path::Path;
@@ -185,7 +185,7 @@ pub(super) fn sensitivity_chart(path: &Path, c: &ControllerReport) -> Result<boo
     }
     // Each boundary named for what it is: the ISO 14839-3 zone boundary of the peak |S|.
     let zone_labels: Vec<(f64, String)> =
-        ZONE_DB.iter().map(|(db, l)| (*db, format!("ISO 14839-3 zone {l} ({db:.1} dB)"))).collect();
+        zone_db().iter().map(|(db, l)| (*db, format!("ISO 14839-3 zone {l} ({db:.1} dB)"))).collect();
     let zones: Vec<(f64, &str)> = zone_labels.iter().map(|(db, l)| (*db, l.as_str())).collect();
     ensure_font(path)?;
     // Taller than wide charts: the legend takes rows above the panels.

@@ -1,13 +1,14 @@
 //! The report's legend: what its words, abbreviations and colours mean.
 
 use super::super::Report;
-use super::{EQUAL_DB, ZONE_DB};
+use super::{zone_db, EQUAL_DB};
 use std::fmt::Write as _;
 
 /// What the report's words, abbreviations and colours mean: the page reads without the guide.
 pub(super) fn legend(r: &Report) -> String {
     let min_p = r.ladder_settings.min_p;
     let duty_g = r.ladder_settings.duty_g;
+    let [ab, bc, cd] = zone_db().map(|(db, _)| db);
     let mut h = String::from("<h2>How to read this report</h2>\n<dl class=\"note\">\n");
     let mut item = |term: &str, text: String| {
         let _ = writeln!(h, "<dt>{term}</dt><dd>{text}</dd>");
@@ -17,11 +18,10 @@ pub(super) fn legend(r: &Report) -> String {
         format!(
             "The plant adds a sine E to the sensor signal the controller reads, one axis at a time; \
              S = (what the controller read) / E is the sensitivity function, T = S − 1. The peak of |S| \
-             over frequency grades the axis: zone <b>A</b> |S| &lt; 3 ({:.1} dB), <b>B</b> 3 to 4 ({:.1} dB), \
-             <b>C</b> 4 to 5 ({:.1} dB), <b>D</b> 5 or more. <b>unstable</b>: the free decay after an offset grows, \
+             over frequency grades the axis: zone <b>A</b> |S| &lt; 3 ({ab:.1} dB), <b>B</b> 3 to 4 ({bc:.1} dB), \
+             <b>C</b> 4 to 5 ({cd:.1} dB), <b>D</b> 5 or more. <b>unstable</b>: the free decay after an offset grows, \
              so there is no margin to grade. Each axis (x, y; on a two-plane rotor x_A, y_A, x_B, y_B) is \
              measured at standstill and at the rotor's speed (“x at 500 Hz”: axis x, rotor at 500 Hz).",
-            ZONE_DB[0].0, ZONE_DB[1].0, ZONE_DB[2].0
         ),
     );
     item(
