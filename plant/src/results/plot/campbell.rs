@@ -90,7 +90,7 @@ pub(crate) fn campbell(path: &Path, title: &str, modes: &[ModePoints]) -> Result
             draw_mesh(&mut chart, "spin speed (Hz)", &y_label, &x_fmt, &y_fmt, path)?;
             let end = max_speed.max(0.0).min(*y1);
             chart
-                .draw_series(DashedLineSeries::new([(0.0, 0.0), (end, end)], 10, 6, BLACK.stroke_width(2)))
+                .draw_series(DashedLineSeries::new([(0.0, 0.0), (end, end)], DASH.0, DASH.1, BLACK.stroke_width(2)))
                 .map_err(draw_err(path))?;
             let rigid_panel = panels.len() > 1 && *name == "rigid-body modes";
             for (m, p) in modes.iter().zip(&points) {

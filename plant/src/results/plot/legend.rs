@@ -105,8 +105,9 @@ pub(crate) fn draw_mark(
     match mark {
         Mark::Line(c) => area.draw(&PathElement::new(vec![(x, y), (x + w, y)], c.stroke_width(3))),
         Mark::Dashed(c) => {
-            area.draw(&PathElement::new(vec![(x, y), (x + 10, y)], c.stroke_width(2)))?;
-            area.draw(&PathElement::new(vec![(x + 16, y), (x + w, y)], c.stroke_width(2)))
+            let (on, off) = super::DASH;
+            area.draw(&PathElement::new(vec![(x, y), (x + on, y)], c.stroke_width(2)))?;
+            area.draw(&PathElement::new(vec![(x + on + off, y), (x + w, y)], c.stroke_width(2)))
         }
         Mark::Dotted(c) => {
             for k in (0..w).step_by(6) {

@@ -157,7 +157,9 @@ where
             // A dashed series is dashed along each piece as a whole (its dashes are short
             // paths, so the mitre spikes below do not arise).
             for p in series_pieces.iter().filter(|p| p.len() > 1) {
-                chart.draw_series(DashedLineSeries::new(p.iter().copied(), 10, 6, style)).map_err(draw_err(path))?;
+                chart
+                    .draw_series(DashedLineSeries::new(p.iter().copied(), DASH.0, DASH.1, style))
+                    .map_err(draw_err(path))?;
             }
             continue;
         }

@@ -96,6 +96,9 @@ pub const WIDE_SIZE: (u32, u32) = (1200, 800);
 /// Size of the square charts ([`orbit`], [`scatter`] with equal axes), in
 /// pixels.
 pub const SQUARE_SIZE: (u32, u32) = (900, 900);
+/// The dash of a dashed curve, in pixels: `DASH.0` drawn, then `DASH.1` left out (the legend's
+/// dashed mark, `Mark::Dashed`, draws the same).
+pub const DASH: (i32, i32) = (10, 6);
 /// Orbits with more samples than this are stride-decimated for drawing.
 pub const ORBIT_MAX_POINTS: usize = 200_000;
 

@@ -104,7 +104,7 @@ pub fn probability(
                 (0..c.x.len()).filter(|&i| finite(i)).map(|i| (c.x[i] + dx, c.p[i])).collect();
             if dashed(k) {
                 chart
-                    .draw_series(DashedLineSeries::new(points.iter().copied(), 10, 6, tint.stroke_width(2)))
+                    .draw_series(DashedLineSeries::new(points.iter().copied(), DASH.0, DASH.1, tint.stroke_width(2)))
                     .map_err(draw_err(path))?;
             } else {
                 chart

@@ -12,7 +12,7 @@ use super::sensitivity::AxisResult;
 use super::{ControllerReport, Report};
 use crate::plot::{
     builder, colour, draw_err, draw_mesh, ensure_font, legend_strip, log_axis, log_ticks, titled_root, Mark, PlotError,
-    SeriesStyle, Shape, WIDE_SIZE,
+    SeriesStyle, Shape, DASH, WIDE_SIZE,
 };
 use nalgebra::Complex;
 use plotters::coord::ranged1d::ValueFormatter;
@@ -137,7 +137,7 @@ where
         let style = col.stroke_width(2);
         for seg in segments(closed, &inside, p.jump) {
             if dashed(i) {
-                c.draw_series(DashedLineSeries::new(seg, 10, 6, style)).map_err(draw_err(path))?;
+                c.draw_series(DashedLineSeries::new(seg, DASH.0, DASH.1, style)).map_err(draw_err(path))?;
             } else {
                 c.draw_series(LineSeries::new(seg, style)).map_err(draw_err(path))?;
             }
