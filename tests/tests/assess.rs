@@ -36,8 +36,12 @@ fn a_report_card_of_a_stable_and_an_unstable_controller() {
     let controllers = "[[controller]]\nlabel = \"damped\"\nset = [\"controller.law=\\\"pd_delay\\\"\", \"controller.damping_ratio=0.2\"]\n\
                        [[controller]]\nlabel = \"study pd\"\nset = [\"controller.law=\\\"pd\\\"\"]\n";
     let out = dir.join("out");
+    // An earlier assessment's charts of a third controller: not this one's.
+    let earlier = ["sensitivity_3.png", "open_loop_3.png"];
+    seed_earlier_outputs(&out, &earlier);
     let o = assess(&file(&dir.join("assess.toml"), controllers, ""), &out);
     assert_exit(&o, 0);
+    assert_only_this_runs_outputs(&out, &earlier, plant::assess::FILES);
     let r = read_json(&out.join("report.json"));
     let c = r["controllers"].as_array().expect("controllers");
     assert_eq!(c.len(), 2);

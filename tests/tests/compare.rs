@@ -172,6 +172,9 @@ fn compare_realtime_puts_realtime_runs_beside_their_lockstep_twin() {
     controller_bin();
     let dir = TempDir::new("compare-realtime");
     let out = dir.join("out");
+    // An earlier comparison's tables of other forms, and a robustness table not asked for.
+    let earlier = ["laws.csv", "compare_robustness.json", "stability_damping.png"];
+    seed_earlier_outputs(&out, &earlier);
     let o = output_within(
         Command::new(plant_bin())
             .arg("compare")
@@ -208,6 +211,7 @@ fn compare_realtime_puts_realtime_runs_beside_their_lockstep_twin() {
     }
     assert!(stderr(&o).contains("realtime 2:"), "{}", stderr(&o));
     assert!(out.join("realtime_radius.png").exists());
+    assert_only_this_runs_outputs(&out, &earlier, plant::compare::FILES);
 }
 
 /// Issue 40 item 1: `plant compare --robustness N` gives each compared run the robustness

@@ -12,8 +12,8 @@
 mod common;
 
 use common::{
-    assert_exit, controller_bin, num, output_within, plant_bin, plant_run, plant_sweep, read_json, read_text, refused,
-    scene, stderr, Csv, Table, TempDir,
+    assert_exit, assert_only_this_runs_outputs, controller_bin, num, output_within, plant_bin, plant_run, plant_sweep,
+    read_json, read_text, refused, scene, seed_earlier_outputs, stderr, Csv, Table, TempDir,
 };
 use std::process::Command;
 use std::time::Duration;
@@ -201,6 +201,8 @@ fn flexible_scene_runs_in_every_mode_and_analyze_reads_it_back() {
 fn campbell_of_a_flexible_scene_shows_its_bending_modes() {
     let dir = TempDir::new("flexible-campbell");
     let out = dir.join("c");
+    // An earlier call's free decays: this one runs none.
+    seed_earlier_outputs(&out, &["decay.csv"]);
     let run = output_within(
         Command::new(plant_bin())
             .arg("campbell")
@@ -211,6 +213,7 @@ fn campbell_of_a_flexible_scene_shows_its_bending_modes() {
     );
     assert_exit(&run, 0);
     assert!(stderr(&run).contains("no free decays"), "{}", stderr(&run));
+    assert_only_this_runs_outputs(&out, &["decay.csv"], plant::campbell::FILES);
     // `--decay-speeds-hz ""` is none, as --help says; a negative speed is refused by the flag's parser.
     for (args, code, says) in [
         (&["--points", "2", "--decay-speeds-hz", ""][..], 0, ""),

@@ -115,6 +115,23 @@ fn short_soak_writes_consistent_per_shock_and_overall_figures() {
         let n = Png::read(&out.join(png)).count_in_plot(SERIES_BLUE);
         assert!(n >= min_pixels, "{png}: {n} pixels of the data colour");
     }
+
+    // A second soak into the same folder, without charts, leaves none of the first one's
+    // beside its results: every chart the first drew is gone.
+    let pngs = || {
+        let mut names: Vec<String> = std::fs::read_dir(&out)
+            .expect("the soak's folder")
+            .filter_map(|e| e.ok()?.file_name().into_string().ok())
+            .filter(|n| n.ends_with(".png"))
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(pngs(), ["max_force.png", "radius.png", "recovery.png", "rss.png", "tet.png"]);
+    let again = output_within(&mut soak(&short_programme(), &out, &["output.plots=false"]), LIMIT);
+    assert_exit(&again, 0);
+    assert_eq!(pngs(), Vec::<String>::new(), "an earlier soak's charts left in the folder");
+    assert_eq!(read_json(&out.join("soak.json"))["status"], "completed");
 }
 
 #[test]

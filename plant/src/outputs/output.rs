@@ -131,11 +131,7 @@ fn remove_stale_except(dir: &Path, keep: &[&str]) -> anyhow::Result<()> {
         .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(crate::snapshot::is_file_name))
         .collect();
     for path in RUN_FILES.iter().filter(|n| !keep.contains(n)).map(|name| dir.join(name)).chain(snapshots) {
-        match std::fs::remove_file(&path) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(e).with_context(|| format!("removing {} of an earlier run", path.display())),
-        }
+        crate::outfile::remove(&path).context("an earlier run's file")?;
     }
     Ok(())
 }

@@ -341,7 +341,8 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
         );
     }
     let out = crate::output::out_dir(req.out, &format!("campbell-{}", scene.name));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let _claim = crate::claim::claim(&out, true)?;
+    crate::outfile::clear_earlier(&out, FILES)?;
     let speeds: Vec<f64> = (0..req.points).map(|i| req.max_speed_hz * i as f64 / (req.points - 1) as f64).collect();
     let rows = diagram(rotor.as_ref(), &speeds)?;
     let csv = out.join("campbell.csv");
@@ -384,6 +385,11 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
     }
     Ok(written)
 }
+
+/// The files `plant campbell` writes into its folder (`decay.csv` with `--decay-speeds-hz`
+/// only): an earlier diagram's are removed first, so that no free decay of another call is
+/// left beside this one's diagram.
+pub const FILES: &[&str] = &["campbell.csv", "campbell.png", "decay.csv"];
 
 /// `campbell.png`: each mode's frequency against the spin speed as points (a name per speed
 /// comes from the mode's shape there, and lines would jump where modes cross), the rigid-body

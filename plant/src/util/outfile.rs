@@ -102,6 +102,40 @@ pub fn keep_aside(path: &Path) -> anyhow::Result<Option<std::path::PathBuf>> {
     Ok(Some(free))
 }
 
+/// Removes the file at `path` if there is one (nothing there is fine); an error names the file.
+pub fn remove(path: &Path) -> anyhow::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("removing {}", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Removes from `dir` the files an earlier command of the same kind may have left there, so
+/// that none of them sits beside this command's results as if it were one of them: `names`
+/// are file names, each with at most one `*` standing for any run of characters
+/// (`sensitivity_*.png`). Other files, and folders, stay.
+pub fn clear_earlier(dir: &Path, names: &[&str]) -> anyhow::Result<()> {
+    let matches = |file: &str| {
+        names.iter().any(|n| match n.split_once('*') {
+            None => file == *n,
+            Some((head, tail)) => {
+                file.len() >= head.len() + tail.len() && file.starts_with(head) && file.ends_with(tail)
+            }
+        })
+    };
+    let entries = std::fs::read_dir(dir).with_context(|| format!("listing {}", dir.display()))?;
+    for entry in entries {
+        let entry = entry.with_context(|| format!("listing {}", dir.display()))?;
+        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+        if !is_dir && entry.file_name().to_str().is_some_and(matches) {
+            remove(&entry.path()).context("an earlier run's file")?;
+        }
+    }
+    Ok(())
+}
+
 /// Creates the folder `path` (and its parents) if missing; a symbolic link at `path` is
 /// refused, so that the files written into it stay inside the output folder.
 pub fn folder(path: &Path) -> anyhow::Result<()> {
@@ -138,6 +172,33 @@ pub(crate) mod tests {
 
     fn scratch(name: &str) -> PathBuf {
         crate::util::scratch(&format!("outfile-{name}"))
+    }
+
+    /// An earlier run's files go by name and pattern; the user's other files, a folder whose
+    /// name matches, and what a matching link points to stay.
+    #[test]
+    fn clearing_an_earlier_run_removes_its_files_and_nothing_else() {
+        let dir = scratch("clear");
+        let out = dir.join("out");
+        std::fs::create_dir_all(out.join("sensitivity_9.png")).unwrap();
+        let outside = dir.join("precious.png");
+        std::fs::write(&outside, b"precious").unwrap();
+        std::os::unix::fs::symlink(&outside, out.join("open_loop_2.png")).unwrap();
+        let earlier = ["report.html", "sensitivity_1.png", "sensitivity_12.png", "open_loop_.png"];
+        let kept = ["notes.txt", "report.html.bak", "my_sensitivity_1.png", "sensitivity_1.png.txt", "sensitivity.png"];
+        for n in earlier.iter().chain(&kept) {
+            std::fs::write(out.join(n), b"x").unwrap();
+        }
+        clear_earlier(&out, &["report.html", "sensitivity_*.png", "open_loop_*.png"]).unwrap();
+        let mut left: Vec<String> =
+            std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        left.sort();
+        let mut want: Vec<String> = kept.iter().map(|n| n.to_string()).collect();
+        want.push("sensitivity_9.png".into()); // a folder
+        want.sort();
+        assert_eq!(left, want);
+        assert_eq!(std::fs::read(&outside).unwrap(), b"precious");
+        assert!(clear_earlier(&dir.join("missing"), &["a"]).is_err(), "a folder that is not there is an error");
     }
 
     /// Every way of writing replaces a symbolic or hard link at its name and leaves what it

@@ -661,3 +661,40 @@ pub fn write_script(to: &Path, text: &str) {
     install_executable(&draft, to);
     std::fs::remove_file(&draft).unwrap_or_else(|e| panic!("{}: {e}", draft.display()));
 }
+
+/// Writes into `out` (made if missing) files named as an earlier command of the same kind
+/// would have left them (`earlier`, names this run will not write) and a file of the user's,
+/// `notes.txt`; [`assert_only_this_runs_outputs`] checks the folder afterwards.
+pub fn seed_earlier_outputs(out: &Path, earlier: &[&str]) {
+    std::fs::create_dir_all(out).expect("the output folder");
+    for name in earlier.iter().chain(&["notes.txt"]) {
+        std::fs::write(out.join(name), b"an earlier run's").expect("seed");
+    }
+}
+
+/// After a command ran into a folder seeded by [`seed_earlier_outputs`]: none of `earlier` is
+/// left, the user's `notes.txt` is, and every other file is one the command says it writes
+/// (`files`: names, each with at most one `*`), so the list it clears by stays that of its
+/// writers.
+pub fn assert_only_this_runs_outputs(out: &Path, earlier: &[&str], files: &[&str]) {
+    let matches = |name: &str| {
+        files.iter().any(|f| match f.split_once('*') {
+            None => name == *f,
+            Some((head, tail)) => {
+                name.len() >= head.len() + tail.len() && name.starts_with(head) && name.ends_with(tail)
+            }
+        })
+    };
+    let mut left: Vec<String> = std::fs::read_dir(out)
+        .expect("the output folder")
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .collect();
+    left.sort();
+    for name in earlier {
+        assert!(!left.iter().any(|l| l == name), "{name}: an earlier run's file left in {}", out.display());
+    }
+    assert!(left.iter().any(|l| l == "notes.txt"), "the user's notes.txt was removed");
+    for name in left.iter().filter(|l| *l != "notes.txt") {
+        assert!(matches(name), "{name}: written but not in the command's list of files ({files:?})");
+    }
+}

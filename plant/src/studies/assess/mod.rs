@@ -101,6 +101,20 @@ pub fn axis_names(scene: &Scene) -> Vec<&'static str> {
 /// blocking waits had been slower in a loaded debug build: `cosim::session::check_silence`).
 pub const LOCKSTEP_WAIT: &str = "controller.spin_us=0.0";
 
+/// The files an assessment writes into its folder (`N`: the controller's number): an earlier
+/// assessment's are removed first, so that no chart of a controller this one does not have,
+/// or of a part it does not run, is left beside its report.
+pub const FILES: &[&str] = &[
+    "report.html",
+    "report.json",
+    "sensitivity_*.png",
+    "open_loop_*.png",
+    "duty_ball_pressure.png",
+    "duty_friction.png",
+    "ladder_probability.png",
+    "ladder_recovery.png",
+];
+
 /// A co-simulated controller started once, for one tick, before anything is measured: a
 /// command that cannot run, a controller that refuses the run or speaks another protocol is
 /// found here, with the exit code `plant run` gives it (bad input: 2), instead of failing every
@@ -231,6 +245,7 @@ pub fn command(args: &AssessArgs, stop: &AtomicBool) -> anyhow::Result<PathBuf> 
     let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("assess-{stem}")));
     let _claim = crate::claim::claim(&dir, true)?;
+    crate::outfile::clear_earlier(&dir, FILES)?;
     let quiet = args.quiet;
     let log = move |l: &str| {
         if !quiet {

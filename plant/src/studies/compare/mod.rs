@@ -148,6 +148,26 @@ fn plane_traces(label: &str, trace: &crate::trace::Trace) -> Vec<(String, crate:
     }
 }
 
+/// The files `plant compare` writes into its folder, over all its forms (rates and their
+/// stability maps, laws, realtime, `--robustness`): an earlier comparison's are removed first,
+/// so that another form's table, or a robustness table this one was not asked for, is not
+/// left beside its results.
+pub const FILES: &[&str] = &[
+    "compare.csv",
+    "compare_orbit.png",
+    "compare_radius.png",
+    "compare_robustness.csv",
+    "compare_robustness.json",
+    "laws.csv",
+    "laws_current.png",
+    "laws_orbit.png",
+    "laws_radius.png",
+    "realtime.csv",
+    "realtime_radius.png",
+    "stability_map.csv",
+    "stability_*.png",
+];
+
 /// What `plant compare` was asked to do.
 pub struct Request<'a> {
     /// The scene file.
@@ -189,6 +209,7 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&s
     let stem = req.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = req.out.map_or_else(|| PathBuf::from("runs").join(format!("compare-{stem}")), Path::to_path_buf);
     let _claim = crate::claim::claim(&dir, true)?;
+    crate::outfile::clear_earlier(&dir, FILES)?;
     let stop = crate::interrupt::stop_flag();
     if let Some(runs) = req.realtime {
         compare_realtime(req.scene, req.set, runs, &dir, log, &stop, req.live)?;

@@ -7,6 +7,10 @@ use super::sink::RssSample;
 use crate::plot::{self, PointGroup, Scale, Series};
 use std::path::Path;
 
+/// The charts a soak draws into its folder: these here and `tet.png` (the plant's execution
+/// time per tick, a co-simulated soak's). A new soak removes an earlier soak's first.
+pub(crate) const CHARTS: &[&str] = &["radius.png", "recovery.png", "max_force.png", "rss.png", "tet.png"];
+
 /// Reads `envelope.csv` back (written by this module, through the `csv` crate), by column name.
 fn read_envelope(path: &Path) -> anyhow::Result<Vec<EnvelopeRow>> {
     crate::table::read(path)

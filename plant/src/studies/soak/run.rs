@@ -230,12 +230,7 @@ fn recording(dir: &Path, prog: &Programme, resume: bool) -> Result<Option<McapSi
     let path = dir.join(SOAK_MCAP);
     if !prog.scene.mcap {
         if !resume {
-            match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(io(anyhow::Error::new(e).context(format!("removing {}", path.display()))))
-                }
-                _ => {}
-            }
+            crate::outfile::remove(&path).map_err(io)?;
         }
         return Ok(None);
     }
@@ -265,12 +260,13 @@ fn open_files(dir: &Path, prog: &Programme, saved: Option<&Checkpoint>) -> Resul
     let rss_header: Vec<&str> = RSS_CSV_HEADER.split(',').collect();
     match saved {
         None => {
-            // A checkpoint of an earlier soak in this folder would not describe this one's files.
-            match std::fs::remove_file(checkpoint::path(dir)) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(io(anyhow::Error::new(e).context("removing the earlier soak's checkpoint")))
-                }
-                _ => {}
+            // A checkpoint of an earlier soak in this folder would not describe this one's files,
+            // and its charts and controller log would sit beside this one's results as if they
+            // were its own: this soak draws its own charts (none with `output.plots = false`),
+            // and a co-simulated one writes its own log.
+            let earlier = [checkpoint::path(dir), dir.join("controller.log")];
+            for path in earlier.into_iter().chain(super::plots::CHARTS.iter().map(|n| dir.join(n))) {
+                crate::outfile::remove(&path).context("the earlier soak's file").map_err(io)?;
             }
             let resolved = prog.scene.to_toml().context("serialising the resolved scene").map_err(io)?;
             crate::outfile::write(&dir.join("scene.toml"), resolved.as_bytes()).map_err(io)?;
@@ -454,11 +450,8 @@ fn write_results(
     }
     if result.outcome == crate::run::Outcome::Completed {
         // A completed soak has nothing to resume.
-        match std::fs::remove_file(checkpoint::path(dir)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                hooks.note(&format!("warning: {}: {e}", checkpoint::path(dir).display()));
-            }
-            _ => {}
+        if let Err(e) = crate::outfile::remove(&checkpoint::path(dir)) {
+            hooks.note(&format!("warning: {e:#}"));
         }
     }
     Ok(Finished { outcome: result.outcome, report, live: None })
