@@ -358,6 +358,8 @@ fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
     // --redraw: the chart again from the table alone, the crossings found again from its
     // points: the same picture, to the byte.
     let again = dir.join("overlay-again");
+    // An earlier overlay's table there would not be this chart's.
+    seed_earlier_outputs(&again, &["overlay.csv"]);
     let mut cmd = Command::new(plant_bin());
     cmd.arg("overlay").arg("--redraw").arg(out.join("overlay.csv")).arg("--out").arg(&again);
     assert_exit(&output_within(&mut cmd, LIMIT), 0);
@@ -365,7 +367,12 @@ fn overlay_draws_ensemble_sweeps_and_refuses_what_is_not_one() {
         std::fs::read(again.join("overlay.png")).unwrap() == std::fs::read(out.join("overlay.png")).unwrap(),
         "the redrawn chart differs from the one drawn from the sweeps"
     );
-    assert!(!again.join("overlay.csv").exists(), "--redraw wrote a table");
+    assert_only_this_runs_outputs(&again, &["overlay.csv"], &["overlay.png"]);
+    // Redrawn in its own folder, the table it is drawn from stays.
+    let mut cmd = Command::new(plant_bin());
+    cmd.arg("overlay").arg("--redraw").arg(out.join("overlay.csv")).arg("--out").arg(&out);
+    assert_exit(&output_within(&mut cmd, LIMIT), 0);
+    assert!(out.join("overlay.csv").is_file(), "--redraw removed the table it redrew");
 
     // A sweep of single runs, another key, a map: each refused.
     let plain = dir.join("plain");

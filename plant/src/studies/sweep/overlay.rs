@@ -220,8 +220,17 @@ pub fn command(args: &OverlayArgs) -> anyhow::Result<()> {
     let (key, log) = (curves[0].key.clone(), curves[0].log);
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("runs").join("overlay"));
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    if args.redraw.is_none() {
-        write_table(&curves, &key, &out)?;
+    match &args.redraw {
+        None => write_table(&curves, &key, &out)?,
+        // An earlier overlay's table would sit beside a chart drawn from another one; the
+        // table this chart is drawn from (redrawn in its own folder) stays.
+        Some(csv) => {
+            let table = out.join("overlay.csv");
+            let canonical = |p: &Path| std::fs::canonicalize(p).ok();
+            if canonical(&table).is_none_or(|t| Some(t) != canonical(csv)) {
+                crate::outfile::remove(&table)?;
+            }
+        }
     }
     write_chart(args, &curves, &key, log, &out)?;
     let written = if args.redraw.is_some() { "overlay.png" } else { "overlay.png, overlay.csv" };
