@@ -136,6 +136,29 @@ fn bench_charts_are_drawn_again_from_their_rows() {
         let png = out.join(format!("models_{scene}.png"));
         assert!(std::fs::metadata(&png).map(|m| m.len() > 10_000).unwrap_or(false), "{}", png.display());
     }
+    // Redrawn in the folder of its own table: an earlier failure chart of a method that does
+    // not fail in this table goes, the table and the notes stay.
+    let own = dir.join("own");
+    let earlier = ["failure_levitation_rk4.png"];
+    common::seed_earlier_outputs(&own, &earlier);
+    for f in ["accuracy.csv", "stability.csv"] {
+        std::fs::copy(common::workspace_root().join("docs/charts").join(f), own.join(f)).unwrap();
+    }
+    let run = output_within(
+        Command::new(plant_bin())
+            .args(["bench", "accuracy", "--redraw"])
+            .arg(own.join("accuracy.csv"))
+            .arg("--out")
+            .arg(&own)
+            .arg("--config")
+            .arg(common::workspace_root().join("config")),
+        RUN,
+    );
+    assert_exit(&run, 0);
+    common::assert_only_this_runs_outputs(&own, &earlier, plant::bench::accuracy::FILES);
+    for f in ["accuracy.csv", "stability.csv", "work_precision_rub.png", "failure_rub_rk4.png"] {
+        assert!(own.join(f).is_file(), "{f} missing after the redraw");
+    }
     let garbage = dir.join("bad/models.csv");
     std::fs::create_dir_all(garbage.parent().unwrap()).unwrap();
     std::fs::write(&garbage, "scene,variant\nrub\n").unwrap();

@@ -375,6 +375,7 @@ fn redraw(config: &Path, csv: &Path, dir: &Path, log: &mut dyn FnMut(&str)) -> a
     let stability: Vec<StabilityRow> =
         crate::table::read(&stability_csv).map_err(|e| bad("--redraw (its stability.csv)", e))?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::outfile::clear_earlier(dir, CHARTS)?;
     let (mut floors, mut written) = (Vec::new(), Vec::new());
     for b in super::scenes(config)? {
         log(&format!("{}: reference (DOP853 rtol 1e-13, checked with DP5 rtol 1e-11)", b.name));
@@ -413,6 +414,24 @@ pub struct Request<'a> {
     pub redraw: Option<&'a Path>,
 }
 
+/// The files `plant bench accuracy` writes into its folder (per bench scene, and the failure
+/// charts per fixed-step method that fails): an earlier run's are removed first, so that no
+/// failure chart of a method that no longer fails is left beside this run's. `--redraw`
+/// removes only the charts ([`CHARTS`]): the table it redraws may be the folder's own.
+pub const FILES: &[&str] = &[
+    "accuracy.csv",
+    "stability.csv",
+    "reference_*.csv",
+    "scene_*.toml",
+    "spec_*.json",
+    "peer_*.csv",
+    "work_precision_*.png",
+    "failure_*.png",
+];
+
+/// The charts among [`FILES`].
+pub const CHARTS: &[&str] = &["work_precision_*.png", "failure_*.png"];
+
 /// `plant bench accuracy`: runs the bench, joins any earlier peer rows, draws the charts;
 /// returns the files written.
 pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<PathBuf>> {
@@ -430,6 +449,8 @@ pub fn command(req: &Request, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<P
         .map(|p| rows::read_accuracy(p).map_err(|e| crate::exit::BadArgument(format!("--peer-rows: {e:#}"))))
         .transpose()?
         .unwrap_or_default();
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::outfile::clear_earlier(&dir, FILES)?;
     let mut report = accuracy(req.config, &dir, req.quick, req.repeats, peer.as_ref(), log)?;
     let mut written = vec![dir.join("accuracy.csv"), dir.join("stability.csv")];
     if !earlier.is_empty() {
