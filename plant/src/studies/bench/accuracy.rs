@@ -198,8 +198,9 @@ fn describe(r: &AccuracyRow) -> String {
     )
 }
 
-/// Runs the work-precision and stability bench, writing into `out`; with `peer`, the scipy
-/// peer runs on the same scenes, references and error measure, and its rows join the charts.
+/// Runs the work-precision and stability bench, writing into the folder `out` (made and
+/// cleared by [`command`]); with `peer`, the scipy peer runs on the same scenes, references
+/// and error measure, and its rows join the charts.
 pub fn accuracy(
     config_dir: &Path,
     out: &Path,
@@ -208,7 +209,6 @@ pub fn accuracy(
     peer: Option<&Peer>,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<AccuracyReport> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut report = AccuracyReport { rows: Vec::new(), floors: Vec::new(), stability: Vec::new() };
     for b in super::scenes(config_dir)? {
         let (t0, t1) = (b.window_start, b.window_start + WINDOW);
